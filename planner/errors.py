@@ -1,0 +1,21 @@
+"""Errors raised by ``planner``: subclasses of the ``calib`` errors that name files and fields."""
+
+from __future__ import annotations
+
+from calib.errors import InputError, WobjcalError
+
+
+class URDFError(InputError):
+    """A URDF file is missing, malformed, or lacks what wobjcal needs (named in the message)."""
+
+
+class MeshError(InputError):
+    """A mesh file is missing, unreadable, empty, or has unusable geometry."""
+
+
+class UnknownFrameError(InputError):
+    """A frame, link, joint or TCP name is not known; the message lists the valid names."""
+
+
+class UnreachableError(WobjcalError):
+    """A target cannot be reached by the robot; the message says why."""
