@@ -1,0 +1,98 @@
+"""Session state: undo/redo, listeners, atomic autosave."""
+
+from __future__ import annotations
+
+import json
+import threading
+from pathlib import Path
+
+import pytest
+
+from webui.state import SessionState, atomic_write_bytes
+
+
+def _state(tmp_path: Path) -> SessionState[tuple[int, ...]]:
+    return SessionState(
+        (),
+        serialize=lambda d: json.dumps(list(d)).encode(),
+        autosave_path=tmp_path / "sub" / "autosave.json",
+    )
+
+
+def test_apply_undo_redo_round_trip(tmp_path: Path) -> None:
+    s = _state(tmp_path)
+    s.apply((1,), "add 1")
+    s.apply((1, 2), "add 2")
+    assert s.doc == (1, 2)
+    ch = s.undo()
+    assert ch is not None and ch.label == "undo add 2" and s.doc == (1,)
+    assert s.can_redo
+    s.redo()
+    assert s.doc == (1, 2)
+    s.undo()
+    s.apply((1, 3), "add 3")
+    assert not s.can_redo, "a new edit clears the redo stack"
+    s.undo()
+    s.undo()
+    assert s.doc == () and s.undo() is None
+
+
+def test_autosave_follows_every_change(tmp_path: Path) -> None:
+    s = _state(tmp_path)
+    s.apply((4, 5), "edit")
+    path = tmp_path / "sub" / "autosave.json"
+    assert json.loads(path.read_text()) == [4, 5]
+    s.undo()
+    assert json.loads(path.read_text()) == []
+    assert not list(path.parent.glob("*.tmp")), "no temp files left behind"
+
+
+def test_failed_edit_changes_nothing(tmp_path: Path) -> None:
+    s = _state(tmp_path)
+    s.apply((1,), "a")
+
+    def bad(_d: tuple[int, ...]) -> tuple[int, ...]:
+        raise ValueError("nope")
+
+    with pytest.raises(ValueError):
+        s.update(bad, "bad")
+    assert s.doc == (1,) and s.undo() is not None and s.doc == ()
+
+
+def test_listeners_see_changes_and_may_read_state(tmp_path: Path) -> None:
+    s = _state(tmp_path)
+    seen: list[tuple[str, tuple[int, ...]]] = []
+    s.subscribe(lambda ch: seen.append((ch.label, s.doc)))
+    s.apply((7,), "seven")
+    s.undo()
+    assert seen == [("seven", (7,)), ("undo seven", ())]
+
+
+def test_concurrent_updates_are_not_lost(tmp_path: Path) -> None:
+    s: SessionState[tuple[int, ...]] = SessionState(())
+
+    def add(k: int) -> None:
+        for i in range(50):
+            s.update(lambda d, v=k * 100 + i: (*d, v), "add")
+
+    threads = [threading.Thread(target=add, args=(k,)) for k in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len(s.doc) == 200 and len(set(s.doc)) == 200
+
+
+def test_atomic_write_replaces_whole_file(tmp_path: Path) -> None:
+    path = tmp_path / "f.json"
+    atomic_write_bytes(path, b"old contents that are long")
+    atomic_write_bytes(path, b"new")
+    assert path.read_bytes() == b"new"
+
+
+def test_autosave_error_is_reported_not_raised(tmp_path: Path) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    s: SessionState[int] = SessionState(0, serialize=lambda d: b"1", autosave_path=blocker / "a")
+    s.apply(1, "edit")
+    assert s.doc == 1 and s.last_autosave_error

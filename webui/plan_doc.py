@@ -1,0 +1,193 @@
+"""The document the UI edits: the probe points of the plan, with pure edit functions.
+
+The UI keeps the points as :class:`calib.probing.ProbePoint` values (wobj frame, metres) plus a
+role. Each edit returns a new :class:`UiPlan`; :class:`webui.state.SessionState` keeps the old
+one for undo. The plan file the points came from (``source``) rides along unchanged so that
+saving writes everything else back as it was.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import string
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from calib.errors import InputError
+from calib.probing import ProbePoint, SearchSpec
+
+#: Roles a point can play; shown in the panel's role dropdown.
+ROLES: tuple[str, ...] = ("plane", "line", "point", "edge", "xoffset", "approach")
+#: The paper's point names, offered first in the point dropdown.
+PAPER_IDS: tuple[str, ...] = tuple("ABCDEFGH")
+
+
+@dataclass(frozen=True)
+class UiPoint:
+    """One probe point as the UI shows it.
+
+    Attributes:
+        probe: the nominal point, normal and search, wobj frame (metres).
+        role: what the point is for in the procedure, one of :data:`ROLES` (free text allowed
+            for plans written by other tools).
+    """
+
+    probe: ProbePoint
+    role: str = "plane"
+
+    @property
+    def id(self) -> str:
+        """The point's id, e.g. ``"A"``."""
+        return self.probe.id
+
+
+@dataclass(frozen=True)
+class UiPlan:
+    """The probe points being edited, in order, and the plan they came from.
+
+    Attributes:
+        points: the probe points, in procedure order.
+        name: a short name of the plan for titles and file names.
+        source: the loaded plan object (``calib.plan``) the points came from, or ``None``.
+    """
+
+    points: tuple[UiPoint, ...] = ()
+    name: str = "plan"
+    source: Any = field(default=None, compare=False)
+
+    @property
+    def ids(self) -> tuple[str, ...]:
+        """The point ids in order."""
+        return tuple(p.id for p in self.points)
+
+    def get(self, point_id: str) -> UiPoint:
+        """The point named ``point_id``; :class:`InputError` listing the ids when unknown."""
+        for p in self.points:
+            if p.id == point_id:
+                return p
+        raise InputError(f"no point {point_id!r} in the plan (points: {', '.join(self.ids)})")
+
+
+def next_id(plan: UiPlan) -> str:
+    """The first unused id: A-H first, then I, J, ... Z, then P1, P2, ..."""
+    used = set(plan.ids)
+    for name in string.ascii_uppercase:
+        if name not in used:
+            return name
+    k = 1
+    while f"P{k}" in used:
+        k += 1
+    return f"P{k}"
+
+
+def _tuple3(v: ArrayLike) -> tuple[float, float, float]:
+    a = np.asarray(v, dtype=np.float64).reshape(3)
+    return (float(a[0]), float(a[1]), float(a[2]))
+
+
+def _search_for_normal(search: SearchSpec, normal: ArrayLike) -> SearchSpec:
+    """Keep an edge search valid after the normal changed: project its direction into the face."""
+    if search.kind != "edge" or search.edge_direction is None:
+        return search
+    n = np.asarray(normal, float)
+    d = np.asarray(search.edge_direction, float)
+    d = d - (d @ n) * n
+    norm = float(np.linalg.norm(d))
+    if norm < 1e-9:  # direction along the new normal: fall back to an approach search
+        return SearchSpec(start_offset_m=search.start_offset_m, overtravel_m=search.overtravel_m)
+    return dataclasses.replace(search, edge_direction=_tuple3(d / norm))
+
+
+def place_point(
+    plan: UiPlan,
+    point_id: str,
+    position_wobj: ArrayLike,
+    normal_wobj: ArrayLike,
+    role: str | None = None,
+) -> UiPlan:
+    """Put point ``point_id`` at a surface point with that face's normal (add it if new).
+
+    An existing point keeps its role and search settings (an edge direction is projected into the
+    new face); a new one gets an approach search and the role ``role`` (default ``"plane"``).
+    """
+    if not point_id:
+        raise InputError("point id must not be empty")
+    n = np.asarray(normal_wobj, float)
+    n = n / np.linalg.norm(n)
+    existing = {p.id: p for p in plan.points}
+    old = existing.get(point_id)
+    search = SearchSpec() if old is None else _search_for_normal(old.probe.search, n)
+    edge_normal = None if old is None or search.kind != "edge" else old.probe.edge_normal
+    probe = ProbePoint(
+        id=point_id,
+        position_m=_tuple3(position_wobj),
+        normal=_tuple3(n),
+        search=search,
+        edge_normal=edge_normal,
+    )
+    new_role = role if role is not None else ("plane" if old is None else old.role)
+    new = UiPoint(probe=probe, role=new_role)
+    if old is None:
+        return dataclasses.replace(plan, points=(*plan.points, new))
+    return dataclasses.replace(
+        plan, points=tuple(new if p.id == point_id else p for p in plan.points)
+    )
+
+
+def replace_point(plan: UiPlan, point: UiPoint) -> UiPlan:
+    """Replace the point with the same id (which must exist)."""
+    plan.get(point.id)
+    return dataclasses.replace(
+        plan, points=tuple(point if p.id == point.id else p for p in plan.points)
+    )
+
+
+def delete_point(plan: UiPlan, point_id: str) -> UiPlan:
+    """Remove point ``point_id`` (which must exist)."""
+    plan.get(point_id)
+    return dataclasses.replace(plan, points=tuple(p for p in plan.points if p.id != point_id))
+
+
+def edit_search(
+    plan: UiPlan,
+    point_id: str,
+    *,
+    kind: str,
+    start_offset_m: float,
+    overtravel_m: float,
+    edge_direction: ArrayLike | None = None,
+    role: str | None = None,
+) -> UiPlan:
+    """Change the search settings (and optionally the role) of one point.
+
+    For an edge search the direction is projected into the point's face and normalised; a
+    direction along the normal is refused with a message.
+
+    Raises:
+        InputError: unknown point, bad lengths, or an unusable edge direction.
+    """
+    old = plan.get(point_id)
+    direction = None
+    if kind == "edge":
+        if edge_direction is None:
+            raise InputError(f"point {point_id}: an edge search needs an edge direction")
+        n = np.asarray(old.probe.normal, float)
+        d = np.asarray(edge_direction, float)
+        d = d - (d @ n) * n
+        if float(np.linalg.norm(d)) < 1e-6:
+            raise InputError(
+                f"point {point_id}: the edge direction must lie in the face, not along its normal"
+            )
+        direction = _tuple3(d / np.linalg.norm(d))
+    search = SearchSpec(
+        kind=kind,  # type: ignore[arg-type]  # SearchSpec validates the value
+        start_offset_m=float(start_offset_m),
+        overtravel_m=float(overtravel_m),
+        edge_direction=direction,
+    )
+    edge_normal = old.probe.edge_normal if kind == "edge" else None
+    probe = dataclasses.replace(old.probe, search=search, edge_normal=edge_normal)
+    return replace_point(plan, UiPoint(probe=probe, role=old.role if role is None else role))

@@ -1,0 +1,172 @@
+"""Session state: the plan being edited, undo/redo and atomic autosave.
+
+The session holds one immutable document (the plan). Every edit replaces it with a new value
+through :meth:`SessionState.apply`, which keeps the previous value for undo, clears the redo
+stack, writes the autosave file atomically and tells the listeners. Because the document is
+immutable, undo and redo are just swaps, and every browser tab sees the same plan.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Generic, TypeVar
+
+from calib.atomic_io import write_bytes_atomic
+
+logger = logging.getLogger(__name__)
+
+D = TypeVar("D")
+
+#: Default autosave location of the session plan.
+DEFAULT_AUTOSAVE = Path.home() / ".cache" / "wobjcal" / "autosave.json"
+
+
+def atomic_write_bytes(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` atomically (creating its folder): see :mod:`calib.atomic_io`."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_bytes_atomic(path, data)
+
+
+@dataclass(frozen=True)
+class Change(Generic[D]):
+    """One change of the session document, as told to listeners.
+
+    Attributes:
+        doc: the document after the change.
+        previous: the document before the change.
+        label: what happened, e.g. ``"move A"``, ``"undo move A"``.
+    """
+
+    doc: D
+    previous: D
+    label: str
+
+
+class SessionState(Generic[D]):
+    """The edited document with undo/redo and autosave; safe to use from many threads.
+
+    Args:
+        doc: the initial document.
+        serialize: turns a document into the bytes written to ``autosave_path``.
+        autosave_path: where to autosave after each change; ``None`` disables autosave.
+        max_undo: how many steps undo remembers.
+    """
+
+    def __init__(
+        self,
+        doc: D,
+        serialize: Callable[[D], bytes] | None = None,
+        autosave_path: Path | None = None,
+        max_undo: int = 200,
+    ) -> None:
+        self._doc = doc
+        self._undo: list[tuple[D, str]] = []
+        self._redo: list[tuple[D, str]] = []
+        self._serialize = serialize
+        self._autosave_path = None if autosave_path is None else Path(autosave_path)
+        self._max_undo = max_undo
+        self._lock = threading.RLock()
+        self._listeners: list[Callable[[Change[D]], None]] = []
+        self.last_autosave_error: str = ""
+
+    @property
+    def doc(self) -> D:
+        """The current document."""
+        with self._lock:
+            return self._doc
+
+    @property
+    def autosave_path(self) -> Path | None:
+        """Where the session autosaves, or ``None``."""
+        return self._autosave_path
+
+    @property
+    def can_undo(self) -> bool:
+        """True when there is a change to undo."""
+        with self._lock:
+            return bool(self._undo)
+
+    @property
+    def can_redo(self) -> bool:
+        """True when there is an undone change to redo."""
+        with self._lock:
+            return bool(self._redo)
+
+    def subscribe(self, listener: Callable[[Change[D]], None]) -> None:
+        """Call ``listener(change)`` after every change, in the thread that made it, unlocked."""
+        with self._lock:
+            self._listeners.append(listener)
+
+    def apply(self, new_doc: D, label: str) -> Change[D]:
+        """Replace the document with ``new_doc``; remember the old one for undo."""
+        return self.update(lambda _old: new_doc, label)
+
+    def update(self, edit: Callable[[D], D], label: str) -> Change[D]:
+        """Apply ``edit(current_doc)`` atomically (no other edit can slip in between).
+
+        If ``edit`` raises, nothing changes and the exception propagates.
+        """
+        with self._lock:
+            previous = self._doc
+            new_doc = edit(previous)
+            self._undo.append((previous, label))
+            del self._undo[: -self._max_undo]
+            self._redo.clear()
+            self._doc = new_doc
+            change = Change(new_doc, previous, label)
+            self.autosave()
+        self._notify(change)
+        return change
+
+    def undo(self) -> Change[D] | None:
+        """Go back one change; ``None`` when there is nothing to undo."""
+        with self._lock:
+            if not self._undo:
+                return None
+            doc, label = self._undo.pop()
+            self._redo.append((self._doc, label))
+            change = Change(doc, self._doc, f"undo {label}")
+            self._doc = doc
+            self.autosave()
+        self._notify(change)
+        return change
+
+    def redo(self) -> Change[D] | None:
+        """Re-apply the last undone change; ``None`` when there is nothing to redo."""
+        with self._lock:
+            if not self._redo:
+                return None
+            doc, label = self._redo.pop()
+            self._undo.append((self._doc, label))
+            change = Change(doc, self._doc, f"redo {label}")
+            self._doc = doc
+            self.autosave()
+        self._notify(change)
+        return change
+
+    def autosave(self) -> bool:
+        """Write the current document to the autosave file; return True on success."""
+        with self._lock:
+            if self._autosave_path is None or self._serialize is None:
+                return False
+            try:
+                atomic_write_bytes(self._autosave_path, self._serialize(self._doc))
+            except Exception as exc:  # a failed autosave must not lose the edit
+                self.last_autosave_error = f"{type(exc).__name__}: {exc}"
+                logger.warning("autosave to %s failed: %s", self._autosave_path, exc)
+                return False
+            self.last_autosave_error = ""
+            return True
+
+    def _notify(self, change: Change[D]) -> None:
+        # outside the lock: a listener may wait for the cell worker, which may read the doc
+        for listener in list(self._listeners):
+            try:
+                listener(change)
+            except Exception:
+                logger.exception("session listener failed after %r", change.label)
