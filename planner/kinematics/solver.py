@@ -1,0 +1,110 @@
+"""One IK entry point for any chain: analytic OPW when the robot qualifies, numeric otherwise.
+
+    solver = make_ik_solver(chain)          # solver.kind is "opw" or "numeric"
+    sol = solver.solve(T_base_flange)       # (N, 4, 4) in, IKSolutions(q (N, K, n), valid (N, K))
+
+``solver.why_not_opw`` says why the analytic solver was not used (``None`` when it was).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from calib.frames import check_transform
+from planner.kinematics.chain import KinematicChain
+from planner.kinematics.numeric_ik import NumericIK
+
+log = logging.getLogger(__name__)
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class IKSolutions:
+    """Inverse-kinematics solutions of ``N`` flange poses.
+
+    Attributes:
+        q: joint values ``(N, K, n)``, rad (robot joint convention of the URDF); NaN where
+            ``valid`` is False, so a forgotten mask cannot pass as a solution.
+        valid: ``(N, K)`` bool: reaches the pose (1e-6 m, 1e-6 rad or better) within joint limits.
+        branch: ``(N, K)`` int: for 6-axis OPW arms the configuration index 0-7 (ABB ``cfx``:
+            4 * shoulder behind + 2 * wrist centre behind the lower arm + axis 5 negative, see
+            :mod:`planner.kinematics.branches`); -1 for numeric solutions and invalid entries.
+    """
+
+    q: FloatArray
+    valid: NDArray[np.bool_]
+    branch: NDArray[np.int_]
+
+    @property
+    def found(self) -> NDArray[np.bool_]:
+        """``(N,)`` bool: at least one valid solution per pose."""
+        return np.asarray(self.valid.any(axis=1), dtype=bool)
+
+    def nearest(self, q_ref: ArrayLike) -> tuple[FloatArray, NDArray[np.bool_]]:
+        """The valid solution closest to ``q_ref`` ``(n,)`` or ``(N, n)`` (max-abs joint distance).
+
+        Returns:
+            ``q (N, n)`` (NaN where none is valid) and ``found (N,)``.
+        """
+        ref = np.broadcast_to(np.asarray(q_ref, dtype=np.float64), self.q[:, 0].shape)
+        d = np.where(self.valid, np.abs(self.q - ref[:, None]).max(axis=-1), np.inf)
+        k = np.argmin(d, axis=1)
+        q = self.q[np.arange(self.q.shape[0]), k]
+        return q, self.found
+
+
+class IKSolver:
+    """Inverse kinematics of one chain (build with :func:`make_ik_solver`).
+
+    Attributes:
+        chain: the kinematic chain; poses are ``T_base_tip`` of it (the flange for ``tool0``).
+        kind: ``"opw"`` (analytic, all branches) or ``"numeric"`` (seeded Levenberg-Marquardt).
+        why_not_opw: why the analytic solver does not apply; ``None`` when ``kind == "opw"``.
+    """
+
+    def __init__(
+        self, chain: KinematicChain, kind: str, why_not_opw: str | None, numeric: NumericIK
+    ) -> None:
+        self.chain = chain
+        self.kind = kind
+        self.why_not_opw = why_not_opw
+        self._numeric = numeric
+
+    def solve(self, T_base_flange: ArrayLike, seeds: ArrayLike | None = None) -> IKSolutions:
+        """All solutions found for flange poses ``(N, 4, 4)`` (or one ``(4, 4)``).
+
+        Args:
+            T_base_flange: target tip poses in the base frame.
+            seeds: start configurations for the numeric solver, ``(S, n)`` or ``(N, S, n)``;
+                ignored by the analytic solver, which returns every branch anyway.
+
+        Raises:
+            ShapeError, NonFiniteError, DegenerateGeometryError: the poses are not valid
+                rigid transforms (wrong shape, NaN, non-orthonormal rotation).
+        """
+        T = check_transform(T_base_flange, "T_base_flange")
+        T = T[None] if T.ndim == 2 else T
+        res = self._numeric.solve(T, seeds)
+        branch = np.full(res.valid.shape, -1, dtype=int)
+        return IKSolutions(res.q, res.valid, branch)
+
+
+def make_ik_solver(
+    chain: KinematicChain, n_seeds: int = 12, rng: np.random.Generator | None = None
+) -> IKSolver:
+    """The best IK solver for ``chain``: OPW when it qualifies, else numeric.
+
+    Args:
+        chain: the kinematic chain (tip = flange).
+        n_seeds: seeds per pose of the numeric solver.
+        rng: random seeds for the numeric solver (default: a fixed low-discrepancy set).
+    """
+    numeric = NumericIK(chain, n_seeds=n_seeds, rng=rng)
+    why = "the analytic OPW solver is not available yet"
+    log.info("IK for %s: numeric (%s)", chain.name, why)
+    return IKSolver(chain, "numeric", why, numeric)
