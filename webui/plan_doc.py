@@ -19,9 +19,7 @@ from numpy.typing import ArrayLike
 from calib.errors import InputError
 from calib.probing import ProbePoint, SearchSpec
 
-#: Roles a point can play; shown in the panel's role dropdown.
-ROLES: tuple[str, ...] = ("plane", "line", "point", "edge", "xoffset", "approach")
-#: The paper's point names, offered first in the point dropdown.
+#: The paper's point names (also the roles of its A-H procedure).
 PAPER_IDS: tuple[str, ...] = tuple("ABCDEFGH")
 
 
@@ -31,12 +29,14 @@ class UiPoint:
 
     Attributes:
         probe: the nominal point, normal and search, wobj frame (metres).
-        role: what the point is for in the procedure, one of :data:`ROLES` (free text allowed
-            for plans written by other tools).
+        role: what the point is for in the procedure (e.g. ``"A"`` for the paper's A-H
+            procedure, ``"primary"`` for 3-2-1); see ``calib.plan_procedures``.
+        speed_m_s: search speed written into robot programs, m/s.
     """
 
     probe: ProbePoint
-    role: str = "plane"
+    role: str = "A"
+    speed_m_s: float = 0.010
 
     @property
     def id(self) -> str:
@@ -51,11 +51,13 @@ class UiPlan:
     Attributes:
         points: the probe points, in procedure order.
         name: a short name of the plan for titles and file names.
+        roles: the roles the plan's procedure allows, offered in the role dropdown.
         source: the loaded plan object (``calib.plan``) the points came from, or ``None``.
     """
 
     points: tuple[UiPoint, ...] = ()
     name: str = "plan"
+    roles: tuple[str, ...] = PAPER_IDS
     source: Any = field(default=None, compare=False)
 
     @property
@@ -111,7 +113,8 @@ def place_point(
     """Put point ``point_id`` at a surface point with that face's normal (add it if new).
 
     An existing point keeps its role and search settings (an edge direction is projected into the
-    new face); a new one gets an approach search and the role ``role`` (default ``"plane"``).
+    new face); a new one gets an approach search and the role ``role`` (default: its id when the
+    procedure has such a role, else the procedure's first role).
     """
     if not point_id:
         raise InputError("point id must not be empty")
@@ -128,8 +131,11 @@ def place_point(
         search=search,
         edge_normal=edge_normal,
     )
-    new_role = role if role is not None else ("plane" if old is None else old.role)
-    new = UiPoint(probe=probe, role=new_role)
+    if role is None:
+        role = old.role if old is not None else (point_id if point_id in plan.roles else "")
+        role = role or (plan.roles[0] if plan.roles else point_id)
+    speed = 0.010 if old is None else old.speed_m_s
+    new = UiPoint(probe=probe, role=role, speed_m_s=speed)
     if old is None:
         return dataclasses.replace(plan, points=(*plan.points, new))
     return dataclasses.replace(
@@ -190,4 +196,5 @@ def edit_search(
     )
     edge_normal = old.probe.edge_normal if kind == "edge" else None
     probe = dataclasses.replace(old.probe, search=search, edge_normal=edge_normal)
-    return replace_point(plan, UiPoint(probe=probe, role=old.role if role is None else role))
+    new_role = old.role if role is None else role
+    return replace_point(plan, UiPoint(probe=probe, role=new_role, speed_m_s=old.speed_m_s))

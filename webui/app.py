@@ -1,0 +1,307 @@
+"""The wobjcal web UI: a viser server over one plan, its cell and its checks.
+
+``run()`` starts the server (127.0.0.1:8080 by default), loads a plan or the built-in demo and
+returns the :class:`WobjcalApp`. The app is thin: browser events become edits of the session
+plan (:mod:`webui.state`), and every edit is checked in the cell on the one worker thread
+(:mod:`webui.worker`) and drawn back (:mod:`webui.scene`).
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import viser
+from numpy.typing import ArrayLike
+
+from calib.errors import InputError
+from calib.plan import Plan
+from webui import demo, plan_doc
+from webui.backend import CellSession, CellView, NotAvailableError
+from webui.plan_adapter import autosave_bytes, ui_plan_from_file
+from webui.plan_doc import UiPlan
+from webui.robot_view import RobotView
+from webui.scene import PlanScene
+from webui.state import DEFAULT_AUTOSAVE, Change, SessionState
+from webui.status import PointCheck
+from webui.surface import SurfacePicker
+from webui.worker import CellWorker
+
+logger = logging.getLogger(__name__)
+
+
+class WobjcalApp:
+    """One UI session: the server, the plan being edited, the cell worker and the panels.
+
+    Args:
+        server: the viser server to draw on.
+        plan: the initial plan (editable form).
+        plan_dir: folder relative file references of the plan are resolved against.
+        autosave_path: where the session plan autosaves (``None``: no autosave).
+    """
+
+    def __init__(
+        self,
+        server: viser.ViserServer,
+        plan: UiPlan,
+        plan_dir: Path,
+        autosave_path: Path | None = DEFAULT_AUTOSAVE,
+    ) -> None:
+        from webui import files_panel, points_panel, validate_panel
+
+        self.server = server
+        self.plan_dir = Path(plan_dir)
+        self.scene = PlanScene(server)
+        self.state: SessionState[UiPlan] = SessionState(
+            plan, serialize=autosave_bytes, autosave_path=autosave_path
+        )
+        self.worker: CellWorker[CellSession | None] = CellWorker(None)
+        self.view: CellView | None = None
+        self.picker: SurfacePicker | None = None
+        self.robot: RobotView | None = None
+        self.cell_error = ""
+        self.selected: str | None = None
+        self._checks: dict[str, tuple[Any, PointCheck]] = {}
+        self._lock = threading.RLock()
+        self._cell_key: Any = None
+        self.points_panel = points_panel.PointsPanel(self)
+        self.validate_panel = validate_panel.ValidatePanel(self)
+        self.files_panel = files_panel.FilesPanel(self)
+        self.state.subscribe(self._on_change)
+        server.on_client_connect(self._on_connect)
+        if isinstance(plan.source, Plan):
+            self.load_cell(plan.source, self.plan_dir)
+
+    # ---- cell ---------------------------------------------------------------------------
+    def load_cell(self, plan: Plan, plan_dir: Path) -> None:
+        """Build the plan's cell on the worker and redraw the scene; raise if it fails.
+
+        On failure the previous cell, scene and plan stay as they were.
+        """
+        self.worker.replace_resource(lambda: CellSession(plan, plan_dir)).result(300)
+        session = self.worker.call(lambda s: s)
+        view = session.view
+        picker = SurfacePicker(view.wobj_mesh, view.T_world_wobj)
+        with self._lock:
+            self.plan_dir = Path(plan_dir)
+            self.view, self.picker, self.cell_error = view, picker, session.cell_error
+            self._cell_key = _cell_key(plan)
+            self._checks.clear()
+        handle = self.scene.draw_work_object(view.wobj_mesh, view.T_world_wobj)
+        handle.on_click(self._on_mesh_click)
+        self.scene.draw_fixtures(view.fixtures)
+        if self.robot is not None:
+            self.robot.remove()
+            self.robot = None
+        if view.robot_urdf is not None:
+            self.robot = RobotView(self.server, view.robot_urdf, view.T_world_base)
+        self.recheck(self.state.doc.ids)
+
+    # ---- checks ---------------------------------------------------------------------------
+    def check_of(self, point_id: str) -> PointCheck | None:
+        """The latest check of a point, or ``None`` while it is being computed."""
+        with self._lock:
+            entry = self._checks.get(point_id)
+        return None if entry is None else entry[1]
+
+    def checks(self) -> dict[str, PointCheck]:
+        """The latest check of every point that has one."""
+        with self._lock:
+            return {pid: c for pid, (_, c) in self._checks.items()}
+
+    def recheck(self, point_ids: tuple[str, ...] | list[str]) -> list[PointCheck]:
+        """Check the given points in the cell (on the worker), store and draw the results."""
+        doc = self.state.doc
+        points = [doc.get(pid) for pid in point_ids if pid in doc.ids]
+        if not points:
+            return []
+        probes = [p.probe for p in points]
+        results = self.worker.call(lambda s: [] if s is None else s.check_points(probes))
+        current = self.state.doc
+        with self._lock:
+            for point, check in zip(points, results, strict=False):
+                still = point.id in current.ids and current.get(point.id).probe == point.probe
+                if still:  # drop results of a point that moved on meanwhile
+                    self._checks[point.id] = (point.probe, check)
+        self._redraw()
+        return results
+
+    def _redraw(self) -> None:
+        doc = self.state.doc
+        self.scene.draw_points(doc, self.checks(), self.selected)
+        self.points_panel.refresh()
+        self.server.flush()
+
+    def _on_change(self, change: Change[UiPlan]) -> None:
+        source = change.doc.source
+        if isinstance(source, Plan) and _cell_key(source) != self._cell_key:
+            try:  # e.g. undo of an upload: go back to the earlier cell
+                self.load_cell(source, self.plan_dir)
+            except Exception as exc:
+                self.notify("Cell not loaded", str(exc), error=True)
+            self._redraw()
+            return
+        before = {p.id: p for p in change.previous.points}
+        changed = [p.id for p in change.doc.points if before.get(p.id) != p]
+        with self._lock:
+            for pid in [*changed, *(set(before) - set(change.doc.ids))]:
+                self._checks.pop(pid, None)
+        self._redraw()
+        self.recheck(changed)
+        if self.selected is not None and self.selected not in change.doc.ids:
+            self.select(None)
+        elif self.selected in changed:
+            self.select(self.selected)
+
+    def show_reachability(self, n_samples: int = 4000) -> None:
+        """Colour the work object by reachability (samples from ``cell.reachability_map``)."""
+        from webui.scene import heat_rgb
+
+        def job(session: CellSession | None) -> Any:
+            if session is None or session.cell is None:
+                why = "no cell" if session is None else session.cell_error
+                raise NotAvailableError(f"the reachability map needs the cell: {why}")
+            return session.reachability(n_samples)
+
+        points_wobj, score = self.worker.call(job)
+        self.scene.show_heat_map(points_wobj, heat_rgb(score))
+
+    # ---- editing ---------------------------------------------------------------------------
+    def place_at_ray(
+        self, origin_world: ArrayLike, direction_world: ArrayLike, point_id: str | None = None
+    ) -> PointCheck | None:
+        """Put a point where a ray (world frame) hits the work object; return its check.
+
+        This is what a click on the work object does.
+
+        Raises:
+            InputError: no work object is loaded or the ray misses it.
+        """
+        picker = self.picker
+        if picker is None:
+            raise InputError("no work object is loaded")
+        hit = picker.pick(origin_world, direction_world)
+        if hit is None:
+            raise InputError("the click missed the work object")
+        pid = point_id or self.points_panel.target_id()
+
+        def edit(doc: UiPlan) -> UiPlan:
+            return plan_doc.place_point(doc, pid, hit.position_wobj, hit.normal_wobj)
+
+        self.selected = pid
+        self.state.update(edit, f"place {pid}")
+        return self.check_of(pid)
+
+    def move_point_to(self, point_id: str, point_wobj: ArrayLike) -> PointCheck | None:
+        """Move a point to the surface point closest to ``point_wobj`` (e.g. after a drag)."""
+        if self.picker is None:
+            raise InputError("no work object is loaded")
+        hit = self.picker.project(point_wobj)
+        self.state.update(
+            lambda d: plan_doc.place_point(d, point_id, hit.position_wobj, hit.normal_wobj),
+            f"move {point_id}",
+        )
+        return self.check_of(point_id)
+
+    def select(self, point_id: str | None) -> None:
+        """Select a point: highlight it and show the robot at its probe pose."""
+        self.selected = point_id
+        check = None if point_id is None else self.check_of(point_id)
+        if self.robot is not None and check is not None and check.q is not None:
+            self.robot.stop()
+            self.robot.set_q(check.q)
+        self._redraw()
+        self.points_panel.on_select(point_id)
+
+    def _on_mesh_click(self, event: Any) -> None:
+        try:
+            self.place_at_ray(event.ray_origin, event.ray_direction)
+        except InputError as exc:
+            self.notify("Point not placed", str(exc), client=event.client, error=True)
+        except Exception as exc:  # never a traceback in the browser
+            logger.exception("placing a point failed")
+            self.notify("Point not placed", f"{type(exc).__name__}: {exc}", client=event.client)
+
+    # ---- clients ---------------------------------------------------------------------------
+    def _on_connect(self, client: viser.ClientHandle) -> None:
+        view = self.view
+        if view is None:
+            if self.cell_error:
+                self.notify("No cell", self.cell_error, client=client, error=True)
+            return
+        target = view.T_world_wobj[:3, 3] + view.T_world_wobj[:3, :3] @ view.wobj_mesh.centroid
+        client.camera.up_direction = (0.0, 0.0, 1.0)
+        client.camera.position = tuple(target + np.array([2.2, -1.6, 1.4]))
+        client.camera.look_at = tuple(target)
+        if self.cell_error:
+            self.notify("Feasibility not available", self.cell_error, client=client, error=True)
+
+    def notify(
+        self, title: str, body: str, client: viser.ClientHandle | None = None, error: bool = True
+    ) -> None:
+        """Show a notification to one client, or to all clients when ``client`` is None."""
+        logger.info("%s: %s", title, body)
+        clients = [client] if client is not None else list(self.server.get_clients().values())
+        for c in clients:
+            c.add_notification(
+                title, body, color="red" if error else "green", auto_close_seconds=8.0
+            )
+
+    def stop(self) -> None:
+        """Stop the server and the worker."""
+        if self.robot is not None:
+            self.robot.stop()
+        self.validate_panel.close()
+        self.server.stop()
+        self.worker.close()
+
+
+def _cell_key(plan: Plan) -> tuple[Any, Any]:
+    """What decides the cell: when it changes, the cell is rebuilt."""
+    return (plan.cell, plan.work_object)
+
+
+def run(
+    plan_path: str | Path | None = None,
+    host: str = "127.0.0.1",
+    port: int = 8080,
+    block: bool = True,
+    autosave_path: str | Path | None = DEFAULT_AUTOSAVE,
+) -> WobjcalApp:
+    """Start the wobjcal UI on ``http://host:port`` with a plan file or the built-in demo.
+
+    Args:
+        plan_path: a ``wobjcal.plan/1`` file; ``None`` opens the built-in stator-section demo.
+        host: interface to bind; 127.0.0.1 (this machine only) unless told otherwise.
+        port: TCP port.
+        block: serve until interrupted (Ctrl-C), then stop; ``False`` returns at once.
+        autosave_path: where the session plan autosaves; ``None`` disables autosave.
+
+    Returns:
+        The running app (``app.server`` is the viser server; ``app.stop()`` ends it).
+    """
+    if plan_path is not None:
+        ui_plan, plan_dir = ui_plan_from_file(Path(plan_path)), Path(plan_path).parent
+    else:
+        ui_plan, plan_dir = demo.demo_ui_plan()
+    server = viser.ViserServer(host=host, port=port, label="wobjcal", verbose=block)
+    server.gui.configure_theme(control_width="large", show_share_button=False)
+    logger.info("wobjcal UI at http://%s:%d", host, server.get_port())
+    app = WobjcalApp(
+        server,
+        ui_plan,
+        plan_dir,
+        autosave_path=None if autosave_path is None else Path(autosave_path),
+    )
+    if not block:
+        return app
+    try:
+        threading.Event().wait()
+    except KeyboardInterrupt:
+        logger.info("stopping the wobjcal UI")
+    finally:
+        app.stop()
+    return app

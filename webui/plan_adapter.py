@@ -1,0 +1,97 @@
+"""Between the plan file (:mod:`calib.plan`, ``wobjcal.plan/1``) and the UI's editable points.
+
+The strict :class:`calib.plan.Plan` refuses a plan whose points do not fit its procedure (e.g.
+the A-H procedure needs each role A-H exactly once), but a plan being edited is often incomplete.
+So the UI edits a :class:`webui.plan_doc.UiPlan`; :func:`plan_from_ui` builds the strict plan for
+downloads and exports (its error says what is missing), and :func:`autosave_bytes` writes the
+same JSON layout without the procedure check so that no edit is ever lost.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+from typing import Any
+
+import msgspec
+
+from calib.plan import Plan, PlanError, PlanPoint, load_plan, plan_from_json, plan_to_json
+from calib.plan_json import canonical_json
+from calib.plan_procedures import (
+    BEST_FIT_ROLE,
+    HULTMAN_ROLES,
+    THREE_TWO_ONE_ROLES,
+    method_of,
+)
+from webui.plan_doc import UiPlan, UiPoint
+
+
+def roles_of(plan: Plan) -> tuple[str, ...]:
+    """The point roles the plan's procedure allows."""
+    method = method_of(plan.procedure)
+    if method == "hultman2013":
+        return HULTMAN_ROLES
+    if method == "three_two_one":
+        return tuple(THREE_TWO_ONE_ROLES)
+    return (BEST_FIT_ROLE,)
+
+
+def ui_plan_from_plan(plan: Plan, name: str | None = None) -> UiPlan:
+    """The editable points of ``plan`` (the plan itself rides along as ``source``)."""
+    points = tuple(
+        UiPoint(probe=p.to_probe_point(), role=p.role, speed_m_s=p.search.speed_m_s)
+        for p in plan.points
+    )
+    return UiPlan(
+        points=points, name=name or plan.name or "plan", roles=roles_of(plan), source=plan
+    )
+
+
+def _plan_points(ui: UiPlan) -> list[PlanPoint]:
+    return [PlanPoint.from_probe_point(p.probe, p.role, p.speed_m_s) for p in ui.points]
+
+
+def plan_from_ui(ui: UiPlan) -> Plan:
+    """The strict plan: ``ui.source`` with the edited points.
+
+    Raises:
+        PlanError: the points do not fit the procedure (the message says what is missing), or
+            there is no source plan to take the cell and procedure from.
+    """
+    if not isinstance(ui.source, Plan):
+        raise PlanError("no plan is loaded: load a plan or the demo first")
+    return msgspec.structs.replace(ui.source, points=_plan_points(ui))
+
+
+def plan_json_from_ui(ui: UiPlan) -> str:
+    """Canonical JSON text of :func:`plan_from_ui` (raises :class:`PlanError` when incomplete)."""
+    return plan_to_json(plan_from_ui(ui))
+
+
+def autosave_bytes(ui: UiPlan) -> bytes:
+    """The plan JSON of ``ui``, written even when the points do not fit the procedure yet."""
+    if not isinstance(ui.source, Plan):
+        return b"{}\n"
+    raw: dict[str, Any] = msgspec.to_builtins(ui.source)
+    raw["points"] = msgspec.to_builtins(_plan_points(ui))
+    return canonical_json(raw).encode("utf-8")
+
+
+def ui_plan_from_bytes(data: bytes, source: str) -> UiPlan:
+    """Parse an uploaded plan strictly (errors name ``source`` and the JSON path)."""
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise PlanError(f"{source}: not UTF-8 text, so not a plan JSON file") from None
+    plan = plan_from_json(text, source=source)
+    return ui_plan_from_plan(plan, name=Path(source).stem)
+
+
+def ui_plan_from_file(path: Path) -> UiPlan:
+    """Load a plan file strictly, checking the files it refers to."""
+    return ui_plan_from_plan(load_plan(path), name=Path(path).stem)
+
+
+def with_source(ui: UiPlan, plan: Plan) -> UiPlan:
+    """``ui`` with another source plan (e.g. after a new work object was uploaded)."""
+    return dataclasses.replace(ui, source=plan, roles=roles_of(plan))

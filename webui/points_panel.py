@@ -1,0 +1,209 @@
+"""The "Points" panel: which point a click places, the selected point's settings, status list."""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import threading
+from collections.abc import Iterator
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from calib.errors import InputError
+from webui import plan_doc
+from webui.plan_doc import PAPER_IDS
+
+if TYPE_CHECKING:
+    from webui.app import WobjcalApp
+
+logger = logging.getLogger(__name__)
+
+NEXT = "next"
+NONE = "(none)"
+
+
+class PointsPanel:
+    """GUI widgets for placing, selecting, editing and inspecting points (shared by all tabs).
+
+    Args:
+        app: the app whose plan the panel edits.
+    """
+
+    def __init__(self, app: WobjcalApp) -> None:
+        self._app = app
+        self._syncing = threading.local()
+        gui = app.server.gui
+        self._gizmo: Any = None
+        with gui.add_folder("Points"):
+            self.place = gui.add_dropdown(
+                "Place", (NEXT, *PAPER_IDS), initial_value=NEXT, hint="id a click places"
+            )
+            gui.add_markdown("Click the work object to place the point on its surface.")
+            self.selected = gui.add_dropdown("Selected", (NONE,), initial_value=NONE)
+            self.role = gui.add_dropdown("Role", PAPER_IDS, initial_value="A")
+            self.kind = gui.add_dropdown("Search", ("approach", "edge"), initial_value="approach")
+            self.start_mm = gui.add_number("Start offset (mm)", 30.0, min=0.1, step=0.5)
+            self.over_mm = gui.add_number("Overtravel (mm)", 20.0, min=0.1, step=0.5)
+            self.edge_dir = gui.add_vector3("Edge direction", (0.0, 0.0, 1.0), step=0.1)
+            self.apply = gui.add_button("Apply settings")
+            self.delete = gui.add_button("Delete point", color="red")
+            self.undo = gui.add_button("Undo")
+            self.redo = gui.add_button("Redo")
+            self.drag = gui.add_checkbox("Drag selected point", False)
+            self.play = gui.add_button("Play search path")
+            self.heat = gui.add_checkbox("Reachability heat map", False)
+            self.status_md = gui.add_markdown("")
+        self.selected.on_update(self._on_selected)
+        self.apply.on_click(self._on_apply)
+        self.delete.on_click(self._on_delete)
+        self.undo.on_click(lambda ev: self._guard(ev, self._app.state.undo))
+        self.redo.on_click(lambda ev: self._guard(ev, self._app.state.redo))
+        self.drag.on_update(lambda ev: self._guard(ev, self._update_gizmo))
+        self.play.on_click(self._on_play)
+        self.heat.on_update(self._on_heat)
+
+    # ---- helpers ---------------------------------------------------------------------------
+    @contextlib.contextmanager
+    def _programmatic(self) -> Iterator[None]:
+        self._syncing.on = True
+        try:
+            yield
+        finally:
+            self._syncing.on = False
+
+    def _is_programmatic(self) -> bool:
+        return bool(getattr(self._syncing, "on", False))
+
+    def _guard(self, event: Any, fn: Any, *args: Any) -> Any:
+        """Run ``fn``; turn input errors into a notification for the event's client."""
+        try:
+            return fn(*args)
+        except InputError as exc:
+            self._app.notify("Not done", str(exc), client=getattr(event, "client", None))
+        except Exception as exc:
+            logger.exception("panel action failed")
+            self._app.notify("Error", f"{type(exc).__name__}: {exc}", client=event.client)
+        return None
+
+    def target_id(self) -> str:
+        """The id a click places: the chosen one, or the next free id."""
+        choice = str(self.place.value)
+        return plan_doc.next_id(self._app.state.doc) if choice == NEXT else choice
+
+    # ---- refresh from state ----------------------------------------------------------------
+    def refresh(self) -> None:
+        """Update the lists and the status table from the session plan and checks."""
+        doc = self._app.state.doc
+        checks = self._app.checks()
+        with self._programmatic():
+            extra = tuple(i for i in doc.ids if i not in PAPER_IDS)
+            self.place.options = (NEXT, *PAPER_IDS, *extra)
+            self.selected.options = (NONE, *doc.ids)
+            self.role.options = doc.roles or PAPER_IDS
+            sel = self._app.selected
+            self.selected.value = sel if sel in doc.ids else NONE
+        rows = ["| point | role | status | reason |", "|---|---|---|---|"]
+        for p in doc.points:
+            c = checks.get(p.id)
+            status = "checking..." if c is None else c.status
+            reason = "" if c is None else c.reason.replace("|", "/")
+            rows.append(f"| {p.id} | {p.role} | {status} | {reason} |")
+        if not doc.points:
+            rows.append("| - | - | no points yet | |")
+        self.status_md.content = "\n".join(rows)
+        self._update_gizmo()
+
+    def on_select(self, point_id: str | None) -> None:
+        """Show the selected point's settings in the widgets."""
+        doc = self._app.state.doc
+        if point_id is None or point_id not in doc.ids:
+            return
+        p = doc.get(point_id)
+        s = p.probe.search
+        with self._programmatic():
+            self.selected.value = point_id
+            if p.role in self.role.options:
+                self.role.value = p.role
+            self.kind.value = s.kind
+            self.start_mm.value = round(s.start_offset_m * 1000.0, 3)
+            self.over_mm.value = round(s.overtravel_m * 1000.0, 3)
+            if s.edge_direction is not None:
+                self.edge_dir.value = tuple(round(v, 4) for v in s.edge_direction)
+
+    def _update_gizmo(self) -> None:
+        sel = self._app.selected
+        doc = self._app.state.doc
+        scene = self._app.server.scene
+        if not self.drag.value or sel is None or sel not in doc.ids:
+            if self._gizmo is not None:
+                self._gizmo.remove()
+                self._gizmo = None
+            return
+        pos = np.asarray(doc.get(sel).probe.position_m)
+        if self._gizmo is None:
+            self._gizmo = scene.add_transform_controls(
+                "/wobj/gizmo", scale=0.15, disable_rotations=True, position=pos
+            )
+            self._gizmo.on_update(self._on_gizmo)
+        else:
+            self._gizmo.position = pos
+
+    # ---- callbacks -------------------------------------------------------------------------
+    def _on_selected(self, event: Any) -> None:
+        if self._is_programmatic():
+            return
+        value = str(self.selected.value)
+        self._guard(event, self._app.select, None if value == NONE else value)
+
+    def _on_apply(self, event: Any) -> None:
+        sel = self._app.selected
+        if sel is None:
+            self._app.notify("Not done", "select a point first", client=event.client)
+            return
+
+        def edit(doc: plan_doc.UiPlan) -> plan_doc.UiPlan:
+            return plan_doc.edit_search(
+                doc,
+                sel,
+                kind=str(self.kind.value),
+                start_offset_m=float(self.start_mm.value) / 1000.0,
+                overtravel_m=float(self.over_mm.value) / 1000.0,
+                edge_direction=self.edge_dir.value if self.kind.value == "edge" else None,
+                role=str(self.role.value),
+            )
+
+        self._guard(event, self._app.state.update, edit, f"edit {sel}")
+
+    def _on_delete(self, event: Any) -> None:
+        sel = self._app.selected
+        if sel is None:
+            self._app.notify("Not done", "select a point first", client=event.client)
+            return
+        self._guard(
+            event, self._app.state.update, lambda d: plan_doc.delete_point(d, sel), f"delete {sel}"
+        )
+
+    def _on_gizmo(self, event: Any) -> None:
+        if event.phase != "end" or self._app.selected is None:
+            return
+        pos = np.asarray(event.target.position, dtype=np.float64)
+        self._guard(event, self._app.move_point_to, self._app.selected, pos)
+
+    def _on_play(self, event: Any) -> None:
+        sel = self._app.selected
+        check = None if sel is None else self._app.check_of(sel)
+        robot = self._app.robot
+        if check is None or check.q_path is None or robot is None:
+            why = "select a point whose search path was computed" if robot else "no robot loaded"
+            self._app.notify("Nothing to play", why, client=event.client)
+            return
+        robot.play(check.q_path)
+
+    def _on_heat(self, event: Any) -> None:
+        if self._is_programmatic():
+            return
+        if not self.heat.value:
+            self._app.scene.show_heat_map(None)
+            return
+        self._guard(event, self._app.show_reachability)

@@ -1,0 +1,172 @@
+"""Drawing the cell in viser: work object, frames, probe points, approach arrows, search paths.
+
+Everything is drawn on the server-wide scene so that every browser tab sees the same plan.
+Points live under the ``/wobj`` node (posed at ``T_world_wobj``), so their coordinates are the
+plan's wobj-frame coordinates. Colours follow the feasibility status.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+import trimesh
+import viser
+from numpy.typing import ArrayLike, NDArray
+
+from calib.frames import quat_wxyz_from_matrix
+from calib.probing import SearchCommand
+from webui.plan_doc import UiPlan, UiPoint
+from webui.status import PointCheck
+
+#: RGB colour of each feasibility status (``pending``: being computed; ``unknown``: no cell).
+STATUS_RGB: dict[str, tuple[int, int, int]] = {
+    "feasible": (40, 170, 60),
+    "marginal": (240, 165, 0),
+    "infeasible": (215, 40, 40),
+    "pending": (150, 150, 150),
+    "unknown": (110, 110, 140),
+}
+WOBJ_RGB = (170, 185, 200)
+SELECTED_RGB = (60, 120, 255)
+MARKER_RADIUS_M = 0.008
+
+
+def pose_kwargs(T: ArrayLike) -> dict[str, Any]:
+    """viser ``wxyz``/``position`` keyword arguments of a 4x4 transform."""
+    T_arr = np.asarray(T, dtype=np.float64)
+    return {"wxyz": quat_wxyz_from_matrix(T_arr[:3, :3]), "position": T_arr[:3, 3].copy()}
+
+
+def search_segment_wobj(point: UiPoint) -> NDArray[np.float64]:
+    """``(2, 3)`` start and end of the point's search (sensor TCP), wobj frame, metres."""
+    cmd = SearchCommand.from_point(point.probe, np.eye(4))
+    return np.stack([cmd.start_m, cmd.start_m + cmd.length_m * cmd.direction])
+
+
+class PlanScene:
+    """The server-wide 3D scene of one session.
+
+    Args:
+        server: the viser server (its scene is shared by all clients).
+    """
+
+    def __init__(self, server: viser.ViserServer) -> None:
+        self._server = server
+        self._scene = server.scene
+        self.wobj_mesh_handle: viser.MeshHandle | None = None
+        self._point_nodes: dict[str, list[Any]] = {}
+        self._heat: Any = None
+
+    def draw_work_object(self, mesh: trimesh.Trimesh, T_world_wobj: ArrayLike) -> viser.MeshHandle:
+        """Draw the work object (wobj frame mesh) and the nominal WOCS axes at ``T_world_wobj``."""
+        self._scene.add_frame(
+            "/wobj", axes_length=0.12, axes_radius=0.004, **pose_kwargs(T_world_wobj)
+        )
+        self.wobj_mesh_handle = self._scene.add_mesh_simple(
+            "/wobj/mesh",
+            np.asarray(mesh.vertices, dtype=np.float32),
+            np.asarray(mesh.faces, dtype=np.uint32),
+            color=WOBJ_RGB,
+            flat_shading=True,
+        )
+        self._scene.add_label("/wobj/name", "WOCS (nominal)", position=(0.0, 0.0, 0.03))
+        return self.wobj_mesh_handle
+
+    def draw_fixtures(self, fixtures: Mapping[str, tuple[trimesh.Trimesh, ArrayLike]]) -> None:
+        """Draw fixed obstacles ``{name: (mesh, T_world_fixture)}``."""
+        for name, (mesh, T) in fixtures.items():
+            self._scene.add_mesh_simple(
+                f"/fixtures/{name}",
+                np.asarray(mesh.vertices, dtype=np.float32),
+                np.asarray(mesh.faces, dtype=np.uint32),
+                color=(120, 110, 100),
+                **pose_kwargs(T),
+            )
+
+    def draw_calibrated_frame(self, T_world_wobj: ArrayLike | None) -> None:
+        """Show (or with ``None`` hide) the calibrated WOCS frame."""
+        if T_world_wobj is None:
+            self._scene.remove_by_name("/wobj_calibrated")
+            return
+        self._scene.add_frame(
+            "/wobj_calibrated", axes_length=0.15, axes_radius=0.003, **pose_kwargs(T_world_wobj)
+        )
+        self._scene.add_label("/wobj_calibrated/name", "WOCS (calibrated)")
+
+    def draw_points(
+        self, plan: UiPlan, checks: Mapping[str, PointCheck], selected: str | None = None
+    ) -> None:
+        """Draw all points of ``plan``, coloured by their check; remove points that are gone."""
+        for pid in set(self._point_nodes) - set(plan.ids):
+            self._remove_point(pid)
+        with self._server.atomic():
+            for point in plan.points:
+                self.draw_point(point, checks.get(point.id), selected == point.id)
+
+    def draw_point(self, point: UiPoint, check: PointCheck | None, selected: bool = False) -> None:
+        """Draw (or redraw) one point: marker, label, approach arrow and search path."""
+        status = "pending" if check is None else check.status
+        rgb = STATUS_RGB.get(status, STATUS_RGB["unknown"])
+        p = np.asarray(point.probe.position_m, dtype=np.float64)
+        n = np.asarray(point.probe.normal, dtype=np.float64)
+        base = f"/wobj/points/{point.id}"
+        seg = search_segment_wobj(point)
+        approach_len = max(point.probe.search.start_offset_m, 0.02)
+        tail = p + n * (approach_len + 0.01)
+        nodes = [
+            self._scene.add_icosphere(
+                f"{base}/marker",
+                radius=MARKER_RADIUS_M * (1.5 if selected else 1.0),
+                color=SELECTED_RGB if selected else rgb,
+                subdivisions=2,
+                position=p,
+            ),
+            self._scene.add_label(f"{base}/label", f"{point.id} ({status})", position=p + 0.02 * n),
+            self._scene.add_arrows(
+                f"{base}/approach",
+                points=np.stack([tail, p + n * 0.004])[None, :, :],
+                colors=rgb,
+                shaft_radius=0.002,
+                head_radius=0.005,
+                head_length=0.01,
+            ),
+            self._scene.add_line_segments(
+                f"{base}/search",
+                points=seg[None, :, :],
+                colors=rgb,
+                thickness=3.0,
+                thickness_units="screen",
+            ),
+        ]
+        self._point_nodes[point.id] = nodes
+
+    def _remove_point(self, point_id: str) -> None:
+        self._scene.remove_by_name(f"/wobj/points/{point_id}")
+        self._point_nodes.pop(point_id, None)
+
+    def show_heat_map(self, points_wobj: ArrayLike | None, rgb: ArrayLike | None = None) -> None:
+        """Show reachability samples on the work object as coloured dots, or hide them (None)."""
+        if points_wobj is None or rgb is None:
+            self._scene.remove_by_name("/wobj/heat")
+            self._heat = None
+            return
+        self._heat = self._scene.add_point_cloud(
+            "/wobj/heat",
+            points=np.asarray(points_wobj, dtype=np.float32),
+            colors=np.asarray(rgb, dtype=np.uint8),
+            point_size=0.006,
+            point_shape="circle",
+        )
+
+
+def heat_rgb(score: ArrayLike) -> NDArray[np.uint8]:
+    """Colours of scores in [0, 1]: red (0, unreachable) through amber to green (1)."""
+    s = np.clip(np.asarray(score, dtype=np.float64), 0.0, 1.0)[:, None]
+    red = np.array(STATUS_RGB["infeasible"], float)
+    amber = np.array(STATUS_RGB["marginal"], float)
+    green = np.array(STATUS_RGB["feasible"], float)
+    low = red + (amber - red) * np.clip(2 * s, 0, 1)
+    out = np.where(s < 0.5, low, amber + (green - amber) * np.clip(2 * s - 1, 0, 1))
+    return out.round().astype(np.uint8)

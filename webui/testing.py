@@ -1,0 +1,112 @@
+"""Helpers for tests and benchmarks of the UI: a small box plan, free ports, screen projection."""
+
+from __future__ import annotations
+
+import socket
+from pathlib import Path
+
+import numpy as np
+import trimesh
+from numpy.typing import ArrayLike, NDArray
+
+from calib.frames import (
+    make_transform,
+    matrix_from_quat_wxyz,
+    matrix_from_rotvec,
+    quat_wxyz_from_matrix,
+)
+from calib.plan import (
+    CellSpec,
+    Plan,
+    PlanPoint,
+    Pose,
+    RobotSpec,
+    WorkObjectSpec,
+    file_sha256,
+    save_plan,
+)
+from calib.plan_procedures import ThreeTwoOne
+from calib.probing import ProbePoint
+
+#: Size of the test box, metres (x, y, z); its top face is z = 0 and it lies in z < 0.
+BOX_EXTENTS = (0.6, 0.4, 0.3)
+#: Pose of the box's wobj frame in the world: in front of the robot, turned 90 deg about z.
+T_WORLD_WOBJ_BOX = make_transform(matrix_from_rotvec([0.0, 0.0, np.pi / 2]), [1.5, 0.2, 0.8])
+
+
+def box_mesh(subdivisions: int = 0) -> trimesh.Trimesh:
+    """The test box in its wobj frame, optionally subdivided (each step x4 triangles)."""
+    mesh = trimesh.creation.box(extents=BOX_EXTENTS)
+    mesh.apply_translation((0.0, 0.0, -BOX_EXTENTS[2] / 2))
+    for _ in range(subdivisions):
+        mesh = mesh.subdivide()
+    return mesh
+
+
+def box_plan(folder: Path, subdivisions: int = 0, name: str = "box_plan") -> Path:
+    """Write a 3-2-1 plan on the test box (mesh in metres) into ``folder``; return its path."""
+    folder.mkdir(parents=True, exist_ok=True)
+    mesh_path = folder / f"box_{subdivisions}.stl"
+    box_mesh(subdivisions).export(mesh_path)
+    hx, hy = BOX_EXTENTS[0] / 2, BOX_EXTENTS[1] / 2
+    spots = [
+        ("P1", "primary", (-0.2, -0.1, 0.0), (0, 0, 1)),
+        ("P2", "primary", (0.2, -0.1, 0.0), (0, 0, 1)),
+        ("P3", "primary", (0.0, 0.12, 0.0), (0, 0, 1)),
+        ("S1", "secondary", (-0.2, -hy, -0.1), (0, -1, 0)),
+        ("S2", "secondary", (0.2, -hy, -0.1), (0, -1, 0)),
+        ("T1", "tertiary", (hx, 0.0, -0.1), (1, 0, 0)),
+    ]
+    points = [
+        PlanPoint.from_probe_point(ProbePoint(pid, pos, nrm), role) for pid, role, pos, nrm in spots
+    ]
+    q = quat_wxyz_from_matrix(T_WORLD_WOBJ_BOX[:3, :3])
+    plan = Plan(
+        name=name,
+        cell=CellSpec(robot=RobotSpec(urdf="builtin:irb4400")),
+        work_object=WorkObjectSpec(
+            mesh=mesh_path.name,
+            units="m",
+            sha256=file_sha256(mesh_path),
+            T_world_wobj=Pose(
+                position_m=tuple(float(v) for v in T_WORLD_WOBJ_BOX[:3, 3]),  # type: ignore[arg-type]
+                quat_wxyz=tuple(float(v) for v in q),  # type: ignore[arg-type]
+            ),
+        ),
+        points=points,
+        procedure=ThreeTwoOne(),
+    )
+    return save_plan(plan, folder / f"{name}.json")
+
+
+def free_port() -> int:
+    """A TCP port on 127.0.0.1 that is free right now."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def project_to_screen(
+    p_world: ArrayLike,
+    position: ArrayLike,
+    wxyz: ArrayLike,
+    fov_rad: float,
+    width_px: int,
+    height_px: int,
+) -> NDArray[np.float64]:
+    """Pixel ``(u, v)`` of a world point in a viser camera (OpenCV axes: x right, y down, z fwd).
+
+    Args:
+        p_world: ``(3,)`` the point, world frame.
+        position: ``(3,)`` camera position, world frame.
+        wxyz: camera orientation ``R_world_camera`` as a (w, x, y, z) quaternion.
+        fov_rad: vertical field of view, radians.
+        width_px: canvas width, pixels.
+        height_px: canvas height, pixels.
+    """
+    R = matrix_from_quat_wxyz(wxyz)
+    pc = R.T @ (np.asarray(p_world, float) - np.asarray(position, float))
+    if pc[2] <= 0:
+        raise ValueError("the point is behind the camera")
+    f = (height_px / 2.0) / np.tan(fov_rad / 2.0)
+    return np.array([width_px / 2.0 + f * pc[0] / pc[2], height_px / 2.0 + f * pc[1] / pc[2]])

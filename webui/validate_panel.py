@@ -1,0 +1,134 @@
+"""The "Validate" panel: Monte Carlo validation with a progress bar, Table-1 and histograms.
+
+Validation runs on its own thread (:class:`webui.worker.CellWorker` without a shared resource),
+not on the cell worker: point checks from any tab stay fast while it runs. Whatever simulator
+state ``planner.montecarlo`` needs it builds itself, inside that thread.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from calib.errors import InputError
+from webui import validation
+from webui.backend import NotAvailableError
+from webui.plan_adapter import plan_from_ui
+from webui.worker import CellWorker
+
+if TYPE_CHECKING:
+    from webui.app import WobjcalApp
+
+logger = logging.getLogger(__name__)
+
+
+class ValidatePanel:
+    """GUI widgets of the validation, shared by all tabs.
+
+    Args:
+        app: the app whose plan is validated.
+    """
+
+    def __init__(self, app: WobjcalApp) -> None:
+        self._app = app
+        self._worker: CellWorker[None] = CellWorker(None, name="wobjcal-validate")
+        self._running = threading.Event()
+        self.last_report: Any = None
+        self.last_markdown = ""
+        gui = app.server.gui
+        self._folder = gui.add_folder("Validate", expand_by_default=True)
+        with self._folder:
+            self.trials = gui.add_number("Trials", 200, min=10, max=100000, step=10)
+            self.button = gui.add_button("Validate plan", color="blue")
+            self.progress = gui.add_progress_bar(0.0, visible=False, animated=True)
+            self.result_md = gui.add_markdown("")
+            self.plots: list[Any] = []
+        self.button.on_click(self._on_click)
+
+    def _on_click(self, event: Any) -> None:
+        client = getattr(event, "client", None)
+        try:
+            self.start(int(self.trials.value))
+        except (InputError, NotAvailableError) as exc:
+            self._app.notify("Validation not started", str(exc), client=client)
+
+    def start(self, trials: int) -> Any:
+        """Start a validation of the session plan; return a future of the report.
+
+        Raises:
+            InputError: a validation is already running, or the plan is incomplete.
+            NotAvailableError: ``planner.montecarlo`` is not available.
+        """
+        if self._running.is_set():
+            raise InputError("a validation is already running")
+        validation.check_available()
+        plan = plan_from_ui(self._app.state.doc)
+        plan_dir = self._app.plan_dir
+        self._running.set()
+        self.button.disabled = True
+        self.progress.value = 0.0
+        self.progress.visible = True
+        self.result_md.content = f"Running {trials} trials..."
+        last = [0.0]
+
+        def progress(done: int, total: int) -> None:
+            now = time.monotonic()
+            if now - last[0] > 0.1 or done == total:  # at most 10 updates a second
+                last[0] = now
+                self.progress.value = 100.0 * done / max(total, 1)
+
+        def job(_res: None) -> Any:
+            return validation.run_validation(plan, plan_dir, trials, progress)
+
+        fut = self._worker.submit(job)
+        fut.add_done_callback(self._done)
+        return fut
+
+    def _done(self, fut: Any) -> None:
+        self._running.clear()
+        self.button.disabled = False
+        self.progress.visible = False
+        try:
+            summary = fut.result()
+        except Exception as exc:
+            logger.exception("validation failed")
+            self.result_md.content = f"**Validation failed:** {exc}"
+            self._app.notify("Validation failed", str(exc))
+            return
+        self.last_report = summary.report
+        self.last_markdown = summary.markdown
+        self.result_md.content = summary.markdown
+        for plot in self.plots:
+            plot.remove()
+        self.plots = []
+        gui = self._app.server.gui
+        for title, edges, counts in summary.histograms:
+            with self._folder:
+                self._add_plot(gui, title, edges, counts)
+        if summary.T_world_wobj_example is not None:
+            self._app.scene.draw_calibrated_frame(summary.T_world_wobj_example)
+        self._app.notify("Validation done", summary.headline, error=False)
+
+    def _add_plot(self, gui: Any, title: str, edges: Any, counts: Any) -> None:
+        centers = 0.5 * (np.asarray(edges[:-1], float) + np.asarray(edges[1:], float))
+        self.plots.append(
+            gui.add_uplot(
+                data=(centers, np.asarray(counts, dtype=np.float64)),
+                series=({"label": "error (mm)"}, {"label": "trials", "stroke": "steelblue"}),
+                title=title,
+                aspect=2.0,
+            )
+        )
+
+    @property
+    def running(self) -> bool:
+        """True while a validation runs."""
+        return self._running.is_set()
+
+    def close(self) -> None:
+        """Stop the validation thread (after a running validation)."""
+        self._worker.close(timeout=1.0)
