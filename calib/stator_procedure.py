@@ -1,0 +1,367 @@
+"""The paper's A-H calibration procedure for the UU WEC stator section (section 3.2).
+
+The procedure never moves anything. It builds each search with
+:meth:`calib.probing.SearchCommand.from_point` in the WOCS estimated so far, asks the
+``probe`` callback for the result, and updates the estimate with the equations of
+:mod:`calib.hultman`, in the paper's order:
+
+1. A, B measured in the preliminary WOCS; alpha1 and P3 (eq. 11-12); rotation from A, B, P3
+   (eq. 1-9).
+2. B as P4 adjusts the x origin (eq. 10).
+3. C (short side) as P5 adjusts the y origin.
+4. D, E over a tooth; rotation from ``V1 = B - A`` and ``V2 = D - E`` (eq. 2-9), which turns
+   the WOCS about its y and z axes onto the side face.
+5. E adjusts the x origin (the paper writes "P5_W", but says it fixes the x origin: E is used
+   as P4, the x point of eq. 10).
+6. F (edge search up the side face), G, then H (edge search started from G); final rotation
+   from H = P1, F = P2, D = P3 with V2 inverted (eq. 1-9).
+7. H as P6 adjusts the z origin.
+8. C retaken (``"C2"``) as P5 adjusts y; 9. D retaken (``"D2"``) as P4 adjusts x.
+
+Errors: a failed probe raises :class:`calib.errors.ProbeFailedError` with the measurement's
+key (``"A"``... ``"H"``, ``"C2"``, ``"D2"``) and the probe's reason; bad layouts raise
+:class:`calib.errors.InputError` subclasses before any probe is called. Edge probes must
+return the edge point on the face (the sensor TCP at its sensing distance when the face ends);
+a point left off the face by ``d`` tilts the final WOCS by about ``d / |F - D|``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from types import MappingProxyType
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from calib.errors import DegenerateGeometryError, ProbeFailedError, ShapeError
+from calib.frames import check_transform
+from calib.hultman import (  # the unchecked kernels: inputs are checked here, once
+    _rotation_from_points,
+    _rotation_from_vectors,
+    _shift_origin,
+    alpha1_from_points,
+    p3_estimate,
+)
+from calib.probing import Probe, ProbePoint, ProbeResult, SearchCommand, SearchSpec
+from calib.validation import check_vector3
+
+FloatArray = NDArray[np.float64]
+
+STATOR_POINT_IDS = ("A", "B", "C", "D", "E", "F", "G", "H")
+#: Nominal layout tolerance (metres, and unit-vector components).
+LAYOUT_TOL = 1e-6
+
+_X, _Y, _Z = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
+
+
+@dataclass(frozen=True)
+class StatorSettings:
+    """Settings of the A-H procedure.
+
+    Attributes:
+        beta1_rad: assumed inclination of the stator side in the base frame (eq. 12), radians
+            (paper: 15 deg; positive when the face's top leans towards base +x).
+        p3_height_m: height of the constructed point P3 above B (eq. 12), metres (paper: 50 mm).
+        retake_c_d: measure C and D again at the end, as the paper does (``"C2"``, ``"D2"``);
+            when False the first C and D are reused for the final origin.
+    """
+
+    beta1_rad: float = math.radians(15.0)
+    p3_height_m: float = 0.050
+    retake_c_d: bool = True
+
+
+@dataclass(frozen=True)
+class StatorLayout:
+    """A validated A-H layout (build it once with :func:`check_stator_points`, reuse it).
+
+    Attributes:
+        points: the nominal probe points ``"A"`` ... ``"H"``, wobj frame.
+        face_coords_wobj: ``(3,)`` x of the side face, y of the short side, z of the top side
+            in the nominal WOCS, metres (all 0 for the paper's WOCS at the corner).
+    """
+
+    points: Mapping[str, ProbePoint]
+    face_coords_wobj: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class ProcedureStep:
+    """One update of the WOCS estimate.
+
+    Attributes:
+        name: what the step does, e.g. ``"x origin from B (P4)"``.
+        point_ids: measurement keys the step uses, e.g. ``("A", "B")``.
+        equations: the paper's equations applied, e.g. ``"eq. 10"``.
+        T_base_wobj: ``(4, 4)`` the estimate after the step, base frame, metres.
+    """
+
+    name: str
+    point_ids: tuple[str, ...]
+    equations: str
+    T_base_wobj: FloatArray
+
+
+@dataclass(frozen=True)
+class ProcedureResult:
+    """The outcome of a complete A-H procedure.
+
+    Attributes:
+        T_base_wobj: ``(4, 4)`` the calibrated work-object frame.
+        steps: the estimate after each step, in order (the first is the preliminary frame).
+        measured_m: measured point per key (``"A"`` ... ``"H"``, retakes ``"C2"``, ``"D2"``),
+            each ``(3,)``, base frame, metres.
+        commands: the search command sent for each key, base frame.
+        n_probes: number of probe calls.
+        alpha1_rad: alpha1 of eq. 11, radians.
+        p3_m: ``(3,)`` the constructed P3 of eq. 12, base frame, metres.
+    """
+
+    T_base_wobj: FloatArray
+    steps: tuple[ProcedureStep, ...]
+    measured_m: Mapping[str, FloatArray]
+    commands: Mapping[str, SearchCommand]
+    n_probes: int
+    alpha1_rad: float
+    p3_m: FloatArray = field(repr=False)
+
+
+def _same(a: Sequence[float] | None, b: Sequence[float]) -> bool:
+    return a is not None and bool(np.allclose(a, b, atol=LAYOUT_TOL, rtol=0.0))
+
+
+def check_stator_points(
+    points: Mapping[str, ProbePoint] | Sequence[ProbePoint] | StatorLayout,
+) -> StatorLayout:
+    """Validate the nominal A-H layout against what the paper's equations assume.
+
+    A, B, D, E, G are approach points on the side face (normal +x); F and H are edge searches
+    up (+z) that face to the top side; C is an approach point on the short side (normal +y).
+    All side-face points share one x, F and H one z; A and B share z with A at smaller y;
+    E lies below D, D below F, and H at smaller y than F. Extra points are ignored.
+
+    Raises:
+        ShapeError: a point is missing or of the wrong kind.
+        DegenerateGeometryError: the layout breaks one of the conditions above.
+    """
+    if isinstance(points, StatorLayout):
+        return points
+    by_id = dict(points) if isinstance(points, Mapping) else {p.id: p for p in points}
+    missing = [i for i in STATOR_POINT_IDS if i not in by_id]
+    if missing:
+        raise ShapeError(f"stator points are missing {', '.join(missing)} (need A-H)")
+    pts = {i: by_id[i] for i in STATOR_POINT_IDS}
+    for pid in STATOR_POINT_IDS:
+        p = pts[pid]
+        want_edge = pid in ("F", "H")
+        if (p.search.kind == "edge") != want_edge:
+            kind = "an edge search" if want_edge else "an approach search"
+            raise ShapeError(f"point {pid} must be {kind}, got {p.search.kind!r}")
+        want_normal = _Y if pid == "C" else _X
+        if not _same(p.normal, want_normal):
+            raise DegenerateGeometryError(
+                f"point {pid} must have normal {want_normal} (wobj frame), got {p.normal}"
+            )
+        if want_edge and not (
+            _same(p.search.edge_direction, _Z) and _same(p.edge_normal or (0, 0, 0), _Z)
+        ):
+            raise DegenerateGeometryError(
+                f"point {pid} must search up the side face: edge_direction and edge_normal "
+                f"(0, 0, 1), got {p.search.edge_direction} and {p.edge_normal}"
+            )
+    pos = {i: np.asarray(p.position_m, dtype=np.float64) for i, p in pts.items()}
+    x_face, y_face, z_top = float(pos["A"][0]), float(pos["C"][1]), float(pos["F"][2])
+    conditions = [
+        (all(abs(pos[i][0] - x_face) <= LAYOUT_TOL for i in "ABDEFGH"), "A, B, D-H share x"),
+        (abs(pos["H"][2] - z_top) <= LAYOUT_TOL, "F and H share z (the top edge)"),
+        (abs(pos["A"][2] - pos["B"][2]) <= LAYOUT_TOL, "A and B share z (A -> B along +y)"),
+        (pos["B"][1] > pos["A"][1] + LAYOUT_TOL, "A lies at smaller y than B"),
+        (pos["D"][2] > pos["E"][2] + LAYOUT_TOL, "E lies below D (D - E along +z)"),
+        (pos["F"][2] > pos["D"][2] + LAYOUT_TOL, "D lies below the edge point F"),
+        (pos["F"][1] > pos["H"][1] + LAYOUT_TOL, "H lies at smaller y than F"),
+    ]
+    for ok, what in conditions:
+        if not ok:
+            raise DegenerateGeometryError(f"stator layout: the A-H procedure needs that {what}")
+    return StatorLayout(MappingProxyType(pts), (x_face, y_face, z_top))
+
+
+def probe_from_measurements(measured_m: Mapping[str, ArrayLike]) -> Probe:
+    """A probe that replays measured points (base frame, metres) by measurement key.
+
+    Use it to compute the calibration from points measured on a real robot: the keys are the
+    measurement keys of the procedure (``"A"`` ... ``"H"``, ``"C2"``, ``"D2"``).
+    """
+    table = {k: check_vector3(v, f"measured_m[{k!r}]") for k, v in measured_m.items()}
+
+    def probe(command: SearchCommand) -> ProbeResult:
+        point = table.get(command.point_id)
+        if point is None:
+            return ProbeResult(None, f"no measurement for {command.point_id!r}")
+        return ProbeResult(point.copy(), travel_m=float("nan"))
+
+    return probe
+
+
+class _Run:
+    """State of one run: the estimate, the measurements and the steps so far."""
+
+    def __init__(self, layout: StatorLayout, T: FloatArray, probe: Probe) -> None:
+        self.layout = layout
+        self.T = T
+        self.probe = probe
+        self.measured: dict[str, FloatArray] = {}
+        self.commands: dict[str, SearchCommand] = {}
+        self.steps: list[ProcedureStep] = [ProcedureStep("preliminary WOCS", (), "", T)]
+
+    def measure(self, point_id: str, key: str | None = None) -> FloatArray:
+        key = point_id if key is None else key
+        point = self.layout.points[point_id]
+        if key != point_id:
+            point = ProbePoint(key, point.position_m, point.normal, point.search, point.edge_normal)
+        command = SearchCommand.from_point(point, self.T)
+        self.commands[key] = command
+        result = self.probe(command)
+        if not result.ok:
+            raise ProbeFailedError(key, result.reason or "the probe gave no reason")
+        p = check_vector3(result.point_m, f"probe result for point {key}")
+        self.measured[key] = p
+        return p
+
+    def step(self, T: FloatArray, name: str, ids: tuple[str, ...], equations: str) -> None:
+        self.T = T
+        self.steps.append(ProcedureStep(name, ids, equations, T))
+
+    def origin(self, axis: int, key: str, name: str) -> None:
+        face = self.layout.face_coords_wobj[axis]
+        T = _shift_origin(self.T, axis, self.measured[key], face)
+        self.step(T, name, (key,), "eq. 10")
+
+    def rotate(self, R: FloatArray, name: str, ids: tuple[str, ...], equations: str) -> None:
+        T = self.T.copy()
+        T[:3, :3] = R
+        self.step(T, name, ids, equations)
+
+
+def run_stator_procedure(
+    points: Mapping[str, ProbePoint] | Sequence[ProbePoint] | StatorLayout,
+    T_base_wobj_prelim: ArrayLike,
+    probe: Probe | Callable[[SearchCommand], ProbeResult],
+    settings: StatorSettings | None = None,
+) -> ProcedureResult:
+    """Run the paper's A-H procedure (section 3.2) with ``probe`` and return the calibrated WOCS.
+
+    Args:
+        points: the nominal probe points A-H (wobj frame), or a layout from
+            :func:`check_stator_points` (validated once; pass it when running many times).
+        T_base_wobj_prelim: ``(4, 4)`` the preliminary ``T_base_wobj`` the first searches are
+            commanded in.
+        probe: runs one search and returns its result.
+        settings: beta1, P3 height and whether C and D are retaken; paper values by default.
+
+    Returns:
+        The final frame, the estimate after every step, all measured points and commands.
+
+    Raises:
+        ProbeFailedError: a probe returned no point (``point_id`` is the measurement key).
+        InputError: bad layout, frame or settings; a probe result that is not a finite
+            ``(3,)`` point; measured points that define no frame (DegenerateGeometryError).
+    """
+    layout = check_stator_points(points)
+    cfg = StatorSettings() if settings is None else settings
+    T0 = check_transform(T_base_wobj_prelim, "T_base_wobj_prelim")
+    if T0.shape != (4, 4):
+        raise ShapeError(f"T_base_wobj_prelim must be (4, 4), got {T0.shape}")
+    run = _Run(layout, T0, probe)
+
+    a, b = run.measure("A"), run.measure("B")
+    alpha1 = alpha1_from_points(a, b)
+    p3 = p3_estimate(a, b, cfg.beta1_rad, cfg.p3_height_m)
+    R1 = _rotation_from_points(a, b, p3, False, ("A", "B", "P3"))
+    run.rotate(R1, "preliminary rotation from A, B, P3", ("A", "B"), "eq. 1-9, 11-12")
+    run.origin(0, "B", "x origin from B (P4)")
+
+    run.measure("C")
+    run.origin(1, "C", "y origin from C (P5)")
+
+    d, e = run.measure("D"), run.measure("E")
+    R2 = _rotation_from_vectors(b - a, d - e, ("V1 = B - A", "V2 = D - E"))
+    run.rotate(R2, "rotation about y and z from A, B, D, E", ("A", "B", "D", "E"), "eq. 2-9")
+    run.origin(0, "E", "x origin from E (P4; the paper's 'P5_W')")
+
+    f = run.measure("F")
+    run.measure("G")
+    h = run.measure("H")
+    R3 = _rotation_from_points(h, f, d, True, ("H", "F", "D"))
+    run.rotate(R3, "final rotation from H, F, D (V2 inverted)", ("H", "F", "D"), "eq. 1-9")
+    run.origin(2, "H", "z origin from H (P6)")
+
+    c_key, d_key = ("C2", "D2") if cfg.retake_c_d else ("C", "D")
+    if cfg.retake_c_d:
+        run.measure("C", "C2")
+    run.origin(1, c_key, f"y origin from {c_key} (P5)")
+    if cfg.retake_c_d:
+        run.measure("D", "D2")
+    run.origin(0, d_key, f"x origin from {d_key} (P4)")
+
+    if not np.all(np.isfinite(run.T)):  # cannot happen after the checks above; never silent
+        raise DegenerateGeometryError("the A-H procedure produced a non-finite frame")
+    return ProcedureResult(
+        T_base_wobj=run.T,
+        steps=tuple(run.steps),
+        measured_m=MappingProxyType(run.measured),
+        commands=MappingProxyType(run.commands),
+        n_probes=len(run.commands),
+        alpha1_rad=alpha1,
+        p3_m=p3,
+    )
+
+
+def example_stator_points(
+    *,
+    yoke_z_m: float = -0.25,
+    a_y_m: float = -0.90,
+    b_y_m: float = -0.30,
+    c_x_m: float = -0.04,
+    c_z_m: float = -0.15,
+    tooth_y_m: float = -0.10,
+    d_z_m: float = -0.04,
+    e_z_m: float = -0.15,
+    h_y_m: float = -0.50,
+    g_z_m: float = -0.10,
+    approach: SearchSpec | None = None,
+    edge_overtravel_m: float = 0.050,
+) -> dict[str, ProbePoint]:
+    """A nominal A-H layout in the paper's stator WOCS (origin at the top corner of the side
+    face at the short side), after Fig. 8a; all positions wobj frame, metres.
+
+    A and B lie on the yoke at ``yoke_z_m``; C on the short side (``y = 0``); D and E over the
+    tooth at ``tooth_y_m``; F is the edge search up that tooth, starting at E's height (the
+    paper starts it "from point E"); G lies at ``h_y_m`` and H is the edge search up from G.
+
+    Args:
+        approach: search of the approach points; default 80 mm start, 80 mm overtravel, which
+            covers the paper's misplacement (20 mm and 3 deg over a 1 m section).
+        edge_overtravel_m: how far past the nominal top edge F and H may search, metres.
+    """
+    spec = approach or SearchSpec(kind="approach", start_offset_m=0.080, overtravel_m=0.080)
+
+    def side(pid: str, y: float, z: float) -> ProbePoint:
+        return ProbePoint(pid, (0.0, y, z), _X, spec)
+
+    def edge(pid: str, y: float, start_z: float) -> ProbePoint:
+        search = SearchSpec("edge", -start_z, edge_overtravel_m, _Z)
+        return ProbePoint(pid, (0.0, y, 0.0), _X, search, edge_normal=_Z)
+
+    return {
+        "A": side("A", a_y_m, yoke_z_m),
+        "B": side("B", b_y_m, yoke_z_m),
+        "C": ProbePoint("C", (c_x_m, 0.0, c_z_m), _Y, spec),
+        "D": side("D", tooth_y_m, d_z_m),
+        "E": side("E", tooth_y_m, e_z_m),
+        "F": edge("F", tooth_y_m, e_z_m),
+        "G": side("G", h_y_m, g_z_m),
+        "H": edge("H", h_y_m, g_z_m),
+    }

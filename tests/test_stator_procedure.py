@@ -1,0 +1,276 @@
+"""The paper's A-H procedure against an ideal analytic probe on a randomly posed stator box."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from calib.errors import DegenerateGeometryError, ProbeFailedError, ShapeError
+from calib.frames import (
+    invert_transform,
+    make_transform,
+    matrix_from_rotvec,
+    matrix_from_tait_bryan_zyx,
+    motion_between,
+    random_transform,
+    transform_directions,
+    transform_points,
+)
+from calib.probing import ProbePoint, ProbeResult, SearchCommand, SearchSpec
+from calib.stator_procedure import (
+    StatorSettings,
+    check_stator_points,
+    example_stator_points,
+    probe_from_measurements,
+    run_stator_procedure,
+)
+
+#: The stator-like box in its true WOCS: x in [-0.25, 0], y in [-1.2, 0], z in [-0.40, 0].
+BOX_LO = np.array([-0.25, -1.2, -0.40])
+BOX_HI = np.zeros(3)
+
+
+def slab(start: np.ndarray, direction: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+    """Entry parameter and entry axis of the line ``start + t d`` into the box, or None."""
+    t_in, t_out, axis_in = -np.inf, np.inf, -1
+    for k in range(3):
+        if abs(direction[k]) < 1e-15:
+            if not lo[k] <= start[k] <= hi[k]:
+                return None
+            continue
+        t1, t2 = (lo[k] - start[k]) / direction[k], (hi[k] - start[k]) / direction[k]
+        near, far = min(t1, t2), max(t1, t2)
+        if near > t_in:
+            t_in, axis_in = near, k
+        t_out = min(t_out, far)
+    if t_in > t_out or t_out < 0:
+        return None
+    return t_in, axis_in
+
+
+class BoxProbe:
+    """Ideal noise-free sensor on a box posed at ``T_base_true``.
+
+    Approach: the first point where the commanded line enters the box. Edge: the sensor axis
+    foot on the face it looks at moves with the TCP; the event is where that foot leaves the
+    face (reaches an edge); the foot there is returned, exactly on the edge.
+    """
+
+    def __init__(self, T_base_true: np.ndarray, offset_wobj=(0.0, 0.0, 0.0), fail=()) -> None:
+        self.T_true_base = invert_transform(T_base_true)
+        self.T_base_true = T_base_true
+        self.lo = BOX_LO + np.asarray(offset_wobj)
+        self.hi = BOX_HI + np.asarray(offset_wobj)
+        self.fail = set(fail)
+        self.calls: list[str] = []
+
+    def __call__(self, cmd: SearchCommand) -> ProbeResult:
+        self.calls.append(cmd.point_id)
+        if cmd.point_id in self.fail:
+            return ProbeResult(None, "sensor already detecting at start")
+        s = transform_points(self.T_true_base, cmd.start_m)
+        d = transform_directions(self.T_true_base, cmd.direction)
+        if cmd.kind == "approach":
+            if np.all(s >= self.lo) and np.all(s <= self.hi):
+                return ProbeResult(None, "sensor already detecting at start")
+            hit = slab(s, d, self.lo, self.hi)
+            if hit is None or hit[0] > cmd.length_m:
+                return ProbeResult(None, f"no detection within {cmd.length_m * 1e3:.0f} mm")
+            q, t = s + hit[0] * d, hit[0]
+        else:
+            a = transform_directions(self.T_true_base, cmd.sensor_axis)
+            look = slab(s - 0.05 * a, a, self.lo, self.hi)
+            if look is None:
+                return ProbeResult(None, "no face under the sensor at start")
+            k = look[1]
+            face = (s - 0.05 * a)[k] + look[0] * a[k]
+            q0 = s + (face - s[k]) / a[k] * a
+            w = d - d[k] / a[k] * a
+            ts = [
+                ((self.hi[m] if w[m] > 0 else self.lo[m]) - q0[m]) / w[m]
+                for m in range(3)
+                if m != k and abs(w[m]) > 1e-15
+            ]
+            t = min(ts)
+            if t > cmd.length_m:
+                return ProbeResult(None, "the face did not end within the search")
+            q = q0 + t * w
+        return ProbeResult(transform_points(self.T_base_true, q), travel_m=float(t))
+
+
+def nominal_pose(alpha_rad: float, position_m) -> np.ndarray:
+    """The preliminary WOCS: side face inclined by the paper's beta1 = 15 deg."""
+    return make_transform(
+        matrix_from_tait_bryan_zyx(alpha_rad, math.radians(15.0), 0.0), position_m
+    )
+
+
+def pose_error(T_est: np.ndarray, T_true: np.ndarray) -> tuple[float, float]:
+    """(translation error in m, rotation error in rad) of an estimate against the truth."""
+    delta = motion_between(T_true, T_est)
+    return float(np.linalg.norm(delta[:3])), float(np.linalg.norm(delta[3:]))
+
+
+LAYOUT = check_stator_points(example_stator_points())
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), retake=st.booleans())
+def test_noise_free_random_pose_is_exact(seed: int, retake: bool) -> None:
+    rng = np.random.default_rng(seed)
+    T_prelim = nominal_pose(
+        rng.uniform(-0.15, 0.15), rng.uniform([0.8, -0.5, 0.3], [1.4, 0.5, 1.0])
+    )
+    T_true = T_prelim @ random_transform(rng, 0.020, math.radians(3.0))
+    probe = BoxProbe(T_true)
+    res = run_stator_procedure(LAYOUT, T_prelim, probe, StatorSettings(retake_c_d=retake))
+    dt, dr = pose_error(res.T_base_wobj, T_true)
+    assert dt < 1e-9 and dr < 1e-9
+    assert res.n_probes == (10 if retake else 8) == len(probe.calls)
+
+
+def test_converges_from_worst_misplacement_commanded_in_wrong_frame() -> None:
+    T_prelim = nominal_pose(0.0, (1.1, 0.0, 0.6))
+    axis = np.array([1.0, -1.0, 1.0]) / math.sqrt(3.0)
+    misplace = make_transform(matrix_from_rotvec(axis * math.radians(3.0)), 0.020 * axis)
+    T_true = T_prelim @ misplace
+    res = run_stator_procedure(example_stator_points(), T_prelim, BoxProbe(T_true))
+    # the first searches went where the part is not: A and B land > 10 mm from their nominal
+    for pid in "AB":
+        miss = np.linalg.norm(res.measured_m[pid] - res.commands[pid].nominal_m)
+        assert miss > 0.010
+    start_dt, start_dr = pose_error(T_prelim, T_true)
+    assert start_dt >= 0.019 and start_dr >= math.radians(2.99)
+    errors = [pose_error(step.T_base_wobj, T_true) for step in res.steps]
+    assert errors[-1][0] < 1e-9 and errors[-1][1] < 1e-9
+    # later searches are commanded in the improved estimate: D2 lands on its nominal
+    d2_miss = np.linalg.norm(res.measured_m["D2"] - res.commands["D2"].nominal_m)
+    assert d2_miss < 1e-9
+
+
+def test_steps_follow_the_paper(rng: np.random.Generator) -> None:
+    T_prelim = nominal_pose(0.05, (1.0, 0.2, 0.7))
+    T_true = T_prelim @ random_transform(rng, 0.015, math.radians(2.0))
+    res = run_stator_procedure(LAYOUT, T_prelim, BoxProbe(T_true))
+    assert [s.point_ids for s in res.steps] == [
+        (), ("A", "B"), ("B",), ("C",), ("A", "B", "D", "E"), ("E",), ("H", "F", "D"),
+        ("H",), ("C2",), ("D2",),
+    ]  # fmt: skip
+    assert list(res.measured_m) == ["A", "B", "C", "D", "E", "F", "G", "H", "C2", "D2"]
+    R_true = T_true[:3, :3]
+    # after A, B, D, E the x axis is the side-face normal exactly (all four lie on the face)
+    np.testing.assert_allclose(res.steps[4].T_base_wobj[:3, 0], R_true[:, 0], atol=1e-12)
+    # but y still follows A -> B, which was commanded in the wrong frame (rotation about x)
+    assert np.linalg.norm(res.steps[4].T_base_wobj[:3, 1] - R_true[:, 1]) > 1e-6
+    # the final rotation (H, F, D) is exact before any origin update
+    np.testing.assert_allclose(res.steps[6].T_base_wobj[:3, :3], R_true, atol=1e-12)
+    # each origin step moves the origin along one WOCS axis only
+    for i, axis in ((2, 0), (3, 1), (5, 0), (7, 2), (8, 1), (9, 0)):
+        before, after = res.steps[i - 1].T_base_wobj, res.steps[i].T_base_wobj
+        shift_w = before[:3, :3].T @ (after[:3, 3] - before[:3, 3])
+        assert np.all(np.abs(np.delete(shift_w, axis)) < 1e-12)
+        np.testing.assert_array_equal(after[:3, :3], before[:3, :3])
+    # the edge points lie on the true top edge, x = z = 0 in the true WOCS
+    for pid in "FH":
+        p_true = transform_points(invert_transform(T_true), res.measured_m[pid])
+        assert abs(p_true[0]) < 1e-12 and abs(p_true[2]) < 1e-12
+    # eq. 12's P3 lies 50 mm above B
+    assert res.p3_m[2] - res.measured_m["B"][2] == pytest.approx(0.050)
+
+
+def test_faces_off_the_origin_are_handled() -> None:
+    offset = np.array([-0.010, 0.020, -0.030])  # the WOCS origin is not at the box corner
+    pts = {
+        k: replace(p, position_m=tuple(np.asarray(p.position_m) + offset))
+        for k, p in example_stator_points().items()
+    }
+    T_prelim = nominal_pose(-0.1, (1.2, 0.1, 0.5))
+    T_true = T_prelim @ random_transform(np.random.default_rng(7), 0.02, math.radians(3.0))
+    res = run_stator_procedure(pts, T_prelim, BoxProbe(T_true, offset_wobj=offset))
+    dt, dr = pose_error(res.T_base_wobj, T_true)
+    assert dt < 1e-9 and dr < 1e-9
+
+
+def test_replayed_measurements_give_the_same_frame(rng: np.random.Generator) -> None:
+    T_prelim = nominal_pose(0.0, (1.0, 0.0, 0.5))
+    T_true = T_prelim @ random_transform(rng, 0.02, math.radians(3.0))
+    first = run_stator_procedure(LAYOUT, T_prelim, BoxProbe(T_true))
+    noisy = {k: v + rng.normal(0, 1e-4, 3) for k, v in first.measured_m.items()}
+    again = run_stator_procedure(LAYOUT, T_prelim, probe_from_measurements(noisy))
+    assert set(again.measured_m) == set(noisy)
+    dt, dr = pose_error(again.T_base_wobj, T_true)
+    assert 1e-6 < dt < 0.005 and 1e-6 < dr < math.radians(0.5)  # noise moves it, a little
+
+
+@pytest.mark.parametrize("failing", ["A", "C", "F", "G", "C2", "D2"])
+def test_probe_failure_names_the_point(failing: str) -> None:
+    T = nominal_pose(0.0, (1.0, 0.0, 0.5))
+    probe = BoxProbe(T, fail={failing})
+    with pytest.raises(ProbeFailedError) as info:
+        run_stator_procedure(LAYOUT, T, probe)
+    assert info.value.point_id == failing
+    assert info.value.reason == "sensor already detecting at start"
+    assert probe.calls[-1] == failing
+
+
+def test_search_that_misses_the_part_fails_with_reason() -> None:
+    T_prelim = nominal_pose(0.0, (1.0, 0.0, 0.5))
+    T_true = T_prelim @ make_transform(p=(0.0, 0.0, -0.15))  # part 150 mm lower: D hits air
+    with pytest.raises(ProbeFailedError) as info:
+        run_stator_procedure(LAYOUT, T_prelim, BoxProbe(T_true))
+    assert info.value.point_id == "D" and "no detection" in info.value.reason
+
+
+def test_missing_replayed_measurement_fails() -> None:
+    T = nominal_pose(0.0, (1.0, 0.0, 0.5))
+    full = run_stator_procedure(LAYOUT, T, BoxProbe(T)).measured_m
+    partial = {k: v for k, v in full.items() if k != "D2"}
+    with pytest.raises(ProbeFailedError, match="no measurement for 'D2'"):
+        run_stator_procedure(LAYOUT, T, probe_from_measurements(partial))
+
+
+def test_bad_probe_output_is_an_input_error() -> None:
+    T = nominal_pose(0.0, (1.0, 0.0, 0.5))
+    with pytest.raises(ShapeError, match="probe result for point A"):
+        run_stator_procedure(LAYOUT, T, lambda cmd: ProbeResult(np.zeros(2)))
+
+
+def test_degenerate_measurements_raise() -> None:
+    T = nominal_pose(0.0, (1.0, 0.0, 0.5))
+    with pytest.raises(DegenerateGeometryError, match="A and B coincide"):
+        run_stator_procedure(LAYOUT, T, lambda cmd: ProbeResult(np.ones(3)))
+
+
+def _with(point_id: str, **changes) -> dict[str, ProbePoint]:
+    pts = example_stator_points()
+    pts[point_id] = replace(pts[point_id], **changes)
+    return pts
+
+
+@pytest.mark.parametrize(
+    ("points", "error", "match"),
+    [
+        ({k: v for k, v in example_stator_points().items() if k != "H"}, ShapeError, "missing H"),
+        (_with("C", normal=(1.0, 0.0, 0.0)), DegenerateGeometryError, "point C must have normal"),
+        (_with("E", position_m=(0.0, -0.1, -0.01)), DegenerateGeometryError, "E lies below D"),
+        (_with("B", position_m=(0.0, -0.95, -0.25)), DegenerateGeometryError, "smaller y than B"),
+        (_with("A", position_m=(0.0, -0.9, -0.20)), DegenerateGeometryError, "A and B share z"),
+        (_with("G", position_m=(-0.01, -0.5, -0.1)), DegenerateGeometryError, "share x"),
+        (_with("F", search=SearchSpec()), ShapeError, "F must be an edge search"),
+    ],
+)
+def test_bad_layouts_raise_before_probing(points, error, match) -> None:
+    probe = BoxProbe(np.eye(4))
+    with pytest.raises(error, match=match):
+        run_stator_procedure(points, np.eye(4), probe)
+    assert probe.calls == []
+
+
+def test_bad_preliminary_frame_raises() -> None:
+    with pytest.raises(ShapeError, match="T_base_wobj_prelim"):
+        run_stator_procedure(LAYOUT, np.eye(3), BoxProbe(np.eye(4)))
