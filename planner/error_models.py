@@ -1,0 +1,127 @@
+"""Error models of the simulated cell: robot repeatability and accuracy, part misplacement.
+
+All defaults are justified in ``docs/simulation.md``. Every sampler takes an explicit
+``rng: numpy.random.Generator``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from calib.frames import make_transform, matrix_from_rotvec
+from calib.validation import check_positive, check_vector3
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class AccuracyField:
+    """A smooth absolute-positioning error field of one robot, base frame.
+
+    ``e(p) = sum_k a_k sin(w_k . p + phi_k)``: where the TCP really is minus where the controller
+    believes it is, at commanded position ``p``.
+
+    Attributes:
+        amplitudes_m: ``(K, 3)`` error amplitude of each term, m.
+        wavevectors: ``(K, 3)`` spatial angular frequencies, rad/m.
+        phases: ``(K,)`` phases, rad.
+    """
+
+    amplitudes_m: FloatArray
+    wavevectors: FloatArray
+    phases: FloatArray
+
+    def __call__(self, p_m: ArrayLike) -> FloatArray:
+        """Error ``(..., 3)`` (m) at commanded TCP position(s) ``(..., 3)`` (base, m)."""
+        p = np.asarray(p_m, dtype=np.float64)
+        arg = p @ self.wavevectors.T + self.phases  # (..., K)
+        return np.sin(arg) @ self.amplitudes_m
+
+
+@dataclass(frozen=True)
+class RobotErrorModel:
+    """Robot positioning errors added to every commanded search.
+
+    Attributes:
+        repeatability_sigma_m: 1-sigma per-axis TCP offset, drawn anew for each search (the
+            robot returns to a commanded pose with this scatter), m.
+        accuracy_amplitude_m: RMS size per axis of the smooth absolute-accuracy field, m; 0
+            turns the field off. One field is drawn per validation run (it belongs to the robot,
+            not to the trial).
+        accuracy_wavelength_m: typical wavelength of the accuracy field, m.
+        accuracy_terms: number of sine terms in the field.
+    """
+
+    repeatability_sigma_m: float = 0.00002
+    accuracy_amplitude_m: float = 0.0
+    accuracy_wavelength_m: float = 1.0
+    accuracy_terms: int = 6
+
+    def __post_init__(self) -> None:
+        check_positive(self.repeatability_sigma_m, "robot_error.repeatability_sigma_m", True)
+        check_positive(self.accuracy_amplitude_m, "robot_error.accuracy_amplitude_m", True)
+        check_positive(self.accuracy_wavelength_m, "robot_error.accuracy_wavelength_m")
+        check_positive(self.accuracy_terms, "robot_error.accuracy_terms")
+
+    @classmethod
+    def none(cls) -> RobotErrorModel:
+        """A perfect robot."""
+        return cls(repeatability_sigma_m=0.0, accuracy_amplitude_m=0.0)
+
+    def sample_repeatability_m(self, rng: np.random.Generator) -> FloatArray:
+        """``(3,)`` TCP offset of one search, base frame, m."""
+        if self.repeatability_sigma_m == 0.0:
+            return np.zeros(3)
+        return rng.normal(0.0, self.repeatability_sigma_m, size=3)
+
+    def sample_field(self, rng: np.random.Generator) -> AccuracyField | None:
+        """One robot's absolute-accuracy field, or ``None`` when the amplitude is 0."""
+        if self.accuracy_amplitude_m == 0.0:
+            return None
+        k = int(self.accuracy_terms)
+        directions = rng.normal(size=(k, 3))
+        directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+        wavelengths = self.accuracy_wavelength_m * rng.uniform(0.5, 1.5, size=k)
+        # each sine term has RMS a / sqrt(2); scale so the sum has the requested RMS per axis
+        amps = rng.normal(size=(k, 3)) * self.accuracy_amplitude_m * math.sqrt(2.0 / k)
+        return AccuracyField(
+            amplitudes_m=amps,
+            wavevectors=directions * (2 * math.pi / wavelengths)[:, None],
+            phases=rng.uniform(0, 2 * math.pi, size=k),
+        )
+
+
+@dataclass(frozen=True)
+class Misplacement:
+    """Tolerance of the part's placement: a random rigid motion about a pivot.
+
+    Attributes:
+        max_translation_m: largest translation, uniform in a ball, m (paper: 20 mm).
+        max_angle_rad: largest rotation, uniform in angle about a random axis, rad (paper: 3 deg).
+    """
+
+    max_translation_m: float = 0.020
+    max_angle_rad: float = math.radians(3.0)
+
+    def __post_init__(self) -> None:
+        check_positive(self.max_translation_m, "misplacement.max_translation_m", True)
+        check_positive(self.max_angle_rad, "misplacement.max_angle_rad", True)
+
+    def sample(self, rng: np.random.Generator, pivot_wobj_m: ArrayLike) -> FloatArray:
+        """``T_nominal_true`` ``(4, 4)``: the true part frame in the nominal one.
+
+        The rotation turns about ``pivot_wobj_m`` (``(3,)``, nominal wobj, m), e.g. the middle
+        of the probed region, so a 3 deg turn does not swing the far end of a 2 m part by 100 mm.
+        """
+        c = check_vector3(pivot_wobj_m, "pivot_wobj_m")
+        direction = rng.normal(size=3)
+        direction /= np.linalg.norm(direction)
+        t = direction * self.max_translation_m * rng.uniform() ** (1.0 / 3.0)
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        R = matrix_from_rotvec(axis * rng.uniform(-self.max_angle_rad, self.max_angle_rad))
+        return make_transform(R, c - R @ c + t)

@@ -1,0 +1,234 @@
+"""Simulated searches: a :data:`calib.probing.Probe` that runs against the true, misplaced part.
+
+The robot moves the sensor TCP along the commanded straight path; where it really is differs by
+its repeatability (a fresh offset per search) and, optionally, a smooth absolute-accuracy field.
+The sensor model (:mod:`planner.sensor`) decides where it switches, from a ray bundle cast
+against the true part. The probe returns what the robot controller records: the *commanded*
+TCP position at the switching event, in the base frame.
+
+- Approach search (motion along the sensor axis): every ray shortens by the travel, so the
+  switching travel is solved in closed form from one ray cast (no stepping).
+- Edge search ("move until the sensor stops detecting"): a coarse scan with few rays finds the
+  step where the signal drops below the switch-off level, then bisection with the full bundle.
+
+Failures are returned as :class:`~calib.probing.ProbeResult` with a reason, never as a number:
+no detection within the search length, already detecting at the start, not detecting at the
+start of an edge search, the face touching the part, or an unreachable commanded path (when a
+reachability hook is given).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from calib.frames import check_transform, invert_transform
+from calib.probing import ProbeResult, SearchCommand
+from planner.error_models import AccuracyField, RobotErrorModel
+from planner.raycast import MeshRayCaster
+from planner.sensor import ProximitySensor
+from planner.stator import StatorGeometry
+
+FloatArray = NDArray[np.float64]
+
+#: A reachability hook: returns "" when the commanded search is feasible, else the reason.
+ReachabilityHook = Callable[[SearchCommand], str]
+
+
+@dataclass(frozen=True)
+class ProbeEvent:
+    """What happened in one simulated search (for the failure report).
+
+    Attributes:
+        point_id: id of the probe point.
+        kind: ``"approach"`` or ``"edge"``.
+        reason: empty on success, else why the search failed.
+        landing: ``"over slot hole"``, ``"off face"`` or ``""``: where an approach really landed.
+        travel_m: travel from the start to the event, m (``nan`` on failure).
+    """
+
+    point_id: str
+    kind: str
+    reason: str = ""
+    landing: str = ""
+    travel_m: float = float("nan")
+
+
+def footprint_landing(
+    geom: StatorGeometry, tcp_wobj_m: FloatArray, axis_wobj: FloatArray, radius_m: float
+) -> str:
+    """Classify where a sensor footprint lies on the true part (wobj of the true part).
+
+    Returns:
+        ``"over slot hole"`` when the footprint centre is over a hole of the side face,
+        ``"off face"`` when the footprint hangs over an edge of the face it looks at, else ``""``.
+    """
+    n = -np.asarray(axis_wobj, float)
+    i = int(np.argmax(np.abs(n)))
+    x, y, z = (float(c) for c in tcp_wobj_m)
+    lo = {0: -geom.depth_m, 1: -geom.length_m, 2: -geom.height_m}
+    in_plane = [a for a in range(3) if a != i]
+    coords = {0: x, 1: y, 2: z}
+    if i == 0 and n[0] > 0 and bool(geom.hole_near(y, z)):
+        return "over slot hole"
+    for a in in_plane:
+        if coords[a] + radius_m > 1e-9 or coords[a] - radius_m < lo[a] - 1e-9:
+            return "off face"
+    return ""
+
+
+@dataclass
+class SimulatedProbe:
+    """A probe callback against the true part at ``T_base_wobj_true``.
+
+    Args:
+        caster: ray caster of the part mesh in its own (wobj) frame.
+        T_base_wobj_true: ``(4, 4)`` where the part really is, base frame.
+        rng: random generator for robot and sensor noise.
+        sensor: the sensor model.
+        robot_error: robot repeatability (per search) and accuracy model.
+        accuracy_field: this robot's accuracy field (``robot_error.sample_field``), or None.
+        geometry: the stator geometry, to classify landings over slot holes or off the face.
+        reachability: optional hook that vets each commanded search.
+        scan_step_m: step of the coarse edge scan, m.
+        edge_tolerance_m: bisection tolerance of the edge event, m.
+    """
+
+    caster: MeshRayCaster
+    T_base_wobj_true: ArrayLike
+    rng: np.random.Generator
+    sensor: ProximitySensor = field(default_factory=ProximitySensor)
+    robot_error: RobotErrorModel = field(default_factory=RobotErrorModel)
+    accuracy_field: AccuracyField | None = None
+    geometry: StatorGeometry | None = None
+    reachability: ReachabilityHook | None = None
+    scan_step_m: float = 0.002
+    edge_tolerance_m: float = 1e-5
+    events: list[ProbeEvent] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.T_base_wobj_true = check_transform(self.T_base_wobj_true, "T_base_wobj_true")
+        self._T_wobj_base = invert_transform(self.T_base_wobj_true)
+
+    # -- helpers ---------------------------------------------------------------------------
+    def _to_part(self, p_base: FloatArray) -> FloatArray:
+        T = self._T_wobj_base
+        return p_base @ T[:3, :3].T + T[:3, 3]
+
+    def _signal(self, tcp_base: FloatArray, axis: FloatArray, coarse: bool = False) -> FloatArray:
+        """Signal at TCP positions ``(K, 3)`` (base) -> ``(K,)``; ``-1`` where the face collides."""
+        origins = self.sensor.ray_origins(tcp_base, axis, coarse=coarse)  # (K, n, 3)
+        k, n = origins.shape[:2]
+        o = self._to_part(origins.reshape(-1, 3))
+        d_part = np.broadcast_to(self._T_wobj_base[:3, :3] @ axis, (k * n, 3))
+        dist = self.caster.first_hits(o, d_part).reshape(k, n)
+        s = self.sensor.signal(dist)
+        return np.where(np.any(dist <= 0.0, axis=1), -1.0, s)
+
+    def _fail(self, cmd: SearchCommand, reason: str) -> ProbeResult:
+        self.events.append(ProbeEvent(cmd.point_id, cmd.kind, reason=reason))
+        return ProbeResult(point_m=None, reason=reason)
+
+    def _succeed(self, cmd: SearchCommand, tcp0: FloatArray, travel: float) -> ProbeResult:
+        landing = ""
+        if self.geometry is not None and cmd.kind == "approach":
+            tcp_w = self._to_part((tcp0 + travel * cmd.direction)[None])[0]
+            axis_w = self._T_wobj_base[:3, :3] @ cmd.sensor_axis
+            landing = footprint_landing(self.geometry, tcp_w, axis_w, self.sensor.radius_m)
+        self.events.append(ProbeEvent(cmd.point_id, cmd.kind, landing=landing, travel_m=travel))
+        point = np.asarray(cmd.start_m, float) + travel * np.asarray(cmd.direction, float)
+        return ProbeResult(point_m=point, travel_m=travel)
+
+    # -- the probe -------------------------------------------------------------------------
+    def __call__(self, cmd: SearchCommand) -> ProbeResult:
+        """Run one commanded search against the true part."""
+        if self.reachability is not None:
+            why = self.reachability(cmd)
+            if why:
+                return self._fail(cmd, why)
+        start = np.asarray(cmd.start_m, float)
+        offset = self.robot_error.sample_repeatability_m(self.rng)
+        if self.accuracy_field is not None:
+            offset = offset + self.accuracy_field(start)
+        tcp0 = start + offset
+        axis = np.asarray(cmd.sensor_axis, float)
+        direction = np.asarray(cmd.direction, float)
+        length = float(cmd.length_m)
+        if cmd.kind == "approach" and float(direction @ axis) > 1.0 - 1e-12:
+            return self._approach_along_axis(cmd, tcp0, axis, length)
+        return self._scan(cmd, tcp0, axis, direction, length, want_on=cmd.kind == "approach")
+
+    def _approach_along_axis(
+        self, cmd: SearchCommand, tcp0: FloatArray, axis: FloatArray, length: float
+    ) -> ProbeResult:
+        origins = self._to_part(self.sensor.ray_origins(tcp0, axis))
+        axis_part = np.broadcast_to(self._T_wobj_base[:3, :3] @ axis, origins.shape)
+        dist = self.caster.first_hits(origins, axis_part)
+        if np.any(dist <= 0.0):
+            return self._fail(cmd, "sensor face inside the part at start")
+        travel = self.sensor.switch_travel_m(dist, self.sensor.sample_jitter_m(self.rng))
+        if travel <= 0.0:
+            return self._fail(cmd, "sensor already detecting at start")
+        if not math.isfinite(travel) or travel > length:
+            return self._fail(cmd, f"no detection within {length * 1e3:.0f} mm")
+        if travel >= float(dist.min()):
+            return self._fail(cmd, "sensor face touched the part before switching")
+        return self._succeed(cmd, tcp0, travel)
+
+    def _scan(
+        self,
+        cmd: SearchCommand,
+        tcp0: FloatArray,
+        axis: FloatArray,
+        direction: FloatArray,
+        length: float,
+        want_on: bool,
+    ) -> ProbeResult:
+        """Stepping search for the first travel where the sensor turns on (or off)."""
+        on = self.sensor.on_level(self.sensor.sample_jitter_m(self.rng))
+        off = self.sensor.off_level(self.sensor.sample_jitter_m(self.rng))
+
+        def event(sig: FloatArray) -> NDArray[np.bool_]:
+            return (sig >= on) if want_on else (sig < off)
+
+        s0 = self._signal(tcp0[None], axis)[0]
+        if s0 < 0:
+            return self._fail(cmd, "sensor face inside the part at start")
+        if want_on and s0 >= on:
+            return self._fail(cmd, "sensor already detecting at start")
+        if not want_on and s0 < on:
+            return self._fail(cmd, "sensor not detecting at start of edge search")
+        n_steps = max(1, math.ceil(length / self.scan_step_m))
+        s_grid = np.linspace(0.0, length, n_steps + 1)
+        coarse = self._signal(tcp0 + s_grid[:, None] * direction, axis, coarse=True)
+        if np.any(coarse < 0):
+            first_hit = int(np.argmax(coarse < 0))
+            if not np.any(event(coarse[1:first_hit])):
+                return self._fail(cmd, "sensor face collided with the part during the search")
+        hits = np.flatnonzero(event(coarse[1:]) & (coarse[1:] >= 0)) + 1
+        k = int(hits[0]) if len(hits) else n_steps
+
+        def fine(s: float) -> float:
+            return float(self._signal((tcp0 + s * direction)[None], axis)[0])
+
+        while k > 1 and event(np.array([fine(s_grid[k - 1])]))[0]:
+            k -= 1
+        while k <= n_steps and not event(np.array([fine(s_grid[k])]))[0]:
+            k += 1
+        if k > n_steps:
+            what = "detection" if want_on else "edge (sensor still detecting)"
+            return self._fail(cmd, f"no {what} within {length * 1e3:.0f} mm")
+        lo, hi = float(s_grid[k - 1]), float(s_grid[k])
+        while hi - lo > self.edge_tolerance_m:
+            mid = 0.5 * (lo + hi)
+            if event(np.array([fine(mid)]))[0]:
+                hi = mid
+            else:
+                lo = mid
+        if fine(hi) < 0:
+            return self._fail(cmd, "sensor face collided with the part during the search")
+        return self._succeed(cmd, tcp0, hi)
