@@ -1,0 +1,47 @@
+"""Fixtures of the end-to-end UI tests: one headless Chromium, a UI server per test on a free port.
+
+Chromium is the Debian package at ``/usr/bin/chromium`` driven by Playwright (``playwright
+install`` cannot download browsers here); WebGL runs on SwiftShader.
+"""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from ui_helpers import CHROMIUM, CHROMIUM_ARGS, UiSession, open_page, start_ui
+
+from webui.testing import box_plan
+
+
+@pytest.fixture(scope="session")
+def browser() -> Iterator[Any]:
+    """One headless Chromium for the whole session."""
+    if shutil.which(CHROMIUM) is None:
+        pytest.skip(f"{CHROMIUM} not installed")
+    sync_api = pytest.importorskip("playwright.sync_api")
+    with sync_api.sync_playwright() as pw:
+        b = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        yield b
+        b.close()
+
+
+@pytest.fixture(scope="session")
+def box_plan_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A 3-2-1 plan on a box work object (mesh file next to the plan)."""
+    return box_plan(tmp_path_factory.mktemp("plan"))
+
+
+@pytest.fixture
+def ui(browser: Any, box_plan_path: Path, tmp_path: Path) -> Iterator[UiSession]:
+    """The UI on the box plan, with one page open."""
+    app = start_ui(box_plan_path, tmp_path)
+    session = open_page(browser, app)
+    try:
+        yield session
+    finally:
+        session.page.close()
+        app.stop()

@@ -1,0 +1,123 @@
+"""End-to-end tests of the web UI in a real headless Chromium (Playwright).
+
+Each test starts the UI in-process on a free port and drives it through the browser; what the
+browser did is checked on the server side (the session plan and its checks).
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from ui_helpers import VIEWPORT, UiSession, wait_for
+
+from calib.frames import transform_points
+from webui.testing import T_WORLD_WOBJ_BOX, project_to_screen
+
+pytestmark = pytest.mark.browser
+
+
+def set_camera(client: Any, position: Any, look_at: Any) -> None:
+    """Put the page's camera at ``position`` looking at ``look_at`` (z up) and wait for it."""
+    client.camera.up_direction = (0.0, 0.0, 1.0)
+    client.camera.position = tuple(float(v) for v in position)
+    client.camera.look_at = tuple(float(v) for v in look_at)
+    client.flush()
+    time.sleep(0.6)  # the browser applies the pose and reports it back
+
+
+def click_world_point(ui: UiSession, p_world: Any) -> None:
+    """Click the canvas where ``p_world`` appears in the page's camera."""
+    cam = ui.client().camera
+    u, v = project_to_screen(
+        p_world, cam.position, cam.wxyz, cam.fov, cam.image_width, cam.image_height
+    )
+    box = ui.page.locator("canvas").first.bounding_box()
+    x = box["x"] + u * box["width"] / cam.image_width
+    y = box["y"] + v * box["height"] / cam.image_height
+    assert 0 < x < VIEWPORT["width"] * 0.6, "keep the target clear of the control panel"
+    ui.page.mouse.click(float(x), float(y))
+
+
+def test_page_loads_with_plan_points_and_status(ui: UiSession) -> None:
+    wait_for(lambda: "P1" in ui.page.content(), what="the status table")
+    assert set(ui.app.state.doc.ids) == {"P1", "P2", "P3", "S1", "S2", "T1"}
+    text = ui.page.inner_text("body")
+    for label in ("Points", "Validate", "Files", "Place"):
+        assert label in text
+    checks = wait_for(lambda: len(ui.app.checks()) == 6 and ui.app.checks(), what="checks")
+    assert all(
+        c.status in {"feasible", "marginal", "infeasible", "unknown"} for c in checks.values()
+    )
+
+
+def test_click_on_mesh_places_point_on_surface(ui: UiSession) -> None:
+    target_wobj = np.array([0.12, -0.07, 0.0])  # on the top face
+    target = transform_points(T_WORLD_WOBJ_BOX, target_wobj)
+    set_camera(ui.client(), target + np.array([0.9, -0.5, 1.1]), target + np.array([0.05, 0.15, 0]))
+    ui.app.points_panel.place.value = "A"
+    click_world_point(ui, target)
+    point = wait_for(lambda: "A" in ui.app.state.doc.ids and ui.app.state.doc.get("A"), what="A")
+    np.testing.assert_allclose(point.probe.position_m, target_wobj, atol=0.005)
+    np.testing.assert_allclose(point.probe.normal, [0, 0, 1], atol=1e-9)
+    check = wait_for(lambda: ui.app.check_of("A"), what="A's check")
+    assert check.status in {"feasible", "marginal", "infeasible", "unknown"}
+    wait_for(lambda: "| A |" in ui.app.points_panel.status_md.content, what="A in the table")
+    wait_for(lambda: check.status in ui.page.inner_text("body"), what="status on the page")
+
+
+def test_unreachable_spot_is_infeasible_with_reason(ui: UiSession) -> None:
+    if ui.app.cell_error:
+        pytest.skip(f"feasibility checks not available: {ui.app.cell_error}")
+    # the bottom face (normal -z) cannot be probed from above
+    origin = transform_points(T_WORLD_WOBJ_BOX, [0.0, 0.0, -1.0])
+    direction = T_WORLD_WOBJ_BOX[:3, :3] @ np.array([0.0, 0.0, 1.0])
+    check = ui.app.place_at_ray(origin, direction, point_id="Z")
+    assert check is not None and check.status == "infeasible" and check.reason
+    wait_for(lambda: "infeasible" in ui.page.inner_text("body"), what="infeasible shown")
+
+
+def test_validate_button_produces_table_or_clear_message(ui: UiSession) -> None:
+    ui.page.get_by_role("button", name="Validate plan").click()
+    if ui.app.validate_panel.running or ui.app.validate_panel.last_markdown:
+        wait_for(lambda: ui.app.validate_panel.last_markdown, timeout=40, what="validation")
+        wait_for(lambda: "|" in ui.page.inner_text("body"), what="the table on the page")
+    else:
+        msg = wait_for(
+            lambda: "not available" in ui.notifications() and ui.notifications(),
+            what="the not-available notification",
+        )
+        assert "Monte Carlo" in msg
+
+
+def test_plan_download_matches_server_plan(ui: UiSession, tmp_path: Path) -> None:
+    wait_for(lambda: "P1" in ui.page.content(), what="page ready")
+    with ui.page.expect_download(timeout=15000) as dl:
+        ui.page.get_by_text("Files").first.click()
+        ui.page.get_by_role("button", name="Download plan JSON").click()
+    saved = tmp_path / "downloaded.json"
+    dl.value.save_as(saved)
+    _, server_bytes = ui.app.files_panel.plan_bytes()
+    assert saved.read_bytes() == server_bytes
+    assert json.loads(saved.read_text())["schema"] == "wobjcal.plan/1"
+
+
+def test_bad_upload_shows_error_and_changes_nothing(ui: UiSession, tmp_path: Path) -> None:
+    wait_for(lambda: "P1" in ui.page.content(), what="page ready")
+    before = ui.app.state.doc
+    bad = tmp_path / "broken.json"
+    bad.write_text('{"schema": "wobjcal.plan/1", "points": [}')
+    ui.page.get_by_text("Files").first.click()
+    with ui.page.expect_file_chooser(timeout=10000) as fc:
+        ui.page.get_by_role("button", name="Upload plan (.json)").click()
+    fc.value.set_files(str(bad))
+    text = wait_for(
+        lambda: "File not used" in ui.notifications() and ui.notifications(),
+        what="the error notification",
+    )
+    assert "broken.json" in text
+    assert ui.app.state.doc is before
