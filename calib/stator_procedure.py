@@ -224,7 +224,7 @@ class _Run:
         command = SearchCommand.from_point(point, self.T)
         self.commands[key] = command
         result = self.probe(command)
-        if not result.ok:
+        if result.point_m is None:
             raise ProbeFailedError(key, result.reason or "the probe gave no reason")
         p = check_vector3(result.point_m, f"probe result for point {key}")
         self.measured[key] = p

@@ -87,12 +87,13 @@ class SlotGrid:
     @property
     def slot_y_m(self) -> FloatArray:
         """``(n_slots,)`` y of each slot, wobj frame, metres."""
-        return self.first_slot_y_m + np.arange(self.n_slots) * self.slot_step_y_m
+        return self.first_slot_y_m + np.arange(self.n_slots, dtype=np.float64) * self.slot_step_y_m
 
     @property
     def layer_z_m(self) -> FloatArray:
         """``(n_layers,)`` z of each layer, wobj frame, metres."""
-        return self.first_layer_z_m + np.arange(self.n_layers) * self.layer_step_z_m
+        steps = np.arange(self.n_layers, dtype=np.float64)
+        return self.first_layer_z_m + steps * self.layer_step_z_m
 
     def tooth_y_m(self, tooth: int) -> float:
         """y of tooth ``tooth``, the one between slots ``tooth`` and ``tooth + 1``, metres.
