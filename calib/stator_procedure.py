@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 
 import numpy as np
@@ -45,7 +45,7 @@ from calib.hultman import (  # the unchecked kernels: inputs are checked here, o
     p3_estimate,
 )
 from calib.probing import Probe, ProbePoint, ProbeResult, SearchCommand, SearchSpec
-from calib.validation import check_vector3
+from calib.validation import check_positive, check_vector3
 
 FloatArray = NDArray[np.float64]
 
@@ -66,11 +66,26 @@ class StatorSettings:
         p3_height_m: height of the constructed point P3 above B (eq. 12), metres (paper: 50 mm).
         retake_c_d: measure C and D again at the end, as the paper does (``"C2"``, ``"D2"``);
             when False the first C and D are reused for the final origin.
+        edge_start_from_measured: start the edge search F at the measured E and H at the
+            measured G, shifted ``edge_start_offset_m`` along the estimated WOCS +x (the
+            paper's literal wording); when False (default) F and H start where the plan's
+            search says (e.g. at E's and G's nominal height). The search still runs up
+            to the height where the plan's search ends.
+        edge_start_offset_m: the paper's "few millimeters" offset in +x of that start, metres.
     """
 
     beta1_rad: float = math.radians(15.0)
     p3_height_m: float = 0.050
     retake_c_d: bool = True
+    edge_start_from_measured: bool = False
+    edge_start_offset_m: float = 0.0
+
+    def __post_init__(self) -> None:
+        beta1 = float(self.beta1_rad)
+        if not (math.isfinite(beta1) and abs(beta1) < math.pi / 2):
+            raise ShapeError(f"settings.beta1_rad must lie in (-pi/2, pi/2), got {beta1}")
+        check_positive(self.p3_height_m, "settings.p3_height_m")
+        check_positive(self.edge_start_offset_m, "settings.edge_start_offset_m", allow_zero=True)
 
 
 @dataclass(frozen=True)
@@ -216,12 +231,21 @@ class _Run:
         self.commands: dict[str, SearchCommand] = {}
         self.steps: list[ProcedureStep] = [ProcedureStep("preliminary WOCS", (), "", T)]
 
-    def measure(self, point_id: str, key: str | None = None) -> FloatArray:
+    def measure(
+        self, point_id: str, key: str | None = None, start_m: FloatArray | None = None
+    ) -> FloatArray:
+        """Probe ``point_id`` in the current estimate; ``start_m`` replaces the start (base)."""
         key = point_id if key is None else key
         point = self.layout.points[point_id]
         if key != point_id:
             point = ProbePoint(key, point.position_m, point.normal, point.search, point.edge_normal)
         command = SearchCommand.from_point(point, self.T)
+        if start_m is not None:  # run up to where the plan's search ends, along its direction
+            end = command.start_m + command.length_m * command.direction
+            length = float(command.direction @ (end - start_m))
+            if length <= 0.0:
+                raise ProbeFailedError(key, "the measured start lies past the end of the search")
+            command = replace(command, start_m=start_m, length_m=length)
         self.commands[key] = command
         result = self.probe(command)
         if result.point_m is None:
@@ -291,9 +315,14 @@ def run_stator_procedure(
     run.rotate(R2, "rotation about y and z from A, B, D, E", ("A", "B", "D", "E"), "eq. 2-9")
     run.origin(0, "E", "x origin from E (P4; the paper's 'P5_W')")
 
-    f = run.measure("F")
-    run.measure("G")
-    h = run.measure("H")
+    f_start = g_start = None
+    if cfg.edge_start_from_measured:
+        f_start = e + cfg.edge_start_offset_m * run.T[:3, 0]
+    f = run.measure("F", start_m=f_start)
+    g = run.measure("G")
+    if cfg.edge_start_from_measured:
+        g_start = g + cfg.edge_start_offset_m * run.T[:3, 0]
+    h = run.measure("H", start_m=g_start)
     R3 = _rotation_from_points(h, f, d, True, ("H", "F", "D"))
     run.rotate(R3, "final rotation from H, F, D (V2 inverted)", ("H", "F", "D"), "eq. 1-9")
     run.origin(2, "H", "z origin from H (P6)")

@@ -274,3 +274,36 @@ def test_bad_layouts_raise_before_probing(points, error, match) -> None:
 def test_bad_preliminary_frame_raises() -> None:
     with pytest.raises(ShapeError, match="T_base_wobj_prelim"):
         run_stator_procedure(LAYOUT, np.eye(3), BoxProbe(np.eye(4)))
+
+
+def test_edge_searches_can_start_from_measured_e_and_g(rng: np.random.Generator) -> None:
+    T_prelim = nominal_pose(0.1, (1.0, -0.2, 0.8))
+    T_true = T_prelim @ random_transform(rng, 0.02, math.radians(3.0))
+    cfg = StatorSettings(edge_start_from_measured=True, edge_start_offset_m=0.003)
+    res = run_stator_procedure(LAYOUT, T_prelim, BoxProbe(T_true), cfg)
+    dt, dr = pose_error(res.T_base_wobj, T_true)
+    assert dt < 1e-9 and dr < 1e-9
+    T_f = res.commands["F"].T_base_wobj_estimate
+    for edge, start in (("F", "E"), ("H", "G")):
+        cmd = res.commands[edge]
+        np.testing.assert_allclose(cmd.start_m, res.measured_m[start] + 0.003 * T_f[:3, 0])
+        # the search still ends at the height where the plan's search ends
+        plan = SearchCommand.from_point(LAYOUT.points[edge], T_f)
+        end_cmd = cmd.start_m + cmd.length_m * cmd.direction
+        end_plan = plan.start_m + plan.length_m * plan.direction
+        assert cmd.direction @ (end_cmd - end_plan) == pytest.approx(0.0, abs=1e-12)
+        assert np.linalg.norm(cmd.start_m - plan.start_m) > 0.002  # not the plan's start
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"beta1_rad": math.pi / 2}, "beta1_rad must lie in"),
+        ({"beta1_rad": float("nan")}, "beta1_rad must lie in"),
+        ({"p3_height_m": 0.0}, "p3_height_m must be > 0"),
+        ({"edge_start_offset_m": -0.001}, "edge_start_offset_m must be >= 0"),
+    ],
+)
+def test_bad_settings_raise(kwargs, match) -> None:
+    with pytest.raises(ShapeError, match=match):
+        StatorSettings(**kwargs)
