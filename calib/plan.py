@@ -137,24 +137,34 @@ class ToolSpec(_Strict, kw_only=True):
 
 
 class FixtureSpec(_Strict, kw_only=True):
-    """A fixed obstacle (table, fixture) for collision checks.
+    """A fixed obstacle (table, fixture) for collision checks: a mesh or a box.
 
     Attributes:
         name: unique fixture name.
-        mesh: mesh file (relative to the plan) or ``builtin:NAME``.
+        mesh: mesh file (relative to the plan) or ``builtin:NAME``; ``None`` for a box.
+        box_size_m: ``(3,)`` edge lengths of a box centred on its frame, m; ``None`` for a mesh.
         units: length unit of the mesh file.
         sha256: hex digest of the mesh file, checked on load (``None``: not checked).
-        T_world_fixture: pose of the mesh frame in the world frame.
+        T_world_fixture: pose of the mesh (or box centre) frame in the world frame.
     """
 
     name: str
-    mesh: str
+    mesh: str | None = None
+    box_size_m: Vec3 | None = None
     units: MeshUnits = "m"
     sha256: str | None = None
     T_world_fixture: Pose = Pose()
 
     def __post_init__(self) -> None:
-        _check_sha256(self.sha256, self.mesh, "sha256")
+        if (self.mesh is None) == (self.box_size_m is None):
+            raise PlanError("mesh: give exactly one of mesh and box_size_m")
+        if self.box_size_m is not None:
+            if not all(math.isfinite(v) and v > 0 for v in self.box_size_m):
+                raise PlanError(f"box_size_m: must be 3 lengths > 0, got {list(self.box_size_m)}")
+            if self.sha256 is not None:
+                raise PlanError("sha256: must be null for a box")
+        else:
+            _check_sha256(self.sha256, self.mesh or "", "sha256")
 
 
 class CellSpec(_Strict, kw_only=True):
@@ -288,49 +298,72 @@ class PlanPoint(_Strict, kw_only=True):
 
 
 class SensorModel(_Strict, kw_only=True):
-    """The proximity sensor, for validation.
+    """The proximity sensor, for validation (``planner.sensor.ProximitySensor``).
 
     Attributes:
-        sensing_distance_m: switching distance from the sensor face, metres.
-        repeatability_m: 1-sigma scatter of the switching point along the sensor axis, metres.
-        spot_radius_m: radius of the sensed spot on the surface, metres (0: a ray).
+        face_diameter_m: diameter of the active face, m.
+        sensing_distance_m: nominal sensing distance on a flat steel target, m.
+        decay_length_m: length over which the damping signal falls by ``e``, m.
+        hysteresis_fraction: switch-off distance exceeds switch-on by this part of the distance.
+        repeatability_sigma_m: 1-sigma jitter of the switching distance, m.
+        n_rays: rays over the face for switching decisions.
+        n_scan_rays: rays for the coarse scan of an edge search.
     """
 
-    sensing_distance_m: float = 0.004
-    repeatability_m: float = 0.00002
-    spot_radius_m: float = 0.0
+    face_diameter_m: float = 0.018
+    sensing_distance_m: float = 0.008
+    decay_length_m: float = 0.003
+    hysteresis_fraction: float = 0.10
+    repeatability_sigma_m: float = 0.00004
+    n_rays: int = 256
+    n_scan_rays: int = 37
 
     def __post_init__(self) -> None:
+        _check_positive(self.face_diameter_m, "face_diameter_m", allow_zero=True)
         _check_positive(self.sensing_distance_m, "sensing_distance_m")
-        _check_positive(self.repeatability_m, "repeatability_m", allow_zero=True)
-        _check_positive(self.spot_radius_m, "spot_radius_m", allow_zero=True)
+        _check_positive(self.decay_length_m, "decay_length_m")
+        _check_positive(self.hysteresis_fraction, "hysteresis_fraction", allow_zero=True)
+        _check_positive(self.repeatability_sigma_m, "repeatability_sigma_m", allow_zero=True)
+        _check_positive(self.n_rays, "n_rays")
+        _check_positive(self.n_scan_rays, "n_scan_rays")
 
 
 class RobotErrorModel(_Strict, kw_only=True):
-    """Robot positioning errors, for validation (1 sigma per axis, metres).
+    """Robot positioning errors, for validation (``planner.error_models.RobotErrorModel``).
 
     Attributes:
-        repeatability_m: scatter of reaching the same target again.
-        absolute_error_m: scatter of the static absolute error between nearby targets.
+        repeatability_sigma_m: 1-sigma per-axis TCP scatter of each search, m.
+        accuracy_amplitude_m: RMS per axis of the smooth absolute-accuracy field, m (0: off).
+        accuracy_wavelength_m: typical wavelength of the accuracy field, m.
+        accuracy_terms: number of sine terms of the field.
     """
 
-    repeatability_m: float = 0.00002
-    absolute_error_m: float = 0.0
+    repeatability_sigma_m: float = 0.00002
+    accuracy_amplitude_m: float = 0.0
+    accuracy_wavelength_m: float = 1.0
+    accuracy_terms: int = 6
 
     def __post_init__(self) -> None:
-        _check_positive(self.repeatability_m, "repeatability_m", allow_zero=True)
-        _check_positive(self.absolute_error_m, "absolute_error_m", allow_zero=True)
+        _check_positive(self.repeatability_sigma_m, "repeatability_sigma_m", allow_zero=True)
+        _check_positive(self.accuracy_amplitude_m, "accuracy_amplitude_m", allow_zero=True)
+        _check_positive(self.accuracy_wavelength_m, "accuracy_wavelength_m")
+        _check_positive(self.accuracy_terms, "accuracy_terms")
 
 
 class Misplacement(_Strict, kw_only=True):
-    """How far the real part may lie from its nominal pose (uniform, for validation)."""
+    """How far the real part may lie from its nominal pose (uniform, for validation).
 
-    max_translation_m: float = 0.003
-    max_rotation_rad: float = math.radians(1.0)
+    Attributes:
+        max_translation_m: largest translation, m (paper: 20 mm).
+        max_angle_rad: largest rotation, rad (paper: 3 deg).
+    """
+
+    max_translation_m: float = 0.020
+    max_angle_rad: float = math.radians(3.0)
 
     def __post_init__(self) -> None:
         _check_positive(self.max_translation_m, "max_translation_m", allow_zero=True)
-        _check_positive(self.max_rotation_rad, "max_rotation_rad", allow_zero=True)
+        _check_positive(self.max_angle_rad, "max_angle_rad", allow_zero=True)
 
 
 class ValidationSpec(_Strict, kw_only=True):
@@ -342,8 +375,6 @@ class ValidationSpec(_Strict, kw_only=True):
         misplacement: misplacement tolerance of the part.
         trials: number of simulated calibrations.
         seed: seed of the ``numpy.random.Generator``.
-        evaluation_points_m: named points (wobj frame, metres) where the error is reported,
-            e.g. the paper's ``epsilon`` = (0, -1.0, -0.1).
     """
 
     sensor: SensorModel = SensorModel()
@@ -351,13 +382,10 @@ class ValidationSpec(_Strict, kw_only=True):
     misplacement: Misplacement = Misplacement()
     trials: int = 400
     seed: int = 20131023
-    evaluation_points_m: dict[str, Vec3] = {}
 
     def __post_init__(self) -> None:
-        if self.trials < 1:
-            raise PlanError(f"trials: must be >= 1, got {self.trials}")
-        for name, p in self.evaluation_points_m.items():
-            _check_finite(p, f"evaluation_points_m.{name}")
+        if self.trials < 2:
+            raise PlanError(f"trials: must be >= 2, got {self.trials}")
 
 
 class Plan(_Strict, kw_only=True):
@@ -453,7 +481,11 @@ def plan_to_json(plan: Plan) -> str:
 def check_plan_files(plan: Plan, plan_dir: str | Path, source: str = "plan") -> None:
     """Check that referenced files exist and match their ``sha256``; errors name the file."""
     refs = [("work_object", plan.work_object.mesh, plan.work_object.sha256)]
-    refs += [(f"cell.fixtures[{i}]", f.mesh, f.sha256) for i, f in enumerate(plan.cell.fixtures)]
+    refs += [
+        (f"cell.fixtures[{i}]", f.mesh, f.sha256)
+        for i, f in enumerate(plan.cell.fixtures)
+        if f.mesh is not None
+    ]
     for where, ref, sha in refs:
         path = resolve_ref(ref, plan_dir)
         if isinstance(path, str):

@@ -4,9 +4,10 @@
 
 - ``hultman2013``: the paper's A-H procedure for the stator section (section 3.2). Every role
   ``A`` ... ``H`` is used exactly once.
-- ``three_two_one``: general 3-2-1 alignment: at least 3 ``primary`` points on one face, 2
+- ``three_two_one``: general 3-2-1 alignment: exactly 3 ``primary`` points on one face, 2
   ``secondary`` on a second, 1 ``tertiary`` on a third.
-- ``best_fit``: least-squares point-to-plane fit of all ``fit`` points (at least 6).
+- ``best_fit``: least-squares point-to-plane fit of all ``fit`` points (at least 3; together
+  they must constrain all 6 degrees of freedom: an edge point constrains two faces).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import msgspec
 HULTMAN_ROLES = ("A", "B", "C", "D", "E", "F", "G", "H")
 THREE_TWO_ONE_ROLES = {"primary": 3, "secondary": 2, "tertiary": 1}
 BEST_FIT_ROLE = "fit"
-BEST_FIT_MIN_POINTS = 6
+BEST_FIT_MIN_POINTS = 3
 
 
 class Hultman2013(
@@ -36,10 +37,12 @@ class Hultman2013(
     Attributes:
         p3_height_m: height of the constructed point P3 above B (eq. 12), metres (paper: 50 mm).
         beta1_rad: assumed inclination of the stator side (eq. 12), radians (paper: 15 deg).
+        retake_c_d: measure C and D again at the end, as the paper does.
     """
 
     p3_height_m: float = 0.050
     beta1_rad: float = math.radians(15.0)
+    retake_c_d: bool = True
 
 
 class ThreeTwoOne(
@@ -65,11 +68,12 @@ class BestFit(
 
     Attributes:
         max_iterations: largest number of Gauss-Newton iterations.
-        tolerance_m: stop when the update is smaller than this, metres.
+        tol: stop when the step is smaller than this (metres, and radians times the layout
+            size).
     """
 
-    max_iterations: int = 50
-    tolerance_m: float = 1e-12
+    max_iterations: int = 30
+    tol: float = 1e-13
 
 
 Procedure = Hultman2013 | ThreeTwoOne | BestFit
@@ -113,7 +117,7 @@ def check_roles(procedure: Procedure, roles: Sequence[str], complete: bool = Tru
             return f"points: hultman2013 needs each role A-H exactly once; wrong count of {bad}"
     elif method == "three_two_one":
         for role, need in THREE_TWO_ONE_ROLES.items():
-            if counts[role] < need:
+            if counts[role] != need:
                 return f"points: three_two_one needs {need} {role!r} points, got {counts[role]}"
     elif counts[BEST_FIT_ROLE] < BEST_FIT_MIN_POINTS:
         return f"points: best_fit needs at least {BEST_FIT_MIN_POINTS} points, got {len(roles)}"

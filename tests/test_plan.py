@@ -153,8 +153,8 @@ def test_roles_must_fit_procedure() -> None:
     plan = load_plan(VALID)
     with pytest.raises(PlanError, match=r"points\[0\]\.role: must be one of \['A'"):
         Plan(points=plan.points, procedure=Hultman2013())
-    fit = [msgspec.structs.replace(p, role="fit") for p in plan.points[:5]]
-    with pytest.raises(PlanError, match="best_fit needs at least 6 points, got 5"):
+    fit = [msgspec.structs.replace(p, role="fit") for p in plan.points[:2]]
+    with pytest.raises(PlanError, match="best_fit needs at least 3 points, got 2"):
         Plan(points=fit, procedure=BestFit()).require_complete()
     incomplete = Plan(points=plan.points[:4], procedure=ThreeTwoOne())
     with pytest.raises(PlanError, match="three_two_one needs 2 'secondary' points, got 1"):

@@ -1,4 +1,4 @@
-"""Regenerate the malformed-plan cases from ``valid_three_two_one.json``.
+"""Regenerate ``valid_three_two_one.json`` and the malformed-plan cases made from it.
 
 Run ``python tests/data/plans/make_cases.py``; ``tests/test_plan.py`` holds the expected
 message of each case. The files are checked in so the CLI can be tried on them by hand.
@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import copy
 import json
+import math
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -62,8 +63,44 @@ CASES: dict[str, Callable[[Any], None]] = {
 }
 
 
+def write_valid() -> None:
+    """A small valid 3-2-1 plan on the stator section's three faces (WOCS of ARCHITECTURE.md)."""
+    from calib.plan import Plan, PlanPoint, Pose, Search, WorkObjectSpec, save_plan
+    from calib.plan_procedures import ThreeTwoOne
+
+    s = 1 / math.sqrt(2)
+    x, y, z = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
+    edge = Search(kind="edge", start_offset_m=0.01, overtravel_m=0.01, edge_direction=z)
+    points = [
+        PlanPoint(id="P1", role="primary", position_m=(0.0, -0.9, -0.15), normal=x),
+        PlanPoint(id="P2", role="primary", position_m=(0.0, -0.2, -0.15), normal=x),
+        PlanPoint(id="P3", role="primary", position_m=(0.0, -0.5, -0.05), normal=x),
+        PlanPoint(id="S1", role="secondary", position_m=(-0.05, 0.0, -0.05), normal=y),
+        PlanPoint(id="S2", role="secondary", position_m=(-0.05, 0.0, -0.15), normal=y),
+        PlanPoint(
+            id="T1",
+            role="tertiary",
+            position_m=(0.0, -0.6, 0.0),
+            normal=x,
+            search=edge,
+            edge_normal=z,
+        ),
+    ]
+    plan = Plan(
+        name="three_two_one_small",
+        description="3-2-1 test plan on the stator section's faces",
+        work_object=WorkObjectSpec(
+            T_world_wobj=Pose(position_m=(1.4, 0.5, 0.8), quat_wxyz=(s, 0.0, 0.0, s))
+        ),
+        points=points,
+        procedure=ThreeTwoOne(),
+    )
+    save_plan(plan, HERE / "valid_three_two_one.json")
+
+
 def main() -> None:
-    """Write ``bad_<case>.json`` for every case."""
+    """Write the valid plan and ``bad_<case>.json`` for every case."""
+    write_valid()
     valid = json.loads((HERE / "valid_three_two_one.json").read_text())
     for name, edit in CASES.items():
         data = copy.deepcopy(valid)
