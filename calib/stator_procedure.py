@@ -20,9 +20,12 @@ The procedure never moves anything. It builds each search with
 
 Errors: a failed probe raises :class:`calib.errors.ProbeFailedError` with the measurement's
 key (``"A"``... ``"H"``, ``"C2"``, ``"D2"``) and the probe's reason; bad layouts raise
-:class:`calib.errors.InputError` subclasses before any probe is called. Edge probes must
-return the edge point on the face (the sensor TCP at its sensing distance when the face ends);
-a point left off the face by ``d`` tilts the final WOCS by about ``d / |F - D|``.
+:class:`calib.errors.InputError` subclasses before any probe is called. Probes return
+the sensor-TCP position the robot records at the event. For the edge searches F and H that is
+on the side face: by then the WOCS yz-plane is the plane measured through A, B, D, E and the
+search runs in it. When an edge search is started ``edge_start_offset_m`` outside the face
+(:class:`StatorSettings`), F and H are moved back by that offset before use; a point left off
+the face by ``d`` would tilt the final WOCS by about ``d / |F - D|``.
 """
 
 from __future__ import annotations
@@ -258,9 +261,10 @@ class _Run:
         self.T = T
         self.steps.append(ProcedureStep(name, ids, equations, T))
 
-    def origin(self, axis: int, key: str, name: str) -> None:
+    def origin(self, axis: int, key: str, name: str, point: FloatArray | None = None) -> None:
         face = self.layout.face_coords_wobj[axis]
-        T = _shift_origin(self.T, axis, self.measured[key], face)
+        p = self.measured[key] if point is None else point
+        T = _shift_origin(self.T, axis, p, face)
         self.step(T, name, (key,), "eq. 10")
 
     def rotate(self, R: FloatArray, name: str, ids: tuple[str, ...], equations: str) -> None:
@@ -315,17 +319,17 @@ def run_stator_procedure(
     run.rotate(R2, "rotation about y and z from A, B, D, E", ("A", "B", "D", "E"), "eq. 2-9")
     run.origin(0, "E", "x origin from E (P4; the paper's 'P5_W')")
 
-    f_start = g_start = None
-    if cfg.edge_start_from_measured:
-        f_start = e + cfg.edge_start_offset_m * run.T[:3, 0]
-    f = run.measure("F", start_m=f_start)
+    # F: edge search up the tooth over D and E; G, then H: edge search up from G (eq. 1-9)
+    x_now, off = run.T[:3, 0].copy(), cfg.edge_start_offset_m
+    starts = (e + off * x_now, None) if cfg.edge_start_from_measured else (None, None)
+    f = run.measure("F", start_m=starts[0])
     g = run.measure("G")
-    if cfg.edge_start_from_measured:
-        g_start = g + cfg.edge_start_offset_m * run.T[:3, 0]
-    h = run.measure("H", start_m=g_start)
+    h = run.measure("H", start_m=g + off * x_now if cfg.edge_start_from_measured else None)
+    if cfg.edge_start_from_measured:  # the TCP ran `off` outside the face: back onto it
+        f, h = f - off * x_now, h - off * x_now
     R3 = _rotation_from_points(h, f, d, True, ("H", "F", "D"))
     run.rotate(R3, "final rotation from H, F, D (V2 inverted)", ("H", "F", "D"), "eq. 1-9")
-    run.origin(2, "H", "z origin from H (P6)")
+    run.origin(2, "H", "z origin from H (P6)", point=h)
 
     c_key, d_key = ("C2", "D2") if cfg.retake_c_d else ("C", "D")
     if cfg.retake_c_d:

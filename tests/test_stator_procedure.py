@@ -56,9 +56,10 @@ def slab(start: np.ndarray, direction: np.ndarray, lo: np.ndarray, hi: np.ndarra
 class BoxProbe:
     """Ideal noise-free sensor on a box posed at ``T_base_true``.
 
-    Approach: the first point where the commanded line enters the box. Edge: the sensor axis
-    foot on the face it looks at moves with the TCP; the event is where that foot leaves the
-    face (reaches an edge); the foot there is returned, exactly on the edge.
+    Approach: the first point where the commanded line enters the box. Edge: the foot of the
+    sensor axis on the face it looks at moves with the TCP; the event is where that foot
+    leaves the face (reaches an edge). Both return the commanded TCP at the event, as a robot
+    controller records it.
     """
 
     def __init__(self, T_base_true: np.ndarray, offset_wobj=(0.0, 0.0, 0.0), fail=()) -> None:
@@ -99,7 +100,7 @@ class BoxProbe:
             t = min(ts)
             if t > cmd.length_m:
                 return ProbeResult(None, "the face did not end within the search")
-            q = q0 + t * w
+            q = s + t * d
         return ProbeResult(transform_points(self.T_base_true, q), travel_m=float(t))
 
 
@@ -293,6 +294,10 @@ def test_edge_searches_can_start_from_measured_e_and_g(rng: np.random.Generator)
         end_plan = plan.start_m + plan.length_m * plan.direction
         assert cmd.direction @ (end_cmd - end_plan) == pytest.approx(0.0, abs=1e-12)
         assert np.linalg.norm(cmd.start_m - plan.start_m) > 0.002  # not the plan's start
+        # the robot recorded its TCP 3 mm outside the face; the procedure moved it back
+        raw_true = transform_points(invert_transform(T_true), res.measured_m[edge])
+        assert raw_true[0] == pytest.approx(0.003, abs=1e-12)
+        assert raw_true[2] == pytest.approx(0.0, abs=1e-12)
 
 
 @pytest.mark.parametrize(
