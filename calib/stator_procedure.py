@@ -150,6 +150,13 @@ def _same(a: Sequence[float] | None, b: Sequence[float]) -> bool:
     return a is not None and bool(np.allclose(a, b, atol=LAYOUT_TOL, rtol=0.0))
 
 
+def _with_id(point: ProbePoint, new_id: str) -> ProbePoint:
+    """``point`` under the id ``new_id`` (its role, or a retake key such as ``"C2"``)."""
+    if point.id == new_id:
+        return point
+    return ProbePoint(new_id, point.position_m, point.normal, point.search, point.edge_normal)
+
+
 def check_stator_points(
     points: Mapping[str, ProbePoint] | Sequence[ProbePoint] | StatorLayout,
 ) -> StatorLayout:
@@ -159,6 +166,10 @@ def check_stator_points(
     up (+z) that face to the top side; C is an approach point on the short side (normal +y).
     All side-face points share one x, F and H one z; A and B share z with A at smaller y;
     E lies below D, D below F, and H at smaller y than F. Extra points are ignored.
+
+    A mapping is keyed by role (``"A"`` ... ``"H"``); a point whose own id differs (a plan id
+    such as ``"yoke_left"``) is re-labelled with its role, so search commands, measurements
+    and :class:`ProbeFailedError` all use the role names (and ``"C2"``, ``"D2"``).
 
     Raises:
         ShapeError: a point is missing or of the wrong kind.
@@ -170,7 +181,7 @@ def check_stator_points(
     missing = [i for i in STATOR_POINT_IDS if i not in by_id]
     if missing:
         raise ShapeError(f"stator points are missing {', '.join(missing)} (need A-H)")
-    pts = {i: by_id[i] for i in STATOR_POINT_IDS}
+    pts = {i: _with_id(by_id[i], i) for i in STATOR_POINT_IDS}
     for pid in STATOR_POINT_IDS:
         p = pts[pid]
         want_edge = pid in ("F", "H")
@@ -239,9 +250,7 @@ class _Run:
     ) -> FloatArray:
         """Probe ``point_id`` in the current estimate; ``start_m`` replaces the start (base)."""
         key = point_id if key is None else key
-        point = self.layout.points[point_id]
-        if key != point_id:
-            point = ProbePoint(key, point.position_m, point.normal, point.search, point.edge_normal)
+        point = _with_id(self.layout.points[point_id], key)
         command = SearchCommand.from_point(point, self.T)
         if start_m is not None:  # run up to where the plan's search ends, along its direction
             end = command.start_m + command.length_m * command.direction

@@ -312,3 +312,14 @@ def test_edge_searches_can_start_from_measured_e_and_g(rng: np.random.Generator)
 def test_bad_settings_raise(kwargs, match) -> None:
     with pytest.raises(ShapeError, match=match):
         StatorSettings(**kwargs)
+
+
+def test_points_keyed_by_role_are_commanded_under_the_role() -> None:
+    pts = {k: replace(p, id=f"plan_{k.lower()}") for k, p in example_stator_points().items()}
+    T = nominal_pose(0.0, (1.0, 0.0, 0.5))
+    probe = BoxProbe(T)
+    res = run_stator_procedure(pts, T, probe)
+    assert probe.calls == ["A", "B", "C", "D", "E", "F", "G", "H", "C2", "D2"]
+    assert all(res.commands[k].point_id == k for k in res.commands)
+    again = run_stator_procedure(pts, T, probe_from_measurements(res.measured_m))
+    np.testing.assert_array_equal(again.T_base_wobj, res.T_base_wobj)
