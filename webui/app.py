@@ -126,12 +126,13 @@ class WobjcalApp:
                 still = point.id in current.ids and current.get(point.id).probe == point.probe
                 if still:  # drop results of a point that moved on meanwhile
                     self._checks[point.id] = (point.probe, check)
-        self._redraw()
+        self._redraw([p.id for p in points])
         return results
 
-    def _redraw(self) -> None:
+    def _redraw(self, point_ids: list[str] | None = None) -> None:
+        """Redraw the given points (all when ``None``), drop removed ones, refresh the panel."""
         doc = self.state.doc
-        self.scene.draw_points(doc, self.checks(), self.selected)
+        self.scene.draw_points(doc, self.checks(), self.selected, only=point_ids)
         self.points_panel.refresh()
         self.server.flush()
 
@@ -149,7 +150,7 @@ class WobjcalApp:
         with self._lock:
             for pid in [*changed, *(set(before) - set(change.doc.ids))]:
                 self._checks.pop(pid, None)
-        self._redraw()
+        self._redraw(changed)  # grey "pending" markers until the check is back
         self.recheck(changed)
         if self.selected is not None and self.selected not in change.doc.ids:
             self.select(None)
@@ -208,12 +209,13 @@ class WobjcalApp:
 
     def select(self, point_id: str | None) -> None:
         """Select a point: highlight it and show the robot at its probe pose."""
-        self.selected = point_id
+        previous, self.selected = self.selected, point_id
         check = None if point_id is None else self.check_of(point_id)
         if self.robot is not None and check is not None and check.q is not None:
             self.robot.stop()
             self.robot.set_q(check.q)
-        self._redraw()
+        ids = self.state.doc.ids
+        self._redraw([i for i in (previous, point_id) if i is not None and i in ids])
         self.points_panel.on_select(point_id)
 
     def _on_mesh_click(self, event: Any) -> None:

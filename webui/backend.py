@@ -71,12 +71,11 @@ def resolve_robot_urdf(ref: str, plan_dir: Path) -> Path | None:
     resolved = resolve_ref(ref, plan_dir)
     if isinstance(resolved, Path):
         return resolved if resolved.is_file() else None
-    name = ref.split(":", 1)[1]
     try:
         builtins = importlib.import_module("planner.builtins")
-        path = builtins.builtin_robot_urdf(name)
-        return Path(path)
-    except (ImportError, AttributeError, KeyError, ValueError):
+        return Path(builtins.robot_urdf(ref))
+    except ImportError:
+        name = ref.split(":", 1)[1]
         candidate = REPO_ASSETS / "robots" / name / f"{name}.urdf"
         return candidate if candidate.is_file() else None
 

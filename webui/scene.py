@@ -96,14 +96,23 @@ class PlanScene:
         self._scene.add_label("/wobj_calibrated/name", "WOCS (calibrated)")
 
     def draw_points(
-        self, plan: UiPlan, checks: Mapping[str, PointCheck], selected: str | None = None
+        self,
+        plan: UiPlan,
+        checks: Mapping[str, PointCheck],
+        selected: str | None = None,
+        only: list[str] | None = None,
     ) -> None:
-        """Draw all points of ``plan``, coloured by their check; remove points that are gone."""
+        """Draw the points of ``plan`` (or just those in ``only``), coloured by their check.
+
+        Points no longer in the plan are removed.
+        """
         for pid in set(self._point_nodes) - set(plan.ids):
             self._remove_point(pid)
+        wanted = None if only is None else set(only)
         with self._server.atomic():
             for point in plan.points:
-                self.draw_point(point, checks.get(point.id), selected == point.id)
+                if wanted is None or point.id in wanted:
+                    self.draw_point(point, checks.get(point.id), selected == point.id)
 
     def draw_point(self, point: UiPoint, check: PointCheck | None, selected: bool = False) -> None:
         """Draw (or redraw) one point: marker, label, approach arrow and search path."""

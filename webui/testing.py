@@ -34,20 +34,52 @@ BOX_EXTENTS = (0.6, 0.4, 0.3)
 T_WORLD_WOBJ_BOX = make_transform(matrix_from_rotvec([0.0, 0.0, np.pi / 2]), [1.5, 0.2, 0.8])
 
 
-def box_mesh(subdivisions: int = 0) -> trimesh.Trimesh:
-    """The test box in its wobj frame, optionally subdivided (each step x4 triangles)."""
+def box_mesh() -> trimesh.Trimesh:
+    """The test box (12 triangles) in its wobj frame."""
     mesh = trimesh.creation.box(extents=BOX_EXTENTS)
     mesh.apply_translation((0.0, 0.0, -BOX_EXTENTS[2] / 2))
-    for _ in range(subdivisions):
-        mesh = mesh.subdivide()
     return mesh
 
 
-def box_plan(folder: Path, subdivisions: int = 0, name: str = "box_plan") -> Path:
-    """Write a 3-2-1 plan on the test box (mesh in metres) into ``folder``; return its path."""
+def dense_box_mesh(n_triangles: int) -> trimesh.Trimesh:
+    """The test box with each face a regular grid, about ``n_triangles`` triangles in all."""
+    k = max(1, round(np.sqrt(n_triangles / 12.0)))
+    parts = []
+    for axis in range(3):
+        for sign in (-1.0, 1.0):
+            u, v = (axis + 1) % 3, (axis + 2) % 3
+            s = np.linspace(-0.5, 0.5, k + 1)
+            uu, vv = np.meshgrid(s, s, indexing="ij")
+            verts = np.zeros((uu.size, 3))
+            verts[:, axis] = 0.5 * sign
+            verts[:, u], verts[:, v] = uu.ravel(), vv.ravel()
+            idx = np.arange(uu.size).reshape(k + 1, k + 1)
+            a, b = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel()
+            c, d = idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
+            faces = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+            if sign < 0:
+                faces = faces[:, ::-1]
+            grid = trimesh.Trimesh(verts, faces, process=False)
+            parts.append(grid)
+    mesh = trimesh.util.concatenate(parts)
+    mesh.merge_vertices()
+    mesh.apply_scale(BOX_EXTENTS)
+    mesh.apply_translation((0.0, 0.0, -BOX_EXTENTS[2] / 2))
+    return mesh
+
+
+def box_plan(folder: Path, n_triangles: int | None = None, name: str = "box_plan") -> Path:
+    """Write a 3-2-1 plan on the test box (mesh in metres) into ``folder``; return its path.
+
+    Args:
+        folder: where the plan and its mesh file go.
+        n_triangles: make the box of about this many triangles (``None``: 12).
+        name: the plan's name and file stem.
+    """
     folder.mkdir(parents=True, exist_ok=True)
-    mesh_path = folder / f"box_{subdivisions}.stl"
-    box_mesh(subdivisions).export(mesh_path)
+    mesh_path = folder / f"{name}_box.stl"
+    mesh = box_mesh() if n_triangles is None else dense_box_mesh(n_triangles)
+    mesh.export(mesh_path)
     hx, hy = BOX_EXTENTS[0] / 2, BOX_EXTENTS[1] / 2
     spots = [
         ("P1", "primary", (-0.2, -0.1, 0.0), (0, 0, 1)),

@@ -1,0 +1,133 @@
+"""Latency of the web UI: from a click on a 100,000-triangle work object to the point's status.
+
+Server side: ``WobjcalApp.place_at_ray`` is exactly what the mesh's click callback runs (ray cast
+on the mesh, plan edit with autosave, feasibility check of the point and its search path on the
+cell worker, redraw, flush to the browsers). Browser side (``--browser``): a real click in
+headless Chromium until the status row of the new point appears on the page.
+
+Run: ``python bench/bench_ui_latency.py [--clicks 40] [--browser]``; writes
+``bench/results/ui_latency.json``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import platform
+import statistics
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from calib.atomic_io import write_text_atomic
+from calib.frames import transform_points
+from webui.app import run
+from webui.testing import BOX_EXTENTS, T_WORLD_WOBJ_BOX, box_plan, free_port, project_to_screen
+
+RESULTS = Path(__file__).resolve().parent / "results" / "ui_latency.json"
+TARGET_MS = 150.0
+
+
+def _targets(rng: np.random.Generator, n: int) -> np.ndarray:
+    """Random points on the box's top face (wobj frame), away from the edges."""
+    hx, hy = BOX_EXTENTS[0] / 2 - 0.03, BOX_EXTENTS[1] / 2 - 0.03
+    return np.column_stack([rng.uniform(-hx, hx, n), rng.uniform(-hy, hy, n), np.zeros(n)])
+
+
+def _stats(ms: list[float]) -> dict[str, float]:
+    return {
+        "n": len(ms),
+        "median_ms": statistics.median(ms),
+        "p90_ms": float(np.percentile(ms, 90)),
+        "max_ms": max(ms),
+    }
+
+
+def bench_server(app: object, clicks: int, rng: np.random.Generator) -> list[float]:
+    """Milliseconds from the click's ray to the status being flushed, per click."""
+    out = []
+    for k, target_wobj in enumerate(_targets(rng, clicks)):
+        target = transform_points(T_WORLD_WOBJ_BOX, target_wobj)
+        origin = target + np.array([0.4, -0.3, 1.2])
+        t0 = time.perf_counter()
+        check = app.place_at_ray(origin, target - origin, point_id=f"L{k % 4}")  # type: ignore[attr-defined]
+        out.append((time.perf_counter() - t0) * 1000.0)
+        if check is None:
+            raise RuntimeError("no status came back")
+    return out
+
+
+def bench_browser(app: object, clicks: int, rng: np.random.Generator) -> list[float]:
+    """Milliseconds from a browser click to the new status row on the page, per click."""
+    from playwright.sync_api import sync_playwright
+
+    args = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+    out = []
+    with sync_playwright() as pw:
+        browser = pw.chromium.launch(executable_path="/usr/bin/chromium", args=args)
+        page = browser.new_page(viewport={"width": 1100, "height": 720})
+        page.goto(f"http://127.0.0.1:{app.server.get_port()}/")  # type: ignore[attr-defined]
+        page.locator("canvas").first.wait_for(timeout=20000)
+        time.sleep(2.0)
+        client = next(iter(app.server.get_clients().values()))  # type: ignore[attr-defined]
+        centre = transform_points(T_WORLD_WOBJ_BOX, [0.0, 0.0, 0.0])
+        client.camera.up_direction = (0.0, 0.0, 1.0)
+        client.camera.position = tuple(centre + np.array([0.8, -0.4, 1.0]))
+        client.camera.look_at = tuple(centre)
+        time.sleep(1.0)
+        cam = client.camera
+        for k, target_wobj in enumerate(_targets(rng, clicks)):
+            pid = f"W{k}"
+            app.points_panel.place.value = pid  # type: ignore[attr-defined]
+            p = transform_points(T_WORLD_WOBJ_BOX, target_wobj)
+            u, v = project_to_screen(
+                p, cam.position, cam.wxyz, cam.fov, cam.image_width, cam.image_height
+            )
+            t0 = time.perf_counter()
+            page.mouse.click(float(u), float(v))
+            page.locator(f"td:text-is('{pid}')").first.wait_for(timeout=10000)
+            out.append((time.perf_counter() - t0) * 1000.0)
+        browser.close()
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the benchmark and write ``bench/results/ui_latency.json``."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--clicks", type=int, default=40)
+    parser.add_argument("--triangles", type=int, default=100_000)
+    parser.add_argument("--browser", action="store_true", help="also click in headless Chromium")
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.WARNING)
+    rng = np.random.default_rng(7)
+    with tempfile.TemporaryDirectory() as tmp:
+        plan = box_plan(Path(tmp), n_triangles=args.triangles, name="bench_box")
+        app = run(plan, port=free_port(), block=False, autosave_path=Path(tmp) / "autosave.json")
+        try:
+            bench_server(app, 3, rng)  # warm up
+            server_ms = bench_server(app, args.clicks, rng)
+            browser_ms = bench_browser(app, min(args.clicks, 10), rng) if args.browser else []
+            result = {
+                "benchmark": "ui_latency",
+                "what": "click on the work object -> point status sent back",
+                "triangles": len(app.view.wobj_mesh.faces),  # type: ignore[union-attr]
+                "ray_engine": "embree" if app.picker.uses_embree else "numpy",  # type: ignore[union-attr]
+                "cell_check": "unavailable: " + app.cell_error if app.cell_error else "pybullet",
+                "target_median_ms": TARGET_MS,
+                "server": _stats(server_ms),
+                "browser": _stats(browser_ms) if browser_ms else None,
+                "machine": {"python": platform.python_version(), "cpu": platform.processor()},
+            }
+        finally:
+            app.stop()
+    RESULTS.parent.mkdir(parents=True, exist_ok=True)
+    write_text_atomic(RESULTS, json.dumps(result, indent=2) + "\n")
+    logging.getLogger(__name__).warning("%s", json.dumps(result, indent=2))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
