@@ -75,6 +75,9 @@ class StatorSettings:
             search says (e.g. at E's and G's nominal height). The search still runs up
             to the height where the plan's search ends.
         edge_start_offset_m: the paper's "few millimeters" offset in +x of that start, metres.
+        edge_event_offset_m: how far past the true edge, along the search direction, the
+            sensor reports it (a sensor characteristic measured once on a reference edge;
+            footprint and hysteresis make it a few mm), metres; subtracted from F and H.
     """
 
     beta1_rad: float = math.radians(15.0)
@@ -82,6 +85,7 @@ class StatorSettings:
     retake_c_d: bool = True
     edge_start_from_measured: bool = False
     edge_start_offset_m: float = 0.0
+    edge_event_offset_m: float = 0.0
 
     def __post_init__(self) -> None:
         beta1 = float(self.beta1_rad)
@@ -89,6 +93,10 @@ class StatorSettings:
             raise ShapeError(f"settings.beta1_rad must lie in (-pi/2, pi/2), got {beta1}")
         check_positive(self.p3_height_m, "settings.p3_height_m")
         check_positive(self.edge_start_offset_m, "settings.edge_start_offset_m", allow_zero=True)
+        if not math.isfinite(float(self.edge_event_offset_m)):
+            raise ShapeError(
+                f"settings.edge_event_offset_m must be finite, got {self.edge_event_offset_m}"
+            )
 
 
 @dataclass(frozen=True)
@@ -336,6 +344,9 @@ def run_stator_procedure(
     h = run.measure("H", start_m=g + off * x_now if cfg.edge_start_from_measured else None)
     if cfg.edge_start_from_measured:  # the TCP ran `off` outside the face: back onto it
         f, h = f - off * x_now, h - off * x_now
+    if cfg.edge_event_offset_m:  # the sensor reports the edge this far past it
+        f = f - cfg.edge_event_offset_m * run.commands["F"].direction
+        h = h - cfg.edge_event_offset_m * run.commands["H"].direction
     R3 = _rotation_from_points(h, f, d, True, ("H", "F", "D"))
     run.rotate(R3, "final rotation from H, F, D (V2 inverted)", ("H", "F", "D"), "eq. 1-9")
     run.origin(2, "H", "z origin from H (P6)", point=h)

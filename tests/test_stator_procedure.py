@@ -300,6 +300,28 @@ def test_edge_searches_can_start_from_measured_e_and_g(rng: np.random.Generator)
         assert raw_true[2] == pytest.approx(0.0, abs=1e-12)
 
 
+class LateEdgeProbe(BoxProbe):
+    """A box probe whose sensor reports edges 3 mm past them along the search."""
+
+    def __call__(self, cmd: SearchCommand) -> ProbeResult:
+        res = super().__call__(cmd)
+        if cmd.kind == "edge" and res.point_m is not None:
+            return ProbeResult(res.point_m + 0.003 * cmd.direction, travel_m=res.travel_m + 0.003)
+        return res
+
+
+def test_known_edge_event_offset_is_removed(rng: np.random.Generator) -> None:
+    T_prelim = nominal_pose(-0.05, (1.0, 0.3, 0.6))
+    T_true = T_prelim @ random_transform(rng, 0.02, math.radians(3.0))
+    late = run_stator_procedure(LAYOUT, T_prelim, LateEdgeProbe(T_true))
+    dt, dr = pose_error(late.T_base_wobj, T_true)
+    assert dt > 0.002  # uncorrected, the z origin is 3 mm off
+    cfg = StatorSettings(edge_event_offset_m=0.003)
+    fixed = run_stator_procedure(LAYOUT, T_prelim, LateEdgeProbe(T_true), cfg)
+    dt, dr = pose_error(fixed.T_base_wobj, T_true)
+    assert dt < 1e-9 and dr < 1e-9
+
+
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
@@ -307,6 +329,7 @@ def test_edge_searches_can_start_from_measured_e_and_g(rng: np.random.Generator)
         ({"beta1_rad": float("nan")}, "beta1_rad must lie in"),
         ({"p3_height_m": 0.0}, "p3_height_m must be > 0"),
         ({"edge_start_offset_m": -0.001}, "edge_start_offset_m must be >= 0"),
+        ({"edge_event_offset_m": float("inf")}, "edge_event_offset_m must be finite"),
     ],
 )
 def test_bad_settings_raise(kwargs, match) -> None:
