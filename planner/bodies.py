@@ -8,7 +8,9 @@ and return URDF link frames (``T_world_link``) and convert at this one place.
 from __future__ import annotations
 
 import logging
+import math
 import tempfile
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,7 +19,7 @@ import pybullet as pb
 import trimesh
 from numpy.typing import NDArray
 
-from calib.frames import invert_transform, quat_xyzw_from_matrix, transform_from_pos_quat_xyzw
+from calib.frames import invert_transform
 from planner.errors import MeshError, URDFError
 
 FloatArray = NDArray[np.float64]
@@ -51,8 +53,34 @@ class BodyLinks:
 
 
 def pb_pose(T: FloatArray) -> tuple[list[float], list[float]]:
-    """PyBullet ``(position, quat_xyzw)`` of a transform ``(4, 4)``."""
-    return T[:3, 3].tolist(), quat_xyzw_from_matrix(T[:3, :3]).tolist()
+    """PyBullet ``(position, quat_xyzw)`` of a transform ``(4, 4)``.
+
+    Scalar Shepperd method on Python floats: this runs once per candidate pose in the
+    feasibility loop, where ``scipy.spatial.transform`` costs ~30x more per call.
+    """
+    (r00, r01, r02, px), (r10, r11, r12, py), (r20, r21, r22, pz) = T[:3].tolist()
+    tr = r00 + r11 + r22
+    if tr > 0.0:
+        s = 2.0 * math.sqrt(tr + 1.0)
+        q = [(r21 - r12) / s, (r02 - r20) / s, (r10 - r01) / s, 0.25 * s]
+    elif r00 >= r11 and r00 >= r22:
+        s = 2.0 * math.sqrt(max(1.0 + r00 - r11 - r22, 1e-300))
+        q = [0.25 * s, (r01 + r10) / s, (r02 + r20) / s, (r21 - r12) / s]
+    elif r11 >= r22:
+        s = 2.0 * math.sqrt(max(1.0 + r11 - r00 - r22, 1e-300))
+        q = [(r01 + r10) / s, 0.25 * s, (r12 + r21) / s, (r02 - r20) / s]
+    else:
+        s = 2.0 * math.sqrt(max(1.0 + r22 - r00 - r11, 1e-300))
+        q = [(r02 + r20) / s, (r12 + r21) / s, 0.25 * s, (r10 - r01) / s]
+    return [px, py, pz], q
+
+
+def pb_transform(pos: Sequence[float], quat_xyzw: Sequence[float]) -> FloatArray:
+    """``(4, 4)`` transform of a PyBullet ``(position, quat_xyzw)`` pair."""
+    T = np.eye(4)
+    T[:3, :3] = np.reshape(pb.getMatrixFromQuaternion(quat_xyzw), (3, 3))
+    T[:3, 3] = pos
+    return T
 
 
 def _body_links(client: int, body: int) -> BodyLinks:
@@ -60,7 +88,7 @@ def _body_links(client: int, body: int) -> BodyLinks:
     for j in range(pb.getNumJoints(body, physicsClientId=client)):
         names[j] = pb.getJointInfo(body, j, physicsClientId=client)[12].decode()
     info = pb.getDynamicsInfo(body, -1, physicsClientId=client)
-    return BodyLinks(body, names, transform_from_pos_quat_xyzw(info[3], info[4]))
+    return BodyLinks(body, names, pb_transform(info[3], info[4]))
 
 
 def load_urdf_body(client: int, path: Path, T_world_root: FloatArray, what: str) -> BodyLinks:
@@ -95,12 +123,12 @@ def world_link_pose(client: int, links: BodyLinks, index: int) -> FloatArray:
     """``T_world_link`` (4, 4) of link ``index`` (``-1``: base) in the current state."""
     if index == -1:
         pos, quat = pb.getBasePositionAndOrientation(links.body_id, physicsClientId=client)
-        T_world_inertial = transform_from_pos_quat_xyzw(pos, quat)
+        T_world_inertial = pb_transform(pos, quat)
         return T_world_inertial @ invert_transform(links.T_link_inertial)
     state = pb.getLinkState(
         links.body_id, index, computeForwardKinematics=True, physicsClientId=client
     )
-    return transform_from_pos_quat_xyzw(state[4], state[5])
+    return pb_transform(state[4], state[5])
 
 
 def mesh_collision_shape(client: int, mesh: trimesh.Trimesh, concave: bool, source: str) -> int:
