@@ -264,11 +264,12 @@ def _finite_scalar(value: object, name: str) -> float:
 def alpha1_from_points(a_base: ArrayLike, b_base: ArrayLike) -> float:
     """Eq. 11: ``alpha1 = atan((B_x - A_x) / (B_y - A_y))``, radians in ``[-pi/2, pi/2]``.
 
-    ``alpha1`` is the angle of the horizontal projection of ``A -> B`` from the base +y axis
-    towards base +x (clockwise seen from above). For a WOCS turned by the Tait-Bryan angle
-    ``alpha`` about base z, with ``A -> B`` along WOCS +y near base +y, ``alpha1 = -alpha``:
-    the sign is opposite to eq. 7-9's alpha. We evaluate ``arctan2(dx, dy)`` and fold it into
-    ``[-pi/2, pi/2]``, which equals ``atan(dx / dy)`` for every ``dy != 0`` and gives the limit
+    ``alpha1`` is the angle of the horizontal projection of ``A -> B`` from the base y axis
+    towards base +x (clockwise seen from above), folded into ``[-pi/2, pi/2]``, so ``A -> B``
+    along base +y and along base -y both give ``alpha1 = 0``. For a WOCS turned by the
+    Tait-Bryan angle ``alpha`` about base z (``A -> B`` along WOCS +y), ``alpha1 = -alpha``
+    modulo ``pi``: the sign is opposite to eq. 7-9's alpha. We evaluate ``arctan2(dx, dy)``
+    and fold it, which equals ``atan(dx / dy)`` for every ``dy != 0`` and gives the limit
     ``+-pi/2`` when ``dy = 0`` (where the printed formula divides by zero). Eq. 12 is
     unchanged by ``alpha1 -> alpha1 +- pi``, so the fold never matters there.
 
@@ -300,21 +301,25 @@ def p3_estimate(
     """Eq. 11-12: the constructed point P3, ``height_m`` above B on the assumed side face.
 
     ``P3 = B + h * (tan(beta1) cos(alpha1)^2, tan(beta1) sin(alpha1) cos(alpha1), 1)`` with
-    ``alpha1`` from eq. 11 and ``h = height_m`` (the paper's 50 mm). For a face inclined by
-    ``beta1`` (the Tait-Bryan beta of ``R_base_wobj``, top leaning towards base +x), rising
-    ``h`` along the face moves ``h tan(beta1)`` horizontally along its normal. Because eq. 11's
-    alpha1 is ``-alpha`` (see :func:`alpha1_from_points`), the printed y-term has the opposite
-    sign to that exact slope; the error lies along ``A -> B`` (= V1) to first order and so
-    does not change ``X = V1 x V2``: it tilts the preliminary WOCS by only
-    about ``2 tan(beta1) sin(alpha)^2`` rad about WOCS y (0.1 deg at alpha = 3 deg, 1 deg at
-    10 deg, 4 deg at 20 deg), which later steps remove. We keep eq. 12 as printed.
+    ``alpha1`` from eq. 11 and ``h = height_m`` (the paper's 50 mm). The face is taken to be
+    inclined by ``beta1`` from vertical with its top leaning towards base +x: rising ``h``
+    along it moves ``h tan(beta1)`` horizontally, towards ``(cos alpha1, sin alpha1)``
+    (approximately) in the base xy-plane. For a WOCS with y along base +y (the robot at
+    -x) ``beta1`` is the Tait-Bryan beta of ``R_base_wobj``; with y along base -y (the
+    robot at +x, WOCS x towards it) it is ``-beta``. Because eq. 11's alpha1 is minus the
+    WOCS turn about z, the printed y-term has the opposite sign to the exact slope; that
+    error lies along ``A -> B`` (= V1) to first order and so does not change
+    ``X = V1 x V2``: it tilts the preliminary WOCS about its y axis by only about
+    ``2 tan(beta1) sin(a)^2`` rad, ``a`` the turn of ``A -> B`` from the base y axis
+    (0.1 deg at 3 deg, 1 deg at 10 deg, 4 deg at 20 deg), which later steps remove. We keep
+    eq. 12 as printed.
 
     Args:
         a_base: ``(3,)`` measured point A (P1), base frame, metres.
         b_base: ``(3,)`` measured point B (P2), base frame, metres.
-        beta1_rad: assumed inclination of the side face in the base frame, radians
-            (paper: 15 deg). Eq. 12 takes the face's top to lean towards base +x when
-            ``beta1 > 0``; a face leaning the other way needs a negative ``beta1``.
+        beta1_rad: assumed inclination of the side face from vertical, radians (paper:
+            15 deg), positive when the face's top leans towards base +x; a face leaning
+            towards base -x needs a negative ``beta1``.
         height_m: height of P3 above B, metres (paper: 50 mm).
 
     Returns:

@@ -64,8 +64,9 @@ class StatorSettings:
     """Settings of the A-H procedure.
 
     Attributes:
-        beta1_rad: assumed inclination of the stator side in the base frame (eq. 12), radians
-            (paper: 15 deg; positive when the face's top leans towards base +x).
+        beta1_rad: assumed inclination of the stator side from vertical (eq. 12), radians
+            (paper: 15 deg; positive when the face's top leans towards base +x, see
+            :func:`calib.hultman.p3_estimate`).
         p3_height_m: height of the constructed point P3 above B (eq. 12), metres (paper: 50 mm).
         retake_c_d: measure C and D again at the end, as the paper does (``"C2"``, ``"D2"``);
             when False the first C and D are reused for the final origin.

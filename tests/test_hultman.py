@@ -134,9 +134,13 @@ def test_eq12_hand_worked() -> None:
     np.testing.assert_allclose(p3, expect, atol=1e-15)
 
 
-def test_eq12_p3_lies_on_the_inclined_face_when_aligned() -> None:
-    # side face inclined beta = 15 deg in the base frame, WOCS y along base y (alpha = 0)
-    R = matrix_from_tait_bryan_zyx(0.0, math.radians(15.0), 0.0)
+@pytest.mark.parametrize("robot_at_plus_x", [False, True])
+def test_eq12_p3_lies_on_the_inclined_face_when_aligned(robot_at_plus_x: bool) -> None:
+    # side face inclined 15 deg, top leaning towards base +x; WOCS y along base +y (alpha = 0)
+    # or, facing a robot at +x, along base -y (alpha = 180 deg, Tait-Bryan beta = -15 deg)
+    b15 = math.radians(15.0)
+    abg = (math.pi, -b15, 0.0) if robot_at_plus_x else (0.0, b15, 0.0)
+    R = matrix_from_tait_bryan_zyx(*abg)
     T = make_transform(R, [1.0, 0.3, 0.5])
     a, b = (T @ [0, -0.8, -0.25, 1])[:3], (T @ [0, -0.2, -0.25, 1])[:3]
     p3 = hultman.p3_estimate(a, b, math.radians(15.0))
