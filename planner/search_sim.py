@@ -94,6 +94,9 @@ class SimulatedProbe:
         accuracy_field: this robot's accuracy field (``robot_error.sample_field``), or None.
         geometry: the stator geometry, to classify landings over slot holes or off the face.
         reachability: optional hook that vets each commanded search.
+        edge_inset_m: an edge search runs its track this far inside the commanded path along
+            the sensor axis (so the sensor detects the face it slides over); the reported point
+            stays on the commanded path, i.e. on the face (the contract of the A-H procedure).
         scan_step_m: step of the coarse edge scan, m.
         edge_tolerance_m: bisection tolerance of the edge event, m.
     """
@@ -106,6 +109,7 @@ class SimulatedProbe:
     accuracy_field: AccuracyField | None = None
     geometry: StatorGeometry | None = None
     reachability: ReachabilityHook | None = None
+    edge_inset_m: float = 0.003
     scan_step_m: float = 0.002
     edge_tolerance_m: float = 1e-5
     events: list[ProbeEvent] = field(default_factory=list)
@@ -154,8 +158,8 @@ class SimulatedProbe:
         offset = self.robot_error.sample_repeatability_m(self.rng)
         if self.accuracy_field is not None:
             offset = offset + self.accuracy_field(start)
-        tcp0 = start + offset
         axis = np.asarray(cmd.sensor_axis, float)
+        tcp0 = start + offset + (self.edge_inset_m * axis if cmd.kind == "edge" else 0.0)
         direction = np.asarray(cmd.direction, float)
         length = float(cmd.length_m)
         if cmd.kind == "approach" and float(direction @ axis) > 1.0 - 1e-12:

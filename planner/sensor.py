@@ -61,7 +61,7 @@ class ProximitySensor:
 
     face_diameter_m: float = 0.018
     sensing_distance_m: float = 0.008
-    decay_length_m: float = 0.003
+    decay_length_m: float = 0.0016
     hysteresis_fraction: float = 0.10
     repeatability_sigma_m: float = 0.00004
     n_rays: int = 256
@@ -105,7 +105,7 @@ class ProximitySensor:
         return sunflower_disk(self.n_scan_rays, self.radius_m)
 
     def signal(self, distances_m: FloatArray) -> FloatArray:
-        """Damping signal from face-to-metal distances ``(..., n)`` (m, ``inf`` = none) -> ``(...)``.
+        """Damping signal ``(...)`` from face-to-metal distances ``(..., n)`` (m, ``inf``: none).
 
         1.0 is the switch-on level of a full flat target at Sn (without jitter).
         """
@@ -140,6 +140,38 @@ class ProximitySensor:
         if not 0.0 < covered_fraction <= 1.0:
             raise ShapeError(f"covered_fraction must be in (0, 1], got {covered_fraction}")
         return self.decay_length_m * math.log(1.0 / covered_fraction)
+
+    def edge_event_offset_m(self, inset_m: float) -> float:
+        """How far past a straight edge the face centre is when the sensor switches off, m.
+
+        The sensor slides over a flat face ``inset_m`` closer than Sn (signal ``exp(inset /
+        lambda)`` while fully covered) towards a straight edge; it switches off (no jitter) when
+        the covered fraction ``c(t) = (acos(t/R) - (t/R) sqrt(1 - (t/R)^2)) / pi`` of the disk
+        falls to ``off_level() exp(-inset / lambda)``. Solved for ``t`` on the exact disk, not
+        the ray bundle: this is the analytic bias of an edge search, which a robot program
+        measures once on a reference edge (``StatorSettings.edge_event_offset_m``).
+        """
+        c_off = self.off_level() * math.exp(-float(inset_m) / self.decay_length_m)
+        if c_off >= 1.0:
+            raise ShapeError(
+                f"edge inset {inset_m} m is too small: the sensor would not detect the face"
+            )
+        r = self.radius_m
+        if r == 0.0:
+            return 0.0
+
+        def covered(t: float) -> float:
+            u = min(max(t / r, -1.0), 1.0)
+            return (math.acos(u) - u * math.sqrt(1.0 - u * u)) / math.pi
+
+        lo, hi = -r, r  # covered(-r) = 1 > c_off > 0 = covered(r)
+        for _ in range(80):
+            mid = 0.5 * (lo + hi)
+            if covered(mid) > c_off:
+                lo = mid
+            else:
+                hi = mid
+        return 0.5 * (lo + hi)
 
     def sample_jitter_m(self, rng: np.random.Generator) -> float:
         """One switching-distance jitter ``nu ~ N(0, repeatability_sigma_m)``, m."""
