@@ -15,8 +15,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from calib.frames import check_transform
+from planner.kinematics.branches import BranchFlags, classify
 from planner.kinematics.chain import KinematicChain
 from planner.kinematics.numeric_ik import NumericIK
+from planner.kinematics.opw_from_urdf import NotOPWError, opw_from_chain
+from planner.kinematics.opw_robot import OPWRobot
 
 log = logging.getLogger(__name__)
 
@@ -68,10 +71,15 @@ class IKSolver:
     """
 
     def __init__(
-        self, chain: KinematicChain, kind: str, why_not_opw: str | None, numeric: NumericIK
+        self,
+        chain: KinematicChain,
+        numeric: NumericIK,
+        opw: OPWRobot | None = None,
+        why_not_opw: str | None = None,
     ) -> None:
         self.chain = chain
-        self.kind = kind
+        self.opw = opw
+        self.kind = "opw" if opw is not None else "numeric"
         self.why_not_opw = why_not_opw
         self._numeric = numeric
 
@@ -89,9 +97,36 @@ class IKSolver:
         """
         T = check_transform(T_base_flange, "T_base_flange")
         T = T[None] if T.ndim == 2 else T
+        if self.opw is not None:
+            q8, ok8 = self.opw.ik_branches(T)
+            q, valid = self.opw.expand(q8, ok8)
+            V = q.shape[1] // 8
+            # bits 4 and 2 of the OPW branch index are the geometric shoulder / elbow flags
+            # (wrist centre behind axis 1 / behind the lower arm); bit 1 is axis 5's sign
+            code = (np.arange(8) & 6) + (q8[:, :, 4] < 0)
+            branch = np.where(valid, np.repeat(code, V, axis=1), -1)
+            return IKSolutions(q, valid, branch)
         res = self._numeric.solve(T, seeds)
         branch = np.full(res.valid.shape, -1, dtype=int)
         return IKSolutions(res.q, res.valid, branch)
+
+    def classify(self, q: ArrayLike) -> BranchFlags:
+        """Shoulder, elbow and wrist flags of ``q (6,)`` (OPW arms only).
+
+        Raises:
+            NotOPWError: the chain is not an OPW arm (the message says why).
+        """
+        if self.opw is None:
+            raise NotOPWError(f"branches are defined for OPW arms only: {self.why_not_opw}")
+        return classify(self.opw, q)
+
+    def abb_confdata(self, q: ArrayLike) -> tuple[int, int, int, int]:
+        """ABB ``confdata`` ``(cf1, cf4, cf6, cfx)`` of ``q (6,)`` (OPW arms only)."""
+        from planner.kinematics.branches import abb_confdata
+
+        if self.opw is None:
+            raise NotOPWError(f"confdata needs an OPW arm: {self.why_not_opw}")
+        return abb_confdata(q, self.opw)
 
 
 def make_ik_solver(
@@ -105,6 +140,10 @@ def make_ik_solver(
         rng: random seeds for the numeric solver (default: a fixed low-discrepancy set).
     """
     numeric = NumericIK(chain, n_seeds=n_seeds, rng=rng)
-    why = "the analytic OPW solver is not available yet"
-    log.info("IK for %s: numeric (%s)", chain.name, why)
-    return IKSolver(chain, "numeric", why, numeric)
+    try:
+        opw = opw_from_chain(chain)
+    except NotOPWError as exc:
+        log.info("IK for %s: numeric, not OPW: %s", chain.name, exc)
+        return IKSolver(chain, numeric, None, str(exc))
+    log.info("IK for %s: analytic OPW %s", chain.name, opw.params)
+    return IKSolver(chain, numeric, opw, None)

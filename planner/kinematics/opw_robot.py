@@ -1,0 +1,112 @@
+"""An OPW arm placed in a URDF's frames: base and tip transforms, joint limits, 2*pi variants.
+
+``T_base_tip = T_base_opw @ opw_fk(params, q) @ T_ee_tip``: the OPW frame sits on axis 1 of the
+URDF base, the OPW end frame on axis 6, and both constant transforms are derived from the URDF
+(:mod:`planner.kinematics.opw_from_urdf`).
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from calib.frames import invert_transform
+from planner.kinematics.opw import OPWParameters, opw_fk, opw_ik
+
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+
+@dataclass(frozen=True, eq=False)
+class OPWRobot:
+    """An OPW arm with its place in the URDF and its joint limits.
+
+    Attributes:
+        params: the OPW parameters (lengths in metres, offsets in rad, sign corrections).
+        T_base_opw: the OPW frame in the URDF base frame, ``(4, 4)``.
+        T_ee_tip: the chain's tip frame (flange) in the OPW end frame, ``(4, 4)``.
+        lower: lower joint limits ``(6,)``, rad (``-inf`` for continuous joints).
+        upper: upper joint limits ``(6,)``, rad (``+inf`` for continuous joints).
+    """
+
+    params: OPWParameters
+    T_base_opw: FloatArray
+    T_ee_tip: FloatArray
+    lower: FloatArray
+    upper: FloatArray
+
+    @property
+    def turn_counts(self) -> tuple[int, ...]:
+        """``(6,)`` how many values of each joint can give the same pose: ``ceil(range / 360)``.
+
+        A joint whose range exceeds 360 degrees (e.g. ABB axis 6, +-400 deg) reaches the same
+        pose at ``q`` and ``q +- 2*pi``; continuous joints (infinite limits) keep one value.
+        """
+        out = []
+        for lo, hi in zip(self.lower, self.upper):
+            finite = np.isfinite(lo) and np.isfinite(hi)
+            out.append(max(1, int(np.ceil((hi - lo) / (2 * np.pi) - 1e-9))) if finite else 1)
+        return tuple(out)
+
+    def fk(self, q: FloatArray) -> FloatArray:
+        """``T_base_tip (..., 4, 4)`` of robot joint values ``q (..., 6)``."""
+        return self.T_base_opw @ opw_fk(self.params, q) @ self.T_ee_tip
+
+    def ik_branches(self, T_base_tip: FloatArray) -> tuple[FloatArray, BoolArray]:
+        """The 8 OPW branches ``q (N, 8, 6)`` wrapped to ``(-pi, pi]`` and ``reachable (N, 8)``.
+
+        Joint limits are not applied; unreachable branches hold NaN.
+        """
+        T = np.asarray(T_base_tip, dtype=np.float64)
+        if not np.array_equal(self.T_base_opw, np.eye(4)):
+            T = invert_transform(self.T_base_opw) @ T
+        if not np.array_equal(self.T_ee_tip, np.eye(4)):
+            T = T @ invert_transform(self.T_ee_tip)
+        return opw_ik(self.params, T)
+
+    def solve(self, T_base_tip: FloatArray) -> tuple[FloatArray, BoolArray]:
+        """All solutions within joint limits, including the 2*pi variants (see :meth:`expand`).
+
+        Args:
+            T_base_tip: ``(N, 4, 4)`` tip poses in the base frame.
+        """
+        return self.expand(*self.ik_branches(T_base_tip))
+
+    def expand(self, q8: FloatArray, ok8: BoolArray) -> tuple[FloatArray, BoolArray]:
+        """Add the 2*pi variants to branches ``q8 (N, 8, 6)`` and apply the joint limits.
+
+        Joints whose limits lie within ``[-pi, pi]`` are checked as they are; the others are
+        moved to their lowest value ``>= lower`` (modulo 2*pi) and ``turn_counts`` values
+        ``+ 2*pi*i`` are tried. ``V = prod(turn_counts)``.
+
+        Returns:
+            ``q (N, 8 * V, 6)``, branch-major (entry ``k`` is OPW branch ``k // V``), NaN where
+            not valid, and ``valid (N, 8 * V)``: reachable and within the joint limits.
+        """
+        counts = self.turn_counts
+        combos = np.array(list(itertools.product(*(range(m) for m in counts))), dtype=int)
+        N, V = q8.shape[0], combos.shape[0]
+        q = np.empty((N, 8, V, 6))
+        inside = np.broadcast_to(ok8[:, :, None], (N, 8, V)).copy()
+        two_pi = 2.0 * np.pi
+        with np.errstate(invalid="ignore"):
+            for j, (lo, hi) in enumerate(zip(self.lower, self.upper)):
+                qj = q8[:, :, j]
+                if not (np.isfinite(lo) and np.isfinite(hi)):
+                    q[:, :, :, j] = qj[:, :, None]
+                    continue
+                if lo >= -np.pi and hi <= np.pi:
+                    q[:, :, :, j] = qj[:, :, None]
+                    inside &= ((qj >= lo - 1e-12) & (qj <= hi + 1e-12))[:, :, None]
+                    continue
+                q_lo = qj - two_pi * np.floor((qj - lo + 1e-12) * (1.0 / two_pi))
+                cand = q_lo[:, :, None] + two_pi * np.arange(counts[j])  # (N, 8, m)
+                q[:, :, :, j] = cand[:, :, combos[:, j]]
+                inside &= (cand <= hi + 1e-12)[:, :, combos[:, j]]
+        q = q.reshape(N, 8 * V, 6)
+        valid = inside.reshape(N, 8 * V)
+        q[~valid] = np.nan
+        return q, valid
