@@ -270,5 +270,5 @@ def _well_spread(pos: FloatArray, normal: FloatArray, size_m: float) -> bool:
     if pos.shape[0] >= 3:
         e1, e2 = pos[1] - pos[0], pos[2] - pos[0]
         area2 = np.linalg.norm(np.cross(e1, e2))
-        return bool(area2 > 0.1 * size_m**2)
+        return bool(area2 > 0.3 * size_m**2)
     return True
