@@ -94,6 +94,9 @@ def _body_links(client: int, body: int) -> BodyLinks:
 def load_urdf_body(client: int, path: Path, T_world_root: FloatArray, what: str) -> BodyLinks:
     """Load a URDF as a fixed-base body with its root link frame at ``T_world_root``.
 
+    Cylinders stay true cylinders (``URDF_USE_IMPLICIT_CYLINDER``; PyBullet otherwise swaps
+    them for coarse convex hulls that under-report distances by millimetres).
+
     Args:
         client: PyBullet client id.
         path: URDF file.
@@ -107,7 +110,14 @@ def load_urdf_body(client: int, path: Path, T_world_root: FloatArray, what: str)
         raise URDFError(f"{what} URDF not found: {path}")
     pos, quat = pb_pose(T_world_root)
     try:
-        body = pb.loadURDF(str(path), pos, quat, useFixedBase=True, flags=0, physicsClientId=client)
+        body = pb.loadURDF(
+            str(path),
+            pos,
+            quat,
+            useFixedBase=True,
+            flags=pb.URDF_USE_IMPLICIT_CYLINDER,
+            physicsClientId=client,
+        )
     except pb.error as exc:
         raise URDFError(f"cannot load {what} URDF {path}: {exc} (malformed XML?)") from None
     return _body_links(client, body)

@@ -39,7 +39,7 @@ from planner.workobject import WorkObject, load_work_object
 
 if TYPE_CHECKING:
     from calib.probing import SearchCommand
-    from planner.feasibility import ProbeFeasibility
+    from planner.feasibility import ProbeFeasibility, ReachModel
     from planner.reachability_map import ReachabilityMap
     from planner.search_paths import PathFeasibility
 
@@ -95,6 +95,7 @@ class Cell:
             np.eye(4) if T_world_base is None else check_transform(T_world_base, "T_world_base")
         )
         self._T_world_wobj = np.eye(4)
+        self._reach: ReachModel | None = None
         self.work_object: WorkObject | None = None
         self.fixtures: dict[str, Fixture] = {}
         self._client: int | None = pb.connect(pb.DIRECT)
@@ -245,6 +246,15 @@ class Cell:
     def T_base_wobj(self) -> FloatArray:
         """``(4, 4)`` work-object frame in the robot base frame, m."""
         return invert_transform(self._T_world_base) @ self._T_world_wobj
+
+    @property
+    def reach_model(self) -> ReachModel:
+        """Shoulder and reach of the robot (computed once, seeded)."""
+        if self._reach is None:
+            from planner.feasibility import reach_model
+
+            self._reach = reach_model(self.chain, np.random.default_rng(0))
+        return self._reach
 
     @property
     def home_q(self) -> FloatArray:

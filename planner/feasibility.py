@@ -1,0 +1,302 @@
+"""Probe-pose feasibility, batch-first: N surface points in, N answers (with reasons) out.
+
+A probe pose puts the TCP (``sensor`` by default) on the surface point with its +z axis along
+``-normal`` (into the surface); the rotation about that axis is free and searched every
+``rotation_step_deg``. All ``N x R`` flange poses go to the IK solver in one call; candidates
+(pose, branch) within limits and away from wrist singularity are then collision-checked in
+order of least joint motion from ``q_ref`` (candidates near a joint limit last) until one
+passes with margin. A feasible pose whose clearance slack or joint-limit margin is small is
+``"marginal"``. Infeasible poses say why: out of reach, a joint at its limit, singular wrist, or
+the limiting collision pair and its clearance.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from calib.errors import DegenerateGeometryError, ShapeError
+from calib.frames import invert_transform
+from calib.validation import check_positive, check_shape
+from planner.collision import Clearance
+
+if TYPE_CHECKING:
+    from planner.cell import Cell
+    from planner.kinematics.chain import KinematicChain
+
+FloatArray = NDArray[np.float64]
+Status = Literal["feasible", "marginal", "infeasible"]
+
+#: Wrist singularity of OPW arms: ``|sin q5|`` below ``sin`` of this angle, rad.
+WRIST_SINGULAR_RAD = math.radians(5.0)
+#: Other arms: smallest singular value of the Jacobian (translation rows / reach) below this.
+MIN_SINGULAR_VALUE = 0.05
+#: A joint closer than this to a limit makes a feasible pose marginal, rad.
+MARGINAL_LIMIT_RAD = math.radians(5.0)
+
+
+@dataclass(frozen=True)
+class ProbeFeasibility:
+    """Feasibility of one probe pose.
+
+    Attributes:
+        feasible: True when a collision-free, within-limits, non-singular pose was found.
+        status: ``"feasible"``, ``"marginal"`` (feasible with small clearance or joint-limit
+            margin) or ``"infeasible"``.
+        reason: empty when ``status == "feasible"``; otherwise why, e.g. ``"out of reach
+            (2.87 m from the shoulder, reach 1.92 m)"``, ``"joint 5 at limit"``,
+            ``"singular wrist"``, ``"link_4 hits table (clearance -3.0 mm)"``.
+        q: ``(n,)`` joint values of the chosen pose, rad; for an infeasible pose the least-bad
+            candidate checked, ``None`` when there is no IK candidate at all.
+        branch: IK branch of ``q`` (OPW configuration 0-7), -1 when unknown or none.
+        rotation_rad: chosen rotation about the sensor axis, rad (NaN when none).
+        clearance_m: clearance of the limiting pair at ``q``, m (NaN when not checked).
+        joint_margin_rad: smallest distance of ``q`` to a joint limit, rad (NaN when none).
+        T_base_flange: ``(4, 4)`` flange pose of ``q``, base frame, m (``None`` when none).
+    """
+
+    feasible: bool
+    status: Status
+    reason: str
+    q: FloatArray | None
+    branch: int
+    rotation_rad: float
+    clearance_m: float
+    joint_margin_rad: float
+    T_base_flange: FloatArray | None
+
+
+def tcp_frames(points: FloatArray, normals: FloatArray, angles: FloatArray) -> FloatArray:
+    """``T_wobj_tcp (N, R, 4, 4)``: origin on each point, +z = ``-normal``, rotated by angles.
+
+    At angle 0 the TCP x axis is the unit vector perpendicular to z closest to the wobj axis
+    least aligned with z (a fixed, deterministic choice); angle ``a`` turns x about z by ``a``.
+    """
+    z = -normals
+    ref = np.eye(3)[np.argmin(np.abs(z), axis=1)]
+    x0 = ref - np.einsum("ij,ij->i", ref, z)[:, None] * z
+    x0 /= np.linalg.norm(x0, axis=1, keepdims=True)
+    y0 = np.cross(z, x0)
+    c, s = np.cos(angles)[None, :, None], np.sin(angles)[None, :, None]
+    x = c * x0[:, None] + s * y0[:, None]
+    y = np.cross(z[:, None], x)
+    T = np.zeros((points.shape[0], angles.size, 4, 4))
+    T[..., :3, 0], T[..., :3, 1] = x, y
+    T[..., :3, 2] = z[:, None]
+    T[..., :3, 3] = points[:, None]
+    T[..., 3, 3] = 1.0
+    return T
+
+
+@dataclass(frozen=True)
+class ReachModel:
+    """Where the shoulder is and how far the flange gets from it.
+
+    Attributes:
+        axis_origin_m: ``(3,)`` a point on joint 1's axis, base frame, m.
+        axis: ``(3,)`` joint 1's unit axis, base frame.
+        shoulder_m: ``(3,)`` the shoulder (joint 2's origin) at zero, base frame, m.
+        reach_m: largest flange distance from the shoulder over 20,000 random in-limit
+            configurations (the shoulder turning with joint 1), m.
+    """
+
+    axis_origin_m: FloatArray
+    axis: FloatArray
+    shoulder_m: FloatArray
+    reach_m: float
+
+    def shoulder_towards(self, p: FloatArray) -> FloatArray:
+        """``(M, 3)``: the shoulder turned about joint 1's axis towards points ``p (M, 3)``."""
+        o, a = self.axis_origin_m, self.axis
+        s = self.shoulder_m - o
+        s_ax = (s @ a) * a
+        r_s = float(np.linalg.norm(s - s_ax))
+        v = p - o
+        r_p = v - np.outer(v @ a, a)
+        norm = np.linalg.norm(r_p, axis=1, keepdims=True)
+        unit = np.divide(r_p, norm, out=np.zeros_like(r_p), where=norm > 1e-12)
+        return o + s_ax + r_s * unit
+
+
+def reach_model(chain: KinematicChain, rng: np.random.Generator) -> ReachModel:
+    """The :class:`ReachModel` of ``chain`` (uses ``rng`` for the sampled configurations)."""
+    lo = np.where(np.isfinite(chain.lower), chain.lower, -np.pi)
+    hi = np.where(np.isfinite(chain.upper), chain.upper, np.pi)
+    zero = chain.joint_frames(np.clip(np.zeros(chain.n_joints), lo, hi))[0]
+    k = min(1, chain.n_joints - 1)
+    axis = zero[0, :3, :3] @ chain.axes[0]
+    q = rng.uniform(lo, hi, size=(20_000, chain.n_joints))
+    frames = chain.joint_frames(q)
+    tip = frames[:, -1] @ chain.T_last_tip
+    reach = float(np.max(np.linalg.norm(tip[:, :3, 3] - frames[:, k, :3, 3], axis=1)))
+    return ReachModel(zero[0, :3, 3].copy(), axis, zero[k, :3, 3].copy(), reach)
+
+
+def limit_margin(chain: KinematicChain, q: FloatArray) -> FloatArray:
+    """Smallest distance of each ``q (..., n)`` to a joint limit, rad (inf for no limits)."""
+    with np.errstate(invalid="ignore"):
+        return np.min(np.minimum(q - chain.lower, chain.upper - q), axis=-1)
+
+
+def singular(cell: Cell, q: FloatArray) -> tuple[NDArray[np.bool_], str]:
+    """Mask ``(M,)`` of configurations ``q (M, n)`` too near a singularity, and the reason."""
+    if cell.solver.kind == "opw" and q.shape[1] == 6:
+        return np.abs(np.sin(q[:, 4])) < math.sin(WRIST_SINGULAR_RAD), "singular wrist"
+    _, J = cell.chain.fk_jacobian(q)
+    Js = J.copy()
+    Js[:, :3] /= max(cell.reach_model.reach_m, 1e-9)
+    sv = np.linalg.svd(Js, compute_uv=False)[:, -1]
+    return sv < MIN_SINGULAR_VALUE, "near a singularity"
+
+
+def _no_ik_reason(cell: Cell, T_flange: FloatArray) -> str:
+    """Why ``(R, 4, 4)`` flange poses of one point have no valid IK solution."""
+    model = cell.reach_model
+    p = T_flange[:, :3, 3]
+    dist = float(np.min(np.linalg.norm(p - model.shoulder_towards(p), axis=1)))
+    where = f"{dist:.2f} m from the shoulder, reach {model.reach_m:.2f} m"
+    if dist > model.reach_m:
+        return f"out of reach ({where})"
+    opw = getattr(cell.solver, "opw", None)
+    if opw is not None:
+        q8, ok8 = opw.ik_branches(T_flange)
+        if not ok8.any():
+            return f"out of reach ({where})"
+        q = q8[ok8]
+        lo, hi = cell.chain.lower, cell.chain.upper
+        two_pi = 2 * np.pi
+        with np.errstate(invalid="ignore"):
+            best = np.full(q.shape, np.inf)  # violation of each joint over its 2*pi variants
+            for k in (-2, -1, 0, 1, 2):
+                qk = q + k * two_pi
+                best = np.minimum(best, np.maximum(lo - qk, 0) + np.maximum(qk - hi, 0))
+        worst = np.argmax(best, axis=1)  # each candidate's worst joint
+        j = int(np.bincount(worst, minlength=q.shape[1]).argmax())
+        return f"joint {j + 1} at limit ({cell.chain.joint_names[j]})"
+    return f"no IK solution within joint limits ({where})"
+
+
+def check_probes(
+    cell: Cell,
+    points_wobj: ArrayLike,
+    normals_wobj: ArrayLike,
+    tcp: str = "sensor",
+    rotation_step_deg: float = 15.0,
+    margin_m: float | None = None,
+    q_ref: ArrayLike | None = None,
+    max_checks: int = 48,
+) -> list[ProbeFeasibility]:
+    """Feasibility of ``N`` probe poses (see the module docstring).
+
+    Args:
+        cell: the cell (its current ``T_base_wobj`` places the points).
+        points_wobj: ``(N, 3)`` surface points, wobj frame, m.
+        normals_wobj: ``(N, 3)`` outward unit normals, wobj frame (normalised here).
+        tcp: the TCP put on the point (its +z looks into the surface).
+        rotation_step_deg: step of the free rotation about the sensor axis, degrees.
+        margin_m: clearance to work object and fixtures, m (default the cell's 5 mm).
+        q_ref: ``(n,)`` reference configuration for "least joint motion" (default home).
+        max_checks: largest number of candidates collision-checked per point.
+
+    Raises:
+        ShapeError, NonFiniteError: bad shapes or NaN/inf in points or normals.
+        DegenerateGeometryError: a zero normal.
+        UnknownFrameError: unknown TCP (the message lists the valid names).
+    """
+    from planner.cell import DEFAULT_MARGIN_M
+
+    pts = check_shape(points_wobj, (None, 3), "points_wobj")
+    nrm = check_shape(normals_wobj, (None, 3), "normals_wobj")
+    if nrm.shape != pts.shape:
+        raise ShapeError(f"normals_wobj must be {pts.shape} like points_wobj, got {nrm.shape}")
+    length = np.linalg.norm(nrm, axis=1)
+    if np.any(length < 1e-9):
+        raise DegenerateGeometryError(f"normals_wobj[{int(np.argmin(length))}] is zero")
+    nrm = nrm / length[:, None]
+    step = math.radians(check_positive(rotation_step_deg, "rotation_step_deg"))
+    margin = DEFAULT_MARGIN_M if margin_m is None else check_positive(margin_m, "margin_m", True)
+    T_flange_tcp = cell.T_flange_tcp(tcp)
+    ref = cell.home_q if q_ref is None else check_shape(q_ref, (cell.chain.n_joints,), "q_ref")
+    angles = np.arange(0.0, 2 * np.pi - 1e-9, step)
+    N, R = pts.shape[0], angles.size
+    if N == 0:
+        return []
+    T_base_tcp = cell.T_base_wobj @ tcp_frames(pts, nrm, angles)
+    T_bf = (T_base_tcp @ invert_transform(T_flange_tcp)).reshape(N * R, 4, 4)
+    sol = cell.solver.solve(T_bf)
+    K = sol.q.shape[1]
+    valid = sol.valid.reshape(N, R * K)
+    q_all = sol.q.reshape(N, R * K, -1)
+    sing = np.zeros_like(valid)
+    sing_reason = "singular wrist"
+    if valid.any():
+        m, sing_reason = singular(cell, q_all[valid])
+        sing[valid] = m
+    usable = valid & ~sing
+    margin_all = np.where(valid, limit_margin(cell.chain, q_all), -np.inf)
+    motion = np.where(usable, np.linalg.norm(np.nan_to_num(q_all - ref), axis=-1), np.inf)
+    out: list[ProbeFeasibility] = []
+    with cell.saved_state():
+        for i in range(N):
+            if not valid[i].any():
+                reason = _no_ik_reason(cell, T_bf[i * R : (i + 1) * R])
+                out.append(_none(reason))
+                continue
+            if not usable[i].any():
+                out.append(_none(sing_reason))
+                continue
+            near_limit = margin_all[i] < MARGINAL_LIMIT_RAD
+            order = np.lexsort((motion[i], near_limit))[: int(usable[i].sum())][:max_checks]
+            best: tuple[Clearance, int] | None = None
+            chosen: tuple[Clearance, int] | None = None
+            for c in order:
+                cell.set_joint_positions(q_all[i, c])
+                cl = cell.clearance(margin, sensor_wobj_allowed=True)
+                if best is None or cl.slack_m > best[0].slack_m:
+                    best = (cl, c)
+                if cl.ok and cl.slack_m >= margin and margin_all[i, c] >= MARGINAL_LIMIT_RAD:
+                    chosen = (cl, c)
+                    break
+            if chosen is None and best is not None and best[0].ok:
+                chosen = best
+            pick = chosen or best
+            if pick is None:  # unreachable: order is non-empty when usable[i].any()
+                out.append(_none("no candidate checked"))
+                continue
+            cl, c = pick
+            r, k = divmod(int(c), K)
+            fine = cl.slack_m >= margin and margin_all[i, c] >= MARGINAL_LIMIT_RAD
+            status: Status = "infeasible" if chosen is None else "feasible" if fine else "marginal"
+            if status == "feasible":
+                reason = ""
+            elif status == "marginal":
+                reason = (
+                    f"small clearance: {cl.describe()}"
+                    if cl.slack_m < margin
+                    else f"joint near limit (margin {math.degrees(margin_all[i, c]):.1f} deg)"
+                )
+            else:
+                reason = cl.describe()
+            out.append(
+                ProbeFeasibility(
+                    feasible=chosen is not None,
+                    status=status,
+                    reason=reason,
+                    q=q_all[i, c].copy(),
+                    branch=int(sol.branch[i * R + r, k]),
+                    rotation_rad=float(angles[r]),
+                    clearance_m=float(cl.clearance_m),
+                    joint_margin_rad=float(margin_all[i, c]),
+                    T_base_flange=T_bf[i * R + r].copy(),
+                )
+            )
+    return out
+
+
+def _none(reason: str) -> ProbeFeasibility:
+    nan = float("nan")
+    return ProbeFeasibility(False, "infeasible", reason, None, -1, nan, nan, nan, None)
