@@ -73,11 +73,14 @@ class ConstraintSet:
         return tuple(self.point_ids[i] for i in self.point_index)
 
 
-def constraint_set(points: Sequence[ProbePoint], name: str = "points") -> ConstraintSet:
+def constraint_set(
+    points: Sequence[ProbePoint] | ConstraintSet, name: str = "points"
+) -> ConstraintSet:
     """Validate a point layout and flatten it into a :class:`ConstraintSet`.
 
     Args:
-        points: the probe points (each already validated by :class:`ProbePoint`).
+        points: the probe points (each already validated by :class:`ProbePoint`); a
+            :class:`ConstraintSet` is returned as it is.
         name: argument name used in error messages.
 
     Raises:
@@ -127,7 +130,7 @@ def check_coincident(positions: FloatArray, ids: Sequence[str], name: str) -> No
         return
     d = np.linalg.norm(positions[:, None, :] - positions[None, :, :], axis=-1)
     d[np.tril_indices(n)] = np.inf
-    i, j = np.unravel_index(int(np.argmin(d)), d.shape)
+    i, j = (int(k) for k in np.unravel_index(int(np.argmin(d)), d.shape))
     if d[i, j] < COINCIDENT_TOL_M:
         raise DegenerateGeometryError(
             f"{name}: points {ids[i]!r} and {ids[j]!r} coincide ({d[i, j] * 1e3:.4f} mm apart); "
@@ -260,7 +263,7 @@ def random_face_layout(
         gaps = np.linalg.norm(all_pos[:, None] - all_pos[None], axis=-1) + np.eye(len(pts))
         if gaps.min() < 0.05 * size_m:
             continue
-        return FaceLayout(n, d, corner, tuple(pts), tuple(face_of))
+        return FaceLayout(n, d, np.asarray(corner, dtype=np.float64), tuple(pts), tuple(face_of))
 
 
 def _well_spread(pos: FloatArray, normal: FloatArray, size_m: float) -> bool:

@@ -261,13 +261,12 @@ def _rotation_parallel_to(
     for f in found:
         if np.linalg.norm(f[3:]) < 1e-9:  # a found pure translation: remove it from the screw
             v = v - (f @ v) * f
-    # drop the translation along the axis (a screw pitch) only if it is itself unconstrained
     return v / np.linalg.norm(v)
 
 
 def _describe_general(v: FloatArray, cs: ConstraintSet) -> tuple[str, str]:
     t, w = _split(v, cs)
-    if np.linalg.norm(w) * cs.scale_m < 1e-9 * max(np.linalg.norm(t), 1e-12):
+    if float(np.linalg.norm(w)) * cs.scale_m < 1e-9 * max(float(np.linalg.norm(t)), 1e-12):
         where = axis_name(t)
         return (
             f"translation along {where}",

@@ -95,7 +95,7 @@ def probe_point(
     result = probe(command)
     if not result.ok:
         raise ProbeFailedError(point.id, result.reason or "no reason given")
-    q = check_vector3(result.point_m, f"probe result for point {point.id!r}")
+    q = check_vector3(np.asarray(result.point_m), f"probe result for point {point.id!r}")
     logger.debug("probed %s (round %d): %s", point.id, round_index, q)
     return ProbeStep(point.id, round_index, command, q)
 

@@ -177,13 +177,13 @@ def three_two_one(
     m1 = _unit(np.cross(q[1] - q[0], q[2] - q[0]))
     if T_base_wobj_guess is None:
         m1 *= np.sign(n1 @ np.cross(p[1] - p[0], p[2] - p[0]))
-        m2 = _secondary_normal(m1, q[4] - q[3], float(n1 @ n2), ids[3:5])
-        m2 = m2[0] if _branch(n1, n2, p[4] - p[3]) > 0 else m2[1]
+        pair = _secondary_normal(m1, q[4] - q[3], float(n1 @ n2), ids[3:5])
+        m2 = pair[0] if _branch(n1, n2, p[4] - p[3]) > 0 else pair[1]
     else:
         R_guess = check_transform(T_base_wobj_guess, "T_base_wobj_guess")[:3, :3]
         m1 *= 1.0 if float(m1 @ R_guess @ n1) >= 0 else -1.0
-        m2_pair = _secondary_normal(m1, q[4] - q[3], float(n1 @ n2), ids[3:5])
-        m2 = max(m2_pair, key=lambda m: float(m @ R_guess @ n2))
+        pair = _secondary_normal(m1, q[4] - q[3], float(n1 @ n2), ids[3:5])
+        m2 = pair[0] if float(pair[0] @ R_guess @ n2) >= float(pair[1] @ R_guess @ n2) else pair[1]
     R = _frame(m1, m2) @ _frame(n1, n2).T
     m3 = R @ n3
     M = np.stack([m1, m2, m3])
@@ -205,7 +205,7 @@ def check_role_geometry(
     names = ROLES
     s_min = np.sin(min_angle)
     for i, j in ((0, 1), (0, 2), (1, 2)):
-        s = np.linalg.norm(np.cross(normals[i], normals[j]))
+        s = float(np.linalg.norm(np.cross(normals[i], normals[j])))
         if s < s_min:
             raise DegenerateGeometryError(
                 f"3-2-1 {what} {names[i]} and {names[j]} faces are parallel or nearly so "
