@@ -10,7 +10,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from types import MappingProxyType
 
 import numpy as np
 
@@ -106,7 +105,7 @@ def check_stator_points(
     for ok, what in conditions:
         if not ok:
             raise DegenerateGeometryError(f"stator layout: the A-H procedure needs that {what}")
-    return StatorLayout(MappingProxyType(pts), (x_face, y_face, z_top))
+    return StatorLayout(pts, (x_face, y_face, z_top))
 
 
 def example_stator_points(

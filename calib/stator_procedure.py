@@ -33,7 +33,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from types import MappingProxyType
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -293,8 +292,8 @@ def run_stator_procedure(
     return ProcedureResult(
         T_base_wobj=run.T,
         steps=tuple(run.steps),
-        measured_m=MappingProxyType(run.measured),
-        commands=MappingProxyType(run.commands),
+        measured_m=run.measured,
+        commands=run.commands,
         n_probes=len(run.commands),
         alpha1_rad=alpha1,
         p3_m=p3,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import pickle
 from dataclasses import replace
 
 import numpy as np
@@ -334,3 +335,12 @@ def test_points_keyed_by_role_are_commanded_under_the_role() -> None:
     assert all(res.commands[k].point_id == k for k in res.commands)
     again = run_stator_procedure(pts, T, probe_from_measurements(res.measured_m))
     np.testing.assert_array_equal(again.T_base_wobj, res.T_base_wobj)
+
+
+def test_result_and_layout_pickle_for_worker_processes() -> None:
+    T = nominal_pose(0.0, (1.0, 0.0, 0.5))
+    res = run_stator_procedure(LAYOUT, T, BoxProbe(T))
+    back = pickle.loads(pickle.dumps(res))
+    np.testing.assert_array_equal(back.T_base_wobj, res.T_base_wobj)
+    assert list(back.measured_m) == list(res.measured_m)
+    assert pickle.loads(pickle.dumps(LAYOUT)).face_coords_wobj == LAYOUT.face_coords_wobj
