@@ -38,11 +38,16 @@ class Hultman2013(
         p3_height_m: height of the constructed point P3 above B (eq. 12), metres (paper: 50 mm).
         beta1_rad: assumed inclination of the stator side (eq. 12), radians (paper: 15 deg).
         retake_c_d: measure C and D again at the end, as the paper does.
+        edge_start_from_measured: start the edge searches F and H at the measured E and G
+            (the paper's literal wording) instead of where the plan's search starts.
+        edge_start_offset_m: offset of that start along the estimated WOCS +x, metres.
     """
 
     p3_height_m: float = 0.050
     beta1_rad: float = math.radians(15.0)
     retake_c_d: bool = True
+    edge_start_from_measured: bool = False
+    edge_start_offset_m: float = 0.0
 
 
 class ThreeTwoOne(

@@ -1,31 +1,109 @@
-"""The ``wobjcal`` command line: ``main(argv) -> int``."""
+"""The ``wobjcal`` command line: ``main(argv) -> int``.
+
+Exit codes: 0 success; 1 the plan was checked and something is not feasible (``check``) or a
+validation failed its targets; 2 bad input (file, plan, measurement, argument) or a part of
+wobjcal the command needs is missing. Errors print one line on stderr, never a traceback
+(``--debug`` shows it). Each command lives in ``planner/cli_<command>.py``.
+"""
 
 from __future__ import annotations
 
 import argparse
+import logging
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from calib._version import __version__
+from calib.errors import WobjcalError
+
+EXIT_OK, EXIT_FAIL, EXIT_INPUT = 0, 1, 2
+
+_FORMATTER = argparse.RawDescriptionHelpFormatter
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that exits with code 2 and one line on bad arguments (argparse's default too)."""
+
+
+def _add(
+    sub: argparse._SubParsersAction,  # type: ignore[type-arg]
+    name: str,
+    help_: str,
+    description: str,
+    example: str,
+) -> argparse.ArgumentParser:
+    parser: argparse.ArgumentParser = sub.add_parser(
+        name,
+        help=help_,
+        description=description,
+        epilog="example:\n  " + example.replace("\n", "\n  "),
+        formatter_class=_FORMATTER,
+    )
+    parser.add_argument(
+        "--debug",
+        action="store_true",
+        default=argparse.SUPPRESS,
+        help="show tracebacks and debug logs",
+    )
+    return parser
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``wobjcal`` command."""
-    parser = argparse.ArgumentParser(
+    from planner import cli_calibrate, cli_check, cli_export, cli_misc, cli_validate
+
+    parser = _Parser(
         prog="wobjcal",
         description="Plan, check and validate work-object calibration with a robot-held "
         "proximity sensor (Hultman & Leijon 2013).",
+        epilog="exit codes: 0 ok, 1 check/validation found a problem, 2 bad input\n"
+        "run 'wobjcal COMMAND --help' for each command; docs/cli.md has more",
+        formatter_class=_FORMATTER,
     )
     parser.add_argument("--version", action="version", version=f"wobjcal {__version__}")
-    parser.add_subparsers(dest="command", metavar="COMMAND")
+    parser.add_argument("--debug", action="store_true", help="show tracebacks and debug logs")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for module in (cli_check, cli_validate, cli_calibrate, cli_export, cli_misc):
+        module.register(sub, _add)
     return parser
+
+
+def _run(args: argparse.Namespace) -> int:
+    handler: Callable[[argparse.Namespace], int] = args.handler
+    return handler(args)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line with ``argv`` (default ``sys.argv[1:]``); return the exit code."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version, or an argument error (argparse printed it)
+        return int(exc.code or 0)
+    debug = bool(getattr(args, "debug", False))
+    logging.basicConfig(level=logging.DEBUG if debug else logging.WARNING, format="%(message)s")
     if args.command is None:
         parser.print_help(sys.stdout)
-        return 0
-    return 0
+        return EXIT_OK
+    try:
+        return _run(args)
+    except (WobjcalError, OSError) as exc:
+        if debug:
+            raise
+        what = (
+            f"{exc.filename}: {exc.strerror}" if isinstance(exc, OSError) and exc.filename else exc
+        )
+        print(f"wobjcal {args.command}: error: {what}", file=sys.stderr)
+        return EXIT_INPUT
+    except KeyboardInterrupt:
+        print(f"wobjcal {args.command}: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # a bug: say so briefly, the traceback is one flag away
+        if debug:
+            raise
+        print(
+            f"wobjcal {args.command}: internal error: {type(exc).__name__}: {exc} "
+            "(run again with --debug for the traceback)",
+            file=sys.stderr,
+        )
+        return EXIT_INPUT

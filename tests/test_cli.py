@@ -1,0 +1,192 @@
+"""Tests of the ``wobjcal`` command line: help, exit codes, errors without tracebacks, outputs."""
+
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from calib.frames import motion_between, random_transform, transform_points
+from calib.measurements import Measurements, save_measurements
+from calib.plan import load_plan, plan_to_json
+from planner.cli import main
+from planner.plan_io import nominal_T_base_wobj
+
+REPO = Path(__file__).resolve().parent.parent
+STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
+DATA = REPO / "tests" / "data" / "plans"
+COMMANDS = ["check", "validate", "calibrate", "export", "schema", "ui", "demo"]
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_help_of_every_command(command: str, capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys, command, "--help")
+    assert code == 0
+    assert f"usage: wobjcal {command}" in out
+    assert "example:\n  wobjcal " + command in out
+
+
+def test_top_level_help_lists_commands(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys)
+    assert code == 0
+    assert all(c in out for c in COMMANDS)
+    assert "exit codes" in out
+
+
+def test_bad_arguments_exit_2(capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run(capsys, "export", str(STATOR), "--format", "cobol", "-o", "x")
+    assert code == 2 and "invalid choice: 'cobol'" in err
+
+
+@pytest.mark.parametrize("case", sorted(p.stem for p in DATA.glob("bad_*.json")))
+@pytest.mark.parametrize("command", ["check", "export", "calibrate", "validate"])
+def test_malformed_plan_exits_2_with_one_line(
+    case: str, command: str, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    from tests.test_plan import MALFORMED
+
+    plan = str(DATA / f"{case}.json")
+    extra = {
+        "check": [],
+        "export": ["--format", "rapid", "-o", str(tmp_path / "x.mod")],
+        "calibrate": [str(tmp_path / "m.json")],
+        "validate": ["--trials", "2"],
+    }[command]
+    code, out, err = run(capsys, command, plan, *extra)
+    assert code == 2
+    assert "Traceback" not in err + out
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith(f"wobjcal {command}: error: {plan}: ")
+    assert MALFORMED[case.removeprefix("bad_")] in lines[0]
+
+
+def test_missing_file_exits_2(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    code, _, err = run(capsys, "check", str(tmp_path / "nope.json"))
+    assert code == 2
+    assert (
+        err.strip() == f"wobjcal check: error: {tmp_path / 'nope.json'}: No such file or directory"
+    )
+
+
+def test_schema_matches_checked_in_files(capsys: pytest.CaptureFixture[str]) -> None:
+    _, out, _ = run(capsys, "schema")
+    assert out == (REPO / "assets" / "schema" / "wobjcal.plan-1.schema.json").read_text()
+    _, out, _ = run(capsys, "schema", "--measurements")
+    assert out == (REPO / "assets" / "schema" / "wobjcal.measurements-1.schema.json").read_text()
+
+
+def test_shipped_plan_equals_regenerated(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, _, _ = run(capsys, "demo", "--write-plan", str(tmp_path / "ah.json"))
+    assert code == 0
+    assert (tmp_path / "ah.json").read_bytes() == STATOR.read_bytes(), (
+        "regenerate with: wobjcal demo --write-plan assets/plans/stator_section_ah.json"
+    )
+    plan = load_plan(STATOR)
+    assert [p.role for p in plan.points] == list("ABCDEFGH")
+    assert plan.method == "hultman2013"
+
+
+@pytest.mark.parametrize("fmt", ["rapid", "krl", "urscript", "json"])
+def test_export_writes_files(fmt: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = (
+        tmp_path / f"prog.{ {'rapid': 'mod', 'krl': 'src', 'urscript': 'script'}.get(fmt, 'json') }"
+    )
+    code, _, err = run(capsys, "export", str(STATOR), "--format", fmt, "-o", str(out), "--no-check")
+    assert code == 0, err
+    text = out.read_text()
+    if fmt == "json":
+        assert text == plan_to_json(load_plan(STATOR))
+    elif fmt == "rapid":
+        assert text.startswith("MODULE WobjcalStatorSectionAh") and text.count("SearchL") == 8
+    elif fmt == "krl":
+        dat = (tmp_path / "prog.dat").read_text()
+        assert len(re.findall(r"DECL E6POS x\w+_(?:start|end)=", dat)) == 16
+    else:
+        assert text.count(' = probe("') == 8
+
+
+def _synthetic(tmp_path: Path, rng: np.random.Generator) -> tuple[Path, np.ndarray]:
+    plan = load_plan(STATOR)
+    T_true = nominal_T_base_wobj(plan) @ random_transform(rng, 0.010, np.radians(2.0))
+    pts = {p.id: transform_points(T_true, p.position_m) for p in plan.points}
+    path = save_measurements(Measurements.from_points_m(pts, units="mm"), tmp_path / "m.json")
+    return path, T_true
+
+
+@pytest.mark.parametrize("method", ["hultman2013", "three_two_one", "best_fit"])
+def test_calibrate_recovers_known_motion(
+    method: str, tmp_path: Path, rng: np.random.Generator, capsys: pytest.CaptureFixture[str]
+) -> None:
+    meas, T_true = _synthetic(tmp_path, rng)
+    code, out, err = run(capsys, "calibrate", str(STATOR), str(meas), "--method", method, "--json")
+    assert code == 0, err
+    res = json.loads(out)
+    T = np.array(res["T_base_wobj"])
+    assert np.abs(motion_between(T_true, T)).max() < 1e-6
+    np.testing.assert_allclose(res["origin_m"], T_true[:3, 3], atol=1e-6)
+    assert len(res["quat_wxyz"]) == 4 and len(res["tait_bryan_zyx_deg"]) == 3
+    assert set(res["residuals_m"]) == set("ABCDEFGH")
+
+
+def test_calibrate_text_has_paste_lines(
+    tmp_path: Path, rng: np.random.Generator, capsys: pytest.CaptureFixture[str]
+) -> None:
+    meas, T_true = _synthetic(tmp_path, rng)
+    code, out, _ = run(capsys, "calibrate", str(STATOR), str(meas))
+    assert code == 0
+    assert 'PERS wobjdata wobjCalibrated:=[FALSE,TRUE,"",[[' in out
+    assert "BASE_DATA[10]={X " in out
+    assert f"x {T_true[0, 3] * 1e3:.3f}" in out
+
+
+def test_calibrate_missing_point_exits_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "m.json").write_text(
+        json.dumps(
+            {
+                "schema": "wobjcal.measurements/1",
+                "points": {"A": [1, 2, 3]},
+                "failed": {"B": "no detection within 110 mm"},
+            }
+        )
+    )
+    code, _, err = run(capsys, "calibrate", str(STATOR), str(tmp_path / "m.json"))
+    assert code == 2
+    assert "points.B: not measured (failed on the robot: no detection within 110 mm)" in err
+
+
+def test_ui_passes_flags_to_webui(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import webui.app
+
+    calls = []
+    monkeypatch.setattr(webui.app, "run", lambda *a, **k: calls.append((a, k)))
+    assert main(["ui", str(STATOR), "--host", "0.0.0.0", "--port", "8123"]) == 0
+    assert main(["demo"]) == 0
+    assert calls[0] == ((str(STATOR),), {"host": "0.0.0.0", "port": 8123, "block": True})
+    assert calls[1] == ((None,), {"host": "127.0.0.1", "port": 8080, "block": True})
+    code, _, err = run(capsys, "ui", "no_such_plan.json")
+    assert code == 2 and "no_such_plan.json" in err
+
+
+def test_python_m_planner_runs() -> None:
+    res = subprocess.run(
+        [sys.executable, "-m", "planner", "--version"], capture_output=True, text=True, check=False
+    )
+    assert res.returncode == 0 and res.stdout.startswith("wobjcal ")
