@@ -196,6 +196,10 @@ class _Run:
             command = replace(command, start_m=start_m, length_m=length)
         self.commands[key] = command
         result = self.probe(command)
+        if not isinstance(result, ProbeResult):
+            raise ShapeError(
+                f"probe must return a ProbeResult, got {type(result).__name__} for point {key}"
+            )
         if result.point_m is None:
             raise ProbeFailedError(key, result.reason or "the probe gave no reason")
         p = check_vector3(result.point_m, f"probe result for point {key}")
@@ -265,12 +269,12 @@ def run_stator_procedure(
     run.origin(0, "E", "x origin from E (P4; the paper's 'P5_W')")
 
     # F: edge search up the tooth over D and E; G, then H: edge search up from G (eq. 1-9)
+    from_measured = cfg.edge_start_from_measured
     x_now, off = run.T[:3, 0].copy(), cfg.edge_start_offset_m
-    starts = (e + off * x_now, None) if cfg.edge_start_from_measured else (None, None)
-    f = run.measure("F", start_m=starts[0])
+    f = run.measure("F", start_m=e + off * x_now if from_measured else None)
     g = run.measure("G")
-    h = run.measure("H", start_m=g + off * x_now if cfg.edge_start_from_measured else None)
-    if cfg.edge_start_from_measured:  # the TCP ran `off` outside the face: back onto it
+    h = run.measure("H", start_m=g + off * x_now if from_measured else None)
+    if from_measured:  # the TCP ran `off` outside the face: back onto it
         f, h = f - off * x_now, h - off * x_now
     if cfg.edge_event_offset_m:  # the sensor reports the edge this far past it
         f = f - cfg.edge_event_offset_m * run.commands["F"].direction

@@ -244,6 +244,8 @@ def test_bad_probe_output_is_an_input_error() -> None:
     T = nominal_pose(0.0, (1.0, 0.0, 0.5))
     with pytest.raises(ShapeError, match="probe result for point A"):
         run_stator_procedure(LAYOUT, T, lambda cmd: ProbeResult(np.zeros(2)))
+    with pytest.raises(ShapeError, match="probe must return a ProbeResult, got tuple for point A"):
+        run_stator_procedure(LAYOUT, T, lambda cmd: (1.0, 2.0, 3.0))
 
 
 def test_degenerate_measurements_raise() -> None:
