@@ -44,7 +44,7 @@ def test_eq5_6_element_ij_is_dot_of_wocs_axis_j_with_base_axis_i(rng) -> None:
             assert R[i, j] == pytest.approx(np.eye(3)[i] @ R_true[:, j], abs=1e-15)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=200, deadline=None, derandomize=True)
 @given(seed=seeds, invert=st.booleans())
 def test_three_points_on_a_posed_face_give_its_rotation(seed: int, invert: bool) -> None:
     rng = np.random.default_rng(seed)
@@ -62,7 +62,7 @@ def test_three_points_on_a_posed_face_give_its_rotation(seed: int, invert: bool)
     assert np.linalg.det(R) == pytest.approx(1.0)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=200, deadline=None, derandomize=True)
 @given(seed=seeds)
 def test_eq7_9_agree_with_scipy_zyx(seed: int) -> None:
     rng = np.random.default_rng(seed)
@@ -94,7 +94,7 @@ def test_eq10_hand_worked() -> None:
     np.testing.assert_allclose(only_z[:3, 3], [1, 2, 2.97], atol=1e-15)
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=100, deadline=None, derandomize=True)
 @given(seed=seeds)
 def test_eq10_points_on_three_faces_give_the_true_origin(seed: int) -> None:
     rng = np.random.default_rng(seed)

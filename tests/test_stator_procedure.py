@@ -126,7 +126,7 @@ def pose_error(T_est: np.ndarray, T_true: np.ndarray) -> tuple[float, float]:
 LAYOUT = check_stator_points(example_stator_points())
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=60, deadline=None, derandomize=True)
 @given(seed=st.integers(0, 2**32 - 1), retake=st.booleans(), facing=st.booleans())
 def test_noise_free_random_pose_is_exact(seed: int, retake: bool, facing: bool) -> None:
     rng = np.random.default_rng(seed)
