@@ -369,10 +369,15 @@ class Cell:
 
     # ----------------------------------------------------------------- queries
     def clearance(
-        self, margin_m: float = DEFAULT_MARGIN_M, sensor_wobj_allowed: bool = True
+        self,
+        margin_m: float = DEFAULT_MARGIN_M,
+        sensor_wobj_allowed: bool = True,
+        skip_sensor_wobj: bool = False,
     ) -> Clearance:
         """Clearance of the current state (see :meth:`CollisionChecker.query`)."""
-        return self.checker.query(margin_m, self.self_margin_m, None, sensor_wobj_allowed)
+        return self.checker.query(
+            margin_m, self.self_margin_m, None, sensor_wobj_allowed, skip_sensor_wobj
+        )
 
     def check_probes(
         self, points_wobj: ArrayLike, normals_wobj: ArrayLike, **kw: Any

@@ -237,6 +237,7 @@ class CollisionChecker:
         self_margin_m: float,
         report_m: float | None = None,
         sensor_wobj_allowed: bool = True,
+        skip_sensor_wobj: bool = False,
     ) -> Clearance:
         """Clearance of the current state.
 
@@ -260,8 +261,11 @@ class CollisionChecker:
                     if not is_tool and link in self.static_links:
                         continue
                     need = margin_m
-                    if is_tool and is_wobj and sensor_wobj_allowed and link in self.sensor_links:
-                        need = 0.0
+                    if is_tool and is_wobj and link in self.sensor_links:
+                        if skip_sensor_wobj:
+                            continue
+                        if sensor_wobj_allowed:
+                            need = 0.0
                     d = pt[8]
                     if d - need < best.slack_m:
                         best = Clearance(d >= need, d, d - need, (self.names(bid, link), env_name))

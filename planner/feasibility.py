@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -165,7 +165,7 @@ def _no_ik_reason(cell: Cell, T_flange: FloatArray) -> str:
     if opw is not None:
         q8, ok8 = opw.ik_branches(T_flange)
         if not ok8.any():
-            return f"out of reach ({where})"
+            return _opw_wrist_reason(opw, T_flange)
         q = q8[ok8]
         lo, hi = cell.chain.lower, cell.chain.upper
         two_pi = 2 * np.pi
@@ -178,6 +178,21 @@ def _no_ik_reason(cell: Cell, T_flange: FloatArray) -> str:
         j = int(np.bincount(worst, minlength=q.shape[1]).argmax())
         return f"joint {j + 1} at limit ({cell.chain.joint_names[j]})"
     return f"no IK solution within joint limits ({where})"
+
+
+def _opw_wrist_reason(opw: Any, T_flange: FloatArray) -> str:
+    """Why an OPW arm reaches none of the flange poses ``(R, 4, 4)``: the wrist centre's
+    distance from the shoulder against the arm's range ``|c2 - k| .. c2 + k``."""
+    P = opw.params
+    T = invert_transform(opw.T_base_opw) @ T_flange @ invert_transform(opw.T_ee_tip)
+    c = T[:, :3, 3] - P.c4 * T[:, :3, 2]
+    radial = np.sqrt(np.maximum(c[:, 0] ** 2 + c[:, 1] ** 2 - P.b**2, 0.0))
+    k = math.hypot(P.c3, P.a2)
+    d = np.minimum(np.hypot(radial - P.a1, c[:, 2] - P.c1), np.hypot(radial + P.a1, c[:, 2] - P.c1))
+    i = int(np.argmin(np.abs(d - np.clip(d, abs(P.c2 - k), P.c2 + k))))
+    if d[i] < abs(P.c2 - k):
+        return f"too close (wrist centre {d[i]:.2f} m from the shoulder, min {abs(P.c2 - k):.2f} m)"
+    return f"out of reach (wrist centre {d[i]:.2f} m from the shoulder, reach {P.c2 + k:.2f} m)"
 
 
 def check_probes(
