@@ -41,6 +41,9 @@ class Hultman2013(
         edge_start_from_measured: start the edge searches F and H at the measured E and G
             (the paper's literal wording) instead of where the plan's search starts.
         edge_start_offset_m: offset of that start along the estimated WOCS +x, metres.
+        edge_event_offset_m: how far past the true edge the sensor reports it (measured once
+            on a reference edge), metres, removed from F and H; ``None``: the sensor model's
+            value in ``validate``, 0 in ``calibrate``.
     """
 
     p3_height_m: float = 0.050
@@ -48,6 +51,7 @@ class Hultman2013(
     retake_c_d: bool = True
     edge_start_from_measured: bool = False
     edge_start_offset_m: float = 0.0
+    edge_event_offset_m: float | None = None
 
 
 class ThreeTwoOne(

@@ -14,9 +14,12 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from calib.atomic_io import write_text_atomic
 from calib.plan import Plan, PlanError
+from calib.plan_procedures import Hultman2013
 from planner.cli_common import read_plan, stderr, stdout
 from planner.plan_io import hultman_points, nominal_T_base_wobj, require
 
+#: Edge searches run this far inside the face (montecarlo's default), m.
+EDGE_INSET_M = 0.002
 #: Built-in work objects validation can simulate, and the StatorGeometry constructor of each.
 SIMULATED_PARTS = {
     "builtin:stator_section": "full_section",
@@ -116,15 +119,22 @@ def cmd_validate(args: argparse.Namespace) -> int:
     trials = plan.validation.trials if args.trials is None else args.trials
     seed = plan.validation.seed if args.seed is None else args.seed
     settings = plan.procedure
-    kwargs: dict[str, Any] = {}
-    if plan.method == "hultman2013":
-        kwargs["settings"] = sp.StatorSettings(
-            beta1_rad=settings.beta1_rad,  # type: ignore[union-attr]
-            p3_height_m=settings.p3_height_m,  # type: ignore[union-attr]
-            retake_c_d=settings.retake_c_d,  # type: ignore[union-attr]
-            edge_start_from_measured=settings.edge_start_from_measured,  # type: ignore[union-attr]
-            edge_start_offset_m=settings.edge_start_offset_m,  # type: ignore[union-attr]
+    if not isinstance(settings, Hultman2013):
+        raise PlanError(
+            f"procedure.method: validate simulates only hultman2013, got {plan.method!r}"
         )
+    models = _models(plan)
+    edge_offset = settings.edge_event_offset_m
+    if edge_offset is None:  # the sensor model's straight-edge offset, as montecarlo's default
+        edge_offset = models["sensor"].edge_event_offset_m(EDGE_INSET_M)
+    stator_settings = sp.StatorSettings(
+        beta1_rad=settings.beta1_rad,
+        p3_height_m=settings.p3_height_m,
+        retake_c_d=settings.retake_c_d,
+        edge_start_from_measured=settings.edge_start_from_measured,
+        edge_start_offset_m=settings.edge_start_offset_m,
+        edge_event_offset_m=edge_offset,
+    )
     with Progress(
         TextColumn("validating"),
         BarColumn(),
@@ -142,8 +152,9 @@ def cmd_validate(args: argparse.Namespace) -> int:
             np.random.default_rng(seed),
             workers=args.workers,
             progress=lambda done, total: bar.update(task, completed=done, total=total),
-            **_models(plan),
-            **kwargs,
+            settings=stator_settings,
+            edge_inset_m=EDGE_INSET_M,
+            **models,
         )
     stdout().print(report.to_markdown(), markup=False)
     if args.json:

@@ -213,6 +213,7 @@ def calibrate_plan(
                 retake_c_d=settings.retake_c_d,
                 edge_start_from_measured=settings.edge_start_from_measured,
                 edge_start_offset_m=settings.edge_start_offset_m,
+                edge_event_offset_m=settings.edge_event_offset_m or 0.0,
             ),
         )
         T, used = result.T_base_wobj, tuple(role_to_id[r] for r in by_role)

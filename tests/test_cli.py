@@ -190,3 +190,25 @@ def test_python_m_planner_runs() -> None:
         [sys.executable, "-m", "planner", "--version"], capture_output=True, text=True, check=False
     )
     assert res.returncode == 0 and res.stdout.startswith("wobjcal ")
+
+
+def test_validate_small_run_writes_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    report = tmp_path / "report.json"
+    args = ["validate", str(STATOR), "--trials", "3", "--seed", "7", "--json", str(report)]
+    code, out, err = run(capsys, *args)
+    assert code == 0, err
+    assert "| WOCS origin x-axis | 95.5 |" in out
+    data = json.loads(report.read_text())
+    assert data["n_trials"] == 3 and data["n_ok"] == 3 and data["seed"] == 7
+    row = next(r for r in data["rows"] if r["key"] == "origin_x")
+    assert row["paper"] == pytest.approx(0.10) and row["procedure"] > 0
+    # the same seed gives the same numbers
+    run(capsys, *args[:-1], str(tmp_path / "again.json"))
+    again = json.loads((tmp_path / "again.json").read_text())
+    assert again["rows"] == data["rows"]
+
+
+def test_validate_rejects_parts_it_cannot_simulate(capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run(capsys, "validate", str(DATA / "valid_three_two_one.json"), "--trials", "2")
+    assert code == 2
+    assert "procedure.method: validate simulates only hultman2013, got 'three_two_one'" in err
