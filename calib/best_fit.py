@@ -21,8 +21,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import ShapeError
-from calib.frames import check_transform, small_motion
-from calib.layout import ConstraintSet, constraint_jacobian, constraint_set, point_motion_jacobian
+from calib.frames import check_transform
+from calib.layout import (
+    ConstraintSet,
+    constraint_jacobian,
+    constraint_set,
+    cross_rows,
+    point_motion_jacobian,
+    small_motion_matrix,
+)
 from calib.observability import analyze_layout, unobservable_error
 from calib.probing import ProbePoint
 from calib.validation import check_points, check_positive, check_vector3
@@ -100,7 +107,7 @@ def best_fit(
     *,
     sigma_m: float | None = None,
     max_iterations: int = 30,
-    tol: float = 1e-13,
+    tol: float = 1e-12,
 ) -> BestFitResult:
     """Fit the wobj frame to measured points by point-to-plane least squares.
 
@@ -139,21 +146,22 @@ def best_fit(
     lam = 0.0
     converged = False
     it = 0
-    for it in range(1, max_iterations + 1):  # noqa: B007
+    for it in range(1, max_iterations + 1):
         # rotations about the layout centroid, scaled by its size: a well conditioned system
         J = constraint_jacobian(cs.normals, x - c)
         J[:, 3:] /= L
         H = J.T @ J
-        if np.linalg.eigvalsh(H)[0] < RANK_TOL_SQ * max(1.0, float(np.trace(H))):
+        if it == 1 and np.linalg.eigvalsh(H)[0] < RANK_TOL_SQ * max(1.0, float(np.trace(H))):
             raise unobservable_error(analyze_layout(cs), "the best-fit point layout")
         g = J.T @ r
         while True:
-            step = -np.linalg.solve(H + lam * np.diag(np.diag(H)), g)
-            w = step[3:] / L
-            T_new = T @ small_motion(np.concatenate([step[:3] - np.cross(w, c), w]))
+            step = -np.linalg.solve(H + lam * np.diag(np.diag(H)) if lam else H, g)
+            w = np.asarray(step[3:] / L, dtype=np.float64)
+            move = small_motion_matrix(np.concatenate([step[:3] - cross_rows(w, c), w]))
+            T_new = np.matmul(T, move)
             r_new, x_new = evaluate(T_new)
             cost_new = float(r_new @ r_new)
-            if cost_new <= cost * (1.0 + 1e-12) + 1e-30 or lam > 1e8:
+            if cost_new <= cost * (1.0 + 1e-9) + 1e-30 or lam > 1e8:
                 break
             lam = max(1e-6, 10.0 * lam)
         T, r, x, cost = T_new, r_new, x_new, cost_new

@@ -145,7 +145,37 @@ def constraint_jacobian(normals: FloatArray, x_m: FloatArray) -> FloatArray:
         normals: ``(M, 3)`` unit constraint normals, wobj frame.
         x_m: ``(M, 3)`` the points where the residuals are evaluated, wobj frame, metres.
     """
-    return np.concatenate([-normals, -np.cross(x_m, normals)], axis=1)
+    J = np.empty((normals.shape[0], 6))
+    J[:, :3] = -normals
+    J[:, 3:] = -cross_rows(x_m, normals)
+    return J
+
+
+def cross_rows(a: FloatArray, b: FloatArray) -> FloatArray:
+    """Row-wise cross product of ``(M, 3)`` arrays (``np.cross`` without its overhead)."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
+
+
+def small_motion_matrix(delta: FloatArray) -> FloatArray:
+    """``(4, 4)`` transform of one small motion ``(dx, dy, dz, rx, ry, rz)``: the same as
+    :func:`calib.frames.small_motion` for a single ``(6,)`` vector, by Rodrigues' formula
+    (no scipy call: this runs in every Gauss-Newton iteration).
+    """
+    w = delta[3:]
+    theta = float(np.sqrt(w @ w))
+    K = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+    if theta < 1e-8:
+        s, c = 1.0 - theta * theta / 6.0, 0.5 - theta * theta / 24.0
+    else:
+        s, c = np.sin(theta) / theta, (1.0 - np.cos(theta)) / (theta * theta)
+    T = np.eye(4)
+    T[:3, :3] += s * K + c * (K @ K)
+    T[:3, 3] = delta[:3]
+    return T
 
 
 def point_motion_jacobian(p_wobj: ArrayLike) -> FloatArray:

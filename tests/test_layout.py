@@ -13,8 +13,10 @@ from calib.layout import (
     axis_name,
     constraint_jacobian,
     constraint_set,
+    cross_rows,
     point_motion_jacobian,
     random_face_layout,
+    small_motion_matrix,
 )
 from calib.probing import ProbePoint, SearchSpec
 
@@ -67,6 +69,21 @@ def test_point_motion_jacobian_matches_small_motions(rng: np.random.Generator) -
     delta = rng.normal(size=6) * 1e-7
     moved = transform_points(small_motion(delta), p) - p
     np.testing.assert_allclose(point_motion_jacobian(p) @ delta, moved, atol=1e-13)
+
+
+@pytest.mark.parametrize("angle", [0.0, 1e-12, 1e-9, 1e-7, 1e-3, 0.5, 3.0])
+def test_fast_small_motion_equals_frames_small_motion(
+    rng: np.random.Generator, angle: float
+) -> None:
+    axis = rng.normal(size=3)
+    delta = np.concatenate([rng.normal(size=3), angle * axis / np.linalg.norm(axis)])
+    np.testing.assert_allclose(small_motion_matrix(delta), small_motion(delta), atol=1e-15)
+
+
+def test_cross_rows_equals_numpy(rng: np.random.Generator) -> None:
+    a, b = rng.normal(size=(7, 3)), rng.normal(size=(7, 3))
+    np.testing.assert_allclose(cross_rows(a, b), np.cross(a, b), atol=1e-15)
+    np.testing.assert_allclose(cross_rows(a[0], b), np.cross(a[0], b), atol=1e-15)
 
 
 def test_random_layout_points_lie_on_their_faces(rng: np.random.Generator) -> None:
