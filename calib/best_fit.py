@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import ShapeError
-from calib.frames import check_transform
+from calib.frames import check_transform, small_motion
 from calib.layout import (
     ConstraintSet,
     constraint_jacobian,
@@ -30,9 +30,15 @@ from calib.layout import (
     point_motion_jacobian,
     small_motion_matrix,
 )
-from calib.observability import analyze_layout, unobservable_error
+from calib.observability import analyze_layout, require_observable, unobservable_error
 from calib.probing import ProbePoint
-from calib.validation import check_points, check_positive, check_vector3
+from calib.validation import (
+    as_float_array,
+    check_finite,
+    check_points,
+    check_positive,
+    check_vector3,
+)
 
 FloatArray = NDArray[np.float64]
 
@@ -198,3 +204,83 @@ def _sandwich_covariance(J: FloatArray, cs: ConstraintSet) -> FloatArray:
     B = A @ J.T
     cov = B @ W @ B.T
     return 0.5 * (cov + cov.T)
+
+
+@dataclass(frozen=True)
+class BatchFitResult:
+    """Best fits of many measurement sets of one layout (e.g. Monte Carlo runs).
+
+    Attributes:
+        T_base_wobj: ``(K, 4, 4)`` the fitted frames, base frame.
+        rms_m: ``(K,)`` RMS of each fit's point-to-face residuals, metres.
+        converged: ``(K,)`` True where the last Gauss-Newton step was below the tolerance.
+        iterations: Gauss-Newton iterations run (the same for all fits).
+    """
+
+    T_base_wobj: FloatArray
+    rms_m: FloatArray
+    converged: NDArray[np.bool_]
+    iterations: int
+
+
+def best_fit_many(
+    points: Sequence[ProbePoint] | ConstraintSet,
+    measured_base: ArrayLike,
+    T_base_wobj_guess: ArrayLike,
+    *,
+    max_iterations: int = 30,
+    tol: float = 1e-12,
+) -> BatchFitResult:
+    """:func:`best_fit` for ``K`` measurement sets at once, vectorised over the sets.
+
+    Plain Gauss-Newton (no damping), for guesses within a few centimetres and degrees of the
+    truth; the covariance depends only on the layout and pose, so take it from one
+    :func:`best_fit` call.
+
+    Args:
+        points: the nominal probe points (or a prepared :class:`ConstraintSet`).
+        measured_base: ``(K, N, 3)`` measured points, base frame, metres.
+        T_base_wobj_guess: ``(4, 4)`` or ``(K, 4, 4)`` start estimate(s).
+        max_iterations: largest number of iterations.
+        tol: convergence threshold on the step (m, and rad times the layout size).
+
+    Raises:
+        ShapeError: ``measured_base`` is not ``(K, N, 3)`` or the guesses do not match ``K``.
+        NonFiniteError: NaN or infinity in the inputs.
+        UnobservableError: the layout leaves a motion unconstrained.
+    """
+    cs = constraint_set(points)
+    q = check_finite(as_float_array(measured_base, "measured_base"), "measured_base")
+    if q.ndim != 3 or q.shape[1:] != (cs.n_points, 3):
+        raise ShapeError(f"measured_base must be (K, {cs.n_points}, 3), got {q.shape}")
+    k = q.shape[0]
+    T0 = check_transform(T_base_wobj_guess, "T_base_wobj_guess")
+    if T0.shape not in ((4, 4), (k, 4, 4)):
+        raise ShapeError(f"T_base_wobj_guess must be (4, 4) or ({k}, 4, 4), got {T0.shape}")
+    require_observable(cs)
+    T = np.broadcast_to(T0, (k, 4, 4)).copy()
+    qm = q[:, cs.point_index]
+    L, c, n = cs.scale_m, cs.centroid_m, cs.normals
+    step = np.full((k, 6), np.inf)
+    it = 0
+    for it in range(1, max_iterations + 1):  # noqa: B007
+        x = np.einsum("kmj,kji->kmi", qm - T[:, None, :3, 3], T[:, :3, :3])
+        r = np.einsum("mj,kmj->km", n, x - cs.nominal_m)
+        J = np.empty((*r.shape, 6))
+        J[..., :3] = -n
+        J[..., 3:] = -cross_rows(x - c, n) / L
+        H = np.einsum("kmi,kmj->kij", J, J)
+        g = np.einsum("kmi,km->ki", J, r)
+        step = -np.linalg.solve(H, g[..., None])[..., 0]
+        w = step[:, 3:] / L
+        T = T @ small_motion(np.concatenate([step[:, :3] - cross_rows(w, c), w], axis=1))
+        if float(np.max(np.abs(step))) < tol:
+            break
+    x = np.einsum("kmj,kji->kmi", qm - T[:, None, :3, 3], T[:, :3, :3])
+    r = np.einsum("mj,kmj->km", n, x - cs.nominal_m)
+    return BatchFitResult(
+        T_base_wobj=T,
+        rms_m=np.sqrt(np.mean(r * r, axis=1)),
+        converged=np.max(np.abs(step), axis=1) < tol,
+        iterations=it,
+    )

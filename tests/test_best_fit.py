@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from calib.best_fit import best_fit
+from calib.best_fit import best_fit, best_fit_many
 from calib.errors import NonFiniteError, ShapeError, UnobservableError
 from calib.frames import (
     invert_transform,
@@ -206,3 +206,37 @@ def test_bad_input_raises_named_errors() -> None:
         res.predicted_sigma(np.zeros(3), np.zeros(3))
     with pytest.raises(NonFiniteError, match="p_wobj"):
         res.predicted_error([np.nan, 0.0, 0.0])
+
+
+def test_batched_fits_equal_single_fits() -> None:
+    rng = np.random.default_rng(21)
+    faces = random_face_layout(rng, (4, 3, 2), n_edge_points=1)
+    cs = constraint_set(faces.points)
+    T_true = random_transform(rng, 1.0, np.pi)
+    k = 40
+    q = transform_points(T_true, cs.positions_m) + rng.normal(scale=2e-4, size=(k, cs.n_points, 3))
+    guesses = T_true @ np.stack([random_transform(rng, 0.02, np.deg2rad(3.0)) for _ in range(k)])
+    batch = best_fit_many(cs, q, guesses)
+    assert batch.T_base_wobj.shape == (k, 4, 4) and batch.converged.all()
+    for i in (0, 17, k - 1):
+        single = best_fit(cs, q[i], guesses[i])
+        np.testing.assert_allclose(batch.T_base_wobj[i], single.T_base_wobj, atol=1e-12)
+        assert batch.rms_m[i] == pytest.approx(single.rms_m, rel=1e-9)
+    # one shared guess broadcasts over the batch
+    shared = best_fit_many(faces.points, q, T_true)
+    np.testing.assert_allclose(shared.T_base_wobj, batch.T_base_wobj, atol=1e-12)
+
+
+def test_batched_fit_bad_input() -> None:
+    pts = _stator_like_points()
+    q = np.array([p.position_m for p in pts])
+    with pytest.raises(ShapeError, match=r"measured_base must be \(K, 7, 3\)"):
+        best_fit_many(pts, q, np.eye(4))
+    with pytest.raises(ShapeError, match="T_base_wobj_guess"):
+        best_fit_many(pts, np.stack([q, q]), np.stack([np.eye(4)] * 3))
+    bad = np.stack([q, q])
+    bad[1, 0, 0] = np.nan
+    with pytest.raises(NonFiniteError, match="measured_base"):
+        best_fit_many(pts, bad, np.eye(4))
+    with pytest.raises(UnobservableError, match="translation along wobj y"):
+        best_fit_many(pts[:-1], np.stack([q[:-1]]), np.eye(4))
