@@ -29,7 +29,7 @@ def _check_fk_and_ik(chain: KinematicChain, rng: np.random.Generator) -> None:
     q = rng.uniform(chain.lower, chain.upper, (300, 6))
     T = chain.fk(q)
     assert np.abs(robot.fk(q) - T).max() <= 1e-9
-    q_sol, valid = robot.solve(T)
+    q_sol, valid, _ = robot.solve(T)
     assert valid.any(axis=1).all()
     K = q_sol.shape[1]
     assert np.abs(chain.fk(q_sol[valid]) - np.repeat(T, K, axis=0)[valid.ravel()]).max() <= 1e-9

@@ -44,6 +44,10 @@ def test_coverage_and_round_trip_on_2000_reachable_poses(
     assert np.abs(irb.fk(q) - np.repeat(T, K, axis=0)[ok]).max() <= 1e-9
     assert irb.within_limits(q, tol=1e-12).all()
     assert np.isnan(sol.q[~sol.valid]).all() and (sol.branch[~sol.valid] == -1).all()
+    # solutions are packed first in each row; K is the largest count (at least 8)
+    count = sol.valid.sum(axis=1)
+    np.testing.assert_array_equal(sol.valid, np.arange(K) < count[:, None])
+    assert K == max(8, count.max())
     # the branch code stored with each solution is its geometric classification
     np.testing.assert_array_equal(sol.branch[sol.valid], branch_codes(make_ik_solver(irb).opw, q))
 

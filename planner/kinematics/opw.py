@@ -39,8 +39,6 @@ BoolArray = NDArray[np.bool_]
 
 #: Below this sin(theta5) the wrist is taken as singular and theta4 is set to 0.
 WRIST_SINGULAR_SIN = 1e-10
-#: Largest position (m) and rotation-matrix (1) error a branch may show in the round trip.
-ROUND_TRIP_TOL = 1e-7
 
 
 @dataclass(frozen=True)
@@ -130,52 +128,54 @@ def opw_ik(p: OPWParameters, T_opw_ee: FloatArray) -> tuple[FloatArray, BoolArra
 
     Returns:
         ``q (N, 8, 6)`` robot joint values wrapped to ``[-pi, pi]`` (NaN where not reachable)
-        and ``reachable (N, 8)``: the branch exists and its wrist centre is reproduced within
-        :data:`ROUND_TRIP_TOL` (joint limits are not checked here). At a wrist singularity
+        (a view of a joint-major array) and ``reachable (N, 8)``: the branch exists (joint limits
+        are not checked here). At a wrist singularity
         (``theta5 = 0``) ``theta4 = 0`` and ``theta6`` takes the whole rotation.
     """
     T = np.asarray(T_opw_ee, dtype=np.float64)
     N = T.shape[0]
-    r = [[T[:, i, j, None] for j in range(3)] for i in range(3)]  # (N, 1) each
-    Cx, Cy, Cz = (T[:, i, 3, None] - p.c4 * r[i][2] for i in range(3))
+    flat = np.ascontiguousarray(T.reshape(N, 16).T)  # (16, N): contiguous rows per entry
+    r = [[flat[4 * i + j] for j in range(3)] for i in range(3)]  # R entries, (N,) each
+    Cx, Cy, Cz = (flat[4 * i + 3] - p.c4 * r[i][2] for i in range(3))  # wrist centre
     r2 = Cx * Cx + Cy * Cy
     rho = np.sqrt(np.maximum(r2 - p.b**2, 0.0))  # |x1| of the wrist centre in the arm plane
     phi, lam = np.arctan2(Cy, Cx), np.arctan2(p.b, rho)
-    # 4 arm solutions: (front, elbow 0), (front, elbow 1), (back, elbow 0), (back, elbow 1)
-    back = np.array([0.0, 0.0, 1.0, 1.0])
-    sgn_elbow = np.array([1.0, -1.0, 1.0, -1.0])
-    t1 = phi - lam + back * (2.0 * lam - np.pi)
-    x = rho * (1.0 - 2.0 * back) - p.a1
+    # shoulder front (row 0) and back (row 1): theta1, arm-plane x and z of the wrist centre
+    t1 = np.stack([phi - lam, phi + lam - np.pi])  # (2, N)
+    x = np.stack([rho - p.a1, -rho - p.a1])
     z = Cz - p.c1
     k2 = p.a2**2 + p.c3**2
     k, psi3 = np.sqrt(k2), np.arctan2(p.a2, p.c3)
-    D = (x * x + z * z - p.c2**2 - k2) / (2.0 * p.c2 * k)
-    ok = (r2 >= p.b**2 - 1e-15) & (np.abs(D) <= 1.0 + 1e-14)
-    beta = sgn_elbow * np.arccos(np.clip(D, -1.0, 1.0))  # theta3 + psi3
-    t3 = beta - psi3
-    t2 = np.arctan2(x, z) - np.arctan2(k * np.sin(beta), p.c2 + k * np.cos(beta))
-    t23 = t2 + t3
-    # round trip of the wrist centre (catches the clipped D at the workspace boundary)
-    cx1 = p.a1 + p.c2 * np.sin(t2) + p.c3 * np.sin(t23) + p.a2 * np.cos(t23)
-    cz1 = p.c1 + p.c2 * np.cos(t2) + p.c3 * np.cos(t23) - p.a2 * np.sin(t23)
-    c1, s1 = np.cos(t1), np.sin(t1)
-    err = np.maximum(
-        np.maximum(np.abs(cx1 * c1 - p.b * s1 - Cx), np.abs(cx1 * s1 + p.b * c1 - Cy)),
-        np.abs(cz1 - Cz),
+    D = (x * x + z * z - p.c2**2 - k2) / (2.0 * p.c2 * k)  # cos(theta3 + psi3)
+    # clipping |D| <= 1 + 1e-14 moves the wrist centre by < 1e-11 m, so no round trip is needed
+    ok2 = (r2 - p.b**2 >= -1e-18) & (np.abs(D) <= 1.0 + 1e-14)
+    Dc = np.clip(D, -1.0, 1.0)
+    acos_d = np.arccos(Dc)
+    sin_b = np.sqrt(1.0 - Dc * Dc)
+    gamma = np.arctan2(x, z)
+    # arm solutions (4, N): (front, elbow 0), (front, elbow 1), (back, elbow 0), (back, elbow 1)
+    beta = np.stack([acos_d[0], -acos_d[0], acos_d[1], -acos_d[1]])  # theta3 + psi3
+    t2 = np.repeat(gamma, 2, axis=0) - np.arctan2(
+        k * sin_b[[0, 0, 1, 1]] * np.array([1.0, -1.0, 1.0, -1.0])[:, None],
+        p.c2 + k * Dc[[0, 0, 1, 1]],
     )
-    ok &= err <= ROUND_TRIP_TOL
-    t4, t5, t6 = _wrist(r, c1, s1, np.cos(t23), np.sin(t23))
+    t3 = beta - psi3
+    t23 = t2 + t3
+    t1_4 = t1[[0, 0, 1, 1]]
+    ok = ok2[[0, 0, 1, 1]]
+    c1, s1 = np.cos(t1), np.sin(t1)
+    t4, t5, t6 = _wrist(r, c1[[0, 0, 1, 1]], s1[[0, 0, 1, 1]], np.cos(t23), np.sin(t23))
     sc, off = p.sign_corrections, p.offsets
-    q = np.empty((N, 4, 2, 6))
-    for j, t in enumerate((t1, t2, t3)):
-        q[:, :, :, j] = wrap_angle(sc[j] * (t + off[j]))[:, :, None]
+    out = np.empty((6, 4, 2, N))  # joint-major: contiguous writes
+    for j, t in enumerate((t1_4, t2, t3)):
+        out[j] = wrap_angle(sc[j] * (t + off[j]))[:, None, :]
     for j, t, t_flip in ((3, t4, t4 + np.pi), (4, t5, -t5), (5, t6, t6 + np.pi)):
-        q[:, :, 0, j] = wrap_angle(sc[j] * (t + off[j]))
-        q[:, :, 1, j] = wrap_angle(sc[j] * (t_flip + off[j]))
-    q = q.reshape(N, 8, 6)
-    ok8 = np.repeat(ok, 2, axis=1)
-    q[~ok8] = np.nan
-    return q, ok8
+        out[j, :, 0] = wrap_angle(sc[j] * (t + off[j]))
+        out[j, :, 1] = wrap_angle(sc[j] * (t_flip + off[j]))
+    ok8 = np.repeat(ok, 2, axis=0)  # (8, N)
+    out = out.reshape(6, 8, N)
+    np.copyto(out, np.nan, where=~ok8[None])
+    return out.transpose(2, 1, 0), np.ascontiguousarray(ok8.T)
 
 
 def _wrist(
@@ -186,13 +186,14 @@ def _wrist(
     ``r[i][j]`` are the entries of ``R``; columns of ``Rz(t1) Ry(t23)`` are
     ``(c1 c23, s1 c23, -s23)``, ``(-s1, c1, 0)``, ``(c1 s23, s1 s23, c23)``.
     """
+    c1c23, s1c23, c1s23, s1s23 = c1 * c23, s1 * c23, c1 * s23, s1 * s23
 
     def row(i: int, j: int) -> FloatArray:
         if i == 0:
-            return c1 * c23 * r[0][j] + s1 * c23 * r[1][j] - s23 * r[2][j]
+            return c1c23 * r[0][j] + s1c23 * r[1][j] - s23 * r[2][j]
         if i == 1:
             return -s1 * r[0][j] + c1 * r[1][j]
-        return c1 * s23 * r[0][j] + s1 * s23 * r[1][j] + c23 * r[2][j]
+        return c1s23 * r[0][j] + s1s23 * r[1][j] + c23 * r[2][j]
 
     m02, m12, m22 = row(0, 2), row(1, 2), row(2, 2)
     s5 = np.hypot(m02, m12)

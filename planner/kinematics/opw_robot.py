@@ -67,7 +67,7 @@ class OPWRobot:
             T = T @ invert_transform(self.T_ee_tip)
         return opw_ik(self.params, T)
 
-    def solve(self, T_base_tip: FloatArray) -> tuple[FloatArray, BoolArray]:
+    def solve(self, T_base_tip: FloatArray) -> tuple[FloatArray, BoolArray, NDArray[np.int_]]:
         """All solutions within joint limits, including the 2*pi variants (see :meth:`expand`).
 
         Args:
@@ -75,38 +75,53 @@ class OPWRobot:
         """
         return self.expand(*self.ik_branches(T_base_tip))
 
-    def expand(self, q8: FloatArray, ok8: BoolArray) -> tuple[FloatArray, BoolArray]:
-        """Add the 2*pi variants to branches ``q8 (N, 8, 6)`` and apply the joint limits.
+    def expand(
+        self, q8: FloatArray, ok8: BoolArray, min_k: int = 8
+    ) -> tuple[FloatArray, BoolArray, NDArray[np.int_]]:
+        """Add the 2*pi variants to branches ``q8 (N, 8, 6)``, apply the limits, pack the result.
 
         Joints whose limits lie within ``[-pi, pi]`` are checked as they are; the others are
         moved to their lowest value ``>= lower`` (modulo 2*pi) and ``turn_counts`` values
-        ``+ 2*pi*i`` are tried. ``V = prod(turn_counts)``.
+        ``+ 2*pi*i`` are tried.
 
         Returns:
-            ``q (N, 8 * V, 6)``, branch-major (entry ``k`` is OPW branch ``k // V``), NaN where
-            not valid, and ``valid (N, 8 * V)``: reachable and within the joint limits.
+            ``q (N, K, 6)``: each pose's valid solutions first, ordered by OPW branch then by
+            variant, NaN after them; ``K = max(min_k, most solutions of any pose)``.
+            ``valid (N, K)``: reachable and within the joint limits.
+            ``branch (N, K)``: the OPW branch index 0-7 of each solution, -1 where not valid.
         """
         counts = self.turn_counts
         combos = np.array(list(itertools.product(*(range(m) for m in counts))), dtype=int)
         N, V = q8.shape[0], combos.shape[0]
-        q = np.empty((N, 8, V, 6))
         inside = np.broadcast_to(ok8[:, :, None], (N, 8, V)).copy()
         two_pi = 2.0 * np.pi
+        cands: list[FloatArray] = []  # per joint (N, 8, m_j)
         with np.errstate(invalid="ignore"):
             for j, (lo, hi) in enumerate(zip(self.lower, self.upper)):
                 qj = q8[:, :, j]
                 if not (np.isfinite(lo) and np.isfinite(hi)):
-                    q[:, :, :, j] = qj[:, :, None]
+                    cands.append(qj[:, :, None])
                     continue
                 if lo >= -np.pi and hi <= np.pi:
-                    q[:, :, :, j] = qj[:, :, None]
+                    cands.append(qj[:, :, None])
                     inside &= ((qj >= lo - 1e-12) & (qj <= hi + 1e-12))[:, :, None]
                     continue
                 q_lo = qj - two_pi * np.floor((qj - lo + 1e-12) * (1.0 / two_pi))
                 cand = q_lo[:, :, None] + two_pi * np.arange(counts[j])  # (N, 8, m)
-                q[:, :, :, j] = cand[:, :, combos[:, j]]
+                cands.append(cand)
                 inside &= (cand <= hi + 1e-12)[:, :, combos[:, j]]
-        q = q.reshape(N, 8 * V, 6)
-        valid = inside.reshape(N, 8 * V)
-        q[~valid] = np.nan
-        return q, valid
+        flat = inside.reshape(N, 8 * V)
+        n_idx, kv = np.nonzero(flat)  # row-major: per pose, by branch then variant
+        b_idx, v_idx = kv // V, kv % V
+        per_pose = flat.sum(axis=1)
+        K = max(min_k, int(per_pose.max()) if N else 0)
+        rank = np.arange(n_idx.size) - np.repeat(np.cumsum(per_pose) - per_pose, per_pose)
+        q = np.full((N, K, 6), np.nan)
+        for j, cand in enumerate(cands):
+            m_idx = combos[v_idx, j] if cand.shape[2] > 1 else 0
+            q[n_idx, rank, j] = cand[n_idx, b_idx, m_idx]
+        valid = np.zeros((N, K), dtype=bool)
+        valid[n_idx, rank] = True
+        branch = np.full((N, K), -1, dtype=int)
+        branch[n_idx, rank] = b_idx
+        return q, valid, branch

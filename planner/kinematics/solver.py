@@ -32,7 +32,10 @@ class IKSolutions:
 
     Attributes:
         q: joint values ``(N, K, n)``, rad (robot joint convention of the URDF); NaN where
-            ``valid`` is False, so a forgotten mask cannot pass as a solution.
+            ``valid`` is False, so a forgotten mask cannot pass as a solution. For OPW arms each
+            pose's solutions come first (by branch, then 2*pi variant) and ``K`` is the largest
+            number of solutions of any pose in the batch (at least 8); for the numeric solver
+            ``K`` is the number of seeds.
         valid: ``(N, K)`` bool: reaches the pose (1e-6 m, 1e-6 rad or better) within joint limits.
         branch: ``(N, K)`` int: for 6-axis OPW arms the configuration index 0-7 (ABB ``cfx``:
             4 * shoulder behind + 2 * wrist centre behind the lower arm + axis 5 negative, see
@@ -99,12 +102,11 @@ class IKSolver:
         T = T[None] if T.ndim == 2 else T
         if self.opw is not None:
             q8, ok8 = self.opw.ik_branches(T)
-            q, valid = self.opw.expand(q8, ok8)
-            V = q.shape[1] // 8
+            q, valid, b8 = self.opw.expand(q8, ok8)
             # bits 4 and 2 of the OPW branch index are the geometric shoulder / elbow flags
             # (wrist centre behind axis 1 / behind the lower arm); bit 1 is axis 5's sign
-            code = (np.arange(8) & 6) + (q8[:, :, 4] < 0)
-            branch = np.where(valid, np.repeat(code, V, axis=1), -1)
+            with np.errstate(invalid="ignore"):
+                branch = np.where(valid, (b8 & 6) + (q[:, :, 4] < 0), -1)
             return IKSolutions(q, valid, branch)
         res = self._numeric.solve(T, seeds)
         branch = np.full(res.valid.shape, -1, dtype=int)
