@@ -47,7 +47,7 @@ def test_coverage_and_round_trip_on_2000_reachable_poses(
     # solutions are packed first in each row; K is the largest count (at least 8)
     count = sol.valid.sum(axis=1)
     np.testing.assert_array_equal(sol.valid, np.arange(K) < count[:, None])
-    assert K == max(8, count.max())
+    assert max(8, count.max()) == K
     # the branch code stored with each solution is its geometric classification
     np.testing.assert_array_equal(sol.branch[sol.valid], branch_codes(make_ik_solver(irb).opw, q))
 
