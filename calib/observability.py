@@ -215,13 +215,16 @@ def _name_null_space(null: FloatArray, cs: ConstraintSet) -> tuple[Unconstrained
         if len(out) == k:
             break
         v = _rotation_parallel_to(null, eye[j], cs, found)
-        if v is not None:
-            c = _axis_point(v, cs)
-            accept(
-                v,
-                f"rotation about an axis parallel to wobj {_AXES[j]} through {_mm(c)}",
-                "every probe normal line meets or is parallel to that axis",
-            )
+        if v is None:
+            continue
+        t, w = _split(v, cs)
+        if abs(float(w @ t)) > 1e-9 * float(w @ w) * cs.scale_m:  # a screw: named below
+            continue
+        accept(
+            v,
+            f"rotation about an axis parallel to wobj {_AXES[j]} through {_mm(_axis_point(v, cs))}",
+            "every probe normal line meets or is parallel to that axis",
+        )
     if len(out) < k:
         rest = null - np.stack(found, 1) @ (np.stack(found, 1).T @ null) if found else null
         u, _, _ = np.linalg.svd(rest, full_matrices=False)
