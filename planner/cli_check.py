@@ -150,17 +150,19 @@ def export_job_for(plan: Plan, plan_dir: Path, run_check: bool = True) -> tuple[
         rows = check_plan(plan, plan_dir)
         T_wobj_base = invert_transform(T_nom)
         for r in rows:
-            if r.T_base_flange is not None and r.status != "infeasible":
+            if r.T_base_flange is not None and r.status != "infeasible":  # the chosen pose
                 T_wobj_tcp = T_wobj_base @ r.T_base_flange @ tool.T_flange_tcp
                 rotations[r.point_id] = T_wobj_tcp[:3, :3]
             if r.confdata is not None:
                 confs[r.point_id] = r.confdata
-        bad = [r.point_id for r in rows if not r.feasible]
-        if bad:
-            note = (note + "; " if note else "") + (
-                f"points {bad} are not feasible (see 'wobjcal check'): default orientation, "
-                "no confdata"
-            )
+        no_pose = [r.point_id for r in rows if r.point_id not in rotations]
+        blocked = [r.point_id for r in rows if not r.feasible and r.point_id in rotations]
+        notes = [note] if note else []
+        if no_pose:
+            notes.append(f"no feasible pose for {no_pose}: default orientation, no confdata")
+        if blocked:
+            notes.append(f"points {blocked} are not feasible (see 'wobjcal check')")
+        note = "; ".join(notes)
     else:
         note = (note + "; " if note else "") + "no check: default orientations, no confdata"
     return build_job(plan, T_nom, tool, rotations, confs), note
@@ -195,6 +197,8 @@ def cmd_check(args: argparse.Namespace) -> int:
         print_json({"plan": args.plan, "feasible": not bad, "points": [r.to_json() for r in rows]})
     else:
         out = stdout()
+        if not out.is_terminal:
+            out.width = 160
         out.print(_table(rows, f"wobjcal check {args.plan}"))
         for r in bad:
             reason = "; ".join(x for x in (r.reason, r.path_reason) if x) or "not feasible"

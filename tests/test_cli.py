@@ -212,3 +212,61 @@ def test_validate_rejects_parts_it_cannot_simulate(capsys: pytest.CaptureFixture
     code, _, err = run(capsys, "validate", str(DATA / "valid_three_two_one.json"), "--trials", "2")
     assert code == 2
     assert "procedure.method: validate simulates only hultman2013, got 'three_two_one'" in err
+
+
+def _moved_copy(tmp_path: Path, point_id: str, offset_m: tuple[float, float, float]) -> Path:
+    raw = json.loads(STATOR.read_text())
+    for p in raw["points"]:
+        if p["id"] == point_id:
+            p["position_m"] = [a + b for a, b in zip(p["position_m"], offset_m, strict=True)]
+    path = tmp_path / "moved.json"
+    path.write_text(json.dumps(raw))
+    return path
+
+
+def test_check_names_a_point_moved_5_m_away(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    moved = _moved_copy(tmp_path, "F", (0.0, -5.0, 0.0))
+    code, out, err = run(capsys, "check", str(moved), "--json")
+    assert code == 1, err
+    res = json.loads(out)  # stdout is pure JSON (PyBullet's banner goes to stderr)
+    rows = {r["id"]: r for r in res["points"]}
+    assert res["feasible"] is False
+    assert rows["F"]["status"] == "infeasible" and "reach" in rows["F"]["reason"]
+    code, out, _ = run(capsys, "check", str(moved))
+    assert code == 1
+    assert re.search(r"point F: infeasible: out of reach", out)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="shipped A-H plan not yet feasible in the demo cell: A and G at the joint-3 limit, "
+    "approach overtravel runs the sensor bracket into the part (cell/demo-cell owners)",
+)
+def test_check_shipped_plan_passes(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys, "check", str(STATOR))
+    assert code == 0, out
+
+
+def test_export_takes_orientation_and_confdata_from_check(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from tests.test_export_rapid import parse_rapid
+
+    out = tmp_path / "ah.mod"
+    code, _, err = run(capsys, "export", str(STATOR), "--format", "rapid", "-o", str(out))
+    assert code == 0, err
+    code, checked, _ = run(capsys, "check", str(STATOR), "--json")
+    rows = {r["id"]: r for r in json.loads(checked)["points"]}
+    parsed = parse_rapid(out.read_text())
+    plan = load_plan(STATOR)
+    n_confs = 0
+    for p in plan.points:
+        T, conf = parsed["targets"][(p.id, "start")]
+        axis_err = np.degrees(np.arccos(np.clip(T[:3, 2] @ -np.array(p.normal), -1, 1)))
+        assert axis_err < 1e-3  # the sensor looks into the face, whoever chose the rotation
+        if rows[p.id]["confdata"] is not None:
+            assert list(conf) == rows[p.id]["confdata"]
+            n_confs += 1
+    assert n_confs >= 1
