@@ -1,0 +1,156 @@
+"""Tests of planner.workobject: formats, units, repair, errors and the concave PyBullet body."""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pybullet as pb
+import pytest
+import trimesh
+
+from calib.frames import make_transform
+from planner.builtins import register_builtin_mesh
+from planner.errors import MeshError
+from planner.workobject import AUTO_MM_EXTENT, load_work_object
+
+
+def test_plate_in_mm_is_detected_with_a_warning(reference_dir, caplog) -> None:
+    path = reference_dir / "parts" / "plate_holes.STL"
+    with caplog.at_level(logging.WARNING, logger="planner.workobject"):
+        wobj = load_work_object(path)
+    r = wobj.report
+    assert (r.units, r.units_detected, r.scale) == ("mm", True, 1e-3)
+    # 8 x 12 x 0.5 inch
+    np.testing.assert_allclose(sorted(wobj.mesh.extents), [0.0127, 0.2032, 0.3048], atol=1e-6)
+    assert r.watertight and r.boundary_edges == 0
+    assert r.merged_vertices > 0  # binary STL stores every triangle's corners separately
+    assert "millimetres" in caplog.text and "plate_holes.STL" in caplog.text
+    assert wobj.name == "plate_holes"
+    # the plate has 5 through-holes: genus 5, so Euler characteristic 2 - 2 * 5
+    assert wobj.mesh.euler_number == 2 - 2 * 5
+
+
+def test_explicit_units(reference_dir) -> None:
+    path = reference_dir / "parts" / "plate_holes.STL"
+    inch = load_work_object(path, units="inch")  # wrong on purpose: 25.4x the mm size
+    assert inch.mesh.extents.max() == pytest.approx(304.8 * 0.0254, rel=1e-6)
+    assert not inch.report.units_detected
+    with pytest.raises(MeshError, match=r"furlong"):
+        load_work_object(path, units="furlong")
+
+
+def test_metre_mesh_is_kept_in_metres() -> None:
+    box = trimesh.creation.box([0.3, 0.2, AUTO_MM_EXTENT * 0.99])
+    wobj = load_work_object(box)
+    assert wobj.report.units == "m" and wobj.report.warnings == ()
+
+
+def test_raw_scan_loads_with_a_report(reference_dir) -> None:
+    wobj = load_work_object(reference_dir / "parts" / "noether_raw_mesh.ply")
+    r = wobj.report
+    assert not r.watertight
+    assert r.boundary_edges > 3000
+    assert r.removed_degenerate_faces == 2
+    assert any("open mesh" in w for w in r.warnings)
+    assert r.n_faces == len(wobj.mesh.faces) > 50_000
+
+
+def test_winding_of_a_closed_mesh_is_fixed() -> None:
+    box = trimesh.creation.box([0.2, 0.2, 0.2])
+    box.invert()  # all normals inward
+    assert box.volume < 0
+    wobj = load_work_object(box, units="m")
+    assert wobj.report.fixed_winding
+    assert wobj.mesh.volume == pytest.approx(0.008)
+
+
+@pytest.mark.parametrize("ext", ["obj", "ply", "glb", "stl"])
+def test_formats_trimesh_reads(tmp_path, ext) -> None:
+    box = trimesh.creation.box([0.1, 0.2, 0.3])
+    path = tmp_path / f"part.{ext}"
+    box.export(path)
+    wobj = load_work_object(path, units="m")
+    np.testing.assert_allclose(sorted(wobj.mesh.extents), [0.1, 0.2, 0.3], atol=1e-9)
+    assert wobj.mesh.volume == pytest.approx(0.006)
+
+
+def test_bad_meshes_name_the_file(tmp_path) -> None:
+    with pytest.raises(MeshError, match=r"missing\.stl"):
+        load_work_object(tmp_path / "missing.stl")
+    garbage = tmp_path / "garbage.stl"
+    garbage.write_bytes(b"\x00\x01 this is not a mesh" * 3)
+    with pytest.raises(MeshError, match=r"garbage\.stl"):
+        load_work_object(garbage)
+    empty = tmp_path / "empty.obj"
+    empty.write_text("# no faces\n")
+    with pytest.raises(MeshError, match=r"empty\.obj"):
+        load_work_object(empty)
+    nan = trimesh.creation.box([1, 1, 1])
+    nan.vertices[3, 1] = np.nan
+    with pytest.raises(MeshError, match=r"NaN"):
+        load_work_object(nan)
+    with pytest.raises(MeshError, match=r"empty"):
+        load_work_object(trimesh.Trimesh())
+
+
+def test_builtin_mesh_registry() -> None:
+    register_builtin_mesh("test_cube", lambda: trimesh.creation.box([0.1, 0.1, 0.1]))
+    wobj = load_work_object("builtin:test_cube")
+    assert wobj.name == "test_cube"
+    assert wobj.mesh.volume == pytest.approx(1e-3)
+
+
+def test_concave_body_does_not_fill_holes() -> None:
+    """A sphere inside a ring's hole is clear of the exact mesh; the convex hull swallows it."""
+    ring = trimesh.creation.annulus(r_min=0.05, r_max=0.2, height=0.1)
+    wobj = load_work_object(ring, units="m")
+    client = pb.connect(pb.DIRECT)
+    try:
+        body = wobj.create_body(client, make_transform(p=[1.0, 0.0, 0.0]))
+        sphere = pb.createMultiBody(
+            0,
+            pb.createCollisionShape(pb.GEOM_SPHERE, radius=0.02, physicsClientId=client),
+            basePosition=[1.0, 0.0, 0.0],
+            physicsClientId=client,
+        )
+        pts = pb.getClosestPoints(sphere, body.body_id, 0.1, physicsClientId=client)
+        clear = min(p[8] for p in pts)
+        hull = pb.createMultiBody(
+            0,
+            pb.createCollisionShape(
+                pb.GEOM_MESH, vertices=ring.vertices.tolist(), physicsClientId=client
+            ),
+            basePosition=[1.0, 0.0, 0.0],
+            physicsClientId=client,
+        )
+        blocked = min(p[8] for p in pb.getClosestPoints(sphere, hull, 0.1, physicsClientId=client))
+    finally:
+        pb.disconnect(client)
+    # 0.05 hole radius - 0.02 sphere radius, less the chord error of the polygonal hole
+    assert clear == pytest.approx(0.03, abs=1e-3)
+    assert blocked < -0.05
+
+
+def test_large_mesh_goes_through_a_file(monkeypatch) -> None:
+    """Above the inline vertex limit the body is built from a temporary OBJ, same geometry."""
+    import planner.bodies
+
+    box = trimesh.creation.box([0.5, 0.5, 0.5]).subdivide().subdivide()
+    monkeypatch.setattr(planner.bodies, "MAX_INLINE_VERTICES", 10)
+    wobj = load_work_object(box, units="m")
+    client = pb.connect(pb.DIRECT)
+    try:
+        body = wobj.create_body(client, np.eye(4))
+        sphere = pb.createMultiBody(
+            0,
+            pb.createCollisionShape(pb.GEOM_SPHERE, radius=0.01, physicsClientId=client),
+            basePosition=[0.0, 0.0, 0.30],
+            physicsClientId=client,
+        )
+        d = min(
+            p[8] for p in pb.getClosestPoints(sphere, body.body_id, 0.1, physicsClientId=client)
+        )
+    finally:
+        pb.disconnect(client)
+    assert d == pytest.approx(0.04, abs=1e-6)
