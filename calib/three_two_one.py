@@ -157,8 +157,9 @@ def three_two_one(
             commanded in). Without it, the side of the measured primary plane and the branch
             of the secondary face are taken from the nominal layout, which is right as long as
             the measured points do not flip the primary triangle or cross the secondary pair
-            over; with it, the choice closest to the guess is taken (right for guesses within
-            about 45 degrees).
+            over; with it, the candidate closer to the guess is taken (right when the guess
+            is off by less than half the angle between the two candidate secondary faces,
+            which is large for a secondary pair laid along the primary/secondary edge).
 
     Raises:
         ShapeError: ``measured_base`` is not ``(6, 3)``.
