@@ -173,9 +173,9 @@ def opw_ik(p: OPWParameters, T_opw_ee: FloatArray) -> tuple[FloatArray, BoolArra
         out[j, :, 0] = wrap_angle(sc[j] * (t + off[j]))
         out[j, :, 1] = wrap_angle(sc[j] * (t_flip + off[j]))
     ok8 = np.repeat(ok, 2, axis=0)  # (8, N)
-    out = out.reshape(6, 8, N)
-    np.copyto(out, np.nan, where=~ok8[None])
-    return out.transpose(2, 1, 0), np.ascontiguousarray(ok8.T)
+    q = out.reshape(6, 8, N)
+    np.copyto(q, np.nan, where=~ok8[None])
+    return q.transpose(2, 1, 0), np.ascontiguousarray(ok8.T)
 
 
 def _wrist(
