@@ -76,7 +76,7 @@ class SimulationSetup:
     accuracy_field: AccuracyField | None = None
     settings: StatorSettings = field(default_factory=StatorSettings)
     edge_inset_m: float = 0.003
-    edge_tolerance_m: float = 1e-5
+    edge_tolerance_m: float = 2e-5
 
 
 @dataclass(frozen=True)
@@ -172,7 +172,7 @@ def validate(
     settings: StatorSettings | None = None,
     reachability: ReachabilityHook | None = None,
     edge_inset_m: float = 0.003,
-    edge_tolerance_m: float = 1e-5,
+    edge_tolerance_m: float = 2e-5,
     workers: int | None = None,
     progress: ProgressCallback | None = None,
 ) -> ValidationReport:

@@ -1,13 +1,18 @@
 """Batched first-hit ray casting against one mesh, for the proximity-sensor model.
 
-:class:`MeshRayCaster` uses Embree through trimesh (``trimesh.ray.ray_pyembree``, backed by
-``embreex``) to find the first triangle each ray hits, then recomputes the hit distance in float64
-from that triangle's plane, so distances are exact to float64 on flat faces even though Embree
-works in float32. ``bench/bench_rays.py`` measures it against PyBullet's ``rayTestBatch``; Embree
-is faster (figures in ``docs/simulation.md``).
+:class:`MeshRayCaster` uses Embree (``embreex``, as ``trimesh.ray.ray_pyembree`` does, but
+without its per-call overhead and origin shift) to find the first triangle each ray hits, then
+recomputes the hit distance in float64 from that triangle's plane, so distances are exact to
+float64 on flat faces even though Embree works in float32. Embree also widens triangles by
+about 1e-7 of the scene size, so a ray that passes just beyond a real edge of the part can be
+reported as a hit; every hit is re-checked in float64 (distances to the triangle's edges), and
+a ray that falls outside its triangle across a real (non-coplanar) edge is continued past that
+face. Edges are thus located to float64 precision.
 
-The caster works in the mesh's own frame; callers transform rays into it (cheaper than moving
-the mesh), so one caster serves every misplaced copy of the same part.
+``bench/bench_rays.py`` measures it against PyBullet's ``rayTestBatch``; Embree is faster
+(figures in ``docs/simulation.md``). The caster works in the mesh's own frame; callers
+transform rays into it (cheaper than moving the mesh), so one caster serves every misplaced
+copy of the same part.
 """
 
 from __future__ import annotations
@@ -33,14 +38,21 @@ class MeshRayCaster:
             raise MeshError("mesh must be a trimesh.Trimesh with at least one face")
         self.mesh = mesh
         try:
-            from trimesh.ray.ray_pyembree import RayMeshIntersector
+            from embreex import rtcore_scene
+            from embreex.mesh_construction import TriangleMesh
 
-            self._intersector = RayMeshIntersector(mesh, scale_to_box=False)
+            self._scene = rtcore_scene.EmbreeScene()
+            TriangleMesh(
+                scene=self._scene,
+                vertices=np.asarray(mesh.vertices, dtype=np.float32),
+                indices=np.asarray(mesh.faces, dtype=np.int32),
+            )
             self.backend = "embree"
         except ImportError:  # pragma: no cover - embreex is a dependency on x86_64
-            from trimesh.ray.ray_triangle import RayMeshIntersector as TriIntersector
+            from trimesh.ray.ray_triangle import RayMeshIntersector
 
-            self._intersector = TriIntersector(mesh)
+            self._scene = None
+            self._intersector = RayMeshIntersector(mesh)
             self.backend = "trimesh"
         tri = np.asarray(mesh.triangles, dtype=np.float64)
         normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
@@ -48,8 +60,28 @@ class MeshRayCaster:
         lengths[lengths == 0] = 1.0
         self._normals = normals / lengths[:, None]
         self._offsets = np.einsum("ij,ij->i", self._normals, tri[:, 0])
+        self._triangles = tri
+        self._sharp = self._sharp_local_edges(mesh)
+        # inward in-plane normals of the edge opposite each vertex, and their offsets
+        edge_dir = tri[:, [2, 0, 1]] - tri[:, [1, 2, 0]]  # (F, 3 edges, 3)
+        inward = np.cross(self._normals[:, None, :], edge_dir)
+        inward /= np.maximum(np.linalg.norm(inward, axis=2, keepdims=True), 1e-300)
+        self._edge_normals = inward
+        self._edge_offsets = np.einsum("fkj,fkj->fk", inward, tri[:, [1, 2, 0]])
+        self._scale = float(max(np.ptp(mesh.vertices, axis=0).max(), 1e-9))
 
-    def first_hits(self, origins: FloatArray, directions: FloatArray) -> FloatArray:
+    @staticmethod
+    def _sharp_local_edges(mesh: trimesh.Trimesh) -> NDArray[np.bool_]:
+        """``(F, 3)``: True where a face's edge opposite vertex k is a real edge (not flat)."""
+        nv = len(mesh.vertices)
+        eu = np.sort(np.asarray(mesh.edges_unique, dtype=np.int64), axis=1)
+        flat = np.asarray(mesh.face_adjacency_angles) < 1e-9
+        ae = np.sort(np.asarray(mesh.face_adjacency_edges, dtype=np.int64)[flat], axis=1)
+        smooth = np.isin(eu[:, 0] * nv + eu[:, 1], ae[:, 0] * nv + ae[:, 1])
+        # faces_unique_edges columns are the edges (a, b), (b, c), (c, a)
+        return ~smooth[np.asarray(mesh.faces_unique_edges)[:, [1, 2, 0]]]
+
+    def first_hits(self, origins: FloatArray, directions: FloatArray, depth: int = 0) -> FloatArray:
         """Distance along each ray to the first surface it meets, metres.
 
         Args:
@@ -59,21 +91,40 @@ class MeshRayCaster:
         Returns:
             ``(N,)`` distances; ``inf`` where the ray misses; ``0`` where the ray starts inside
             the part (its first hit is a face seen from behind).
+            ``depth`` is internal (continuations past real edges).
         """
         o = np.ascontiguousarray(origins, dtype=np.float64)
         d = np.ascontiguousarray(directions, dtype=np.float64)
         out = np.full(len(o), np.inf)
         if len(o) == 0:
             return out
-        tri = np.asarray(self._intersector.intersects_first(o, d), dtype=np.int64)
-        hit = tri >= 0
-        if not np.any(hit):
+        if self._scene is not None:
+            ids = self._scene.run(o.astype(np.float32), d.astype(np.float32))
+        else:  # pragma: no cover
+            ids = self._intersector.intersects_first(o, d)
+        tri = np.asarray(ids, dtype=np.int64)
+        idx = np.flatnonzero(tri >= 0)
+        if len(idx) == 0:
             return out
-        n = self._normals[tri[hit]]
-        denom = np.einsum("ij,ij->i", n, d[hit])
-        num = self._offsets[tri[hit]] - np.einsum("ij,ij->i", n, o[hit])
+        n = self._normals[tri[idx]]
+        denom = np.einsum("ij,ij->i", n, d[idx])
+        num = self._offsets[tri[idx]] - np.einsum("ij,ij->i", n, o[idx])
         with np.errstate(divide="ignore", invalid="ignore"):
-            t = np.where(np.abs(denom) > 1e-15, num / denom, 0.0)
-        t = np.where(denom > 0, 0.0, np.maximum(t, 0.0))  # back face first: origin inside
-        out[hit] = t
+            t = np.maximum(np.where(np.abs(denom) > 1e-15, num / denom, 0.0), 0.0)
+        beyond = self._beyond_real_edge(o[idx] + t[:, None] * d[idx], tri[idx])
+        keep = ~beyond
+        out[idx[keep]] = np.where(denom[keep] > 0, 0.0, t[keep])  # back face: origin inside
+        if np.any(beyond) and depth < 4:  # continue just past the face that was not hit
+            r = idx[beyond]
+            step = 1e-9 * self._scale
+            more = self.first_hits(o[r] + (t[beyond] + step)[:, None] * d[r], d[r], depth + 1)
+            out[r] = t[beyond] + step + more
         return out
+
+    def _beyond_real_edge(self, p: FloatArray, tri: NDArray[np.int64]) -> NDArray[np.bool_]:
+        """True where hit points ``(K, 3)`` lie outside their triangle across a real edge."""
+        dist = np.einsum("kej,kj->ke", self._edge_normals[tri], p) - self._edge_offsets[tri]
+        worst = np.argmin(dist, axis=1)
+        rows = np.arange(len(tri))
+        outside = dist[rows, worst] < -1e-12 * self._scale
+        return outside & self._sharp[tri, worst]

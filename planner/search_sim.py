@@ -110,8 +110,8 @@ class SimulatedProbe:
     geometry: StatorGeometry | None = None
     reachability: ReachabilityHook | None = None
     edge_inset_m: float = 0.003
-    scan_step_m: float = 0.002
-    edge_tolerance_m: float = 1e-5
+    scan_step_m: float = 0.0025
+    edge_tolerance_m: float = 2e-5
     events: list[ProbeEvent] = field(default_factory=list)
 
     def __post_init__(self) -> None:
@@ -219,20 +219,37 @@ class SimulatedProbe:
         def fine(s: float) -> float:
             return float(self._signal((tcp0 + s * direction)[None], axis)[0])
 
-        while k > 1 and event(np.array([fine(s_grid[k - 1])]))[0]:
+        def margin(sig: float) -> float:  # log distance from the switching level, < 0 = event
+            log_s = math.log(max(sig, 1e-300))
+            return math.log(on) - log_s if want_on else log_s - math.log(off)
+
+        s_lo = fine(s_grid[k - 1]) if k > 1 else s0
+        while k > 1 and event(np.array([s_lo]))[0]:
             k -= 1
-        while k <= n_steps and not event(np.array([fine(s_grid[k])]))[0]:
+            s_lo = fine(s_grid[k - 1]) if k > 1 else s0
+        s_hi = fine(s_grid[k]) if k <= n_steps else 0.0
+        while k <= n_steps and not event(np.array([s_hi]))[0]:
             k += 1
+            s_lo = s_hi
+            s_hi = fine(s_grid[k]) if k <= n_steps else 0.0
         if k > n_steps:
             what = "detection" if want_on else "edge (sensor still detecting)"
             return self._fail(cmd, f"no {what} within {length * 1e3:.0f} mm")
         lo, hi = float(s_grid[k - 1]), float(s_grid[k])
+        g_lo, g_hi = margin(s_lo), margin(s_hi)
+        it = 0
         while hi - lo > self.edge_tolerance_m:
-            mid = 0.5 * (lo + hi)
-            if event(np.array([fine(mid)]))[0]:
-                hi = mid
+            it += 1
+            width = hi - lo
+            if it % 3 == 0 or not g_lo - g_hi > 0:  # bisect every third step: sure progress
+                s = lo + 0.5 * width
+            else:  # regula falsi on the log signal, kept 5 % inside the bracket
+                s = lo + width * min(max(g_lo / (g_lo - g_hi), 0.05), 0.95)
+            sig = fine(s)
+            if event(np.array([sig]))[0]:
+                hi, g_hi, s_hi = s, margin(sig), sig
             else:
-                lo = mid
-        if fine(hi) < 0:
+                lo, g_lo = s, margin(sig)
+        if s_hi < 0:
             return self._fail(cmd, "sensor face collided with the part during the search")
         return self._succeed(cmd, tcp0, hi)

@@ -65,7 +65,7 @@ class ProximitySensor:
     hysteresis_fraction: float = 0.10
     repeatability_sigma_m: float = 0.00004
     n_rays: int = 256
-    n_scan_rays: int = 37
+    n_scan_rays: int = 19
 
     def __post_init__(self) -> None:
         check_positive(self.face_diameter_m, "sensor.face_diameter_m", allow_zero=True)
@@ -181,19 +181,23 @@ class ProximitySensor:
 
     def face_frame(self, axis: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Two unit vectors ``(u, v)`` spanning the face, perpendicular to ``axis`` ``(3,)``."""
-        a = np.asarray(axis, dtype=np.float64)
-        helper = np.array([1.0, 0.0, 0.0]) if abs(a[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-        u = np.cross(a, helper)
-        u /= np.linalg.norm(u)
-        return u, np.cross(a, u)
+        ax, ay, az = (float(c) for c in axis)
+        # u = axis x helper, helper = e_x unless the axis is close to it (then e_y)
+        u = np.array([0.0, az, -ay]) if abs(ax) < 0.9 else np.array([-az, 0.0, ax])
+        u /= math.sqrt(float(u @ u))
+        v = np.array([ay * u[2] - az * u[1], az * u[0] - ax * u[2], ax * u[1] - ay * u[0]])
+        return u, v
+
+    def face_offsets_m(self, axis: FloatArray, coarse: bool = False) -> FloatArray:
+        """``(n, 3)`` ray-origin offsets from the face centre for a sensor axis ``(3,)``, m."""
+        pts = self.scan_points_m if coarse else self.face_points_m
+        u, v = self.face_frame(axis)
+        return pts[:, :1] * u + pts[:, 1:] * v
 
     def ray_origins(self, tcp_m: FloatArray, axis: FloatArray, coarse: bool = False) -> FloatArray:
         """Ray origins on the face for TCP position(s) ``(..., 3)``: ``(..., n, 3)``, same frame.
 
         The face centre lies ``Sn`` behind the TCP along ``axis``.
         """
-        pts = self.scan_points_m if coarse else self.face_points_m
-        u, v = self.face_frame(axis)
-        offsets = pts[:, :1] * u + pts[:, 1:] * v  # (n, 3)
         centre = np.asarray(tcp_m, float) - self.sensing_distance_m * np.asarray(axis, float)
-        return centre[..., None, :] + offsets
+        return centre[..., None, :] + self.face_offsets_m(axis, coarse)

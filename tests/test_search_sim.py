@@ -1,0 +1,118 @@
+"""Simulated searches against a known box and the stator: exact points, edges, failures."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import trimesh
+
+from calib.frames import make_transform, matrix_from_rotvec
+from calib.probing import ProbePoint, SearchCommand, SearchSpec
+from planner.error_models import RobotErrorModel
+from planner.raycast import MeshRayCaster
+from planner.search_sim import SimulatedProbe
+from planner.sensor import ProximitySensor
+
+# a 0.4 x 0.4 x 0.2 m block whose top face is z = 0 and whose +y edge face is y = 0
+BOX = trimesh.creation.box(extents=(0.4, 0.4, 0.2))
+BOX.apply_translation((0.0, -0.2, -0.1))
+CASTER = MeshRayCaster(BOX)
+TOP = (0.0, 0.0, 1.0)
+
+
+def _probe(T_base_wobj=None, **kw) -> SimulatedProbe:
+    kw.setdefault("robot_error", RobotErrorModel.none())
+    kw.setdefault("sensor", ProximitySensor(repeatability_sigma_m=0.0))
+    T = np.eye(4) if T_base_wobj is None else T_base_wobj
+    return SimulatedProbe(CASTER, T, np.random.default_rng(7), **kw)
+
+
+def _tilted() -> np.ndarray:
+    return make_transform(matrix_from_rotvec([0.02, -0.03, 0.5]), [0.9, 0.1, 0.6])
+
+
+def test_ideal_approach_returns_the_true_surface_point_exactly() -> None:
+    T_true = _tilted()
+    probe = _probe(T_true, sensor=ProximitySensor.ideal())
+    nominal = make_transform(None, [0.004, -0.003, 0.005])  # estimate off by a few mm
+    point = ProbePoint("p", (0.05, -0.1, 0.0), TOP)
+    res = probe(SearchCommand.from_point(point, T_true @ nominal))
+    assert res.ok
+    p_true = np.linalg.inv(T_true) @ np.append(res.point_m, 1.0)
+    assert abs(p_true[2]) < 1e-12  # on the true top face
+
+
+def test_approach_with_full_face_switches_exactly_at_sn() -> None:
+    probe = _probe()
+    res = probe(SearchCommand.from_point(ProbePoint("p", (0.0, -0.2, 0.0), TOP), np.eye(4)))
+    assert np.allclose(res.point_m, [0.0, -0.2, 0.0], atol=1e-12)
+    assert res.travel_m == pytest.approx(0.030)
+
+
+def test_failures_are_reasons_not_numbers() -> None:
+    probe = _probe()
+    close = ProbePoint("c", (0.0, -0.2, 0.0), TOP, SearchSpec(start_offset_m=0.002))
+    shifted = make_transform(None, [0.0, 0.0, 0.005])  # part 5 mm higher than planned
+    res = probe(SearchCommand.from_point(close, np.linalg.inv(shifted)))
+    assert not res.ok and res.reason == "sensor already detecting at start"
+    off = ProbePoint("o", (0.5, -0.2, 0.0), TOP)  # nothing below
+    res = probe(SearchCommand.from_point(off, np.eye(4)))
+    assert res.point_m is None and res.reason == "no detection within 50 mm"
+    assert [e.reason for e in probe.events] == [
+        "sensor already detecting at start",
+        "no detection within 50 mm",
+    ]
+
+
+def test_edge_search_finds_a_straight_edge_within_the_model_bias() -> None:
+    sensor = ProximitySensor(repeatability_sigma_m=0.0)
+    inset = 0.003
+    probe = _probe(sensor=sensor, edge_inset_m=inset, edge_tolerance_m=1e-7)
+    # slide over the top face towards +y until the face ends at y = 0
+    point = ProbePoint(
+        "f", (0.05, 0.0, 0.0), TOP, SearchSpec("edge", 0.06, 0.03, (0.0, 1.0, 0.0)), (0, 1, 0)
+    )
+    res = probe(SearchCommand.from_point(point, np.eye(4)))
+    assert res.ok
+    bias = sensor.edge_event_offset_m(inset)
+    assert bias > 1e-3
+    assert res.point_m[1] == pytest.approx(bias, abs=0.05e-3)  # ray-bundle discretisation
+    assert res.point_m[2] == pytest.approx(0.0, abs=1e-12)  # reported on the commanded path
+
+
+def test_ideal_edge_search_is_exact() -> None:
+    probe = _probe(sensor=ProximitySensor.ideal(), edge_tolerance_m=1e-13)
+    point = ProbePoint(
+        "f", (0.05, 0.0, 0.0), TOP, SearchSpec("edge", 0.06, 0.03, (0.0, 1.0, 0.0)), (0, 1, 0)
+    )
+    res = probe(SearchCommand.from_point(point, np.eye(4)))
+    assert abs(res.point_m[1]) < 1e-12
+
+
+def test_edge_search_must_start_detecting() -> None:
+    probe = _probe()
+    point = ProbePoint(
+        "f", (0.05, 0.0, 0.0), TOP, SearchSpec("edge", 0.30, 0.03, (0.0, 1.0, 0.0)), (0, 1, 0)
+    )  # starts 0.3 m before the edge: off the 0.4 m block's far side? no: y = -0.3, on it
+    res = probe(SearchCommand.from_point(point, make_transform(None, [0.0, 0.0, 0.02])))
+    assert res.reason == "sensor not detecting at start of edge search"
+
+
+def test_repeatability_noise_has_the_modelled_spread(rng) -> None:
+    sensor = ProximitySensor(repeatability_sigma_m=4e-5)
+    robot = RobotErrorModel(repeatability_sigma_m=2e-5)
+    probe = SimulatedProbe(CASTER, np.eye(4), rng, sensor=sensor, robot_error=robot)
+    cmd = SearchCommand.from_point(ProbePoint("p", (0.0, -0.2, 0.0), TOP), np.eye(4))
+    z = np.array([probe(cmd).point_m[2] for _ in range(400)])
+    # reported = commanded at the switch: the robot offset along z and the jitter both add
+    expect = math.hypot(4e-5, 2e-5)
+    assert np.std(z) == pytest.approx(expect, rel=0.15)
+    assert abs(np.mean(z)) < 4 * expect / math.sqrt(400)
+
+
+def test_reachability_hook_fails_the_probe_with_its_reason() -> None:
+    probe = _probe(reachability=lambda cmd: "unreachable: joint 5 at limit")
+    res = probe(SearchCommand.from_point(ProbePoint("p", (0.0, -0.2, 0.0), TOP), np.eye(4)))
+    assert res.reason == "unreachable: joint 5 at limit"
