@@ -355,6 +355,19 @@ class Cell:
         self._log_static_contacts(body.body_id, fixture.name)
         return fixture
 
+    def remove_fixture(self, name: str) -> None:
+        """Remove the fixture ``name``.
+
+        Raises:
+            UnknownFrameError: no such fixture (the message lists the fixtures).
+        """
+        if name not in self.fixtures:
+            raise UnknownFrameError(f"no fixture {name!r}; fixtures: {sorted(self.fixtures)}")
+        body = next(b for b, n in self.checker.environment.items() if n == name)
+        pb.removeBody(body, physicsClientId=self.client)
+        del self.checker.environment[body]
+        del self.fixtures[name]
+
     def _log_static_contacts(self, body: int, name: str) -> None:
         for i in self._static_links:
             pts = pb.getClosestPoints(

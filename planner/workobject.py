@@ -94,7 +94,8 @@ class WorkObject:
 
 def _read(source: str | Path | trimesh.Trimesh) -> tuple[trimesh.Trimesh, str]:
     if isinstance(source, trimesh.Trimesh):
-        return source.copy(), source.metadata.get("name", "mesh") if source.metadata else "mesh"
+        meta = source.metadata or {}
+        return source.copy(), str(meta.get("name") or "work object")
     if is_builtin(source):
         return builtin_mesh(str(source)), str(source)
     path = Path(source)
@@ -182,5 +183,5 @@ def load_work_object(
         n_faces=len(mesh.faces),
         warnings=tuple(warnings),
     )
-    stem = Path(src).stem if not is_builtin(src) else src.split(":", 1)[1]
+    stem = src.split(":", 1)[1] if is_builtin(src) else Path(src).stem or src
     return WorkObject(name=name or stem, mesh=mesh, report=report)
