@@ -260,6 +260,8 @@ def _basis(m1: FloatArray, u: FloatArray) -> tuple[FloatArray, FloatArray, float
     u = _unit(u)
     a = m1 - (m1 @ u) * u
     k = float(np.linalg.norm(a))
+    if k < 1e-12:  # m1 along u: no in-plane direction; callers check k and refuse
+        return a, np.cross(u, a), k
     a = a / k
     return a, np.cross(u, a), k
 
