@@ -363,7 +363,11 @@ class Cell:
         """
         if name not in self.fixtures:
             raise UnknownFrameError(f"no fixture {name!r}; fixtures: {sorted(self.fixtures)}")
-        body = next(b for b, n in self.checker.environment.items() if n == name)
+        body = next(
+            b
+            for b, n in self.checker.environment.items()
+            if n == name and b != self.checker.wobj_body
+        )
         pb.removeBody(body, physicsClientId=self.client)
         del self.checker.environment[body]
         del self.fixtures[name]
