@@ -15,7 +15,7 @@ whose search failed on the robot, with the reason. Inside the code everything is
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Literal
+from typing import Final, Literal
 
 import msgspec
 import numpy as np
@@ -26,7 +26,7 @@ from calib.errors import InputError
 from calib.frames import transform_points
 from calib.plan_json import canonical_json, check_schema_tag, convert_strict, parse_json_text
 
-MEASUREMENTS_SCHEMA = "wobjcal.measurements/1"
+MEASUREMENTS_SCHEMA: Final = "wobjcal.measurements/1"
 SUPPORTED_MEASUREMENTS_SCHEMAS = (MEASUREMENTS_SCHEMA,)
 _SCALE = {"m": 1.0, "mm": 1e-3}
 Vec3 = tuple[float, float, float]

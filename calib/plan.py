@@ -18,7 +18,7 @@ import hashlib
 import math
 import re
 from pathlib import Path
-from typing import Literal, get_args
+from typing import Final, Literal, get_args
 
 import msgspec
 import numpy as np
@@ -36,7 +36,7 @@ from calib.plan_json import canonical_json, check_schema_tag, convert_strict, pa
 from calib.plan_procedures import METHODS, Procedure, check_roles, method_of
 from calib.probing import ProbePoint, SearchSpec
 
-PLAN_SCHEMA = "wobjcal.plan/1"
+PLAN_SCHEMA: Final = "wobjcal.plan/1"
 SUPPORTED_PLAN_SCHEMAS = (PLAN_SCHEMA,)
 BUILTIN_PREFIX = "builtin:"
 MeshUnits = Literal["m", "mm", "cm", "in", "auto"]
@@ -81,7 +81,7 @@ def _check_sha256(value: str | None, ref: str, field: str) -> None:
         raise PlanError(f"{field}: must be 64 lowercase hex digits, got {value!r}")
 
 
-class Pose(_Strict, kw_only=True):
+class Pose(_Strict, frozen=True, kw_only=True):
     """A rigid transform ``T_parent_child``.
 
     Attributes:
@@ -112,7 +112,7 @@ class Pose(_Strict, kw_only=True):
         )
 
 
-class RobotSpec(_Strict, kw_only=True):
+class RobotSpec(_Strict, frozen=True, kw_only=True):
     """The robot: ``urdf`` is a path relative to the plan or ``builtin:irb4400``.
 
     Attributes:
@@ -128,7 +128,7 @@ class RobotSpec(_Strict, kw_only=True):
     tip_link: str | None = None
 
 
-class ToolSpec(_Strict, kw_only=True):
+class ToolSpec(_Strict, frozen=True, kw_only=True):
     """The robot-held tool: ``name`` is a URDF path or ``builtin:cable_feeder``; ``tcp`` is the
     probing TCP (the proximity sensor at its sensing distance)."""
 
@@ -136,7 +136,7 @@ class ToolSpec(_Strict, kw_only=True):
     tcp: str = "sensor"
 
 
-class FixtureSpec(_Strict, kw_only=True):
+class FixtureSpec(_Strict, frozen=True, kw_only=True):
     """A fixed obstacle (table, fixture) for collision checks: a mesh or a box.
 
     Attributes:
@@ -167,7 +167,7 @@ class FixtureSpec(_Strict, kw_only=True):
             _check_sha256(self.sha256, self.mesh or "", "sha256")
 
 
-class CellSpec(_Strict, kw_only=True):
+class CellSpec(_Strict, frozen=True, kw_only=True):
     """Robot, tool and fixtures of the cell."""
 
     robot: RobotSpec = RobotSpec()
@@ -175,7 +175,7 @@ class CellSpec(_Strict, kw_only=True):
     fixtures: list[FixtureSpec] = []
 
 
-class WorkObjectSpec(_Strict, kw_only=True):
+class WorkObjectSpec(_Strict, frozen=True, kw_only=True):
     """The work object: its mesh, the mesh unit, the file digest and its nominal pose.
 
     Attributes:
@@ -194,7 +194,7 @@ class WorkObjectSpec(_Strict, kw_only=True):
         _check_sha256(self.sha256, self.mesh, "sha256")
 
 
-class Search(_Strict, kw_only=True):
+class Search(_Strict, frozen=True, kw_only=True):
     """How a point is searched for; see :class:`calib.probing.SearchSpec`.
 
     Attributes:
@@ -222,7 +222,7 @@ class Search(_Strict, kw_only=True):
         _check_unit(self.edge_direction, "edge_direction")
 
 
-class PlanPoint(_Strict, kw_only=True):
+class PlanPoint(_Strict, frozen=True, kw_only=True):
     """A probe point; the plan-file form of :class:`calib.probing.ProbePoint`.
 
     Attributes:
@@ -297,7 +297,7 @@ class PlanPoint(_Strict, kw_only=True):
         )
 
 
-class SensorModel(_Strict, kw_only=True):
+class SensorModel(_Strict, frozen=True, kw_only=True):
     """The proximity sensor, for validation (``planner.sensor.ProximitySensor``).
 
     Attributes:
@@ -328,7 +328,7 @@ class SensorModel(_Strict, kw_only=True):
         _check_positive(self.n_scan_rays, "n_scan_rays")
 
 
-class RobotErrorModel(_Strict, kw_only=True):
+class RobotErrorModel(_Strict, frozen=True, kw_only=True):
     """Robot positioning errors, for validation (``planner.error_models.RobotErrorModel``).
 
     Attributes:
@@ -350,7 +350,7 @@ class RobotErrorModel(_Strict, kw_only=True):
         _check_positive(self.accuracy_terms, "accuracy_terms")
 
 
-class Misplacement(_Strict, kw_only=True):
+class Misplacement(_Strict, frozen=True, kw_only=True):
     """How far the real part may lie from its nominal pose (uniform, for validation).
 
     Attributes:
@@ -366,7 +366,7 @@ class Misplacement(_Strict, kw_only=True):
         _check_positive(self.max_angle_rad, "max_angle_rad", allow_zero=True)
 
 
-class ValidationSpec(_Strict, kw_only=True):
+class ValidationSpec(_Strict, frozen=True, kw_only=True):
     """Monte Carlo validation settings.
 
     Attributes:
@@ -388,7 +388,7 @@ class ValidationSpec(_Strict, kw_only=True):
             raise PlanError(f"trials: must be >= 2, got {self.trials}")
 
 
-class Plan(_Strict, kw_only=True):
+class Plan(_Strict, frozen=True, kw_only=True):
     """A complete measurement plan (file format ``wobjcal.plan/1``)."""
 
     schema: Literal["wobjcal.plan/1"] = PLAN_SCHEMA

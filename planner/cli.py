@@ -21,12 +21,8 @@ EXIT_OK, EXIT_FAIL, EXIT_INPUT = 0, 1, 2
 _FORMATTER = argparse.RawDescriptionHelpFormatter
 
 
-class _Parser(argparse.ArgumentParser):
-    """argparse that exits with code 2 and one line on bad arguments (argparse's default too)."""
-
-
 def _add(
-    sub: argparse._SubParsersAction,  # type: ignore[type-arg]
+    sub: argparse._SubParsersAction,
     name: str,
     help_: str,
     description: str,
@@ -52,7 +48,7 @@ def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``wobjcal`` command."""
     from planner import cli_calibrate, cli_check, cli_export, cli_misc, cli_validate
 
-    parser = _Parser(
+    parser = argparse.ArgumentParser(
         prog="wobjcal",
         description="Plan, check and validate work-object calibration with a robot-held "
         "proximity sensor (Hultman & Leijon 2013).",

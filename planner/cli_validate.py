@@ -112,6 +112,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
             f"work_object.mesh: validate simulates only {sorted(SIMULATED_PARTS)} for now, "
             f"got {plan.work_object.mesh!r}"
         )
+    plots = require("planner.plots", "validate --plots") if args.plots else None
     mc = require("planner.montecarlo", "validate")
     stator = require("planner.stator", "validate")
     sp = require("calib.stator_procedure", "validate")
@@ -160,8 +161,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
     if args.json:
         data = report_json(report) | {"plan": args.plan, "seed": seed}
         write_text_atomic(args.json, json.dumps(data, indent=2, sort_keys=True) + "\n")
-    if args.plots:
-        plots = require("planner.plots", "validate --plots")
+    if plots is not None:
         out_dir = Path(args.plots)
         out_dir.mkdir(parents=True, exist_ok=True)
         written = plots.save_validation_plots(report, out_dir)

@@ -121,15 +121,16 @@ def assign_three_two_one(plan: Plan) -> dict[str, list[PlanPoint]]:
             free = [p for p in pts if p.id not in used]
             if len(free) >= need:
                 if need == 2:
-                    pairs = [(a, b) for i, a in enumerate(free) for b in free[i + 1 :]]
-                    pick = list(
-                        max(
-                            pairs,
-                            key=lambda ab: float(
-                                np.linalg.norm(np.subtract(ab[0].position_m, ab[1].position_m))
-                            ),
+                    pairs: list[tuple[PlanPoint, PlanPoint]] = [
+                        (a, b) for i, a in enumerate(free) for b in free[i + 1 :]
+                    ]
+
+                    def apart(ab: tuple[PlanPoint, PlanPoint]) -> float:
+                        return float(
+                            np.linalg.norm(np.subtract(ab[0].position_m, ab[1].position_m))
                         )
-                    )
+
+                    pick: list[PlanPoint] = list(max(pairs, key=apart))
                 else:
                     pick = free[:1]
                 chosen[role] = pick
