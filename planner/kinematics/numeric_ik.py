@@ -128,14 +128,36 @@ class NumericIK:
         q = np.where(valid[..., None], q, np.nan)
         return NumericIKResult(q, valid, pos_err, rot_err)
 
+    def refine(
+        self, q: ArrayLike, T_base_tip: ArrayLike, max_iter: int | None = None
+    ) -> tuple[FloatArray, FloatArray]:
+        """Polish configurations ``q (M, n)`` towards poses ``(M, 4, 4)`` without joint limits.
+
+        Returns:
+            the refined ``q (M, n)`` and the final pose errors ``(M, 6)`` (m, rad).
+        """
+        qa = np.array(q, dtype=np.float64).reshape(-1, self.chain.n_joints)
+        T = np.asarray(T_base_tip, dtype=np.float64).reshape(-1, 4, 4)
+        saved = self.max_iter, self._wrap, self._lo, self._hi
+        try:
+            if max_iter is not None:
+                self.max_iter = int(max_iter)
+            self._wrap = np.zeros_like(self._wrap)
+            self._lo, self._hi = np.full_like(self._lo, -np.inf), np.full_like(self._hi, np.inf)
+            return self._iterate(qa, T, lam0=1e-8)
+        finally:
+            self.max_iter, self._wrap, self._lo, self._hi = saved
+
     def _project(self, q: FloatArray) -> FloatArray:
         wrapped = (q + np.pi) % (2 * np.pi) - np.pi
         return np.where(self._wrap, wrapped, np.clip(q, self._lo, self._hi))
 
-    def _iterate(self, q: FloatArray, T_t: FloatArray) -> tuple[FloatArray, FloatArray]:
+    def _iterate(
+        self, q: FloatArray, T_t: FloatArray, lam0: float = 1e-2
+    ) -> tuple[FloatArray, FloatArray]:
         """Levenberg-Marquardt on all problems at once; returns final ``q`` and errors."""
         M, n = q.shape
-        lam = np.full(M, 1e-2)
+        lam = np.full(M, lam0)
         T, J = self.chain.fk_jacobian(q)
         err = pose_error(T_t, T)
         cost = np.einsum("mi,mi->m", err, err)
@@ -163,7 +185,7 @@ class NumericIK:
                 e_new[better],
                 c_new[better],
             )
-            lam[acc] = np.maximum(lam[acc] / 3.0, 1e-9)
+            lam[acc] = np.maximum(lam[acc] / 3.0, 1e-12)
             rej = idx[~better]
             lam[rej] = lam[rej] * 4.0
             active[rej[lam[rej] > 1e8]] = False  # stuck in a local minimum

@@ -56,12 +56,21 @@ def _angle_deg(u: FloatArray, v: FloatArray) -> float:
     return float(np.degrees(np.arccos(np.clip(abs(u @ v), 0.0, 1.0))))
 
 
-def opw_from_chain(chain: KinematicChain, rng: np.random.Generator | None = None) -> OPWRobot:
+def opw_from_chain(
+    chain: KinematicChain,
+    rng: np.random.Generator | None = None,
+    tol: float = GEOM_TOL,
+    verify_tol: float = VERIFY_TOL_M,
+) -> OPWRobot:
     """The OPW model of ``chain`` (``T_base_tip`` identical to ``chain.fk`` within 1e-9).
 
     Args:
         chain: a 6-axis chain, tip at the flange.
         rng: generator of the verification poses (default: a fixed seed).
+        tol: tolerance of the geometric tests (m, or sine of an angle).
+        verify_tol: largest FK disagreement accepted (m, and 1 for rotation entries). Looser
+            values give an *approximate* model of a nearly-OPW arm (e.g. a URDF with rpy
+            rounded to ``1.5708``) whose solutions the solver then polishes numerically.
 
     Raises:
         NotOPWError: the chain does not qualify; the message names the failing condition and
@@ -79,23 +88,23 @@ def opw_from_chain(chain: KinematicChain, rng: np.random.Generator | None = None
     F = chain.joint_frames(np.zeros(6))[0]
     u = np.einsum("kij,kj->ki", F[:, :3, :3], chain.axes)
     P = F[:, :3, 3]
-    if abs(u[0] @ u[1]) > GEOM_TOL:
+    if abs(u[0] @ u[1]) > tol:
         raise NotOPWError(
             f"axis 2 is not perpendicular to axis 1 (angle {90 - _angle_deg(u[0], u[1]):.4g} deg)"
         )
-    if np.linalg.norm(np.cross(u[1], u[2])) > GEOM_TOL:
+    if np.linalg.norm(np.cross(u[1], u[2])) > tol:
         raise NotOPWError(f"axes 2 and 3 are not parallel (angle {_angle_deg(u[1], u[2]):.4g} deg)")
     d45 = _line_distance(P[3], u[3], P[4], u[4])
     d56 = _line_distance(P[4], u[4], P[5], u[5])
     d46 = _line_distance(P[3], u[3], P[5], u[5])
     worst = max((d45, "4 and 5"), (d56, "5 and 6"), (d46, "4 and 6"))
-    if worst[0] > GEOM_TOL:
+    if worst[0] > tol:
         raise NotOPWError(
             f"axes 4-6 do not meet in one point: axes {worst[1]} are {worst[0]:.4g} m apart "
             "(offset wrist, UR-style)"
         )
     for i, j in ((3, 4), (4, 5), (3, 1)):
-        if abs(u[i] @ u[j]) > GEOM_TOL:
+        if abs(u[i] @ u[j]) > tol:
             raise NotOPWError(
                 f"axis {i + 1} is not perpendicular to axis {j + 1} "
                 f"(angle {90 - _angle_deg(u[i], u[j]):.4g} deg off)"
@@ -108,7 +117,8 @@ def opw_from_chain(chain: KinematicChain, rng: np.random.Generator | None = None
     O = P[0] - (P[0] @ u[0]) * u[0]  # axis-1 point closest to the base origin
     z0 = -u[0] if (P[1] - O) @ u[0] < -GEOM_TOL else u[0]  # "up": axis 2 above the origin
     for flip in (1.0, -1.0):
-        y0 = flip * u[1]
+        y_perp = u[1] - (u[1] @ z0) * z0  # exactly perpendicular (nearly-OPW arms)
+        y0 = flip * y_perp / np.linalg.norm(y_perp)
         x0 = np.cross(y0, z0)
         T_base_opw = np.eye(4)
         T_base_opw[:3, 0], T_base_opw[:3, 1], T_base_opw[:3, 2], T_base_opw[:3, 3] = x0, y0, z0, O
@@ -155,14 +165,16 @@ def opw_from_chain(chain: KinematicChain, rng: np.random.Generator | None = None
     T_ee_tip[np.abs(T_ee_tip) < 1e-15] = 0.0  # exact identity when it is one (fast path)
     T_ee_tip[np.abs(T_ee_tip - 1.0) < 1e-15] = 1.0
     robot = OPWRobot(params, T_base_opw, T_ee_tip, chain.lower.copy(), chain.upper.copy())
-    _verify(chain, robot, rng or np.random.default_rng(6))
+    _verify(chain, robot, rng or np.random.default_rng(6), verify_tol)
     return robot
 
 
-def _verify(chain: KinematicChain, robot: OPWRobot, rng: np.random.Generator) -> None:
+def _verify(
+    chain: KinematicChain, robot: OPWRobot, rng: np.random.Generator, verify_tol: float
+) -> None:
     q = rng.uniform(-np.pi, np.pi, (64, 6))
     err = np.abs(robot.fk(q) - chain.fk(q)).max()
-    if not err <= VERIFY_TOL_M:
+    if not err <= verify_tol:
         raise NotOPWError(
             f"the derived OPW model does not reproduce the chain's forward kinematics "
             f"(max error {err:.3g}); the axes are only nearly ortho-parallel"

@@ -18,8 +18,16 @@ from calib.frames import check_transform
 from planner.kinematics.branches import BranchFlags, classify
 from planner.kinematics.chain import KinematicChain
 from planner.kinematics.numeric_ik import NumericIK
+from planner.kinematics.opw import wrap_angle
 from planner.kinematics.opw_from_urdf import NotOPWError, opw_from_chain
 from planner.kinematics.opw_robot import OPWRobot
+
+#: A nearly-OPW arm (axes within this many m / sines of an angle of the ideal) whose OPW model
+#: is within ``APPROX_FK_TOL`` of its FK still takes the analytic path, with numeric polishing.
+APPROX_GEOM_TOL = 1e-4
+APPROX_FK_TOL = 1e-3
+#: Levenberg-Marquardt iterations that polish the branches of an approximate OPW model.
+POLISH_ITER = 50
 
 log = logging.getLogger(__name__)
 
@@ -71,6 +79,10 @@ class IKSolver:
         chain: the kinematic chain; poses are ``T_base_tip`` of it (the flange for ``tool0``).
         kind: ``"opw"`` (analytic, all branches) or ``"numeric"`` (seeded Levenberg-Marquardt).
         why_not_opw: why the analytic solver does not apply; ``None`` when ``kind == "opw"``.
+        opw: the OPW model (``None`` for numeric).
+        opw_exact: the OPW model reproduces the chain's FK within 1e-9; when False (a nearly-OPW
+            URDF, e.g. rpy rounded to 4 digits) every branch is polished numerically on the
+            chain, so solutions are exact for the URDF as written.
     """
 
     def __init__(
@@ -79,11 +91,13 @@ class IKSolver:
         numeric: NumericIK,
         opw: OPWRobot | None = None,
         why_not_opw: str | None = None,
+        opw_exact: bool = True,
     ) -> None:
         self.chain = chain
         self.opw = opw
         self.kind = "opw" if opw is not None else "numeric"
         self.why_not_opw = why_not_opw
+        self.opw_exact = opw_exact and opw is not None
         self._numeric = numeric
 
     def solve(self, T_base_flange: ArrayLike, seeds: ArrayLike | None = None) -> IKSolutions:
@@ -102,6 +116,8 @@ class IKSolver:
         T = T[None] if T.ndim == 2 else T
         if self.opw is not None:
             q8, ok8 = self.opw.ik_branches(T)
+            if not self.opw_exact:
+                q8, ok8 = self._polish(T, q8, ok8)
             q, valid, b8 = self.opw.expand(q8, ok8)
             # bits 4 and 2 of the OPW branch index are the geometric shoulder / elbow flags
             # (wrist centre behind axis 1 / behind the lower arm); bit 1 is axis 5's sign
@@ -111,6 +127,22 @@ class IKSolver:
         res = self._numeric.solve(T, seeds)
         branch = np.full(res.valid.shape, -1, dtype=int)
         return IKSolutions(res.q, res.valid, branch)
+
+    def _polish(
+        self, T: FloatArray, q8: FloatArray, ok8: NDArray[np.bool_]
+    ) -> tuple[FloatArray, NDArray[np.bool_]]:
+        """Refine the branches of an approximate OPW model on the chain (Levenberg-Marquardt)."""
+        q8 = np.array(q8)  # writable copy
+        n_idx, b_idx = np.nonzero(ok8)
+        if n_idx.size:
+            q, err = self._numeric.refine(q8[n_idx, b_idx], T[n_idx], POLISH_ITER)
+            good = (np.linalg.norm(err[:, :3], axis=1) <= self._numeric.tol_pos_m) & (
+                np.linalg.norm(err[:, 3:], axis=1) <= self._numeric.tol_rot_rad
+            )
+            q8[n_idx, b_idx] = np.where(good[:, None], wrap_angle(q), np.nan)
+            ok8 = ok8.copy()
+            ok8[n_idx, b_idx] = good
+        return q8, ok8
 
     def classify(self, q: ArrayLike) -> BranchFlags:
         """Shoulder, elbow and wrist flags of ``q (6,)`` (OPW arms only).
@@ -145,7 +177,12 @@ def make_ik_solver(
     try:
         opw = opw_from_chain(chain)
     except NotOPWError as exc:
-        log.info("IK for %s: numeric, not OPW: %s", chain.name, exc)
-        return IKSolver(chain, numeric, None, str(exc))
+        try:
+            approx = opw_from_chain(chain, tol=APPROX_GEOM_TOL, verify_tol=APPROX_FK_TOL)
+        except NotOPWError:
+            log.info("IK for %s: numeric, not OPW: %s", chain.name, exc)
+            return IKSolver(chain, numeric, None, str(exc))
+        log.info("IK for %s: nearly OPW (%s), analytic + polishing", chain.name, exc)
+        return IKSolver(chain, numeric, approx, None, opw_exact=False)
     log.info("IK for %s: analytic OPW %s", chain.name, opw.params)
     return IKSolver(chain, numeric, opw, None)
