@@ -130,7 +130,8 @@ def assign_three_two_one(plan: Plan) -> dict[str, list[PlanPoint]]:
                             np.linalg.norm(np.subtract(ab[0].position_m, ab[1].position_m))
                         )
 
-                    pick: list[PlanPoint] = list(max(pairs, key=apart))
+                    far = max(pairs, key=apart)
+                    pick = [far[0], far[1]]
                 else:
                     pick = free[:1]
                 chosen[role] = pick
