@@ -95,6 +95,11 @@ def _probe_proc(i: int, t: TargetPair, name: str) -> list[str]:
         else ("already detecting at the start")
     )
     length = fmt(t.length_m * 1000.0, 1)
+    missed = (
+        f"edge not found within {length} mm (sensor kept detecting)"
+        if t.kind == "edge"
+        else f"no detection within {length} mm"
+    )
     wobj = "tSensor\\WObj:=wobjNominal"
     return [
         f"    PROC Probe_{name}()",
@@ -107,7 +112,7 @@ def _probe_proc(i: int, t: TargetPair, name: str) -> list[str]:
         f"        MoveL {name}_start,vApproach,fine,{wobj};",
         "    ERROR",
         "        IF ERRNO=ERR_WHLSEARCH THEN",
-        f'            measuredErr{{{i}}}:="no detection within {length} mm";',
+        f'            measuredErr{{{i}}}:="{missed}";',
         "        ELSEIF ERRNO=ERR_SIGSUPSEARCH THEN",
         f'            measuredErr{{{i}}}:="sensor {level}";',
         "        ELSE",
