@@ -156,3 +156,40 @@ def test_within_limits() -> None:
     q[1, 1] = np.deg2rad(96)
     q[2, 5] = np.deg2rad(-399)
     np.testing.assert_array_equal(chain.within_limits(q), [True, False, True])
+
+
+PRISMATIC = """<robot name="slide">
+  <link name="rail"/><link name="carriage"/><link name="arm"/><link name="tip"/><link name="side"/>
+  <joint name="slide" type="prismatic"><parent link="rail"/><child link="carriage"/>
+    <axis xyz="1 0 0"/><limit lower="0" upper="2"/></joint>
+  <joint name="turn" type="continuous"><parent link="carriage"/><child link="arm"/>
+    <origin xyz="0 0 0.5" rpy="0 0 0"/><axis xyz="0 0 1"/></joint>
+  <joint name="to_tip" type="fixed"><parent link="arm"/><child link="tip"/>
+    <origin xyz="0.3 0 0"/></joint>
+  <joint name="to_side" type="fixed"><parent link="carriage"/><child link="side"/>
+    <origin xyz="0 0.1 0"/></joint>
+</robot>"""
+
+
+def test_prismatic_and_continuous_joints() -> None:
+    from planner.urdf import parse_urdf
+
+    chain = KinematicChain.from_model(parse_urdf(PRISMATIC))
+    assert chain.tip_link == "tip" and chain.joint_types == ("prismatic", "continuous")
+    np.testing.assert_array_equal(chain.lower, [0.0, -np.inf])
+    q = np.array([[1.5, np.pi / 2]])
+    T, J = chain.fk_jacobian(q)
+    np.testing.assert_allclose(T[0, :3, 3], [1.5, 0.3, 0.5], atol=1e-12)
+    np.testing.assert_allclose(J[0, :, 0], [1, 0, 0, 0, 0, 0], atol=1e-12)  # slide: pure x
+    np.testing.assert_allclose(J[0, :, 1], [-0.3, 0, 0, 0, 0, 1], atol=1e-12)  # z x (0, .3, 0)
+    poses = chain.link_poses(q)
+    np.testing.assert_allclose(poses["side"][0, :3, 3], [1.5, 0.1, 0.0], atol=1e-12)
+
+
+def test_floating_joint_in_the_chain_is_refused() -> None:
+    from planner.errors import URDFError
+    from planner.urdf import parse_urdf
+
+    text = PRISMATIC.replace('type="prismatic"', 'type="floating"')
+    with pytest.raises(URDFError, match="joint 'slide' is floating"):
+        KinematicChain.from_model(parse_urdf(text))
