@@ -265,7 +265,8 @@ def check_probes(
                 out.append(_none(sing_reason))
                 continue
             near_limit = margin_all[i] < MARGINAL_LIMIT_RAD
-            order = np.lexsort((motion[i], near_limit))[: int(usable[i].sum())][:max_checks]
+            keys = (motion[i], near_limit, ~usable[i])  # usable first, then by limit
+            order = np.lexsort(keys)[: int(usable[i].sum())][:max_checks]
             best: tuple[Clearance, int] | None = None
             chosen: tuple[Clearance, int] | None = None
             for c in order:

@@ -131,7 +131,8 @@ def check_search(
         return PathFeasibility(False, f"at 0.0 mm: {reason}", 0.0, s, empty, math.nan, -1, math.nan)
     motion = np.where(ok0, np.linalg.norm(np.nan_to_num(q0 - ref), axis=-1), np.inf)
     near = limit_margin(cell.chain, np.nan_to_num(q0)) < MARGINAL_LIMIT_RAD
-    order = np.lexsort((motion.ravel(), near.ravel()))[: int(ok0.sum())][:max_starts]
+    order = np.lexsort((motion.ravel(), near.ravel(), ~ok0.ravel()))[: int(ok0.sum())]
+    order = order[:max_starts]
     best: PathFeasibility | None = None
     with cell.saved_state():
         for flat in order:

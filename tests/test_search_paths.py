@@ -1,0 +1,123 @@
+"""Tests of planner.search_paths: approach and edge searches on a box, blocked by a clamp."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import replace
+
+import numpy as np
+import pytest
+import trimesh
+
+from calib.errors import DegenerateGeometryError, NonFiniteError
+from calib.frames import make_transform
+from calib.probing import ProbePoint, SearchCommand, SearchSpec
+from planner.cell import Cell
+
+BOX = 0.4
+X0 = 1.6  # box centre, world x: far enough for the front face to keep joint 3 off its limit
+T_WORLD_WOBJ = make_transform(p=[X0, 0.0, 0.4])  # top face at world z = 0.6
+TOP_APPROACH = ProbePoint(
+    "A", (0.0, 0.0, BOX / 2), (0.0, 0.0, 1.0), SearchSpec("approach", 0.05, 0.02)
+)
+FRONT_EDGE = ProbePoint(
+    "F",
+    (-BOX / 2, 0.0, BOX / 2),
+    (-1.0, 0.0, 0.0),
+    SearchSpec("edge", 0.05, 0.02, edge_direction=(0.0, 0.0, 1.0)),
+    edge_normal=(0.0, 0.0, 1.0),
+)
+
+
+@pytest.fixture(scope="module")
+def cell() -> Iterator[Cell]:
+    with Cell(use_acl_cache=False) as c:
+        c.set_work_object(trimesh.creation.box([BOX] * 3), "m", T_WORLD_WOBJ, name="box")
+        yield c
+
+
+def _sensor_positions(cell: Cell, q_path: np.ndarray) -> np.ndarray:
+    return (cell.chain.fk(q_path) @ cell.T_flange_tcp("sensor"))[:, :3, 3]
+
+
+def test_approach_search_on_top_is_feasible(cell: Cell) -> None:
+    cmd = SearchCommand.from_point(TOP_APPROACH, cell.T_base_wobj)
+    res = cell.check_search(cmd)
+    assert res.feasible and res.reason == "" and np.isnan(res.fail_at_m)
+    assert res.s_m.size == 71 and np.diff(res.s_m).max() <= 0.001 + 1e-12
+    assert res.q_path.shape == (71, 6)
+    expected = cmd.start_m + res.s_m[:, None] * cmd.direction
+    np.testing.assert_allclose(_sensor_positions(cell, res.q_path), expected, atol=1e-6)
+    assert np.abs(np.diff(res.q_path, axis=0)).max() < np.radians(5)
+    # one branch all along: the analytic solver classifies every sample the same
+    codes = {cell.solver.abb_confdata(q)[3] for q in res.q_path}
+    assert len(codes) == 1
+    # the last 12 mm run the sensor into the nominal surface: allowed past the nominal point
+    with cell.saved_state():
+        cell.set_joint_positions(res.q_path[-1])
+        assert not cell.clearance(sensor_wobj_allowed=True).ok
+
+
+def test_search_into_a_clamp_fails_at_the_right_distance(cell: Cell) -> None:
+    """A 20 mm clamp on the top face under the sensor: the sensor face starts 58 mm above the
+    surface (50 mm start offset + 8 mm standoff) and must keep 5 mm from the clamp top."""
+    top = 0.6 + 0.020
+    cell.add_fixture(
+        "clamp", size_m=(0.05, 0.05, 0.02), T_world_fixture=make_transform(p=[X0, 0.0, top - 0.01])
+    )
+    try:
+        res = cell.check_search(
+            SearchCommand.from_point(TOP_APPROACH, cell.T_base_wobj), margin_m=0.005
+        )
+    finally:
+        cell.remove_fixture("clamp")
+    expected = (0.6 + 0.05 + 0.008) - top - 0.005  # travel where the gap reaches 5 mm
+    assert not res.feasible
+    assert abs(res.fail_at_m - expected) <= 0.001 + 1e-9
+    assert "sensor_body hits clamp" in res.reason and res.reason.startswith(
+        f"at {res.fail_at_m * 1e3:.1f} mm: "
+    )
+    assert res.q_path.shape[0] == int(np.searchsorted(res.s_m, res.fail_at_m))
+
+
+def test_edge_search_up_the_front_face_is_feasible(cell: Cell) -> None:
+    cmd = SearchCommand.from_point(FRONT_EDGE, cell.T_base_wobj)
+    res = cell.check_search(cmd)
+    assert res.feasible, res.reason
+    pos = _sensor_positions(cell, res.q_path)
+    np.testing.assert_allclose(pos[:, 0], X0 - BOX / 2, atol=1e-6)  # on the front face plane
+    np.testing.assert_allclose(pos[[0, -1], 2], [0.55, 0.62], atol=1e-6)
+    assert res.min_clearance_m > 0.005
+
+
+def test_a_search_leaving_the_workspace_fails_midway(cell: Cell) -> None:
+    cmd = SearchCommand.from_point(TOP_APPROACH, cell.T_base_wobj)
+    away = replace(cmd, kind="edge", direction=np.array([1.0, 0.0, 0.0]), length_m=1.0)
+    res = cell.check_search(away)
+    assert not res.feasible
+    assert 0.1 < res.fail_at_m < 1.0
+    assert "out of reach" in res.reason or "at limit" in res.reason
+    # every sample before the failure passed, and is on the path
+    pos = _sensor_positions(cell, res.q_path)
+    np.testing.assert_allclose(
+        pos, away.start_m + res.s_m[: len(pos), None] * away.direction, atol=1e-6
+    )
+
+
+def test_unreachable_start_and_joint_jumps(cell: Cell) -> None:
+    cmd = SearchCommand.from_point(TOP_APPROACH, cell.T_base_wobj)
+    shift = np.array([5.0, 0.0, 0.0])
+    far = replace(cmd, start_m=cmd.start_m + shift, nominal_m=cmd.nominal_m + shift)
+    res = cell.check_search(far)
+    assert not res.feasible and res.fail_at_m == 0.0 and "out of reach" in res.reason
+    tight = cell.check_search(cmd, max_joint_jump_rad=1e-6)
+    assert not tight.feasible and tight.fail_at_m == pytest.approx(0.001)
+    assert "jumps" in tight.reason
+
+
+def test_bad_commands(cell: Cell) -> None:
+    cmd = SearchCommand.from_point(TOP_APPROACH, cell.T_base_wobj)
+    with pytest.raises(DegenerateGeometryError, match=r"command\.direction"):
+        cell.check_search(replace(cmd, direction=np.zeros(3)))
+    with pytest.raises(NonFiniteError, match=r"command\.start_m"):
+        cell.check_search(replace(cmd, start_m=np.array([np.nan, 0.0, 0.0])))
