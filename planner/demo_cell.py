@@ -6,9 +6,10 @@ is serialised from them.
 Placement (robot base frame, metres): the side face leans back by ``beta1 = 15 deg`` (its top is
 farther from the robot than its bottom, so the face looks towards the robot and slightly up, the
 paper's assumed inclination, eq. 12), the section runs along base ``-y`` (wobj ``+y`` = base
-``-y``), and its WOCS origin (top corner at the short side) lies at ``(1.00, -0.50, 0.95)``, so
+``-y``), and its WOCS origin (top corner at the short side) lies at ``(1.20, -0.50, 1.00)``, so
 the first metre of the side face (the part one robot winds) spans base ``y`` from -0.5 to +0.5,
-centred in front of the robot, about 1 m away at shoulder height.
+centred in front of the robot, 1.2 m away and 1 m up. Closer or lower placements put joint 3 of
+the built-in IRB 4400 at its limit for the yoke points (checked with ``Cell.check_probes``).
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ FloatArray = NDArray[np.float64]
 #: Inclination of the side face in the robot base frame (paper eq. 12: beta1 = 15 deg), rad.
 BETA1_RAD = math.radians(15.0)
 #: Where the WOCS origin lies in the robot base frame, m.
-ORIGIN_BASE_M = (1.00, -0.50, 0.95)
+ORIGIN_BASE_M = (1.20, -0.50, 1.00)
 
 _X, _Y, _Z = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
 
@@ -101,6 +102,31 @@ def stator_ah_points(
     }
 
 
+def demo_table(
+    geom: StatorGeometry, T_base_wobj: FloatArray | None = None
+) -> tuple[tuple[float, float, float], FloatArray]:
+    """Size ``(3,)`` (m) and pose ``(4, 4)`` (base = world) of the demo table box.
+
+    The table top lies 50 mm below the lowest corner of the inclined section (its wedge support
+    is not modelled); it is 0.6 m deep and the section's length plus 0.2 m long.
+    """
+    T = nominal_T_base_wobj() if T_base_wobj is None else np.asarray(T_base_wobj, float)
+    g = geom
+    corners = np.array(
+        [
+            [x, y, z, 1.0]
+            for x in (0.0, -g.depth_m)
+            for y in (0.0, -g.length_m)
+            for z in (0.0, -g.height_m)
+        ]
+    )
+    world = corners @ T.T
+    top_z = float(world[:, 2].min()) - 0.05
+    size = (0.6, g.length_m + 0.2, 0.05)
+    centre = (float(world[:, 0].min()) + 0.3, float(world[:, 1].mean()), top_z - 0.025)
+    return size, make_transform(None, centre)
+
+
 def make_demo_cell(geom: StatorGeometry | None = None, **cell_kwargs: Any) -> Cell:
     """The demo cell: built-in IRB 4400 with the cable-feeder tool, the stator on a table.
 
@@ -115,19 +141,6 @@ def make_demo_cell(geom: StatorGeometry | None = None, **cell_kwargs: Any) -> Ce
     cell = Cell(**kwargs)
     T = nominal_T_base_wobj()
     cell.set_work_object(build_stator_mesh(g), units="m", T_world_wobj=T)
-    # a table under the inclined section (its wedge support is not modelled): top 50 mm below
-    # the lowest corner of the part, 0.6 m deep, the section's length plus 0.2 m long
-    corners = np.array(
-        [
-            [x, y, z, 1.0]
-            for x in (0.0, -g.depth_m)
-            for y in (0.0, -g.length_m)
-            for z in (0.0, -g.height_m)
-        ]
-    )
-    world = corners @ T.T
-    top_z = float(world[:, 2].min()) - 0.05
-    size = (0.6, g.length_m + 0.2, 0.05)
-    centre = (float(world[:, 0].min()) + 0.3, float(world[:, 1].mean()), top_z - 0.025)
-    cell.add_fixture("table", size_m=size, T_world_fixture=make_transform(None, centre))
+    size, T_table = demo_table(g, T)
+    cell.add_fixture("table", size_m=size, T_world_fixture=T_table)
     return cell

@@ -45,6 +45,8 @@ FloatArray = NDArray[np.float64]
 log = logging.getLogger(__name__)
 
 PROCEDURES = ("hultman2013",)
+#: Edge searches run this far inside the face along the sensor axis by default, m.
+DEFAULT_EDGE_INSET_M = 0.003
 #: progress(done_trials, total_trials)
 ProgressCallback = Callable[[int, int], None]
 
@@ -75,7 +77,7 @@ class SimulationSetup:
     pivot_wobj_m: FloatArray
     accuracy_field: AccuracyField | None = None
     settings: StatorSettings = field(default_factory=StatorSettings)
-    edge_inset_m: float = 0.003
+    edge_inset_m: float = DEFAULT_EDGE_INSET_M
     edge_tolerance_m: float = 2e-5
 
 
@@ -171,7 +173,7 @@ def validate(
     pivot_wobj_m: ArrayLike | None = None,
     settings: StatorSettings | None = None,
     reachability: ReachabilityHook | None = None,
-    edge_inset_m: float = 0.003,
+    edge_inset_m: float = DEFAULT_EDGE_INSET_M,
     edge_tolerance_m: float = 2e-5,
     workers: int | None = None,
     progress: ProgressCallback | None = None,

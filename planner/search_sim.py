@@ -241,8 +241,8 @@ class SimulatedProbe:
         while hi - lo > self.edge_tolerance_m:
             it += 1
             width = hi - lo
-            if it % 3 == 0 or not g_lo - g_hi > 0:  # bisect every third step: sure progress
-                s = lo + 0.5 * width
+            if it % 3 == 0 or not 0 < g_lo - g_hi < 50:  # bisect every third step, or when
+                s = lo + 0.5 * width  # a side saw no metal at all: sure progress
             else:  # regula falsi on the log signal, kept 5 % inside the bracket
                 s = lo + width * min(max(g_lo / (g_lo - g_hi), 0.05), 0.95)
             sig = fine(s)

@@ -1,0 +1,45 @@
+"""PNG plots of a validation report."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from planner.demo_cell import nominal_T_base_wobj, stator_ah_points
+from planner.montecarlo import validate
+from planner.plots import histogram_figure, save_validation_plots, scatter_figure
+from planner.stator import EPSILON_M, StatorGeometry
+
+
+@pytest.fixture(scope="module")
+def report():
+    g = StatorGeometry.full_section()
+    return validate(
+        stator_ah_points(g), g, nominal_T_base_wobj(), 30, np.random.default_rng(2), workers=1
+    )
+
+
+def test_plots_are_written_as_png(report, tmp_path) -> None:
+    paths = save_validation_plots(report, tmp_path / "plots")
+    assert [p.name for p in paths] == ["histograms.png", "scatter.png"]
+    for p in paths:
+        with Image.open(p) as im:
+            assert im.format == "PNG" and im.size[0] > 800 and im.size[1] > 400
+    assert not list((tmp_path / "plots").glob("*.tmp*"))  # atomic: no leftovers
+
+
+def test_scatter_shows_every_calibration_about_the_mean(report) -> None:
+    fig = scatter_figure(report, np.asarray(EPSILON_M))
+    ax_origin, ax_eps = fig.axes
+    crosses = ax_eps.lines[0]  # the A-H procedure's points at epsilon
+    y, z = crosses.get_xdata(), crosses.get_ydata()
+    assert len(y) == report.n_ok
+    assert abs(np.mean(y)) < 1e-9 and abs(np.mean(z)) < 1e-9
+    assert len(ax_origin.lines[0].get_xdata()) == report.n_ok
+
+
+def test_histograms_have_one_panel_per_table_row(report) -> None:
+    fig = histogram_figure(report)
+    titles = [ax.get_title() for ax in fig.axes]
+    assert "WOCS yz-plane at epsilon" in titles and len(titles) == 9
