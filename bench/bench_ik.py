@@ -6,7 +6,9 @@ and limits for the built-in IRB 4400; numeric otherwise), and to PyBullet's IK (
 defaults, (3) tuned: ``jointDamping=[1e-3]*n``, ``maxNumIterations=100``,
 ``residualThreshold=1e-12`` (ignores joint limits), and (4) tuned with lower/upper limits, ranges
 and rest poses (PyBullet's null-space IK). PyBullet starts every pose from the rest pose (all
-zeros); only the ``calculateInverseKinematics`` calls are timed. A pose counts as solved when
+zeros); only the ``calculateInverseKinematics`` calls are timed. The machine may be shared, so
+both sides are "best of": ours the fastest of 5 runs on all poses, PyBullet's the fastest
+1000-pose chunk (its overall rate is in the JSON too). A pose counts as solved when
 some solution is within the joint limits and reproduces the pose (measured with our FK) within
 1e-6 m and 1e-4 rad (also reported at 1e-3 m). Throughput ratios are taken against PyBullet
 measured in the same run.
@@ -52,7 +54,7 @@ def pose_errors(chain: KinematicChain, q: np.ndarray, T: np.ndarray) -> tuple[np
     return np.where(bad, np.inf, pos), np.where(bad, np.inf, rot)
 
 
-def run_ours(chain: KinematicChain, T: np.ndarray, repeats: int = 3) -> dict[str, object]:
+def run_ours(chain: KinematicChain, T: np.ndarray, repeats: int = 5) -> dict[str, object]:
     solver = make_ik_solver(chain)
     solver.solve(T[:10])  # warm-up
     times = []
@@ -115,7 +117,7 @@ def run_pybullet(chain: KinematicChain, path: Path, T: np.ndarray, mode: str) ->
             )
         quat = Rotation.from_matrix(T[:, :3, :3]).as_quat()  # xyzw
         q = np.empty((len(T), n))
-        spent = 0.0
+        spent = np.zeros(len(T))
         for k in range(len(T)):
             for j in movable:
                 pb.resetJointState(body, j, 0.0, physicsClientId=cid)
@@ -123,21 +125,30 @@ def run_pybullet(chain: KinematicChain, path: Path, T: np.ndarray, mode: str) ->
             sol = pb.calculateInverseKinematics(
                 body, tip, T[k, :3, 3].tolist(), quat[k].tolist(), physicsClientId=cid, **kwargs
             )
-            spent += time.perf_counter() - t0
+            spent[k] = time.perf_counter() - t0
             q[k] = np.asarray(sol)[order]
     finally:
         pb.disconnect(cid)
     pos, rot = pose_errors(chain, q, T)
     inside = chain.within_limits(q, tol=1e-9)
     return {
-        "seconds": spent,
-        "poses_per_s": len(T) / spent,
+        "seconds": float(spent.sum()),
+        # best 1000-pose chunk: the machine is shared, "best of" on both sides is the fairest
+        "poses_per_s": _best_chunk_rate(spent),
+        "poses_per_s_overall": len(T) / float(spent.sum()),
         "solved_1e-6m": float(((pos <= 1e-6) & (rot <= 1e-4) & inside).mean()),
         "solved_1e-3m": float(((pos <= 1e-3) & (rot <= 1e-4) & inside).mean()),
         "median_pos_err_m": float(np.median(pos)),
         "median_rot_err_rad": float(np.median(rot)),
         "within_limits": float(inside.mean()),
     }
+
+
+def _best_chunk_rate(seconds: np.ndarray, chunk: int = 1000) -> float:
+    """Poses per second of the fastest ``chunk`` consecutive poses (all when fewer)."""
+    n = min(chunk, seconds.size)
+    sums = np.convolve(seconds, np.ones(n), mode="valid")[::n]
+    return float(n / sums.min())
 
 
 def pybullet_fk_agreement(chain: KinematicChain, path: Path, q: np.ndarray, T: np.ndarray) -> float:

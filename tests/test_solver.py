@@ -9,7 +9,7 @@ import pybullet as pb
 import pybullet_data
 import pytest
 
-from calib.errors import NonFiniteError, ShapeError
+from calib.errors import DegenerateGeometryError, NonFiniteError, ShapeError
 from planner.kinematics.branches import abb_confdata, branch_codes, classify, quadrant
 from planner.kinematics.chain import KinematicChain
 from planner.kinematics.opw_from_urdf import NotOPWError
@@ -105,6 +105,17 @@ def test_bad_poses_are_rejected(irb: KinematicChain) -> None:
         solver.solve(T)
     with pytest.raises(ShapeError, match="T_base_flange"):
         solver.solve(np.zeros((3, 3)))
+    bad = np.repeat(np.eye(4)[None], 3, axis=0)
+    bad[1, 3, 0] = 1.0
+    with pytest.raises(ShapeError, match=r"T_base_flange last row"):
+        solver.solve(bad)
+    bad = np.repeat(np.eye(4)[None], 3, axis=0)
+    bad[2, 0, 0] = 1.1
+    with pytest.raises(DegenerateGeometryError, match="not orthonormal"):
+        solver.solve(bad)
+    bad[2, 0, 0] = -1.0
+    with pytest.raises(DegenerateGeometryError, match="reflection"):
+        solver.solve(bad)
 
 
 def test_classification_matches_link_geometry(

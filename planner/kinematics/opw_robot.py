@@ -93,35 +93,39 @@ class OPWRobot:
         counts = self.turn_counts
         combos = np.array(list(itertools.product(*(range(m) for m in counts))), dtype=int)
         N, V = q8.shape[0], combos.shape[0]
-        inside = np.broadcast_to(ok8[:, :, None], (N, 8, V)).copy()
+        base = np.ascontiguousarray(np.transpose(q8, (2, 1, 0)))  # (6, 8, N), no copy from opw_ik
+        inside = np.ascontiguousarray(ok8.T)  # (8, N): reachable and simple joints in limits
+        multi: list[tuple[int, FloatArray, NDArray[np.bool_]]] = []  # (joint, q_lo, ok (m,8,N))
         two_pi = 2.0 * np.pi
-        cands: list[FloatArray] = []  # per joint (N, 8, m_j)
         with np.errstate(invalid="ignore"):
             for j, (lo, hi) in enumerate(zip(self.lower, self.upper)):
-                qj = q8[:, :, j]
+                qj = base[j]
                 if not (np.isfinite(lo) and np.isfinite(hi)):
-                    cands.append(qj[:, :, None])
                     continue
-                if lo >= -np.pi and hi <= np.pi:
-                    cands.append(qj[:, :, None])
-                    inside &= ((qj >= lo - 1e-12) & (qj <= hi + 1e-12))[:, :, None]
+                if counts[j] == 1 and lo >= -np.pi and hi <= np.pi:
+                    inside &= (qj >= lo - 1e-12) & (qj <= hi + 1e-12)
                     continue
                 q_lo = qj - two_pi * np.floor((qj - lo + 1e-12) * (1.0 / two_pi))
-                cand = q_lo[:, :, None] + two_pi * np.arange(counts[j])  # (N, 8, m)
-                cands.append(cand)
-                inside &= (cand <= hi + 1e-12)[:, :, combos[:, j]]
-        flat = inside.reshape(N, 8 * V)
+                ok_m = np.stack([q_lo + two_pi * i <= hi + 1e-12 for i in range(counts[j])])
+                multi.append((j, q_lo, ok_m))
+        full = np.broadcast_to(inside[:, None, :], (8, V, N))
+        for j, _, ok_m in multi:
+            full = full & ok_m[combos[:, j]].transpose(1, 0, 2)  # (8, V, N)
+        flat = np.ascontiguousarray(np.transpose(full, (2, 0, 1))).reshape(N, 8 * V)
         n_idx, kv = np.nonzero(flat)  # row-major: per pose, by branch then variant
         b_idx, v_idx = kv // V, kv % V
-        per_pose = flat.sum(axis=1)
+        per_pose = np.count_nonzero(flat, axis=1)
         K = max(min_k, int(per_pose.max()) if N else 0)
         rank = np.arange(n_idx.size) - np.repeat(np.cumsum(per_pose) - per_pose, per_pose)
-        q = np.full((N, K, 6), np.nan)
-        for j, cand in enumerate(cands):
-            m_idx = combos[v_idx, j] if cand.shape[2] > 1 else 0
-            q[n_idx, rank, j] = cand[n_idx, b_idx, m_idx]
-        valid = np.zeros((N, K), dtype=bool)
-        valid[n_idx, rank] = True
-        branch = np.full((N, K), -1, dtype=int)
-        branch[n_idx, rank] = b_idx
-        return q, valid, branch
+        src = b_idx * N + n_idx  # index into a (8, N) plane
+        dest = n_idx * K + rank  # index into an (N, K) plane
+        q = np.full((N * K, 6), np.nan)
+        for j in range(6):
+            q[dest, j] = base[j].ravel()[src]
+        for j, q_lo, _ in multi:
+            q[dest, j] = q_lo.ravel()[src] + two_pi * combos[v_idx, j]
+        valid = np.zeros(N * K, dtype=bool)
+        valid[dest] = True
+        branch = np.full(N * K, -1, dtype=int)
+        branch[dest] = b_idx
+        return q.reshape(N, K, 6), valid.reshape(N, K), branch.reshape(N, K)

@@ -14,7 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from calib.frames import check_transform
+from calib.errors import DegenerateGeometryError, ShapeError
+from calib.validation import as_float_array, check_finite
 from planner.kinematics.branches import BranchFlags, classify
 from planner.kinematics.chain import KinematicChain
 from planner.kinematics.numeric_ik import NumericIK
@@ -72,6 +73,47 @@ class IKSolutions:
         return q, self.found
 
 
+def check_poses(value: ArrayLike, name: str, tol: float = 1e-6) -> FloatArray:
+    """``value`` as ``(N, 4, 4)`` rigid transforms (a single ``(4, 4)`` becomes ``(1, 4, 4)``).
+
+    The same checks as :func:`calib.frames.check_transform`, written element-wise for speed
+    (the IK handles about a million poses per second).
+
+    Raises:
+        ShapeError: not ``(N, 4, 4)`` or ``(4, 4)``, or the last row is not ``(0, 0, 0, 1)``.
+        NonFiniteError: NaN or infinity.
+        DegenerateGeometryError: a rotation part is not orthonormal with determinant +1.
+    """
+    T = as_float_array(value, name)
+    if T.ndim == 2:
+        T = T[None]
+    if T.ndim != 3 or T.shape[1:] != (4, 4):
+        raise ShapeError(f"{name} must be (N, 4, 4) or (4, 4), got shape {np.shape(value)}")
+    check_finite(T, name)
+    if np.abs(T[:, 3] - (0.0, 0.0, 0.0, 1.0)).max(initial=0.0) > tol:
+        raise ShapeError(f"{name} last row must be (0, 0, 0, 1)")
+    c0, c1, c2 = T[:, :3, 0], T[:, :3, 1], T[:, :3, 2]
+    dots = [
+        np.einsum("ni,ni->n", a, b) - e
+        for a, b, e in (
+            (c0, c0, 1),
+            (c1, c1, 1),
+            (c2, c2, 1),
+            (c0, c1, 0),
+            (c0, c2, 0),
+            (c1, c2, 0),
+        )
+    ]
+    worst = max((float(np.abs(d).max(initial=0.0)) for d in dots), default=0.0)
+    if worst > tol:
+        raise DegenerateGeometryError(
+            f"{name} rotation part is not orthonormal (max |R^T R - I| = {worst:.3g})"
+        )
+    if np.any(np.einsum("ni,ni->n", np.cross(c0, c1), c2) < 0):
+        raise DegenerateGeometryError(f"{name} rotation part is a reflection (det < 0)")
+    return T
+
+
 class IKSolver:
     """Inverse kinematics of one chain (build with :func:`make_ik_solver`).
 
@@ -112,8 +154,7 @@ class IKSolver:
             ShapeError, NonFiniteError, DegenerateGeometryError: the poses are not valid
                 rigid transforms (wrong shape, NaN, non-orthonormal rotation).
         """
-        T = check_transform(T_base_flange, "T_base_flange")
-        T = T[None] if T.ndim == 2 else T
+        T = check_poses(T_base_flange, "T_base_flange")
         if self.opw is not None:
             q8, ok8 = self.opw.ik_branches(T)
             if not self.opw_exact:
