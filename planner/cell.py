@@ -257,6 +257,16 @@ class Cell:
         return self._reach
 
     @property
+    def joint_indices(self) -> list[int]:
+        """PyBullet joint indices of the chain's joints, in chain order."""
+        return list(self._joint_index)
+
+    @property
+    def flange_index(self) -> int:
+        """PyBullet link index of the flange (the chain's tip link) in ``self.robot``."""
+        return self._flange_index
+
+    @property
     def home_q(self) -> FloatArray:
         """``(n,)`` a reference configuration: 0 clipped into the limits, rad."""
         return np.clip(np.zeros(self.chain.n_joints), self.chain.lower, self.chain.upper)
