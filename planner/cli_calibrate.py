@@ -15,7 +15,7 @@ from calib.plan_procedures import METHODS
 from planner.cli_common import print_json, read_plan, stdout
 from planner.export.krl import BASE_NO, frame_text
 from planner.export.rapid import pose_text
-from planner.plan_io import CalibrationOutput, calibrate_plan
+from planner.plan_calibrate import CalibrationOutput, calibrate_plan
 
 
 def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:

@@ -6,8 +6,6 @@ equals :func:`stator_plan_text` byte for byte, so the demo cell stays the single
 
 from __future__ import annotations
 
-import numpy as np
-
 from calib.plan import (
     CellSpec,
     FixtureSpec,
@@ -30,13 +28,11 @@ def stator_plan() -> Plan:
     points = [
         PlanPoint.from_probe_point(p, role=pid) for pid, p in demo_cell.stator_ah_points(g).items()
     ]
-    # the table of make_demo_cell: top 0.1 m below the lowest corner of the inclined part
-    low = T @ np.array([-g.depth_m, 0.0, -g.height_m, 1.0])
-    centre = (float(low[0]) + 0.1, float(T[1, 3]) + g.length_m / 2, float(low[2]) - 0.125)
+    size, T_table = demo_cell.demo_table(g, T)  # the table of make_demo_cell
     table = FixtureSpec(
         name="table",
-        box_size_m=(1.0, g.length_m + 0.2, 0.05),
-        T_world_fixture=Pose(position_m=centre),
+        box_size_m=(float(size[0]), float(size[1]), float(size[2])),
+        T_world_fixture=Pose.from_matrix(T_table),
     )
     return Plan(
         name="stator_section_ah",

@@ -241,8 +241,9 @@ def test_check_names_a_point_moved_5_m_away(
 
 @pytest.mark.xfail(
     strict=True,
-    reason="shipped A-H plan not yet feasible in the demo cell: A and G at the joint-3 limit, "
-    "approach overtravel runs the sensor bracket into the part (cell/demo-cell owners)",
+    reason="shipped A-H plan not yet feasible: the 60 mm approach overtravel of the demo points "
+    "brings the sensor bracket / guide tubes within the 5 mm clearance of the part "
+    "(demo-cell / search-path owners)",
 )
 def test_check_shipped_plan_passes(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, _ = run(capsys, "check", str(STATOR))
