@@ -195,9 +195,11 @@ def test_python_m_planner_runs() -> None:
 def test_validate_small_run_writes_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     report = tmp_path / "report.json"
     args = ["validate", str(STATOR), "--trials", "3", "--seed", "7", "--json", str(report)]
-    code, out, err = run(capsys, *args)
+    code, out, err = run(capsys, *args, "--plots", str(tmp_path / "plots"))
     assert code == 0, err
     assert "| WOCS origin x-axis | 95.5 |" in out
+    pngs = sorted(p.name for p in (tmp_path / "plots").glob("*.png"))
+    assert pngs and all((tmp_path / "plots" / n).stat().st_size > 1000 for n in pngs)
     data = json.loads(report.read_text())
     assert data["n_trials"] == 3 and data["n_ok"] == 3 and data["seed"] == 7
     row = next(r for r in data["rows"] if r["key"] == "origin_x")
