@@ -111,8 +111,8 @@ class ProximitySensor:
         """
         d = np.asarray(distances_m, dtype=np.float64)
         with np.errstate(over="ignore"):
-            terms = np.exp(-(d - self.sensing_distance_m) / self.decay_length_m)
-        return terms.mean(axis=-1)
+            terms = np.exp((self.sensing_distance_m - d) * (1.0 / self.decay_length_m))
+        return np.add.reduce(terms, axis=-1) * (1.0 / d.shape[-1])
 
     def on_level(self, jitter_m: float = 0.0) -> float:
         """Signal level at which the sensor switches on, given a switching-distance jitter (m)."""
