@@ -15,9 +15,11 @@ area on its surface (seeded), with their face normals, and checked two ways in t
    against the work object (threshold = the 5 mm margin, sensor exempt down to contact); stop
    at the first rotation that passes. No self-collision check (it would only slow it down).
 
-Reported: checks (points) per second of each, their ratio, and how many points each finds
-feasible. Run: ``python -m bench.bench_feasibility [--n 300] [--pybullet-n 100] [--seed 0]``;
-writes ``bench/results/feasibility.json``.
+Reported: checks (points) per second of each, their ratio on the same points, how many points
+each finds feasible, and the points where the two disagree (with our reason).
+
+Run: ``python -m bench.bench_feasibility [--n 300] [--pybullet-n 100] [--seed 0]``; writes
+``bench/results/feasibility.json``.
 """
 
 from __future__ import annotations
@@ -62,6 +64,8 @@ def run_ours(cell: Cell, pts: np.ndarray, nrm: np.ndarray) -> dict[str, object]:
     dt = time.perf_counter() - t0
     status = [r.status for r in res]
     return {
+        "per_point": [r.status != "infeasible" for r in res],
+        "reasons": [r.reason for r in res],
         "n": len(res),
         "seconds": dt,
         "checks_per_s": len(res) / dt,
@@ -82,6 +86,7 @@ def run_plain_loop(cell: Cell, pts: np.ndarray, nrm: np.ndarray) -> dict[str, ob
     )
     lo, hi = cell.chain.lower, cell.chain.upper
     feasible = 0
+    per_point = [False] * len(pts)
     t0 = time.perf_counter()
     for i in range(len(pts)):
         for r in range(angles.size):
@@ -126,6 +131,7 @@ def run_plain_loop(cell: Cell, pts: np.ndarray, nrm: np.ndarray) -> dict[str, ob
             ]
             if not hits:
                 feasible += 1
+                per_point[i] = True
                 break
     dt = time.perf_counter() - t0
     return {
@@ -133,6 +139,7 @@ def run_plain_loop(cell: Cell, pts: np.ndarray, nrm: np.ndarray) -> dict[str, ob
         "seconds": dt,
         "checks_per_s": len(pts) / dt,
         "feasible": feasible,
+        "per_point": per_point,
     }
 
 
@@ -154,15 +161,23 @@ def main(argv: list[str] | None = None) -> int:
         k = min(args.pybullet_n, args.n)
         ours_same = run_ours(cell, pts[:k], nrm[:k])
         loop = run_plain_loop(cell, pts[:k], nrm[:k])
+    ours_pp, loop_pp = ours_same.pop("per_point"), loop.pop("per_point")
+    reasons = ours_same.pop("reasons")
+    ours.pop("per_point")
+    ours.pop("reasons")
     result = {
         "bench": "feasibility",
+        "only_loop_feasible_our_reasons": [
+            reasons[i] for i in range(k) if loop_pp[i] and not ours_pp[i]
+        ],
+        "only_ours_feasible": int(sum(o and not lp for o, lp in zip(ours_pp, loop_pp))),
         "triangles": len(mesh.faces),
         "work_object_load_s": load_s,
         "seed": args.seed,
         "ours": ours,
         "ours_on_loop_points": ours_same,
         "pybullet_plain_loop": loop,
-        "ratio_checks_per_s": ours["checks_per_s"] / loop["checks_per_s"],
+        "ratio_checks_per_s": ours_same["checks_per_s"] / loop["checks_per_s"],
         "machine": {"python": platform.python_version(), "cpu": platform.processor()},
     }
     args.out.parent.mkdir(parents=True, exist_ok=True)
@@ -189,7 +204,11 @@ def main(argv: list[str] | None = None) -> int:
         f"{loop['feasible']}/{k}",
     )
     Console().print(table)
-    Console().print(f"ratio: {result['ratio_checks_per_s']:.1f}x; written {args.out}")
+    Console().print(
+        f"ratio: {result['ratio_checks_per_s']:.1f}x; only the loop finds feasible (our "
+        f"reasons): {result['only_loop_feasible_our_reasons']}; only we find feasible: "
+        f"{result['only_ours_feasible']}; written {args.out}"
+    )
     return 0
 
 

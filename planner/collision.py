@@ -198,10 +198,11 @@ class Clearance:
     pair: tuple[str, str] | None
 
     def describe(self) -> str:
-        """E.g. ``"link_4 hits table (clearance -3.0 mm)"``."""
+        """E.g. ``"link_4 hits table (clearance -3.0 mm)"``, ``"... is too near ..."`` (inside
+        the margin), ``"... is near ..."`` (the limiting pair of a passing pose)."""
         if self.pair is None:
             return "no collision"
-        verb = "hits" if self.clearance_m < 0 or not self.ok else "is near"
+        verb = "hits" if self.clearance_m < 0 else "is too near" if not self.ok else "is near"
         return f"{self.pair[0]} {verb} {self.pair[1]} (clearance {self.clearance_m * 1e3:.1f} mm)"
 
 

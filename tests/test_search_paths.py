@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from dataclasses import replace
 
@@ -74,7 +75,7 @@ def test_search_into_a_clamp_fails_at_the_right_distance(cell: Cell) -> None:
     expected = (0.6 + 0.05 + 0.008) - top - 0.005  # travel where the gap reaches 5 mm
     assert not res.feasible
     assert abs(res.fail_at_m - expected) <= 0.001 + 1e-9
-    assert "sensor_body hits clamp" in res.reason and res.reason.startswith(
+    assert re.search(r"sensor_body is too near clamp \(clearance [45]\.0 mm\)", res.reason) and res.reason.startswith(
         f"at {res.fail_at_m * 1e3:.1f} mm: "
     )
     assert res.q_path.shape[0] == int(np.searchsorted(res.s_m, res.fail_at_m))
