@@ -198,3 +198,16 @@ def test_checked_in_schema_matches_types(type_name: str, file_name: str) -> None
         f"regenerate with: wobjcal schema{' --measurements' if type_name != 'plan' else ''} "
         f"> assets/schema/{file_name}"
     )
+
+
+@pytest.mark.parametrize(
+    ("literal", "shown"), [("Infinity", "Infinity"), ("-Infinity", "-Infinity"), ("1e999", "inf")]
+)
+def test_infinite_numbers_are_rejected_with_path(literal: str, shown: str) -> None:
+    raw = json.loads(VALID.read_text())
+    raw["points"][2]["normal"][0] = "@"
+    text = json.dumps(raw).replace('"@"', literal)
+    with pytest.raises(
+        PlanError, match=rf"points\[2\]\.normal\[0\]: must be a finite number, got {shown}"
+    ):
+        plan_from_json(text)
