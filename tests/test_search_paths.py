@@ -75,9 +75,8 @@ def test_search_into_a_clamp_fails_at_the_right_distance(cell: Cell) -> None:
     expected = (0.6 + 0.05 + 0.008) - top - 0.005  # travel where the gap reaches 5 mm
     assert not res.feasible
     assert abs(res.fail_at_m - expected) <= 0.001 + 1e-9
-    assert re.search(r"sensor_body is too near clamp \(clearance [45]\.0 mm\)", res.reason) and res.reason.startswith(
-        f"at {res.fail_at_m * 1e3:.1f} mm: "
-    )
+    assert re.search(r"sensor_body is too near clamp \(clearance [45]\.0 mm\)", res.reason)
+    assert res.reason.startswith(f"at {res.fail_at_m * 1e3:.1f} mm: ")
     assert res.q_path.shape[0] == int(np.searchsorted(res.s_m, res.fail_at_m))
 
 
