@@ -26,7 +26,12 @@ def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
     """
     target = Path(path)
     directory = target.parent if str(target.parent) else Path()
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
+    try:
+        fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
+    except OSError as exc:  # name the directory the user gave, not the temporary file
+        msg = f"cannot write into {directory}: {exc.strerror}"
+        raise type(exc)(exc.errno, msg, str(target)) from None
+
     tmp = Path(tmp_name)
     try:
         with os.fdopen(fd, "wb") as handle:

@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 from calib.atomic_io import write_text_atomic
+from calib.plan import load_plan
 from calib.plan_json import json_schema
 from planner.cli_common import DEMO_PLAN, stderr
 from planner.plan_io import FeatureUnavailableError
@@ -83,8 +83,9 @@ def cmd_ui(args: argparse.Namespace) -> int:
         stderr().print(f"wrote the built-in A-H plan to {write_plan}")
         return 0
     plan = getattr(args, "plan", None)
-    if plan is not None and not Path(plan).is_file():
-        raise FileNotFoundError(2, "no such plan file", plan)
+    if plan is not None:
+        load_plan(plan)  # a clear error now, before a server starts
+
     try:
         from webui.app import run
     except ImportError as exc:

@@ -45,6 +45,9 @@ def test_failure_leaves_target_and_no_temp_file(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["plan.json"]
 
 
-def test_missing_directory_raises_oserror(tmp_path: Path) -> None:
-    with pytest.raises(OSError):
-        write_text_atomic(tmp_path / "nope" / "plan.json", "x")
+def test_missing_directory_raises_oserror_naming_target(tmp_path: Path) -> None:
+    target = tmp_path / "nope" / "plan.json"
+    with pytest.raises(FileNotFoundError) as info:
+        write_text_atomic(target, "x")
+    assert info.value.filename == str(target)
+    assert "cannot write into" in str(info.value.strerror)

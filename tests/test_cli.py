@@ -182,7 +182,20 @@ def test_ui_passes_flags_to_webui(
     assert calls[0] == ((str(STATOR),), {"host": "0.0.0.0", "port": 8123, "block": True})
     assert calls[1] == ((None,), {"host": "127.0.0.1", "port": 8080, "block": True})
     code, _, err = run(capsys, "ui", "no_such_plan.json")
-    assert code == 2 and "no_such_plan.json" in err
+    assert code == 2 and "no_such_plan.json: No such file or directory" in err
+    code, _, err = run(capsys, "ui", str(DATA / "bad_nan.json"))
+    assert code == 2 and "must be a finite number, got NaN" in err
+    assert len(calls) == 2  # no server was started for bad plans
+
+
+def test_unwritable_output_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "no_dir" / "x.mod"
+    code, _, err = run(
+        capsys, "export", str(STATOR), "--format", "rapid", "-o", str(out), "--no-check"
+    )
+    assert code == 2
+    want = f"{out}: cannot write into {out.parent}: No such file or directory"
+    assert err.strip().splitlines()[-1] == f"wobjcal export: error: {want}"
 
 
 def test_python_m_planner_runs() -> None:
