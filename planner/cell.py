@@ -399,11 +399,11 @@ class Cell:
         self,
         margin_m: float = DEFAULT_MARGIN_M,
         sensor_wobj_allowed: bool = True,
-        skip_sensor_wobj: bool = False,
+        skip_wobj: bool = False,
     ) -> Clearance:
         """Clearance of the current state (see :meth:`CollisionChecker.query`)."""
         return self.checker.query(
-            margin_m, self.self_margin_m, None, sensor_wobj_allowed, skip_sensor_wobj
+            margin_m, self.self_margin_m, None, sensor_wobj_allowed, skip_wobj
         )
 
     def check_probes(

@@ -272,24 +272,28 @@ class CollisionChecker:
         self_margin_m: float,
         report_m: float | None = None,
         sensor_wobj_allowed: bool = True,
-        skip_sensor_wobj: bool = False,
+        skip_wobj: bool = False,
     ) -> Clearance:
         """Clearance of the current state.
 
         Args:
             margin_m: required distance of robot and tool to the work object and fixtures, m.
             self_margin_m: required distance between robot/tool links not in the ACL, m.
-            report_m: look this far for the limiting pair (default ``2 * margin_m``: far enough
-                to tell a marginal pose, whose slack is below ``margin_m``); the sensor links
-                look only ``margin_m`` far at the work object, as they need no clearance.
+            report_m: look this far for the limiting pair (default ``2 * margin_m + 5 mm``: far
+                enough to tell a marginal pose, whose slack is below ``margin_m``); the sensor
+                links look only ``margin_m`` far at the work object, as they need no clearance.
             sensor_wobj_allowed: the sensor links need only stay out of contact (distance
                 >= 0) with the work object, not the margin.
+            skip_wobj: do not check against the work object at all (an approach search past
+                its nominal point: the real search stops at the surface, wherever it is).
         """
-        look = report_m if report_m is not None else 2.0 * margin_m
+        look = report_m if report_m is not None else 2.0 * margin_m + 0.005
         look = max(look, margin_m, self_margin_m) + 1e-9
         best = Clearance(True, look, look - margin_m, None)
         c = self.client
         for env, env_name in self.environment.items():
+            if skip_wobj and env == self.wobj_body:
+                continue
             queries = [(self.robot.body_id, -2, look)]
             if self.tool is not None:
                 tid = self.tool.body_id
@@ -297,10 +301,8 @@ class CollisionChecker:
                     queries.append((tid, -2, look))
                 else:  # the sensor needs only contact-free (+ margin to call it marginal)
                     for link in self._tool_links():
-                        if link not in self.sensor_links:
-                            queries.append((tid, link, look))
-                        elif not skip_sensor_wobj:
-                            queries.append((tid, link, margin_m if sensor_wobj_allowed else look))
+                        sensor = link in self.sensor_links and sensor_wobj_allowed
+                        queries.append((tid, link, margin_m if sensor else look))
             for bid, link_filter, dist in queries:
                 kw = {} if link_filter == -2 else {"linkIndexA": link_filter}
                 for pt in pb.getClosestPoints(bid, env, dist, physicsClientId=c, **kw):
@@ -309,14 +311,12 @@ class CollisionChecker:
                         continue
                     need = margin_m
                     if (
-                        bid != self.robot.body_id
+                        sensor_wobj_allowed
+                        and bid != self.robot.body_id
                         and link in self.sensor_links
-                        and (env == self.wobj_body)
+                        and env == self.wobj_body
                     ):
-                        if skip_sensor_wobj:
-                            continue
-                        if sensor_wobj_allowed:
-                            need = 0.0
+                        need = 0.0
                     d = pt[8]
                     if d - need < best.slack_m:
                         best = Clearance(d >= need, d, d - need, (self.names(bid, link), env_name))

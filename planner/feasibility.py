@@ -54,7 +54,7 @@ class ProbeFeasibility:
             candidate checked, ``None`` when there is no IK candidate at all.
         branch: IK branch of ``q`` (OPW configuration 0-7), -1 when unknown or none.
         rotation_rad: chosen rotation about the sensor axis, rad (NaN when none).
-        clearance_m: clearance of the limiting pair at ``q``, m, capped at ``2 * margin_m``
+        clearance_m: clearance of the limiting pair at ``q``, m, capped at ``2 * margin_m + 5 mm``
             (nothing nearer); NaN when no pose was checked.
         joint_margin_rad: smallest distance of ``q`` to a joint limit, rad (NaN when none).
         T_base_flange: ``(4, 4)`` flange pose of ``q``, base frame, m (``None`` when none).

@@ -6,9 +6,11 @@ A search (:class:`calib.probing.SearchCommand`, base frame) moves the sensor TCP
 (candidates in order of least joint motion), and every later sample takes the solution of the
 same branch nearest to the previous one. A sample fails when it has no solution on that
 branch within limits, a joint jumps more than ``max_joint_jump_rad``, it is near a singularity,
-or it collides. The sensor may come as close as contact to the work object (not the margin);
-past the nominal point of an approach search it is not checked against the work object at all
-(a real search stops at the surface, and a farther part has moved its surface away too).
+or it collides. The sensor may come as close as contact to the work object (not the margin).
+Past the nominal point of an approach search, robot and tool are not checked against the work
+object at all, only against fixtures and themselves: the real search stops at the surface, and
+a part lying farther away has moved its surface away by just as much, so the geometry at the
+stop is the one checked at the nominal point.
 """
 
 from __future__ import annotations
@@ -202,7 +204,7 @@ def _walk(
     min_cl = math.inf
     for j in range(fail_j):
         cell.set_joint_positions(q_path[j])
-        cl = cell.clearance(margin, sensor_wobj_allowed=True, skip_sensor_wobj=s[j] > skip_from)
+        cl = cell.clearance(margin, sensor_wobj_allowed=True, skip_wobj=s[j] > skip_from)
         min_cl = min(min_cl, cl.clearance_m)
         if not cl.ok:
             fail_j, reason = j, cl.describe()

@@ -108,8 +108,8 @@ def test_sensor_may_approach_the_work_object_within_its_standoff(cell: Cell) -> 
         assert 0.004 <= cl.clearance_m <= 0.005 + 1e-6
         strict = cell.clearance(margin_m=0.010, sensor_wobj_allowed=False)
         assert not strict.ok and strict.pair == cl.pair
-        skipped = cell.clearance(margin_m=0.010, skip_sensor_wobj=True)
-        assert skipped.pair is None or skipped.pair[0] != "sensor_body"
+        skipped = cell.clearance(margin_m=0.010, skip_wobj=True)
+        assert skipped.pair is None or skipped.pair[1] != "work object"
 
 
 def test_static_base_on_a_table_is_not_a_collision() -> None:

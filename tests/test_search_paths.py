@@ -59,6 +59,15 @@ def test_approach_search_on_top_is_feasible(cell: Cell) -> None:
         assert not cell.clearance(sensor_wobj_allowed=True).ok
 
 
+def test_long_overtravel_is_not_checked_against_the_nominal_part(cell: Cell) -> None:
+    """60 mm past the surface the cable tubes would be 32 mm inside the nominal part; a real
+    search stops at the surface wherever the part is, so only fixtures count there."""
+    deep = replace(TOP_APPROACH, search=SearchSpec("approach", 0.05, 0.06))
+    res = cell.check_search(SearchCommand.from_point(deep, cell.T_base_wobj))
+    assert res.feasible, res.reason
+    assert res.s_m[-1] == pytest.approx(0.11)
+
+
 def test_search_into_a_clamp_fails_at_the_right_distance(cell: Cell) -> None:
     """A 20 mm clamp on the top face under the sensor: the sensor face starts 58 mm above the
     surface (50 mm start offset + 8 mm standoff) and must keep 5 mm from the clamp top."""
