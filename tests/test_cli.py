@@ -254,15 +254,10 @@ def test_check_names_a_point_moved_5_m_away(
     assert re.search(r"point F: infeasible: out of reach", out)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="shipped A-H plan not yet feasible: the 60 mm approach overtravel of the demo points "
-    "brings the sensor bracket / guide tubes within the 5 mm clearance of the part "
-    "(demo-cell / search-path owners)",
-)
 def test_check_shipped_plan_passes(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, _ = run(capsys, "check", str(STATOR))
     assert code == 0, out
+    assert "8 of 8 points feasible" in out
 
 
 def test_export_takes_orientation_and_confdata_from_check(
