@@ -24,6 +24,7 @@ import pybullet as pb
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
+from calib.errors import ShapeError
 from calib.frames import check_transform, invert_transform
 from calib.validation import check_shape
 from planner.bodies import BodyLinks, load_urdf_body, set_link_pose, world_link_pose
@@ -85,6 +86,8 @@ class Cell:
         acl_rng: np.random.Generator | None = None,
         use_acl_cache: bool = True,
     ) -> None:
+        if int(acl_samples) < 1:
+            raise ShapeError(f"acl_samples must be >= 1, got {acl_samples}")
         path = robot_urdf(str(robot)) if is_builtin(robot) else Path(robot)
         model = load_urdf(path)
         self.chain: KinematicChain = KinematicChain.from_model(model, base_link, tip_link)
@@ -351,13 +354,16 @@ class Cell:
             T = kwargs.get("T_world_fixture")
             if "mesh" in kwargs:
                 fixture = Fixture.from_mesh(fixture, kwargs["mesh"], T, kwargs.get("units", "auto"))
-            elif "radius_m" in kwargs:
+            elif "radius_m" in kwargs and "height_m" in kwargs:
                 fixture = Fixture.cylinder(fixture, kwargs["radius_m"], kwargs["height_m"], T)
-            else:
+            elif "size_m" in kwargs:
                 fixture = Fixture.box(fixture, kwargs["size_m"], T)
+            else:
+                raise ShapeError(
+                    f"fixture {fixture!r} needs size_m= (box), radius_m= and height_m= "
+                    f"(cylinder) or mesh=, got {sorted(kwargs)}"
+                )
         if fixture.name in self.fixtures:
-            from calib.errors import ShapeError
-
             raise ShapeError(f"a fixture named {fixture.name!r} already exists")
         body = fixture.create_body(self.client)
         self.checker.environment[body.body_id] = fixture.name

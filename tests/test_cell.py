@@ -76,6 +76,21 @@ def test_fixtures_by_name_and_duplicates(cell: Cell) -> None:
         cell.add_fixture("post", size_m=(1, 1, 1))
 
 
+def test_bad_scene_input(cell: Cell) -> None:
+    bad = np.eye(4)
+    bad[0, 3] = np.nan
+    with pytest.raises(NonFiniteError, match="T_world_wobj"):
+        cell.set_work_object(trimesh.creation.box([0.1] * 3), "m", bad)
+    with pytest.raises(NonFiniteError, match="T_world_fixture"):
+        cell.add_fixture("clamp", size_m=(0.1, 0.1, 0.1), T_world_fixture=bad)
+    with pytest.raises(ShapeError, match=r"'clamp' needs size_m"):
+        cell.add_fixture("clamp", radius_m=0.1)
+    with pytest.raises(UnknownFrameError, match="no fixture 'vice'"):
+        cell.remove_fixture("vice")
+    with pytest.raises(NonFiniteError, match="T_world_base"):
+        Cell(T_world_base=bad)
+
+
 def test_bad_joint_values(cell: Cell) -> None:
     with pytest.raises(NonFiniteError, match=r"q"):
         cell.set_joint_positions([0, 0, np.nan, 0, 0, 0])
