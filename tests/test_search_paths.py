@@ -130,3 +130,20 @@ def test_bad_commands(cell: Cell) -> None:
         cell.check_search(replace(cmd, direction=np.zeros(3)))
     with pytest.raises(NonFiniteError, match=r"command\.start_m"):
         cell.check_search(replace(cmd, start_m=np.array([np.nan, 0.0, 0.0])))
+
+
+def test_numeric_ik_robot_runs_a_search(reference_dir) -> None:
+    """UR5 (offset wrist, numeric IK): one approach search, continuous joints on the path."""
+    with Cell(reference_dir / "robots" / "ur5" / "ur5.urdf", use_acl_cache=False) as ur5:
+        # beside the arm's plane: straight in front, the upper arm passes the box within 5 mm
+        ur5.set_work_object(trimesh.creation.box([0.2] * 3), "m", make_transform(p=[0.5, 0.2, 0.1]))
+        point = replace(TOP_APPROACH, position_m=(0.0, 0.0, 0.1))
+        res = ur5.check_search(SearchCommand.from_point(point, ur5.T_base_wobj))
+        assert ur5.solver.kind == "numeric"
+        assert res.feasible, res.reason
+        pos = _sensor_positions(ur5, res.q_path)
+    np.testing.assert_allclose(
+        pos[:, :2], np.broadcast_to([0.5, 0.2], (res.s_m.size, 2)), atol=1e-5
+    )
+    np.testing.assert_allclose(pos[:, 2], 0.2 + 0.05 - res.s_m, atol=1e-5)
+    assert np.abs(np.diff(res.q_path, axis=0)).max() < np.radians(5)
