@@ -172,7 +172,8 @@ class Cell:
             if self.tool.urdf_path is not None:
                 texts.append(self.tool.urdf_path.read_bytes())
             elif self.tool.mesh is not None:
-                texts.append(trimesh.util.sha256(self.tool.mesh.vertices.tobytes()).encode())
+                mesh = self.tool.mesh
+                texts.append(mesh.vertices.tobytes() + mesh.faces.tobytes())
         settings = f"{self.chain.base_link}>{self.chain.tip_link}:{n}:{self.self_margin_m:.6f}"
         with self.saved_state():
             acl = compute_acl(

@@ -14,6 +14,7 @@ from calib.errors import NonFiniteError, ShapeError
 from calib.frames import invert_transform, make_transform, matrix_from_rotvec
 from planner.cell import Cell
 from planner.errors import MeshError, UnknownFrameError, URDFError
+from planner.tool import Tool
 
 T_WORLD_BASE = make_transform(matrix_from_rotvec([0, 0, 0.3]), [0.5, -0.2, 0.1])
 
@@ -106,6 +107,25 @@ def test_unknown_tcp_lists_names(cell: Cell) -> None:
 def test_bad_mesh_names_the_file(cell: Cell, tmp_path) -> None:
     with pytest.raises(MeshError, match=r"nothing\.stl"):
         cell.set_work_object(tmp_path / "nothing.stl")
+
+
+def test_mesh_tool_rides_on_the_flange() -> None:
+    pen = trimesh.creation.cylinder(radius=0.03, height=0.2)
+    pen.apply_translation([0, 0, 0.1])
+    tool = Tool.from_mesh(pen, {"tip": make_transform(p=[0, 0, 0.2])}, name="pen")
+    with Cell(tool=tool, use_acl_cache=False) as c:
+        q = c.home_q + 0.2
+        c.set_joint_positions(q)
+        T_world_tip = c.chain.fk(q)[0] @ c.T_flange_tcp("tip")
+        # a box right at the tip: the pen's hull touches it
+        c.add_fixture(
+            "stop",
+            size_m=(0.05, 0.05, 0.05),
+            T_world_fixture=T_world_tip @ make_transform(p=[0, 0, 0.025 + 0.004]),
+        )
+        cl = c.clearance(margin_m=0.005)
+    assert cl.pair == ("pen", "stop")
+    assert cl.clearance_m == pytest.approx(0.004, abs=1.5e-3)  # hull of a polygonal cylinder
 
 
 def test_close_and_context_manager() -> None:
