@@ -1,4 +1,4 @@
-"""Tests of planner.collision: the sampled allowed-collision list and the clearance query."""
+"""Tests of planner.collision: clearance queries (pairs, distances, sensor rule, base pose)."""
 
 from __future__ import annotations
 
@@ -9,10 +9,8 @@ import numpy as np
 import pytest
 import trimesh
 
-import planner.collision as collision
 from calib.frames import make_transform
 from planner.cell import Cell
-from planner.collision import AllowedCollisions, pair
 from planner.fixtures import table
 
 REFERENCE = Path(__file__).resolve().parents[2] / "shared" / "reference"
@@ -36,27 +34,6 @@ def reference_dir_module() -> Path:
     if not REFERENCE.is_dir():
         pytest.skip(f"reference data not found at {REFERENCE}")
     return REFERENCE
-
-
-def test_builtin_acl_allows_adjacent_links_and_the_tool_mount(cell: Cell) -> None:
-    acl = cell.checker.acl
-    for a, b in [("base_link", "link_1"), ("link_4", "link_5"), ("link_6", "tool_mount")]:
-        assert pair(a, b) in acl.allowed
-    # the forearm can hit the tool: that pair is checked, never allowed
-    assert pair("link_3", "feeder_body") not in acl.allowed
-    assert acl.n_samples == 1000
-
-
-def test_ur5_acl_keeps_real_self_collisions_checked(ur5: Cell) -> None:
-    """Base vs upper arm touch in ~37 % of random samples: a real collision, not an artefact."""
-    acl = ur5.checker.acl
-    f = acl.near_fraction[pair("base_link_inertia", "upper_arm_link")]
-    assert 0.25 < f < 0.55
-    assert pair("base_link_inertia", "upper_arm_link") not in acl.allowed
-    assert pair("forearm_link", "wrist_2_link") not in acl.allowed
-    # the offset wrist links touch in every pose: allowed, or every pose would collide
-    assert acl.near_fraction[pair("wrist_1_link", "wrist_2_link")] == 1.0
-    assert pair("wrist_1_link", "wrist_2_link") in acl.allowed
 
 
 def test_ur5_upper_arm_into_the_base_is_a_self_collision(ur5: Cell) -> None:
@@ -121,24 +98,6 @@ def test_static_base_on_a_table_is_not_a_collision() -> None:
         c.set_joint_positions([0, np.radians(90), np.radians(60), 0, 0, 0])  # dive into it
         cl = c.clearance()
         assert not cl.ok and cl.pair[1] == "table"
-
-
-def test_acl_cache_round_trip(tmp_path, monkeypatch) -> None:
-    monkeypatch.setenv("WOBJCAL_CACHE_DIR", str(tmp_path))
-    collision._MEMORY_CACHE.clear()
-    with Cell(acl_samples=150) as a:
-        acl = a.checker.acl
-    files = list((tmp_path / "acl").glob("*.json"))
-    assert len(files) == 1 and files[0].stem == acl.key
-    assert AllowedCollisions.from_json(files[0].read_text()) == acl
-    collision._MEMORY_CACHE.clear()  # force a read from disk
-    mtime = files[0].stat().st_mtime_ns
-    with Cell(acl_samples=150) as b:
-        assert b.checker.acl == acl
-    assert files[0].stat().st_mtime_ns == mtime
-    with Cell(acl_samples=160) as c:  # other settings: another key
-        assert c.checker.acl.key != acl.key
-    collision._MEMORY_CACHE.clear()
 
 
 def test_base_pose_moves_everything(cell: Cell) -> None:
