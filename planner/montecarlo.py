@@ -23,6 +23,7 @@ from collections import Counter
 from collections.abc import Callable, Mapping
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import trimesh
@@ -37,7 +38,7 @@ from calib.stator_procedure import StatorSettings, check_stator_points, run_stat
 from planner.error_models import AccuracyField, Misplacement, RobotErrorModel
 from planner.montecarlo_report import ValidationReport, build_report
 from planner.raycast import MeshRayCaster
-from planner.search_sim import ReachabilityHook, SimulatedProbe
+from planner.search_sim import ReachabilityHook, SimulatedProbe, cell_search_hook
 from planner.sensor import ProximitySensor
 from planner.stator import StatorGeometry, build_stator_mesh
 
@@ -115,6 +116,9 @@ def _run_trial(seed: np.random.SeedSequence, reach: ReachabilityHook | None) -> 
     rng = np.random.default_rng(seed)
     T_nom = setup.T_base_wobj_nominal
     T_true = T_nom @ setup.misplacement.sample(rng, setup.pivot_wobj_m)
+    cell = _WORKER.get("cell")
+    if cell is not None:  # the cell's part goes where the part really is
+        cell.set_work_object(cell.work_object, T_world_wobj=cell.T_world_base @ T_true)  # type: ignore[attr-defined]
     probe = SimulatedProbe(
         _WORKER["caster"],  # type: ignore[arg-type]
         T_true,
@@ -173,6 +177,7 @@ def validate(
     pivot_wobj_m: ArrayLike | None = None,
     settings: StatorSettings | None = None,
     reachability: ReachabilityHook | None = None,
+    cell: Any = None,
     edge_inset_m: float = DEFAULT_EDGE_INSET_M,
     edge_tolerance_m: float = 2e-5,
     workers: int | None = None,
@@ -197,6 +202,11 @@ def validate(
             straight-edge offset (:meth:`ProximitySensor.edge_event_offset_m`) as the known
             edge-event offset removed from F and H.
         reachability: optional hook vetting each commanded search (runs in one process).
+        cell: optional :class:`planner.cell.Cell` with the part as its work object; each trial
+            moves the work object to the true pose and vets every search with
+            ``cell.check_search`` (see :func:`planner.search_sim.cell_search_hook`), so searches
+            that become unreachable or collide because the part moved are counted as failures.
+            Runs in one process; the work object is put back at the end.
         edge_inset_m: edge-search track inset towards the face, m.
         edge_tolerance_m: edge bisection tolerance, m.
         workers: worker processes (default: ``min(2, os.cpu_count())``; 1 runs in-process).
@@ -236,10 +246,19 @@ def validate(
     part = build_stator_mesh(geometry) if mesh is None else mesh
     seeds = np.random.SeedSequence(int(rng.integers(2**63))).spawn(n_trials)
     n_workers = min(2, os.cpu_count() or 1) if workers is None else max(1, int(workers))
+    if cell is not None and reachability is None:
+        reachability = cell_search_hook(cell)
     if reachability is not None or n_trials < 50:
         n_workers = 1
     t0 = time.perf_counter()
-    results = _run_all(setup, part, seeds, n_workers, reachability, progress)
+    T_cell = None if cell is None else cell.T_world_wobj
+    _WORKER["cell"] = cell
+    try:
+        results = _run_all(setup, part, seeds, n_workers, reachability, progress)
+    finally:
+        _WORKER.pop("cell", None)
+        if cell is not None:
+            cell.set_work_object(cell.work_object, T_world_wobj=T_cell)
     elapsed = time.perf_counter() - t0
     log.info("validated %d trials in %.2f s on %d workers", n_trials, elapsed, n_workers)
     failures = Counter(r.failure for r in results if r.failure)

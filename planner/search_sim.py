@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -37,6 +38,21 @@ FloatArray = NDArray[np.float64]
 
 #: A reachability hook: returns "" when the commanded search is feasible, else the reason.
 ReachabilityHook = Callable[[SearchCommand], str]
+
+
+def cell_search_hook(cell: Any, step_m: float = 0.002) -> ReachabilityHook:
+    """A hook that vets each commanded search with ``cell.check_search`` (a
+    :class:`planner.cell.Cell`); place the cell's work object where the part really is, so a
+    search that collides because the part moved is caught.
+
+    The reason returned is ``"unreachable or colliding: <the cell's reason>"``.
+    """
+
+    def hook(command: SearchCommand) -> str:
+        res = cell.check_search(command, step_m=step_m)
+        return "" if res.feasible else f"unreachable or colliding: {res.reason}"
+
+    return hook
 
 
 @dataclass(frozen=True)
@@ -93,7 +109,8 @@ class SimulatedProbe:
         robot_error: robot repeatability (per search) and accuracy model.
         accuracy_field: this robot's accuracy field (``robot_error.sample_field``), or None.
         geometry: the stator geometry, to classify landings over slot holes or off the face.
-        reachability: optional hook that vets each commanded search.
+        reachability: optional hook that vets the path each successful search really ran (the
+            command cut at the switching event); its reason fails the probe.
         edge_inset_m: an edge search runs its track this far inside the commanded path along
             the sensor axis (so the sensor detects the face it slides over); the reported point
             stays on the commanded path, i.e. on the face (the contract of the A-H procedure).
@@ -138,6 +155,10 @@ class SimulatedProbe:
         return ProbeResult(point_m=None, reason=reason)
 
     def _succeed(self, cmd: SearchCommand, tcp0: FloatArray, travel: float) -> ProbeResult:
+        if self.reachability is not None:  # the path the robot really ran: start to the event
+            why = self.reachability(replace(cmd, length_m=max(travel, 1e-6)))
+            if why:
+                return self._fail(cmd, why)
         landing = ""
         if self.geometry is not None and cmd.kind == "approach":
             tcp_w = self._to_part((tcp0 + travel * cmd.direction)[None])[0]
@@ -150,10 +171,6 @@ class SimulatedProbe:
     # -- the probe -------------------------------------------------------------------------
     def __call__(self, cmd: SearchCommand) -> ProbeResult:
         """Run one commanded search against the true part."""
-        if self.reachability is not None:
-            why = self.reachability(cmd)
-            if why:
-                return self._fail(cmd, why)
         start = np.asarray(cmd.start_m, float)
         offset = self.robot_error.sample_repeatability_m(self.rng)
         if self.accuracy_field is not None:

@@ -82,3 +82,22 @@ def test_bad_arguments_are_named() -> None:
         validate(POINTS, GEOM, T_NOM, 10, np.random.default_rng(0), procedure="magic")
     with pytest.raises(ShapeError, match="missing"):
         validate({"A": POINTS["A"]}, GEOM, T_NOM, 10, np.random.default_rng(0))
+
+
+def test_cell_vets_every_search_and_counts_unreachable_ones() -> None:
+    from planner.demo_cell import make_demo_cell
+
+    cell = make_demo_cell(GEOM)
+    try:
+        T_cell = cell.T_world_wobj.copy()
+        ok = validate(POINTS, GEOM, T_NOM, 2, np.random.default_rng(4), cell=cell)
+        assert ok.n_ok == 2, ok.failures
+        assert np.allclose(cell.T_world_wobj, T_cell)  # put back
+        # a plan whose part is placed 1.2 m further away than the cell can reach
+        far = T_NOM.copy()
+        far[0, 3] += 1.2
+        bad = validate(POINTS, GEOM, far, 2, np.random.default_rng(4), cell=cell)
+        assert bad.n_ok == 0
+        assert all("unreachable or colliding" in k for k in bad.failures), bad.failures
+    finally:
+        cell.close()
