@@ -89,6 +89,15 @@ class AllowedCollisions:
         )
 
 
+def sample_configurations(
+    lower: np.ndarray, upper: np.ndarray, n: int, rng: np.random.Generator
+) -> np.ndarray:
+    """``(n, dof)`` configurations uniform within the limits (``[-pi, pi]`` where unlimited)."""
+    lo = np.where(np.isfinite(lower), lower, -np.pi)
+    hi = np.where(np.isfinite(upper), upper, np.pi)
+    return rng.uniform(lo, hi, size=(int(n), len(lo)))
+
+
 def cache_dir() -> Path:
     """Directory of cached ACLs: ``$WOBJCAL_CACHE_DIR/acl`` or ``~/.cache/wobjcal/acl``."""
     root = os.environ.get("WOBJCAL_CACHE_DIR") or Path.home() / ".cache" / "wobjcal"

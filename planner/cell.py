@@ -27,13 +27,15 @@ from numpy.typing import ArrayLike, NDArray
 from calib.errors import ShapeError
 from calib.frames import check_transform, invert_transform
 from calib.validation import check_shape
-from planner.bodies import BodyLinks, load_urdf_body, set_link_pose, world_link_pose
+from planner.acl import acl_key, compute_acl, sample_configurations
+from planner.bodies import BodyLinks, set_link_pose, world_link_pose
 from planner.builtins import is_builtin, robot_urdf
-from planner.collision import Clearance, CollisionChecker, acl_key, compute_acl, pair
-from planner.errors import UnknownFrameError, URDFError
-from planner.fixtures import Fixture
+from planner.collision import Clearance, CollisionChecker
+from planner.errors import UnknownFrameError
+from planner.fixtures import Fixture, fixture_from_spec
 from planner.kinematics.chain import KinematicChain
 from planner.kinematics.solver import IKSolver, make_ik_solver
+from planner.robot_body import load_robot_body
 from planner.tool import Tool, load_tool
 from planner.urdf import load_urdf
 from planner.workobject import WorkObject, load_work_object
@@ -112,68 +114,32 @@ class Cell:
     # ----------------------------------------------------------------- construction
     def _load_bodies(self, path: Path) -> None:
         c = self.client
-        self.robot = load_urdf_body(c, path, np.eye(4), "robot")
-        by_name = {
-            pb.getJointInfo(self.robot.body_id, j, physicsClientId=c)[1].decode(): j
-            for j in range(pb.getNumJoints(self.robot.body_id, physicsClientId=c))
-        }
-        missing = [n for n in self.chain.joint_names if n not in by_name]
-        if missing:
-            raise URDFError(f"robot URDF {path}: PyBullet did not load joints {missing}")
-        self._joint_index = [by_name[n] for n in self.chain.joint_names]
-        try:
-            base_idx = self.robot.index(self.chain.base_link)
-            self._flange_index = self.robot.index(self.chain.tip_link)
-        except KeyError as exc:
-            raise URDFError(f"robot URDF {path}: PyBullet has no link {exc}") from None
-        T_root_base = world_link_pose(c, self.robot, base_idx)
-        set_link_pose(c, self.robot, self._T_world_base @ invert_transform(T_root_base))
-        moving: set[int] = set()
-        self._parent: dict[int, int] = {}
-        for j in range(pb.getNumJoints(self.robot.body_id, physicsClientId=c)):
-            info = pb.getJointInfo(self.robot.body_id, j, physicsClientId=c)
-            self._parent[j] = info[16]
-            if info[2] != pb.JOINT_FIXED or info[16] in moving:
-                moving.add(j)
-        self._static_links = frozenset(set(self.robot.names) - moving)
+        self.robot_body = load_robot_body(c, path, self.chain, self._T_world_base)
+        self.robot: BodyLinks = self.robot_body.links
         self._names: dict[tuple[int, int], str] = {
             (self.robot.body_id, i): n for i, n in self.robot.names.items()
         }
         self.tool_body: BodyLinks | None = None
-        self._sensor_links: frozenset[int] = frozenset()
         if self.tool is not None:
             self.tool_body = self.tool.create_body(c)
             robot_names = set(self.robot.names.values())
             for i, n in self.tool_body.names.items():
                 self._names[(self.tool_body.body_id, i)] = f"tool:{n}" if n in robot_names else n
-            self._sensor_links = frozenset(
-                i for i, n in self.tool_body.names.items() if n in self.tool.sensor_links
-            )
         self.set_joint_positions(self.home_q)
 
     def _build_checker(
         self, path: Path, n: int, rng: np.random.Generator | None, use_cache: bool
     ) -> None:
         rng = rng if rng is not None else np.random.default_rng(0)
-        lo = np.where(np.isfinite(self.chain.lower), self.chain.lower, -np.pi)
-        hi = np.where(np.isfinite(self.chain.upper), self.chain.upper, np.pi)
-        samples = rng.uniform(lo, hi, size=(n, self.chain.n_joints))
-        adjacent = [pair(self.robot.names[i], self.robot.names[p]) for i, p in self._parent.items()]
+        samples = sample_configurations(self.chain.lower, self.chain.upper, n, rng)
         texts = [path.read_bytes()]
+        root, sensor_links = None, frozenset[int]()
         if self.tool_body is not None and self.tool is not None:
             root = self._names[(self.tool_body.body_id, -1)]
-            flange = self._flange_index
-            while flange >= 0:  # the tool root touches the flange and its rigid parents
-                adjacent.append(pair(root, self.robot.names[flange]))
-                info = pb.getJointInfo(self.robot.body_id, flange, physicsClientId=self.client)
-                if info[2] != pb.JOINT_FIXED:
-                    break
-                flange = self._parent[flange]
-            if self.tool.urdf_path is not None:
-                texts.append(self.tool.urdf_path.read_bytes())
-            elif self.tool.mesh is not None:
-                mesh = self.tool.mesh
-                texts.append(mesh.vertices.tobytes() + mesh.faces.tobytes())
+            sensor_links = frozenset(
+                i for i, name in self.tool_body.names.items() if name in self.tool.sensor_links
+            )
+            texts.append(self.tool.fingerprint())
         settings = f"{self.chain.base_link}>{self.chain.tip_link}:{n}:{self.self_margin_m:.6f}"
         with self.saved_state():
             acl = compute_acl(
@@ -183,7 +149,7 @@ class Cell:
                 self._name,
                 self.set_joint_positions,
                 samples,
-                adjacent,
+                self.robot_body.adjacent_pairs(root),
                 self.self_margin_m,
                 acl_key(texts, settings),
                 use_cache,
@@ -193,9 +159,9 @@ class Cell:
             self.robot,
             self.tool_body,
             self._name,
-            self._static_links,
+            self.robot_body.static_links,
             acl,
-            self._sensor_links,
+            sensor_links,
         )
 
     def _name(self, body: int, link: int) -> str:
@@ -263,12 +229,12 @@ class Cell:
     @property
     def joint_indices(self) -> list[int]:
         """PyBullet joint indices of the chain's joints, in chain order."""
-        return list(self._joint_index)
+        return list(self.robot_body.joint_index)
 
     @property
     def flange_index(self) -> int:
         """PyBullet link index of the flange (the chain's tip link) in ``self.robot``."""
-        return self._flange_index
+        return self.robot_body.flange_index
 
     @property
     def home_q(self) -> FloatArray:
@@ -281,7 +247,7 @@ class Cell:
         return np.array(
             [
                 pb.getJointState(self.robot.body_id, j, physicsClientId=self.client)[0]
-                for j in self._joint_index
+                for j in self.robot_body.joint_index
             ]
         )
 
@@ -292,11 +258,11 @@ class Cell:
             ShapeError, NonFiniteError: ``q`` is not a finite ``(n,)`` vector.
         """
         qa = check_shape(q, (self.chain.n_joints,), "q")
-        c, body = self.client, self.robot.body_id
-        for j, v in zip(self._joint_index, qa):
-            pb.resetJointState(body, j, float(v), physicsClientId=c)
+        c = self.client
+        self.robot_body.set_q(c, qa)
         if self.tool_body is not None:
-            set_link_pose(c, self.tool_body, world_link_pose(c, self.robot, self._flange_index))
+            flange = world_link_pose(c, self.robot, self.robot_body.flange_index)
+            set_link_pose(c, self.tool_body, flange)
 
     def link_poses(self) -> dict[str, FloatArray]:
         """``T_world_link (4, 4)`` of every robot and tool link in the current state."""
@@ -341,7 +307,7 @@ class Cell:
         self.checker.wobj_body = body.body_id
         self.checker.environment[body.body_id] = wobj.name
         self.work_object, self._T_world_wobj = wobj, T
-        self._log_static_contacts(body.body_id, wobj.name)
+        self.checker.log_static_contacts(body.body_id)
         return wobj
 
     def add_fixture(self, fixture: Fixture | str, **kwargs: Any) -> Fixture:
@@ -352,24 +318,13 @@ class Cell:
             ShapeError: bad sizes or pose, or a name already used; MeshError: bad mesh.
         """
         if isinstance(fixture, str):
-            T = kwargs.get("T_world_fixture")
-            if "mesh" in kwargs:
-                fixture = Fixture.from_mesh(fixture, kwargs["mesh"], T, kwargs.get("units", "auto"))
-            elif "radius_m" in kwargs and "height_m" in kwargs:
-                fixture = Fixture.cylinder(fixture, kwargs["radius_m"], kwargs["height_m"], T)
-            elif "size_m" in kwargs:
-                fixture = Fixture.box(fixture, kwargs["size_m"], T)
-            else:
-                raise ShapeError(
-                    f"fixture {fixture!r} needs size_m= (box), radius_m= and height_m= "
-                    f"(cylinder) or mesh=, got {sorted(kwargs)}"
-                )
+            fixture = fixture_from_spec(fixture, **kwargs)
         if fixture.name in self.fixtures:
             raise ShapeError(f"a fixture named {fixture.name!r} already exists")
         body = fixture.create_body(self.client)
         self.checker.environment[body.body_id] = fixture.name
         self.fixtures[fixture.name] = fixture
-        self._log_static_contacts(body.body_id, fixture.name)
+        self.checker.log_static_contacts(body.body_id)
         return fixture
 
     def remove_fixture(self, name: str) -> None:
@@ -388,18 +343,6 @@ class Cell:
         pb.removeBody(body, physicsClientId=self.client)
         del self.checker.environment[body]
         del self.fixtures[name]
-
-    def _log_static_contacts(self, body: int, name: str) -> None:
-        for i in self._static_links:
-            pts = pb.getClosestPoints(
-                self.robot.body_id, body, 0.0, linkIndexA=i, physicsClientId=self.client
-            )
-            if pts:
-                log.info(
-                    "robot %s touches %s: static contact, not checked",
-                    self._name(self.robot.body_id, i),
-                    name,
-                )
 
     # ----------------------------------------------------------------- queries
     def clearance(

@@ -11,6 +11,7 @@ list (:mod:`planner.acl`, re-exported here) are skipped.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -27,6 +28,8 @@ from planner.acl import (
     pair,
 )
 from planner.bodies import BodyLinks
+
+log = logging.getLogger(__name__)
 
 __all__ = [
     "ACL_VERSION",
@@ -95,6 +98,22 @@ class CollisionChecker:
     wobj_body: int | None = None
     _pairs: list[tuple[int, int]] | None = field(default=None, repr=False)
     _solid_tool: list[int] | None = field(default=None, repr=False)
+
+    def log_static_contacts(self, body: int) -> list[str]:
+        """Robot links no joint moves that touch ``body`` (logged; never checked, as a robot
+        standing on a table touches it in every pose)."""
+        touching = [
+            self.names(self.robot.body_id, i)
+            for i in sorted(self.static_links)
+            if pb.getClosestPoints(
+                self.robot.body_id, body, 0.0, linkIndexA=i, physicsClientId=self.client
+            )
+        ]
+        for name in touching:
+            log.info(
+                "robot %s touches %s: static contact, not checked", name, self.environment[body]
+            )
+        return touching
 
     def _tool_links(self) -> list[int]:
         """Tool links that have collision shapes (computed once)."""

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 import pybullet as pb
@@ -95,6 +95,26 @@ class Fixture:
                 raise ShapeError(f"fixture {self.name!r} is a mesh fixture without a mesh")
             shape = mesh_collision_shape(client, self.mesh, True, f"fixture {self.name!r}")
         return static_body(client, shape, self.T_world_fixture, self.name)
+
+
+def fixture_from_spec(name: str, **spec: Any) -> Fixture:
+    """A fixture from keywords: ``size_m=`` (box), ``radius_m=`` and ``height_m=`` (cylinder)
+    or ``mesh=`` (+ ``units=``), each with an optional ``T_world_fixture=``.
+
+    Raises:
+        ShapeError: none of those forms, or bad sizes or pose; MeshError: bad mesh.
+    """
+    T = spec.get("T_world_fixture")
+    if "mesh" in spec:
+        return Fixture.from_mesh(name, spec["mesh"], T, spec.get("units", "auto"))
+    if "radius_m" in spec and "height_m" in spec:
+        return Fixture.cylinder(name, spec["radius_m"], spec["height_m"], T)
+    if "size_m" in spec:
+        return Fixture.box(name, spec["size_m"], T)
+    raise ShapeError(
+        f"fixture {name!r} needs size_m= (box), radius_m= and height_m= (cylinder) or mesh=, "
+        f"got {sorted(spec)}"
+    )
 
 
 def table(

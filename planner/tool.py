@@ -151,6 +151,14 @@ class Tool:
             sensing_distance_m=float(sensing_distance_m),
         )
 
+    def fingerprint(self) -> bytes:
+        """Bytes that change when the tool's geometry changes (for cache keys)."""
+        if self.urdf_path is not None:
+            return self.urdf_path.read_bytes()
+        if self.mesh is None:
+            return b""
+        return self.mesh.vertices.tobytes() + self.mesh.faces.tobytes()
+
     def create_body(self, client: int) -> BodyLinks:
         """Load the tool into PyBullet client ``client`` at the world origin."""
         if self.urdf_path is not None:

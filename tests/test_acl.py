@@ -5,10 +5,11 @@ from __future__ import annotations
 from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import planner.acl as acl_module
-from planner.acl import AllowedCollisions, pair
+from planner.acl import AllowedCollisions, pair, sample_configurations
 from planner.cell import Cell
 
 REFERENCE = Path(__file__).resolve().parents[2] / "shared" / "reference"
@@ -65,3 +66,12 @@ def test_acl_cache_round_trip(tmp_path, monkeypatch) -> None:
     with Cell(acl_samples=160) as c:  # other settings: another key
         assert c.checker.acl.key != acl.key
     acl_module._MEMORY_CACHE.clear()
+
+
+def test_samples_stay_within_limits(rng) -> None:
+    lo, hi = np.array([-1.0, 0.0, -np.inf]), np.array([1.0, 0.5, np.inf])
+    q = sample_configurations(lo, hi, 5000, rng)
+    assert q.shape == (5000, 3)
+    assert np.all(q >= [-1.0, 0.0, -np.pi]) and np.all(q <= [1.0, 0.5, np.pi])
+    # uniform: the mean of each column sits mid-range
+    np.testing.assert_allclose(q.mean(axis=0), [0.0, 0.25, 0.0], atol=0.06)

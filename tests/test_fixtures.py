@@ -10,7 +10,7 @@ import trimesh
 from calib.errors import DegenerateGeometryError, ShapeError
 from calib.frames import make_transform, matrix_from_rotvec
 from planner.errors import MeshError
-from planner.fixtures import Fixture, table
+from planner.fixtures import Fixture, fixture_from_spec, table
 
 
 def _distance_to_point(fixture: Fixture, p: list[float]) -> float:
@@ -66,3 +66,13 @@ def test_bad_fixtures() -> None:
         Fixture.box("clamp", (0.1, 0.1, 0.1), np.diag([1.0, 1.0, -1.0, 1.0]))
     with pytest.raises(MeshError, match=r"nope\.stl"):
         Fixture.from_mesh("m", "nope.stl")
+
+
+def test_fixture_from_keywords() -> None:
+    T = make_transform(p=[0.0, 0.0, 1.0])
+    assert fixture_from_spec("a", size_m=(1, 2, 3), T_world_fixture=T).shape == "box"
+    assert fixture_from_spec("b", radius_m=0.1, height_m=0.2).size_m == (0.1, 0.2)
+    ring = trimesh.creation.annulus(r_min=0.1, r_max=0.2, height=0.05)
+    assert fixture_from_spec("c", mesh=ring, units="m").shape == "mesh"
+    with pytest.raises(ShapeError, match=r"'d' needs size_m"):
+        fixture_from_spec("d", radius_m=0.1)

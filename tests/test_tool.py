@@ -122,3 +122,10 @@ def test_tool_urdf_tcps_compose_fixed_joints(tmp_path) -> None:
     np.testing.assert_allclose(tool.T_flange_tcp("tip")[:3, 3], [0, 0.05, 0.1], atol=1e-12)
     with pytest.raises(URDFError, match=r"no link 'nib'"):
         Tool.from_urdf(urdf, tcps=["nib"])
+
+
+def test_fingerprint_changes_with_geometry(feeder: Tool) -> None:
+    assert feeder.fingerprint() == feeder.urdf_path.read_bytes()
+    a = Tool.from_mesh(trimesh.creation.box([0.1, 0.1, 0.1]), {})
+    b = Tool.from_mesh(trimesh.creation.box([0.1, 0.1, 0.2]), {})
+    assert a.fingerprint() != b.fingerprint()
