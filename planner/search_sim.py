@@ -140,15 +140,16 @@ class SimulatedProbe:
         T = self._T_wobj_base
         return p_base @ T[:3, :3].T + T[:3, 3]
 
-    def _signal(self, tcp_base: FloatArray, axis: FloatArray, coarse: bool = False) -> FloatArray:
-        """Signal at TCP positions ``(K, 3)`` (base) -> ``(K,)``; ``-1`` where the face collides."""
-        origins = self.sensor.ray_origins(tcp_base, axis, coarse=coarse)  # (K, n, 3)
-        k, n = origins.shape[:2]
-        o = self._to_part(origins.reshape(-1, 3))
-        d_part = np.broadcast_to(self._T_wobj_base[:3, :3] @ axis, (k * n, 3))
-        dist = self.caster.first_hits(o, d_part).reshape(k, n)
-        s = self.sensor.signal(dist)
-        return np.where(np.any(dist <= 0.0, axis=1), -1.0, s)
+    def _distances(self, tcp_base: FloatArray, axis: FloatArray, offsets: FloatArray) -> FloatArray:
+        """Face-to-metal distances ``(K, n)`` for TCP positions ``(K, 3)`` (base frame)."""
+        centres = tcp_base - self.sensor.sensing_distance_m * axis
+        origins = (centres[:, None, :] + offsets).reshape(-1, 3)
+        d_part = np.broadcast_to(self._T_wobj_base[:3, :3] @ axis, origins.shape)
+        return self.caster.first_hits(self._to_part(origins), d_part).reshape(len(tcp_base), -1)
+
+    def _signal_of(self, dist: FloatArray) -> FloatArray:
+        """Signal ``(K,)`` from distances ``(K, n)``; ``-1`` where the face is inside the part."""
+        return np.where(np.any(dist <= 0.0, axis=1), -1.0, self.sensor.signal(dist))
 
     def _fail(self, cmd: SearchCommand, reason: str) -> ProbeResult:
         self.events.append(ProbeEvent(cmd.point_id, cmd.kind, reason=reason))
@@ -216,16 +217,30 @@ class SimulatedProbe:
         def event(sig: FloatArray) -> NDArray[np.bool_]:
             return (sig >= on) if want_on else (sig < off)
 
-        s0 = self._signal(tcp0[None], axis)[0]
+        fine_off = self.sensor.face_offsets_m(axis)
+        coarse_off = self.sensor.face_offsets_m(axis, coarse=True)
+        n_fine = len(fine_off)
+        n_steps = max(1, math.ceil(length / self.scan_step_m))
+        s_grid = np.linspace(0.0, length, n_steps + 1)
+        tcps = tcp0 + s_grid[:, None] * direction
+        # one cast: the full bundle at the start and the coarse bundle along the path
+        centres = tcps - self.sensor.sensing_distance_m * axis
+        origins = np.concatenate(
+            [
+                (centres[:1, None, :] + fine_off)[0],
+                (centres[:, None, :] + coarse_off).reshape(-1, 3),
+            ]
+        )
+        d_part = np.broadcast_to(self._T_wobj_base[:3, :3] @ axis, origins.shape)
+        dist = self.caster.first_hits(self._to_part(origins), d_part)
+        s0 = float(self._signal_of(dist[None, :n_fine])[0])
+        coarse = self._signal_of(dist[n_fine:].reshape(len(s_grid), -1))
         if s0 < 0:
             return self._fail(cmd, "sensor face inside the part at start")
         if want_on and s0 >= on:
             return self._fail(cmd, "sensor already detecting at start")
         if not want_on and s0 < on:
             return self._fail(cmd, "sensor not detecting at start of edge search")
-        n_steps = max(1, math.ceil(length / self.scan_step_m))
-        s_grid = np.linspace(0.0, length, n_steps + 1)
-        coarse = self._signal(tcp0 + s_grid[:, None] * direction, axis, coarse=True)
         if np.any(coarse < 0):
             first_hit = int(np.argmax(coarse < 0))
             if not np.any(event(coarse[1:first_hit])):
@@ -233,26 +248,52 @@ class SimulatedProbe:
         hits = np.flatnonzero(event(coarse[1:]) & (coarse[1:] >= 0)) + 1
         k = int(hits[0]) if len(hits) else n_steps
 
+        def full(travels: list[float]) -> FloatArray:
+            return self._distances(tcp0 + np.asarray(travels)[:, None] * direction, axis, fine_off)
+
+        # the bracket [s_grid[k-1], s_grid[k]] with the full bundle (step back or on if needed)
+        d_lo, d_hi = full([float(s_grid[k - 1]), float(s_grid[k])])
+        while k > 1 and event(self._signal_of(d_lo[None]))[0]:
+            k -= 1
+            d_hi, d_lo = d_lo, full([float(s_grid[k - 1])])[0]
+        while k <= n_steps and not event(self._signal_of(d_hi[None]))[0]:
+            k += 1
+            if k > n_steps:
+                what = "detection" if want_on else "edge (sensor still detecting)"
+                return self._fail(cmd, f"no {what} within {length * 1e3:.0f} mm")
+            d_lo, d_hi = d_hi, full([float(s_grid[k])])[0]
+        lo0, hi0 = float(s_grid[k - 1]), float(s_grid[k])
+        # rays that see the same surface at both ends keep seeing it in between (the bracket is
+        # shorter than any hole): interpolate them, cast only the rays that change
+        finite = np.isfinite(d_lo) & np.isfinite(d_hi)
+        jump = np.zeros_like(d_lo)
+        np.subtract(d_lo, d_hi, out=jump, where=finite)
+        changing = np.flatnonzero(
+            (np.isinf(d_lo) != np.isinf(d_hi))
+            | (np.abs(jump) > 1e-4)
+            | (d_lo <= 0.0)
+            | (d_hi <= 0.0)
+        )
+        steady_lo, steady_hi = d_lo.copy(), d_hi.copy()
+        both_inf = np.isinf(d_lo) & np.isinf(d_hi)
+        steady_lo[both_inf] = steady_hi[both_inf] = 0.0
+        sub_off = fine_off[changing]
+
         def fine(s: float) -> float:
-            return float(self._signal((tcp0 + s * direction)[None], axis)[0])
+            f = (s - lo0) / (hi0 - lo0)
+            d = steady_lo + f * (steady_hi - steady_lo)
+            d[both_inf] = np.inf
+            if len(changing):
+                d[changing] = self._distances((tcp0 + s * direction)[None], axis, sub_off)[0]
+            return float(self._signal_of(d[None])[0])
 
         def margin(sig: float) -> float:  # log distance from the switching level, < 0 = event
             log_s = math.log(max(sig, 1e-300))
             return math.log(on) - log_s if want_on else log_s - math.log(off)
 
-        s_lo = fine(s_grid[k - 1]) if k > 1 else s0
-        while k > 1 and event(np.array([s_lo]))[0]:
-            k -= 1
-            s_lo = fine(s_grid[k - 1]) if k > 1 else s0
-        s_hi = fine(s_grid[k]) if k <= n_steps else 0.0
-        while k <= n_steps and not event(np.array([s_hi]))[0]:
-            k += 1
-            s_lo = s_hi
-            s_hi = fine(s_grid[k]) if k <= n_steps else 0.0
-        if k > n_steps:
-            what = "detection" if want_on else "edge (sensor still detecting)"
-            return self._fail(cmd, f"no {what} within {length * 1e3:.0f} mm")
-        lo, hi = float(s_grid[k - 1]), float(s_grid[k])
+        lo, hi = lo0, hi0
+        s_lo = float(self._signal_of(d_lo[None])[0])
+        s_hi = float(self._signal_of(d_hi[None])[0])
         g_lo, g_hi = margin(s_lo), margin(s_hi)
         it = 0
         while hi - lo > self.edge_tolerance_m:
