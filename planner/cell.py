@@ -42,7 +42,8 @@ from planner.workobject import WorkObject, load_work_object
 
 if TYPE_CHECKING:
     from calib.probing import SearchCommand
-    from planner.feasibility import ProbeFeasibility, ReachModel
+    from planner.feasibility import ProbeFeasibility
+    from planner.reach import ReachModel
     from planner.reachability_map import ReachabilityMap
     from planner.search_paths import PathFeasibility
 
@@ -221,7 +222,7 @@ class Cell:
     def reach_model(self) -> ReachModel:
         """Shoulder and reach of the robot (computed once, seeded)."""
         if self._reach is None:
-            from planner.feasibility import reach_model
+            from planner.reach import reach_model
 
             self._reach = reach_model(self.chain, np.random.default_rng(0))
         return self._reach

@@ -27,11 +27,11 @@ from calib.frames import invert_transform
 from calib.validation import check_positive, check_shape, check_vector3
 from planner.feasibility import (
     MARGINAL_LIMIT_RAD,
-    _no_ik_reason,
     limit_margin,
     singular,
     tcp_frames,
 )
+from planner.reach import no_ik_reason
 
 if TYPE_CHECKING:
     from calib.probing import SearchCommand
@@ -126,7 +126,7 @@ def check_search(
     empty = np.zeros((0, cell.chain.n_joints))
     if not ok0.any():
         reason = (
-            _no_ik_reason(cell, T_start @ T_tcp_flange)
+            no_ik_reason(cell, T_start @ T_tcp_flange)
             if not starts.valid.any()
             else ("singular at the start")
         )
@@ -183,7 +183,7 @@ def _walk(
         if not ok.any():
             fail_j = j
             why = (
-                _no_ik_reason(cell, T_flange[j : j + 1])
+                no_ik_reason(cell, T_flange[j : j + 1])
                 if not sol.valid[j].any()
                 else (f"leaves IK branch {branch}")
             )

@@ -1,0 +1,54 @@
+"""Tests of planner.reach: the reach model and the no-IK reasons, against the arm's geometry."""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+import pytest
+
+from calib.frames import make_transform
+from planner.builtins import robot_urdf
+from planner.kinematics.chain import KinematicChain
+from planner.kinematics.solver import make_ik_solver
+from planner.reach import opw_wrist_reason, reach_model
+
+# IRB 4400 figures (assets/robots/irb4400/README.md)
+A1, C1, C2, C3, A2, C4 = 0.200, 0.680, 0.890, 0.880, 0.150, 0.140
+
+
+@pytest.fixture(scope="module")
+def chain() -> KinematicChain:
+    return KinematicChain.from_urdf(robot_urdf("builtin:irb4400"))
+
+
+def test_reach_of_the_builtin_arm(chain: KinematicChain, rng) -> None:
+    model = reach_model(chain, rng)
+    np.testing.assert_allclose(model.shoulder_m, [A1, 0.0, C1], atol=1e-9)
+    np.testing.assert_allclose(model.axis, [0.0, 0.0, 1.0], atol=1e-12)
+    # flange fully stretched: upper arm + |(forearm + flange, offset)|, sampled just below it
+    stretched = C2 + math.hypot(C3 + C4, A2)
+    assert stretched - 0.05 < model.reach_m <= stretched + 1e-9
+
+
+def test_shoulder_turns_towards_the_target(chain: KinematicChain, rng) -> None:
+    model = reach_model(chain, rng)
+    p = np.array([[-2.0, 0.0, 0.3], [0.0, 3.0, 1.0]])
+    np.testing.assert_allclose(
+        model.shoulder_towards(p), [[-A1, 0.0, C1], [0.0, A1, C1]], atol=1e-12
+    )
+
+
+def test_wrist_centre_reasons(chain: KinematicChain) -> None:
+    opw = make_ik_solver(chain).opw
+    k = math.hypot(C3, A2)
+    far = make_transform(p=[3.0, 0.0, C1])  # flange z along base z: wrist centre 0.14 m lower
+    pattern = r"out of reach \(wrist centre (\d\.\d\d) m from the shoulder, reach (\d\.\d\d) m\)"
+    m = re.fullmatch(pattern, opw_wrist_reason(opw, far[None]))
+    assert m is not None
+    assert float(m.group(1)) == pytest.approx(math.hypot(3.0 - A1, C4), abs=0.006)
+    assert float(m.group(2)) == pytest.approx(C2 + k, abs=0.006)
+    # close in front of the shoulder, inside the arm's dead zone |c2 - k|
+    near = make_transform(p=[A1, 0.0, C1 + C4])
+    assert opw_wrist_reason(opw, near[None]).startswith("too close (wrist centre 0.00 m")
