@@ -181,7 +181,7 @@ def load_tool(spec: str | Path | Tool) -> Tool:
     """
     if isinstance(spec, Tool):
         return spec
-    path = tool_description(spec) if is_builtin(spec) else Path(spec)
+    path = tool_description(str(spec)) if is_builtin(spec) else Path(spec)
     if path.suffix.lower() == ".urdf":
         return Tool.from_urdf(path)
     if not path.is_file():
