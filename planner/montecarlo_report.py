@@ -11,7 +11,8 @@ Errors follow section 4 of Hultman & Leijon (2013):
 The paper took the mean of repeated calibrations as the truth, so its intervals measure the
 scatter about the mean; the simulation knows the truth, so the table gives the same
 scatter-based intervals (``+- z * sigma`` about the mean, ``z`` from the confidence level) and
-the bias (mean error) in its own column.
+the bias (mean error) in its own column. Intervals and the signed yz-plane error come from
+:mod:`calib.stats`.
 """
 
 from __future__ import annotations
@@ -20,9 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.stats import norm
 
 from calib.frames import small_motion
+from calib.stats import confidence_intervals, signed_radial_error
 from planner.stator import StatorGeometry
 
 FloatArray = NDArray[np.float64]
@@ -162,11 +163,6 @@ def _point_errors(delta: FloatArray, p_wobj: FloatArray) -> FloatArray:
     return np.einsum("nij,mj->nmi", T[:, :3, :3], p_wobj) + T[:, None, :3, 3] - p_wobj
 
 
-def _signed_yz(e: FloatArray) -> FloatArray:
-    """Signed yz-plane length of error vectors ``(..., 3)`` (sign of the x component)."""
-    return np.where(e[..., 0] < 0, -1.0, 1.0) * np.hypot(e[..., 1], e[..., 2])
-
-
 def _samples(delta: FloatArray, geometry: StatorGeometry) -> tuple[dict, dict]:
     """Centred samples and biases (SI) per row key from frame errors ``(n, 6)``."""
     keys = ("origin_x", "origin_y", "origin_z", "rot_x", "rot_y", "rot_z")
@@ -180,7 +176,7 @@ def _samples(delta: FloatArray, geometry: StatorGeometry) -> tuple[dict, dict]:
     for key, p in pts.items():
         e = _point_errors(delta, p)
         mean = e.mean(axis=0)
-        out[key] = _signed_yz(e - mean).ravel()
+        out[key] = signed_radial_error(e - mean, "yz").ravel()
         bias[key] = float(np.mean(np.hypot(mean[:, 1], mean[:, 2])))
     return out, bias
 
@@ -206,18 +202,28 @@ def build_report(
     rows = []
     for key, label, unit, levels in TABLE1_ROWS:
         scale = _SCALE[unit]
-        sd_p = float(np.std(sp[key], ddof=1)) if len(sp[key]) > 1 else float("nan")
-        sd_f = float(np.std(sf[key], ddof=1)) if len(sf[key]) > 1 else float("nan")
-        for level in levels:
-            z = float(norm.ppf(0.5 + level / 200.0))
+        fractions = [lv / 100.0 for lv in levels]
+        si = "rad" if unit == "deg" else "m"
+        nan = [float("nan")] * len(levels)
+        hw_p = (
+            [r.half_width for r in confidence_intervals(sp[key], label, si, fractions).rows]
+            if len(sp[key]) > 1
+            else nan
+        )
+        hw_f = (
+            [r.half_width for r in confidence_intervals(sf[key], label, si, fractions).rows]
+            if len(sf[key]) > 1
+            else nan
+        )
+        for level, h_p, h_f in zip(levels, hw_p, hw_f, strict=True):
             rows.append(
                 IntervalRow(
                     key=key,
                     label=label,
                     unit=unit,
                     level_percent=level,
-                    procedure=z * sd_p * scale,
-                    best_fit=z * sd_f * scale,
+                    procedure=h_p * scale,
+                    best_fit=h_f * scale,
                     procedure_bias=bp[key] * scale,
                     best_fit_bias=bf[key] * scale,
                     paper=PAPER_TABLE1.get((key, level), float("nan")),
