@@ -36,6 +36,9 @@ Status = Literal["feasible", "marginal", "infeasible"]
 WRIST_SINGULAR_RAD = math.radians(5.0)
 #: Other arms: smallest singular value of the Jacobian (translation rows / reach) below this.
 MIN_SINGULAR_VALUE = 0.05
+#: Clearances closer than this are a tie (Bullet's GJK answers vary by micrometres with the
+#: scene's pose); among ties the earlier candidate (less joint motion) wins, m.
+CLEARANCE_TIE_M = 1e-4
 #: A joint closer than this to a limit makes a feasible pose marginal, rad.
 MARGINAL_LIMIT_RAD = math.radians(5.0)
 
@@ -188,7 +191,7 @@ def check_probes(
             for c in order:
                 cell.set_joint_positions(q_all[i, c])
                 cl = cell.clearance(margin, sensor_wobj_allowed=True)
-                if best is None or cl.slack_m > best[0].slack_m:
+                if best is None or cl.slack_m > best[0].slack_m + CLEARANCE_TIE_M:
                     best = (cl, c)
                 if cl.ok and cl.slack_m >= margin and margin_all[i, c] >= MARGINAL_LIMIT_RAD:
                     chosen = (cl, c)

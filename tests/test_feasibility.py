@@ -11,7 +11,7 @@ import pytest
 import trimesh
 
 from calib.errors import DegenerateGeometryError, NonFiniteError, ShapeError
-from calib.frames import make_transform
+from calib.frames import make_transform, matrix_from_rotvec
 from planner.cell import Cell
 from planner.errors import UnknownFrameError
 from planner.feasibility import tcp_frames
@@ -174,3 +174,25 @@ def test_vendor_robots_answer_through_numeric_ik(which, reference_dir) -> None:
     T = c.chain.fk(near.q)[0] @ c.T_flange_tcp("sensor")
     np.testing.assert_allclose(T[:3, 3], [0.5, 0, 0.2], atol=1e-5)
     assert not far.feasible and far.reason.startswith("out of reach")
+
+
+def test_answers_do_not_depend_on_where_the_cell_stands(cell: Cell) -> None:
+    """Moving base, work object and fixtures together by one world transform changes nothing."""
+    T = make_transform(matrix_from_rotvec([0.2, -0.1, 1.0]), [3.0, -2.0, 0.5])
+    pts = np.array([[0.0, 0.0, BOX / 2], [-BOX / 2, 0.1, 0.0], [0.0, 0.0, -BOX / 2]])
+    nrm = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
+    T_post = make_transform(p=[1.4 + 0.026, 0.0, 0.6075])
+    cell.add_fixture("post", radius_m=0.010, height_m=0.015, T_world_fixture=T_post)
+    try:
+        here = cell.check_probes(pts, nrm)
+    finally:
+        cell.remove_fixture("post")
+    with Cell(T_world_base=T, use_acl_cache=False) as moved:
+        moved.set_work_object(trimesh.creation.box([BOX] * 3), "m", T @ T_WORLD_WOBJ, name="box")
+        moved.add_fixture("post", radius_m=0.010, height_m=0.015, T_world_fixture=T @ T_post)
+        there = moved.check_probes(pts, nrm)
+    assert [r.status for r in here] == ["marginal", "feasible", "infeasible"]
+    for a, b in zip(here, there):
+        assert (a.status, a.reason) == (b.status, b.reason)
+        np.testing.assert_equal(a.rotation_rad, b.rotation_rad)  # NaN == NaN here
+        np.testing.assert_allclose(a.clearance_m, b.clearance_m, atol=1e-4)
