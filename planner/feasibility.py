@@ -136,6 +136,10 @@ def check_probes(
         q_ref: ``(n,)`` reference configuration for "least joint motion" (default home).
         max_checks: largest number of candidates collision-checked per point.
 
+    Returns:
+        One :class:`ProbeFeasibility` per point, in the order given. The cell's joint state is
+        restored afterwards.
+
     Raises:
         ShapeError, NonFiniteError: bad shapes or NaN/inf in points or normals.
         DegenerateGeometryError: a zero normal.

@@ -92,6 +92,10 @@ def check_search(
         q_ref: ``(n,)`` reference configuration for the start choice (default home).
         max_starts: start candidates (rotation, branch) tried before giving up.
 
+    Returns:
+        The first start candidate whose whole path passes, else the one that got farthest.
+        The cell's joint state is restored afterwards.
+
     Raises:
         ShapeError, NonFiniteError: bad vectors in the command; DegenerateGeometryError:
         zero direction or sensor axis; UnknownFrameError: unknown TCP.
