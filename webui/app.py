@@ -97,7 +97,7 @@ class WobjcalApp:
             self.robot.remove()
             self.robot = None
         if view.robot_urdf is not None:
-            self.robot = RobotView(self.server, view.robot_urdf, view.T_world_base)
+            self.robot = RobotView(self.server, view)
         self.recheck(self.state.doc.ids)
 
     # ---- checks ---------------------------------------------------------------------------

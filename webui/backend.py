@@ -8,6 +8,7 @@ status ``unknown`` with that message. Nothing is ever faked.
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import logging
 import time
@@ -17,7 +18,7 @@ from typing import Any
 
 import numpy as np
 import trimesh
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from calib.frames import invert_transform
 from calib.plan import Plan, resolve_ref
@@ -52,6 +53,9 @@ class CellView:
         wobj_mesh: the work object in its own (wobj) frame, metres.
         T_world_wobj: ``(4, 4)`` nominal work-object frame in the world frame.
         fixtures: ``{name: (mesh, T_world_fixture)}`` fixed obstacles.
+        tool_urdf: the tool URDF (root = flange frame), or ``None``.
+        tool_mesh: the tool mesh in the flange frame (mesh tools), or ``None``.
+        chain: the robot's kinematic chain (pure numpy ``fk``), or ``None`` without a cell.
     """
 
     robot_urdf: Path | None
@@ -59,6 +63,16 @@ class CellView:
     wobj_mesh: trimesh.Trimesh
     T_world_wobj: NDArray[np.float64]
     fixtures: dict[str, tuple[trimesh.Trimesh, NDArray[np.float64]]] = field(default_factory=dict)
+    tool_urdf: Path | None = None
+    tool_mesh: trimesh.Trimesh | None = None
+    chain: Any = None
+
+    def T_world_flange(self, q: ArrayLike) -> NDArray[np.float64] | None:
+        """``(4, 4)`` flange pose in the world at joint values ``q`` (``None``: no chain)."""
+        if self.chain is None:
+            return None
+        q_arr = np.asarray(q, dtype=np.float64).reshape(1, -1)
+        return self.T_world_base @ np.asarray(self.chain.fk(q_arr), dtype=np.float64)[0]
 
     @property
     def T_base_wobj(self) -> NDArray[np.float64]:
@@ -80,39 +94,26 @@ def resolve_robot_urdf(ref: str, plan_dir: Path) -> Path | None:
         return candidate if candidate.is_file() else None
 
 
-_UNIT_SCALE = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254}
+#: Plan mesh units -> ``planner.workobject`` units.
+_WOBJ_UNITS = {"m": "m", "mm": "mm", "in": "inch", "auto": "auto"}
 
 
 def load_mesh(ref: str, units: str, plan_dir: Path) -> trimesh.Trimesh:
-    """A work-object or fixture mesh in metres (through ``planner.workobject`` when present).
+    """A work-object or fixture mesh in metres, loaded and repaired by ``planner.workobject``.
 
     Raises:
         MeshError: the file is missing, unreadable or empty, or its units are unknown.
-        NotAvailableError: a ``builtin:`` mesh whose module is not available.
+        NotAvailableError: ``planner.workobject`` is not available.
     """
+    workobject = optional_import("planner.workobject", "work-object mesh loading")
+    if units not in _WOBJ_UNITS:
+        raise MeshError(f"mesh units {units!r} are not supported; use {', '.join(_WOBJ_UNITS)}")
     resolved = resolve_ref(ref, plan_dir)
-    try:
-        workobject = importlib.import_module("planner.workobject")
-    except ImportError:
-        workobject = None
-    if workobject is not None and hasattr(workobject, "load_work_object"):
-        loaded = workobject.load_work_object(resolved, units=units)
-        return getattr(loaded, "mesh", loaded)
-    if isinstance(resolved, str):
-        raise NotAvailableError(f"built-in mesh {ref!r} needs planner.workobject (not available)")
-    # minimal loader until planner.workobject exists: explicit units only
-    if units not in _UNIT_SCALE:
-        raise MeshError(f"{resolved}: units {units!r} need planner.workobject; use m, cm, mm, in")
-    if not resolved.is_file():
-        raise MeshError(f"mesh file not found: {resolved}")
-    try:
-        mesh = trimesh.load(resolved, force="mesh")
-    except Exception as exc:
-        raise MeshError(f"{resolved}: cannot read the mesh ({exc})") from None
-    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-        raise MeshError(f"{resolved}: the file holds no triangles")
-    mesh.apply_scale(_UNIT_SCALE[units])
-    return mesh
+    if isinstance(resolved, str):  # built-in meshes are registered by the modules making them
+        register = optional_import("planner.stator", resolved).register_stator_builtins
+        register()
+    loaded = workobject.load_work_object(resolved, units=_WOBJ_UNITS[units])
+    return loaded.mesh
 
 
 class CellSession:
@@ -131,6 +132,7 @@ class CellSession:
             T_world_base=plan.cell.robot.T_world_base.matrix(),
             wobj_mesh=load_mesh(plan.work_object.mesh, plan.work_object.units, self.plan_dir),
             T_world_wobj=plan.work_object.T_world_wobj.matrix(),
+            fixtures=self._fixture_meshes(),
         )
         self.cell: Any = None
         self.cell_error = ""
@@ -139,13 +141,31 @@ class CellSession:
         except NotAvailableError as exc:
             self.cell_error = str(exc)
             logger.warning("%s", exc)
+        else:
+            tool = getattr(self.cell, "tool", None)
+            self.view = dataclasses.replace(
+                self.view,
+                tool_urdf=getattr(tool, "urdf_path", None),
+                tool_mesh=getattr(tool, "mesh", None),
+                chain=getattr(self.cell, "chain", None),
+            )
+
+    def _fixture_meshes(self) -> dict[str, tuple[trimesh.Trimesh, NDArray[np.float64]]]:
+        out = {}
+        for f in self.plan.cell.fixtures:
+            if f.box_size_m is not None:
+                mesh = trimesh.creation.box(extents=f.box_size_m)
+            else:
+                mesh = load_mesh(f.mesh or "", f.units, self.plan_dir)
+            out[f.name] = (mesh, f.T_world_fixture.matrix())
+        return out
 
     def _build_cell(self) -> Any:
-        cell_mod = optional_import("planner.cell", "the cell (feasibility checks)")
-        plan = self.plan
-        cell = cell_mod.Cell(robot=plan.cell.robot.urdf, tool=plan.cell.tool.name)
-        cell.set_work_object(self.view.wobj_mesh, units="m", T_world_wobj=self.view.T_world_wobj)
-        return cell
+        plan_io = optional_import("planner.plan_io", "the cell (feasibility checks)")
+        try:
+            return plan_io.open_cell(self.plan, self.plan_dir)
+        except (plan_io.FeatureUnavailableError, ImportError) as exc:
+            raise NotAvailableError(f"feasibility checks are not available yet: {exc}") from None
 
     def check_points(self, points: list[ProbePoint]) -> list[PointCheck]:
         """Check the probe poses and search paths of ``points`` (wobj frame) in the cell."""
@@ -157,11 +177,12 @@ class CellSession:
         t0 = time.perf_counter()
         P = np.array([p.position_m for p in points], dtype=np.float64)
         N = np.array([p.normal for p in points], dtype=np.float64)
-        results = self.cell.check_probes(P, N, tcp=self.plan.cell.tool.tcp)
-        out = []
-        for point, res in zip(points, results, strict=True):
-            out.append(self._combine(point, res, t0))
-        return out
+        try:
+            results = self.cell.check_probes(P, N, tcp=self.plan.cell.tool.tcp)
+            return [self._combine(p, r, t0) for p, r in zip(points, results, strict=True)]
+        except ImportError as exc:  # a part of planner the cell needs is missing
+            msg = f"feasibility checks are not available yet ({exc})"
+            return [PointCheck(p.id, "unknown", msg) for p in points]
 
     def _combine(self, point: ProbePoint, res: Any, t0: float) -> PointCheck:
         status, reason = str(res.status), str(res.reason or "")
@@ -173,9 +194,7 @@ class CellSession:
             q_path = None if path.q_path is None else np.asarray(path.q_path, dtype=np.float64)
             if not path.feasible:
                 status = "infeasible"
-                at = getattr(path, "fail_at_m", float("nan"))
-                where = f" at {at * 1000:.0f} mm" if at is not None and np.isfinite(at) else ""
-                reason = f"search path{where}: {path.reason}"
+                reason = f"search path: {path.reason}"
         return PointCheck(
             point_id=point.id,
             status=status,  # type: ignore[arg-type]

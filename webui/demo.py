@@ -16,7 +16,7 @@ logger = logging.getLogger(__name__)
 #: Names ``planner.demo_cell`` may give the function returning the demo plan.
 _DEMO_FUNCTIONS = ("demo_plan", "make_demo_plan", "stator_demo_plan")
 #: Bundled plan files tried when ``planner.demo_cell`` offers no plan function.
-_DEMO_FILES = ("stator_demo.json", "stator_ah.json", "demo.json")
+_DEMO_FILES = ("stator_section_ah.json",)
 
 
 def demo_plan() -> tuple[Plan, Path]:

@@ -1,36 +1,42 @@
-"""Between the files panel and ``planner.export``: robot programs of the session plan."""
+"""Between the files panel and ``planner.export``: robot programs of the session plan.
+
+The job is built exactly as ``wobjcal export`` builds it (``planner.cli_check.export_job_for``:
+orientations and configurations from the cell check when it can run), then formatted by
+``planner.export.export_files``. Call :func:`export_program` on the cell worker: the check opens
+a PyBullet client.
+"""
 
 from __future__ import annotations
 
 import importlib
-import inspect
+import logging
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 from calib.plan import Plan
-from webui.backend import NotAvailableError
+from webui.backend import NotAvailableError, optional_import
 
-#: UI name -> (exporter module, file suffix).
-FORMATS: dict[str, tuple[str, str]] = {
-    "RAPID": ("planner.export.rapid", ".mod"),
-    "KRL": ("planner.export.krl", ".src"),
-    "URScript": ("planner.export.urscript", ".script"),
-}
+logger = logging.getLogger(__name__)
+
+#: UI name -> ``planner.export`` format name.
+FORMATS: dict[str, str] = {"RAPID": "rapid", "KRL": "krl", "URScript": "urscript"}
 
 
-def _call_exporter(mod: Any, plan: Plan, plan_dir: Path) -> Any:
-    for name in ("export_plan", "export", "render_plan", "render"):
-        fn = getattr(mod, name, None)
-        if not callable(fn):
-            continue
-        params = inspect.signature(fn).parameters
-        kwargs = {"plan_dir": plan_dir} if "plan_dir" in params else {}
-        return fn(plan, **kwargs)
-    raise NotAvailableError(f"{mod.__name__} has no export function yet")
+@dataclass(frozen=True)
+class ExportResult:
+    """The files of one export.
+
+    Attributes:
+        files: ``(file name, content)`` pairs (KRL writes a ``.src`` and a ``.dat``).
+        note: what the user should know (e.g. points not feasible, estimated tool mass).
+    """
+
+    files: tuple[tuple[str, bytes], ...]
+    note: str = ""
 
 
-def export_program(plan: Plan, fmt: str, plan_dir: Path) -> tuple[str, bytes]:
-    """The robot program of ``plan`` in ``fmt`` (a key of :data:`FORMATS`): file name and bytes.
+def export_program(plan: Plan, fmt: str, plan_dir: Path) -> ExportResult:
+    """The robot program(s) of ``plan`` in ``fmt`` (a key of :data:`FORMATS`).
 
     Raises:
         NotAvailableError: the exporter is not available.
@@ -38,13 +44,15 @@ def export_program(plan: Plan, fmt: str, plan_dir: Path) -> tuple[str, bytes]:
     """
     if fmt not in FORMATS:
         raise NotAvailableError(f"unknown export format {fmt!r}; known: {', '.join(FORMATS)}")
-    module, suffix = FORMATS[fmt]
+    cli_check = optional_import("planner.cli_check", f"{fmt} export")
+    export = optional_import("planner.export", f"{fmt} export")
+    plan_io = importlib.import_module("planner.plan_io")
     try:
-        mod = importlib.import_module(module)
-    except ImportError as exc:
-        raise NotAvailableError(f"{fmt} export is not available yet ({module}: {exc})") from None
-    out = _call_exporter(mod, plan, plan_dir)
-    text = getattr(out, "text", out)
-    name = getattr(out, "filename", None) or f"{plan.name or 'wobjcal_plan'}{suffix}"
-    data = text if isinstance(text, bytes) else str(text).encode("utf-8")
-    return str(name), data
+        job, note = cli_check.export_job_for(plan, plan_dir, run_check=True)
+    except (ImportError, plan_io.FeatureUnavailableError) as exc:
+        logger.info("export without the check: %s", exc)
+        job, note = cli_check.export_job_for(plan, plan_dir, run_check=False)
+    files = export.export_files(job, FORMATS[fmt])
+    stem = job.name or plan.name or "wobjcal_plan"
+    out = tuple((f"{stem}{suffix}", text.encode("utf-8")) for suffix, text in files.items())
+    return ExportResult(out, note)

@@ -17,7 +17,7 @@ import msgspec
 from calib.errors import InputError
 from calib.plan import Plan, PlanError
 from webui.backend import NotAvailableError
-from webui.exports import FORMATS, export_program
+from webui.exports import FORMATS, ExportResult, export_program
 from webui.plan_adapter import plan_from_ui, plan_json_from_ui, ui_plan_from_bytes, with_source
 from webui.state import atomic_write_bytes
 
@@ -61,7 +61,7 @@ class FilesPanel:
         self._app = app
         self.upload_dir = upload_dir
         gui = app.server.gui
-        with gui.add_folder("Files", expand_by_default=False):
+        with gui.add_folder("Files", expand_by_default=True):
             self.plan_upload = gui.add_upload_button("Upload plan (.json)", mime_type=".json")
             self.units = gui.add_dropdown(
                 "Mesh units", ("mm", "m", "cm", "in", "auto"), initial_value="mm"
@@ -149,8 +149,17 @@ class FilesPanel:
         name, data = self.plan_bytes()
         client.send_file_download(name, data, save_immediately=True)
 
-    def download_export(self, client: Any, fmt: str) -> None:
-        """Send the session plan as a robot program in ``fmt`` to ``client``."""
+    def export(self, fmt: str) -> ExportResult:
+        """The session plan as robot program(s) in ``fmt``, made on the cell worker."""
         plan = plan_from_ui(self._app.state.doc)
-        name, data = export_program(plan, fmt, self._app.plan_dir)
-        client.send_file_download(name, data, save_immediately=True)
+        plan_dir = self._app.plan_dir
+        return self._app.worker.call(lambda _s: export_program(plan, fmt, plan_dir))
+
+    def download_export(self, client: Any, fmt: str) -> str:
+        """Send the session plan as robot program(s) in ``fmt`` to ``client``."""
+        result = self.export(fmt)
+        for name, data in result.files:
+            client.send_file_download(name, data, save_immediately=True)
+        if result.note:
+            self._app.notify(f"{fmt} exported with a note", result.note, client=client)
+        return ""

@@ -12,6 +12,7 @@ import viser
 from numpy.typing import ArrayLike
 from viser.extras import ViserUrdf
 
+from webui.backend import CellView
 from webui.scene import pose_kwargs
 
 logger = logging.getLogger(__name__)
@@ -22,15 +23,35 @@ class RobotView:
 
     Args:
         server: the viser server.
-        urdf_path: the robot URDF; its visual geometry is drawn.
-        T_world_base: ``(4, 4)`` robot base in the world frame.
+        view: the cell geometry: robot URDF and base pose, tool, kinematic chain.
     """
 
-    def __init__(self, server: viser.ViserServer, urdf_path: Path, T_world_base: ArrayLike) -> None:
+    def __init__(self, server: viser.ViserServer, view: CellView) -> None:
         self._server = server
-        server.scene.add_frame("/robot", show_axes=False, **pose_kwargs(T_world_base))
-        self._urdf = ViserUrdf(server, Path(urdf_path), root_node_name="/robot/urdf")
-        self.joint_names: tuple[str, ...] = tuple(self._urdf.get_actuated_joint_names())
+        self._view = view
+        server.scene.add_frame("/robot", show_axes=False, **pose_kwargs(view.T_world_base))
+        self._urdf = ViserUrdf(server, Path(view.robot_urdf), root_node_name="/robot/urdf")
+        self._tool: ViserUrdf | None = None
+        self._tool_frame: viser.FrameHandle | None = None
+        if view.chain is not None and (view.tool_urdf is not None or view.tool_mesh is not None):
+            self._tool_frame = server.scene.add_frame("/tool", show_axes=False)
+            if view.tool_urdf is not None:
+                self._tool = ViserUrdf(server, Path(view.tool_urdf), root_node_name="/tool/urdf")
+            else:
+                mesh = view.tool_mesh
+                server.scene.add_mesh_simple(
+                    "/tool/mesh",
+                    np.asarray(mesh.vertices, np.float32),
+                    np.asarray(mesh.faces, np.uint32),
+                    color=(90, 90, 100),
+                )
+        urdf_names = tuple(self._urdf.get_actuated_joint_names())
+        #: joint names in the order of ``q`` (the chain's order when there is a chain)
+        chain_names = () if view.chain is None else tuple(view.chain.joint_names)
+        self.joint_names: tuple[str, ...] = (
+            chain_names if set(chain_names) == set(urdf_names) else urdf_names
+        )
+        self._to_urdf = np.array([self.joint_names.index(n) for n in urdf_names], dtype=int)
         self._play_stop = threading.Event()
         self._play_thread: threading.Thread | None = None
         self.q = np.zeros(len(self.joint_names))
@@ -47,7 +68,7 @@ class RobotView:
         return np.asarray(q)
 
     def set_q(self, q: ArrayLike) -> None:
-        """Pose the robot at joint values ``q`` (radians, URDF actuated-joint order)."""
+        """Pose the robot and its tool at ``q`` (radians, in :attr:`joint_names` order)."""
         q_arr = np.asarray(q, dtype=np.float64).reshape(-1)
         if q_arr.shape[0] != len(self.joint_names):
             logger.warning(
@@ -55,7 +76,13 @@ class RobotView:
             )
             return
         self.q = q_arr
-        self._urdf.update_cfg(q_arr)
+        with self._server.atomic():
+            self._urdf.update_cfg(q_arr[self._to_urdf])
+            T = self._view.T_world_flange(q_arr)
+            if T is not None and self._tool_frame is not None:
+                pose = pose_kwargs(T)
+                self._tool_frame.wxyz = pose["wxyz"]
+                self._tool_frame.position = pose["position"]
 
     def play(self, q_path: ArrayLike, duration_s: float = 2.0, loops: int = 1) -> None:
         """Animate ``q_path (M, n)`` in a background thread (stops a running animation)."""
@@ -86,4 +113,7 @@ class RobotView:
         """Remove the robot from the scene."""
         self.stop()
         self._urdf.remove()
+        if self._tool is not None:
+            self._tool.remove()
         self._server.scene.remove_by_name("/robot")
+        self._server.scene.remove_by_name("/tool")

@@ -67,6 +67,7 @@ class ValidatePanel:
             raise InputError("a validation is already running")
         validation.check_available()
         plan = plan_from_ui(self._app.state.doc)
+        validation.check_supported(plan)
         plan_dir = self._app.plan_dir
         self._running.set()
         self.button.disabled = True

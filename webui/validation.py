@@ -8,13 +8,17 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import msgspec
 import numpy as np
 from numpy.typing import NDArray
 
 from calib.plan import Plan
+from calib.plan_procedures import method_of
 from webui.backend import NotAvailableError
 
 Progress = Callable[[int, int], None]
+#: Built-in stator meshes the Monte Carlo simulation knows -> StatorGeometry constructor.
+STATOR_MESHES = {"builtin:stator_section": "full_section", "builtin:stator_prototype": "prototype"}
 
 
 @dataclass(frozen=True)
@@ -38,14 +42,11 @@ class ValidationSummary:
 
 def _montecarlo() -> Any:
     try:
-        mod = importlib.import_module("planner.montecarlo")
+        return importlib.import_module("planner.montecarlo")
     except ImportError as exc:
         raise NotAvailableError(
             f"Monte Carlo validation is not available yet (planner.montecarlo: {exc})"
         ) from None
-    if not hasattr(mod, "validate"):
-        raise NotAvailableError("Monte Carlo validation is not available yet (no validate())")
-    return mod
 
 
 def check_available() -> None:
@@ -53,33 +54,71 @@ def check_available() -> None:
     _montecarlo()
 
 
+def check_supported(plan: Plan) -> None:
+    """Raise :class:`NotAvailableError` when ``planner.montecarlo`` cannot simulate ``plan``."""
+    if method_of(plan.procedure) != "hultman2013":
+        raise NotAvailableError(
+            "Monte Carlo validation simulates the paper's A-H procedure (hultman2013) only; "
+            f"this plan uses {method_of(plan.procedure)}"
+        )
+    if plan.work_object.mesh not in STATOR_MESHES:
+        raise NotAvailableError(
+            "Monte Carlo validation simulates the built-in stator sections "
+            f"({', '.join(STATOR_MESHES)}) only; this plan's work object is "
+            f"{plan.work_object.mesh}"
+        )
+
+
 def run_validation(
     plan: Plan, plan_dir: Path, trials: int, progress: Progress
 ) -> ValidationSummary:
-    """Run ``planner.montecarlo.validate`` on ``plan`` and summarise its report."""
-    mod = _montecarlo()
-    rng = np.random.default_rng(plan.validation.seed)
-    report = mod.validate(plan, plan_dir=plan_dir, trials=trials, rng=rng, progress=progress)
+    """Simulate the plan's calibration ``trials`` times with its error models (in-process)."""
+    mc = _montecarlo()
+    check_supported(plan)
+    plan_io = importlib.import_module("planner.plan_io")
+    stator = importlib.import_module("planner.stator")
+    sensor_mod = importlib.import_module("planner.sensor")
+    errors = importlib.import_module("planner.error_models")
+    procedure = importlib.import_module("calib.stator_procedure")
+    v = plan.validation
+    report = mc.validate(
+        plan_io.hultman_points(plan),
+        getattr(stator.StatorGeometry, STATOR_MESHES[plan.work_object.mesh])(),
+        plan_io.nominal_T_base_wobj(plan),
+        int(trials),
+        np.random.default_rng(v.seed),
+        # the plan's error-model structs mirror planner's models field by field
+        sensor=sensor_mod.ProximitySensor(**msgspec.structs.asdict(v.sensor)),
+        robot_error=errors.RobotErrorModel(**msgspec.structs.asdict(v.robot_error)),
+        misplacement=errors.Misplacement(**msgspec.structs.asdict(v.misplacement)),
+        settings=procedure.StatorSettings(
+            beta1_rad=plan.procedure.beta1_rad,  # type: ignore[union-attr]
+            p3_height_m=plan.procedure.p3_height_m,  # type: ignore[union-attr]
+        ),
+        workers=1,  # no fork() of a threaded server process
+        progress=progress,
+    )
     return summarize(report)
 
 
+def _histogram(samples: Any, scale: float, bins: int = 30) -> tuple[Any, Any]:
+    x = np.asarray(samples, dtype=np.float64).ravel() * scale
+    x = x[np.isfinite(x)]
+    counts, edges = np.histogram(x, bins=bins)
+    return edges, counts
+
+
 def summarize(report: Any) -> ValidationSummary:
-    """Shape a validation report for the panel (markdown table, histograms, failures)."""
-    table = report.table_markdown() if callable(getattr(report, "table_markdown", None)) else ""
-    table = table or str(getattr(report, "markdown", ""))
-    failures = getattr(report, "failures", {}) or {}
-    lines = [table, ""]
-    if failures:
-        lines += ["**Failures**", "", "| point | count | reason |", "|---|---|---|"]
-        for key, count in sorted(failures.items(), key=lambda kv: -kv[1]):
-            pid, reason = key if isinstance(key, tuple) else (key, "")
-            lines.append(f"| {pid} | {count} | {str(reason).replace('|', '/')} |")
-    else:
-        lines.append("No failed trials.")
+    """Shape a ``planner.montecarlo_report.ValidationReport`` for the panel."""
+    markdown = report.to_markdown()
+    units = {r.key: r.unit for r in report.rows}
+    labels = {r.key: r.label for r in report.rows}
     hists = []
-    for title, (edges, counts) in (getattr(report, "histograms", {}) or {}).items():
-        hists.append((str(title), np.asarray(edges, float), np.asarray(counts, float)))
-    n_ok = getattr(report, "n_ok", None)
-    n_total = getattr(report, "n_trials", None)
-    headline = f"{n_ok}/{n_total} trials succeeded" if n_total else "validation finished"
-    return ValidationSummary(report, "\n".join(lines), tuple(hists), headline)
+    for key, samples in report.samples_procedure.items():
+        unit = units.get(key, "mm")
+        scale = 1000.0 if unit == "mm" else float(np.degrees(1.0))
+        edges, counts = _histogram(samples, scale)
+        hists.append((f"{labels.get(key, key)} ({unit})", edges, counts.astype(np.float64)))
+    failed = sum(report.failures.values())
+    headline = f"{report.n_ok}/{report.n_trials} trials calibrated, {failed} failed"
+    return ValidationSummary(report, markdown, tuple(hists), headline)

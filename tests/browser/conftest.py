@@ -35,10 +35,27 @@ def box_plan_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return box_plan(tmp_path_factory.mktemp("plan"))
 
 
-@pytest.fixture
-def ui(browser: Any, box_plan_path: Path, tmp_path: Path) -> Iterator[UiSession]:
-    """The UI on the box plan, with one page open."""
-    app = start_ui(box_plan_path, tmp_path)
+@pytest.fixture(scope="module")
+def ui(
+    browser: Any, box_plan_path: Path, tmp_path_factory: pytest.TempPathFactory
+) -> Iterator[UiSession]:
+    """The UI on the box plan, with one page open (shared by a module's tests)."""
+    app = start_ui(box_plan_path, tmp_path_factory.mktemp("ui"))
+    session = open_page(browser, app)
+    try:
+        yield session
+    finally:
+        session.page.close()
+        app.stop()
+
+
+@pytest.fixture(scope="module")
+def demo(browser: Any, tmp_path_factory: pytest.TempPathFactory) -> Iterator[UiSession]:
+    """The UI on the built-in demo (stator section, A-H plan), with one page open."""
+    app = start_ui(None, tmp_path_factory.mktemp("demo"))
+    if app.state.doc.source is None:
+        app.stop()
+        pytest.skip("the built-in demo plan is not available")
     session = open_page(browser, app)
     try:
         yield session

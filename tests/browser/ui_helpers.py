@@ -26,7 +26,7 @@ VIEWPORT = {"width": 1100, "height": 720}
 REPO = Path(__file__).resolve().parents[2]
 
 
-def wait_for(pred: Callable[[], Any], timeout: float = 15.0, what: str = "condition") -> Any:
+def wait_for(pred: Callable[[], Any], timeout: float = 30.0, what: str = "condition") -> Any:
     """Poll ``pred`` until it returns something truthy; fail the test after ``timeout`` s."""
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:

@@ -1,0 +1,62 @@
+"""End-to-end tests on the built-in demo: the stator section and its A-H plan, in Chromium."""
+
+from __future__ import annotations
+
+import shutil
+import time
+
+import numpy as np
+import pytest
+from ui_helpers import REPO, UiSession, wait_for
+
+from webui.plan_doc import PAPER_IDS
+
+pytestmark = pytest.mark.browser
+
+SCREENSHOT = REPO / "docs" / "img" / "demo_cell.png"
+ARTIFACT = REPO / "artifacts" / "demo_cell.png"
+
+
+def test_demo_loads_with_ah_points_and_statuses(demo: UiSession) -> None:
+    assert demo.app.state.doc.ids == PAPER_IDS
+    checks = wait_for(lambda: len(demo.app.checks()) == 8 and demo.app.checks(), what="checks")
+    body = wait_for(
+        lambda: "| A |" in demo.app.points_panel.status_md.content and demo.page.inner_text("body"),
+        what="status table",
+    )
+    for c in checks.values():
+        assert c.status in {"feasible", "marginal", "infeasible", "unknown"}
+        assert c.status == "feasible" or c.reason, f"{c.point_id} gives no reason"
+        assert c.status in body
+
+
+def test_validate_button_produces_table_and_histograms(demo: UiSession) -> None:
+    demo.app.validate_panel.trials.value = 30
+    demo.page.get_by_role("button", name="Validate plan").click()
+    panel = demo.app.validate_panel
+    wait_for(lambda: not panel.running and panel.result_md.content, timeout=90, what="validation")
+    md = panel.last_markdown
+    assert md, f"validation gave no table: {panel.result_md.content}"
+    assert "| WOCS origin x-axis |" in md
+    wait_for(lambda: "WOCS origin x-axis" in demo.page.inner_text("body"), what="table on page")
+    assert len(demo.app.validate_panel.plots) >= 6
+    assert demo.app.validate_panel.last_report.n_trials == 30
+
+
+def test_screenshot_of_demo_cell(demo: UiSession) -> None:
+    demo.page.set_viewport_size({"width": 1500, "height": 900})
+    # hide transient notifications (e.g. SwiftShader's "software WebGL" warning)
+    demo.page.add_style_tag(content=".mantine-Notification-root { display: none !important; }")
+    client = demo.client()
+    client.camera.up_direction = (0.0, 0.0, 1.0)
+    client.camera.position = (-0.5, -1.9, 2.3)
+    client.camera.look_at = (1.0, -0.2, 0.85)
+    client.flush()
+    demo.app.select("C")
+    time.sleep(3.0)  # let SwiftShader render the new view
+    ARTIFACT.parent.mkdir(parents=True, exist_ok=True)
+    demo.page.screenshot(path=str(ARTIFACT))
+    SCREENSHOT.parent.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(ARTIFACT, SCREENSHOT)
+    assert ARTIFACT.stat().st_size > 20_000, "the screenshot looks empty"
+    assert np.isfinite(client.camera.fov)
