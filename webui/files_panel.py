@@ -40,8 +40,8 @@ def check_upload(name: str, content: bytes, suffixes: tuple[str, ...], what: str
     """Refuse an empty, oversized or wrongly named upload with a message naming the file."""
     if len(content) > MAX_UPLOAD_BYTES:
         raise UploadError(
-            f"{name}: {len(content) / 1e6:.1f} MB is larger than the "
-            f"{MAX_UPLOAD_BYTES / 1e6:.0f} MB limit for uploads"
+            f"{name}: {len(content) / 2**20:.1f} MiB is larger than the "
+            f"{MAX_UPLOAD_BYTES / 2**20:.0f} MiB limit for uploads"
         )
     if not content:
         raise UploadError(f"{name}: the file is empty")

@@ -112,8 +112,6 @@ class RobotView:
     def remove(self) -> None:
         """Remove the robot from the scene."""
         self.stop()
-        self._urdf.remove()
-        if self._tool is not None:
-            self._tool.remove()
+        # removing the root nodes removes every link under them
         self._server.scene.remove_by_name("/robot")
         self._server.scene.remove_by_name("/tool")

@@ -1,0 +1,105 @@
+"""The UI app on the server side, without a browser: clicks, edits, undo, files, autosave."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from calib.frames import transform_points
+from calib.plan import plan_from_json
+from webui.app import WobjcalApp, run
+from webui.testing import T_WORLD_WOBJ_BOX, box_plan, free_port
+
+
+@pytest.fixture(scope="module")
+def app(tmp_path_factory: pytest.TempPathFactory) -> Iterator[WobjcalApp]:
+    folder = tmp_path_factory.mktemp("app")
+    a = run(box_plan(folder), port=free_port(), block=False, autosave_path=folder / "auto.json")
+    a.files_panel.upload_dir = folder / "uploads"
+    yield a
+    a.stop()
+
+
+def _ray_to(p_wobj: list[float]) -> tuple[np.ndarray, np.ndarray]:
+    target = transform_points(T_WORLD_WOBJ_BOX, p_wobj)
+    origin = target + np.array([0.3, -0.2, 1.0])
+    return origin, target - origin
+
+
+def test_click_places_point_checks_it_and_autosaves(app: WobjcalApp) -> None:
+    check = app.place_at_ray(*_ray_to([0.1, 0.05, 0.0]), point_id="A")
+    assert check is not None and check.point_id == "A"
+    assert check.status in {"feasible", "marginal", "infeasible", "unknown"}
+    a = app.state.doc.get("A")
+    np.testing.assert_allclose(a.probe.position_m, [0.1, 0.05, 0.0], atol=1e-9)
+    np.testing.assert_allclose(a.probe.normal, [0, 0, 1], atol=1e-12)
+    saved = json.loads(app.state.autosave_path.read_text())  # type: ignore[union-attr]
+    assert "A" in [p["id"] for p in saved["points"]]
+    assert app.selected == "A" and "| A |" in app.points_panel.status_md.content
+
+
+def test_miss_is_a_clear_error_and_changes_nothing(app: WobjcalApp) -> None:
+    before = app.state.doc
+    with pytest.raises(ValueError, match="missed the work object"):
+        app.place_at_ray([10.0, 10.0, 10.0], [0.0, 0.0, 1.0])
+    assert app.state.doc is before
+
+
+def test_undo_redo_restore_points_and_checks(app: WobjcalApp) -> None:
+    app.place_at_ray(*_ray_to([-0.1, 0.0, 0.0]), point_id="B")
+    app.move_point_to("B", [-0.12, 0.02, 0.05])  # above the face: projected onto it
+    np.testing.assert_allclose(
+        app.state.doc.get("B").probe.position_m, [-0.12, 0.02, 0.0], atol=1e-12
+    )
+    app.state.undo()
+    np.testing.assert_allclose(app.state.doc.get("B").probe.position_m, [-0.1, 0, 0], atol=1e-12)
+    assert app.check_of("B") is not None, "undo re-checks the restored point"
+    app.state.undo()
+    assert "B" not in app.state.doc.ids and app.check_of("B") is None
+    app.state.redo()
+    assert "B" in app.state.doc.ids
+
+
+def test_plan_download_is_the_strict_plan(app: WobjcalApp) -> None:
+    name, data = app.files_panel.plan_bytes()
+    plan = plan_from_json(data.decode(), source=name)
+    assert [p.id for p in plan.points] == list(app.state.doc.ids)
+
+
+def test_bad_uploads_change_nothing(app: WobjcalApp) -> None:
+    before = app.state.doc
+    cases = [
+        ("plan.json", b'{"schema": "wobjcal.plan/1", "points": [}', "plan.json"),
+        ("plan.txt", b"{}", "must end in .json"),
+        ("part.stl", b"solid nothing\nendsolid\n", "part.stl"),
+        ("robot.urdf", b"<robot name='x'><link name='a'/>", "robot.urdf"),
+        ("big.json", b" " * (50 * 1024 * 1024 + 1), "50 MiB limit"),
+        ("empty.stl", b"", "empty"),
+    ]
+    for name, content, expected in cases:
+        upload = {
+            ".json": app.files_panel.upload_plan,
+            ".txt": app.files_panel.upload_plan,
+            ".stl": app.files_panel.upload_mesh,
+            ".urdf": app.files_panel.upload_urdf,
+        }[Path(name).suffix]
+        with pytest.raises(Exception, match=expected.replace(".", r"\.")):
+            upload(name, content)
+        assert app.state.doc is before, f"{name} changed the plan"
+
+
+def test_good_plan_upload_replaces_plan_and_undo_restores(app: WobjcalApp) -> None:
+    before_ids = app.state.doc.ids
+    # relative mesh references resolve against the session's plan folder
+    text = box_plan(app.plan_dir, name="other").read_text()
+    plan = plan_from_json(text, "other.json")
+    fewer = text.replace('"name": "other"', '"name": "uploaded"')
+    assert plan.name == "other"
+    app.files_panel.upload_plan("uploaded.json", fewer.encode())
+    assert app.state.doc.name == "uploaded"
+    app.state.undo()
+    assert app.state.doc.ids == before_ids
