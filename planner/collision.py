@@ -4,9 +4,9 @@ The clearance query (:meth:`CollisionChecker.query`) checks the current PyBullet
 and tool against the work object, the fixtures and themselves, and returns the limiting pair and
 its distance. Robot and tool vs the environment are batched ``getClosestPoints`` calls (one per
 body pair; the tool link by link against the work object, because the sensor links look less
-far); robot self pairs go one by one (a whole-body self query also computes every allowed,
-touching neighbour pair); robot vs tool is one batched call. Pairs in the allowed-collision
-list (:mod:`planner.acl`, re-exported here) are skipped.
+far). Robot-robot and robot-tool pairs go one by one (a whole-body self query also computes
+every allowed, touching neighbour pair), skipped first by the allowed-collision list
+(:mod:`planner.acl`, re-exported here) and by their axis-aligned boxes.
 """
 
 from __future__ import annotations
