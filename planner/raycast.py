@@ -62,6 +62,7 @@ class MeshRayCaster:
         self._offsets = np.einsum("ij,ij->i", self._normals, tri[:, 0])
         self._triangles = tri
         self._sharp = self._sharp_local_edges(mesh)
+        self._has_sharp = self._sharp.any(axis=1)
         # inward in-plane normals of the edge opposite each vertex, and their offsets
         edge_dir = tri[:, [2, 0, 1]] - tri[:, [1, 2, 0]]  # (F, 3 edges, 3)
         inward = np.cross(self._normals[:, None, :], edge_dir)
@@ -123,8 +124,13 @@ class MeshRayCaster:
 
     def _beyond_real_edge(self, p: FloatArray, tri: NDArray[np.int64]) -> NDArray[np.bool_]:
         """True where hit points ``(K, 3)`` lie outside their triangle across a real edge."""
-        dist = np.einsum("kej,kj->ke", self._edge_normals[tri], p) - self._edge_offsets[tri]
+        flags = np.zeros(len(tri), bool)
+        check = np.flatnonzero(self._has_sharp[tri])  # only triangles with a real edge matter
+        if len(check) == 0:
+            return flags
+        t = tri[check]
+        dist = np.einsum("kej,kj->ke", self._edge_normals[t], p[check]) - self._edge_offsets[t]
         worst = np.argmin(dist, axis=1)
-        rows = np.arange(len(tri))
-        outside = dist[rows, worst] < -1e-12 * self._scale
-        return outside & self._sharp[tri, worst]
+        outside = dist[np.arange(len(t)), worst] < -1e-12 * self._scale
+        flags[check] = outside & self._sharp[t, worst]
+        return flags
