@@ -46,7 +46,9 @@ def _stats(ms: list[float]) -> dict[str, float]:
     }
 
 
-def bench_server(app: object, clicks: int, rng: np.random.Generator) -> list[float]:
+def bench_server(
+    app: object, clicks: int, rng: np.random.Generator, statuses: list[str] | None = None
+) -> list[float]:
     """Milliseconds from the click's ray to the status being flushed, per click."""
     out = []
     for k, target_wobj in enumerate(_targets(rng, clicks)):
@@ -57,6 +59,8 @@ def bench_server(app: object, clicks: int, rng: np.random.Generator) -> list[flo
         out.append((time.perf_counter() - t0) * 1000.0)
         if check is None:
             raise RuntimeError("no status came back")
+        if statuses is not None:
+            statuses.append(check.status)
     return out
 
 
@@ -108,7 +112,8 @@ def main(argv: list[str] | None = None) -> int:
         app = run(plan, port=free_port(), block=False, autosave_path=Path(tmp) / "autosave.json")
         try:
             bench_server(app, 3, rng)  # warm up
-            server_ms = bench_server(app, args.clicks, rng)
+            statuses: list[str] = []
+            server_ms = bench_server(app, args.clicks, rng, statuses)
             browser_ms = bench_browser(app, min(args.clicks, 10), rng) if args.browser else []
             result = {
                 "benchmark": "ui_latency",
@@ -118,6 +123,7 @@ def main(argv: list[str] | None = None) -> int:
                 "cell_check": "unavailable: " + app.cell_error if app.cell_error else "pybullet",
                 "target_median_ms": TARGET_MS,
                 "server": _stats(server_ms),
+                "server_statuses": {k: statuses.count(k) for k in sorted(set(statuses))},
                 "browser": _stats(browser_ms) if browser_ms else None,
                 "machine": {"python": platform.python_version(), "cpu": platform.processor()},
             }

@@ -103,3 +103,16 @@ def test_good_plan_upload_replaces_plan_and_undo_restores(app: WobjcalApp) -> No
     assert app.state.doc.name == "uploaded"
     app.state.undo()
     assert app.state.doc.ids == before_ids
+
+
+def test_heat_map_grows_in_chunks_and_colours_vertices(app: WobjcalApp) -> None:
+    if app.cell_error:
+        pytest.skip(app.cell_error)
+    app.heatmap.start(n_samples=6, chunk=2)
+    assert app.heatmap.done.wait(120)
+    assert len(app.heatmap.scores) == 6
+    assert set(app.heatmap.scores) <= {0.0, 0.5, 1.0}
+    assert app.server.scene.get_handle_by_name("/wobj/heat_mesh") is not None
+    app.place_at_ray(*_ray_to([0.0, 0.1, 0.0]), point_id="H1")  # clicks still work after
+    app.heatmap.stop()
+    assert app.server.scene.get_handle_by_name("/wobj/heat_mesh") is None

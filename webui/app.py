@@ -20,7 +20,8 @@ from numpy.typing import ArrayLike
 from calib.errors import InputError
 from calib.plan import Plan
 from webui import demo, plan_doc
-from webui.backend import CellSession, CellView, NotAvailableError
+from webui.backend import CellSession, CellView
+from webui.heatmap import HeatMap
 from webui.plan_adapter import autosave_bytes, ui_plan_from_file
 from webui.plan_doc import UiPlan
 from webui.robot_view import RobotView
@@ -67,6 +68,7 @@ class WobjcalApp:
         self._checks: dict[str, tuple[Any, PointCheck]] = {}
         self._lock = threading.RLock()
         self._cell_key: Any = None
+        self.heatmap = HeatMap(self)
         self.points_panel = points_panel.PointsPanel(self)
         self.validate_panel = validate_panel.ValidatePanel(self)
         self.files_panel = files_panel.FilesPanel(self)
@@ -81,6 +83,7 @@ class WobjcalApp:
 
         On failure the previous cell, scene and plan stay as they were.
         """
+        self.heatmap.stop()
         self.worker.replace_resource(lambda: CellSession(plan, plan_dir)).result(300)
         session = self.worker.call(lambda s: s)
         view = session.view
@@ -157,18 +160,10 @@ class WobjcalApp:
         elif self.selected in changed:
             self.select(self.selected)
 
-    def show_reachability(self, n_samples: int = 4000) -> None:
-        """Colour the work object by reachability (samples from ``cell.reachability_map``)."""
-        from webui.scene import heat_rgb
-
-        def job(session: CellSession | None) -> Any:
-            if session is None or session.cell is None:
-                why = "no cell" if session is None else session.cell_error
-                raise NotAvailableError(f"the reachability map needs the cell: {why}")
-            return session.reachability(n_samples)
-
-        points_wobj, score = self.worker.call(job)
-        self.scene.show_heat_map(points_wobj, heat_rgb(score))
+    def show_reachability(self, n_samples: int = 120) -> None:
+        """Start the reachability heat map (computed in chunks on the cell worker)."""
+        self.heatmap.stop()
+        self.heatmap.start(n_samples)
 
     # ---- editing ---------------------------------------------------------------------------
     def place_at_ray(

@@ -204,6 +204,12 @@ class PointsPanel:
         if self._is_programmatic():
             return
         if not self.heat.value:
-            self._app.scene.show_heat_map(None)
+            self._app.heatmap.stop()
             return
+        self._app.notify(
+            "Reachability map",
+            "checking surface samples; the map grows as they finish",
+            client=getattr(event, "client", None),
+            error=False,
+        )
         self._guard(event, self._app.show_reachability)

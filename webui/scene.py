@@ -58,9 +58,25 @@ class PlanScene:
         self.wobj_mesh_handle: viser.MeshHandle | None = None
         self._point_nodes: dict[str, list[Any]] = {}
         self._heat: Any = None
+        self._wobj_mesh: trimesh.Trimesh | None = None
+
+    def color_work_object(self, vertex_rgb: ArrayLike | None) -> None:
+        """Overlay the work object with per-vertex colours (``(V, 3)`` uint8), or remove it."""
+        if vertex_rgb is None or self._wobj_mesh is None:
+            self._scene.remove_by_name("/wobj/heat_mesh")
+            return
+        colored = self._wobj_mesh.copy()
+        rgb = np.asarray(vertex_rgb, dtype=np.uint8)
+        colored.visual = trimesh.visual.ColorVisuals(
+            colored, vertex_colors=np.hstack([rgb, np.full((len(rgb), 1), 255, np.uint8)])
+        )
+        # a hair above the surface so the colours win the depth test; clicks still hit the mesh
+        colored.vertices = colored.vertices + 0.0005 * colored.vertex_normals
+        self._scene.add_mesh_trimesh("/wobj/heat_mesh", colored)
 
     def draw_work_object(self, mesh: trimesh.Trimesh, T_world_wobj: ArrayLike) -> viser.MeshHandle:
         """Draw the work object (wobj frame mesh) and the nominal WOCS axes at ``T_world_wobj``."""
+        self._wobj_mesh = mesh
         self._scene.add_frame(
             "/wobj", axes_length=0.12, axes_radius=0.004, **pose_kwargs(T_world_wobj)
         )

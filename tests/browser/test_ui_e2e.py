@@ -87,12 +87,22 @@ def test_click_on_mesh_places_point_on_surface(ui: UiSession) -> None:
 def test_unreachable_spot_is_infeasible_with_reason(ui: UiSession) -> None:
     if ui.app.cell_error:
         pytest.skip(f"feasibility checks not available: {ui.app.cell_error}")
-    # the bottom face (normal -z) cannot be probed from above
-    origin = transform_points(T_WORLD_WOBJ_BOX, [0.0, 0.0, -1.0])
-    direction = T_WORLD_WOBJ_BOX[:3, :3] @ np.array([0.0, 0.0, 1.0])
-    check = ui.app.place_at_ray(origin, direction, point_id="Z")
-    assert check is not None and check.status == "infeasible" and check.reason
-    wait_for(lambda: "infeasible" in ui.page.inner_text("body"), what="infeasible shown")
+    # the far side face (wobj -y, facing away from the robot) is out of reach
+    target_wobj = np.array([0.05, -0.2, -0.12])
+    target = transform_points(T_WORLD_WOBJ_BOX, target_wobj)
+    set_camera(ui.client(), target + np.array([1.2, 0.5, 0.5]), target + np.array([0, -0.1, 0]))
+    ui.app.points_panel.place.value = "Z"
+    for _attempt in range(3):
+        click_world_point(ui, target)
+        deadline = time.monotonic() + 5.0
+        while time.monotonic() < deadline and ui.app.check_of("Z") is None:
+            time.sleep(0.05)
+        if ui.app.check_of("Z") is not None:
+            break
+    check = wait_for(lambda: ui.app.check_of("Z"), what="Z's check")
+    np.testing.assert_allclose(ui.app.state.doc.get("Z").probe.normal, [0, -1, 0], atol=1e-9)
+    assert check.status == "infeasible" and check.reason
+    wait_for(lambda: check.reason in ui.page.inner_text("body"), what="the reason on the page")
 
 
 def test_validate_unsupported_plan_says_why(ui: UiSession) -> None:

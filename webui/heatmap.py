@@ -1,0 +1,117 @@
+"""The reachability heat map: surface samples checked as probe poses, drawn on the work object.
+
+Checking one sample can take a good part of a second (all sensor rotations are tried before a
+sample is called infeasible), so the map is computed in small chunks queued on the cell worker:
+clicks from any tab slip in between chunks, the map grows on screen as chunks finish, and
+unticking the box stops it. At the end the work object's vertices are coloured by their nearest
+sample (red: infeasible, amber: marginal, green: feasible).
+"""
+
+from __future__ import annotations
+
+import importlib
+import logging
+import threading
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import trimesh
+from numpy.typing import NDArray
+from scipy.spatial import cKDTree
+
+from webui.backend import NotAvailableError
+from webui.scene import heat_rgb
+
+if TYPE_CHECKING:
+    from webui.app import WobjcalApp
+
+logger = logging.getLogger(__name__)
+
+#: Status name -> score in [0, 1] for the colour ramp.
+SCORE = {"infeasible": 0.0, "marginal": 0.5, "feasible": 1.0}
+
+
+def vertex_scores(
+    mesh: trimesh.Trimesh, points: NDArray[np.float64], normals: NDArray[np.float64], score: Any
+) -> NDArray[np.float64]:
+    """Score of each mesh vertex: that of the nearest sample on a similarly facing face."""
+    normal_weight = 0.05  # metres per unit of normal difference: keeps faces apart at edges
+    tree = cKDTree(np.hstack([points, normal_weight * normals]))
+    query = np.hstack([mesh.vertices, normal_weight * mesh.vertex_normals])
+    _, idx = tree.query(query)
+    return np.asarray(score, dtype=np.float64)[idx]
+
+
+class HeatMap:
+    """A reachability map being computed or shown for one app.
+
+    Args:
+        app: the app whose cell and work object are used.
+    """
+
+    def __init__(self, app: WobjcalApp) -> None:
+        self._app = app
+        self._stop = threading.Event()
+        self.points: NDArray[np.float64] = np.zeros((0, 3))
+        self.normals: NDArray[np.float64] = np.zeros((0, 3))
+        self.scores: list[float] = []
+        self.done = threading.Event()
+
+    def start(self, n_samples: int = 120, chunk: int = 3, seed: int = 0) -> None:
+        """Sample the surface and queue the checks in chunks on the cell worker."""
+        view = self._app.view
+        if view is None or self._app.cell_error:
+            raise NotAvailableError(f"the reachability map needs the cell: {self._app.cell_error}")
+        rmap = importlib.import_module("planner.reachability_map")
+        pts, nrm, _ = rmap.sample_surface(view.wobj_mesh, n_samples, np.random.default_rng(seed))
+        self.points, self.normals = np.asarray(pts, float), np.asarray(nrm, float)
+        self.scores, self._stop = [], threading.Event()
+        stop, done = self._stop, self.done
+        done.clear()
+        tcp = self._app.state.doc.source.cell.tool.tcp if self._app.state.doc.source else "sensor"
+        for i in range(0, len(pts), chunk):
+            sl = slice(i, i + chunk)
+            fut = self._app.worker.submit(self._job, self.points[sl], self.normals[sl], tcp, stop)
+            fut.add_done_callback(self._chunk_done)
+        self._app.worker.submit(lambda _s: None).add_done_callback(lambda _f: done.set())
+
+    @staticmethod
+    def _job(session: Any, pts: Any, nrm: Any, tcp: str, stop: threading.Event) -> list[float]:
+        if stop.is_set() or session is None or session.cell is None:
+            return []
+        res = session.cell.check_probes(pts, nrm, tcp=tcp)
+        return [SCORE.get(str(r.status), 0.0) for r in res]
+
+    def _chunk_done(self, fut: Any) -> None:
+        if self._stop.is_set():
+            return
+        try:
+            self.scores.extend(fut.result())
+        except Exception as exc:
+            logger.exception("reachability chunk failed")
+            self._stop.set()
+            self._app.notify("Reachability map stopped", f"{type(exc).__name__}: {exc}")
+            return
+        n = len(self.scores)
+        self._app.scene.show_heat_map(self.points[:n], heat_rgb(np.asarray(self.scores)))
+        if n == len(self.points):
+            self._finish()
+
+    def _finish(self) -> None:
+        view = self._app.view
+        if view is None:
+            return
+        s = vertex_scores(view.wobj_mesh, self.points, self.normals, self.scores)
+        self._app.scene.color_work_object(heat_rgb(s))
+        feasible = float(np.mean(np.asarray(self.scores) > 0.25))
+        self._app.notify(
+            "Reachability map done",
+            f"{feasible:.0%} of {len(self.scores)} surface samples reachable",
+            error=False,
+        )
+
+    def stop(self) -> None:
+        """Stop computing and hide the map."""
+        self._stop.set()
+        self._app.scene.show_heat_map(None)
+        self._app.scene.color_work_object(None)
