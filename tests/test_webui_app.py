@@ -116,3 +116,44 @@ def test_heat_map_grows_in_chunks_and_colours_vertices(app: WobjcalApp) -> None:
     app.place_at_ray(*_ray_to([0.0, 0.1, 0.0]), point_id="H1")  # clicks still work after
     app.heatmap.stop()
     assert app.server.scene.get_handle_by_name("/wobj/heat_mesh") is None
+
+
+def test_feasible_point_has_pose_and_search_path(app: WobjcalApp) -> None:
+    check = app.place_at_ray(*_ray_to([0.05, 0.1, 0.0]), point_id="Q")
+    if check is None or check.status == "unknown":
+        pytest.skip("feasibility checks not available")
+    assert check.status in {"feasible", "marginal"}, check.text
+    assert check.q is not None and check.q_path is not None and len(check.q_path) >= 2
+    app.select("Q")
+    assert app.robot is not None
+    np.testing.assert_allclose(app.robot.q, check.q)
+
+
+def test_exports_are_robot_programs(app: WobjcalApp) -> None:
+    rapid = app.files_panel.export("RAPID")
+    (name, data), *_ = rapid.files
+    assert name.endswith(".mod") and b"MODULE" in data
+    krl = app.files_panel.export("KRL")
+    assert {Path(n).suffix for n, _ in krl.files} == {".src", ".dat"}
+    ur = app.files_panel.export("URScript")
+    assert ur.files[0][0].endswith(".script")
+
+
+def test_mesh_and_urdf_uploads_replace_the_cell(app: WobjcalApp) -> None:
+    from webui.testing import box_mesh
+
+    before = app.state.doc
+    stl = box_mesh()
+    stl.apply_scale(1000.0)  # millimetres
+    app.files_panel.units.value = "mm"
+    app.files_panel.upload_mesh("part_mm.stl", stl.export(file_type="stl"))
+    assert app.view is not None
+    np.testing.assert_allclose(app.view.wobj_mesh.extents, [0.6, 0.4, 0.3], atol=1e-9)
+    assert app.state.doc.source.work_object.units == "mm"
+    urdf = (Path(__file__).resolve().parents[1] / "assets/robots/irb4400/irb4400.urdf").read_bytes()
+    app.files_panel.upload_urdf("my_robot.urdf", urdf)
+    assert app.state.doc.source.cell.robot.urdf.endswith("my_robot.urdf")
+    app.state.undo()
+    app.state.undo()
+    assert app.state.doc.source is before.source
+    np.testing.assert_allclose(app.view.wobj_mesh.extents, [0.6, 0.4, 0.3], atol=1e-9)
