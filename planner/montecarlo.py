@@ -22,23 +22,27 @@ import time
 from collections import Counter
 from collections.abc import Callable, Mapping
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
-from calib.best_fit import best_fit
-from calib.errors import InputError, ProbeFailedError, ShapeError
-from calib.frames import check_transform, motion_between
-from calib.layout import constraint_set
+from calib.errors import InputError, ShapeError
+from calib.frames import check_transform
 from calib.probing import ProbePoint
-from calib.stator_procedure import StatorSettings, check_stator_points, run_stator_procedure
-from planner.error_models import AccuracyField, Misplacement, RobotErrorModel
+from calib.stator_procedure import StatorSettings, check_stator_points
+from planner.error_models import Misplacement, RobotErrorModel
 from planner.montecarlo_report import ValidationReport, build_report
-from planner.raycast import MeshRayCaster
-from planner.search_sim import ReachabilityHook, SimulatedProbe, cell_search_hook
+from planner.montecarlo_trial import (
+    DEFAULT_EDGE_INSET_M,
+    WORKER,
+    SimulationSetup,
+    TrialResult,
+    init_worker,
+    run_chunk,
+)
+from planner.search_sim import ReachabilityHook, cell_search_hook
 from planner.sensor import ProximitySensor
 from planner.stator import StatorGeometry, build_stator_mesh
 
@@ -46,115 +50,8 @@ FloatArray = NDArray[np.float64]
 log = logging.getLogger(__name__)
 
 PROCEDURES = ("hultman2013",)
-#: Edge searches run this far inside the face along the sensor axis by default, m.
-DEFAULT_EDGE_INSET_M = 0.003
 #: progress(done_trials, total_trials)
 ProgressCallback = Callable[[int, int], None]
-
-
-@dataclass(frozen=True)
-class SimulationSetup:
-    """Everything a worker needs to run trials (picklable).
-
-    Attributes:
-        points: the nominal probe points A-H, wobj frame.
-        geometry: the stator geometry (for the mesh, slot holes and landings).
-        T_base_wobj_nominal: ``(4, 4)`` the nominal part pose, base frame.
-        sensor: sensor model.
-        robot_error: robot error model.
-        misplacement: part placement tolerance.
-        pivot_wobj_m: ``(3,)`` pivot of the misplacement rotation, nominal wobj, m.
-        accuracy_field: the robot's absolute-accuracy field for this run, or None.
-        settings: settings of the A-H procedure.
-        edge_inset_m: edge searches run this far inside the face along the sensor axis.
-    """
-
-    points: Mapping[str, ProbePoint]
-    geometry: StatorGeometry
-    T_base_wobj_nominal: FloatArray
-    sensor: ProximitySensor
-    robot_error: RobotErrorModel
-    misplacement: Misplacement
-    pivot_wobj_m: FloatArray
-    accuracy_field: AccuracyField | None = None
-    settings: StatorSettings = field(default_factory=StatorSettings)
-    edge_inset_m: float = DEFAULT_EDGE_INSET_M
-    edge_tolerance_m: float = 2e-5
-
-
-@dataclass(frozen=True)
-class TrialResult:
-    """One trial.
-
-    Attributes:
-        failure: ``""`` or ``"<point>: <reason>"``.
-        landings: ``"<point>: <landing>"`` of approaches that landed over a hole or off a face.
-        delta_procedure: ``(6,)`` procedure frame error ``(dx, dy, dz, rx, ry, rz)`` in the true
-            wobj axes (m, rad); NaN on failure.
-        delta_best_fit: ``(6,)`` the same for the least-squares fit.
-    """
-
-    failure: str
-    landings: tuple[str, ...]
-    delta_procedure: FloatArray
-    delta_best_fit: FloatArray
-
-
-_WORKER: dict[str, object] = {}
-
-
-def _init_worker(setup: SimulationSetup, mesh: trimesh.Trimesh) -> None:
-    _WORKER["setup"] = setup
-    _WORKER["caster"] = MeshRayCaster(mesh)
-    _WORKER["layout"] = check_stator_points(setup.points)
-    pts = [setup.points[k] for k in "ABCDEFGH"]
-    _WORKER["constraints"] = constraint_set(pts)
-
-
-def _run_trial(seed: np.random.SeedSequence, reach: ReachabilityHook | None) -> TrialResult:
-    setup: SimulationSetup = _WORKER["setup"]  # type: ignore[assignment]
-    rng = np.random.default_rng(seed)
-    T_nom = setup.T_base_wobj_nominal
-    T_true = T_nom @ setup.misplacement.sample(rng, setup.pivot_wobj_m)
-    cell = _WORKER.get("cell")
-    if cell is not None:  # the cell's part goes where the part really is
-        cell.set_work_object(cell.work_object, T_world_wobj=cell.T_world_base @ T_true)  # type: ignore[attr-defined]
-    probe = SimulatedProbe(
-        _WORKER["caster"],  # type: ignore[arg-type]
-        T_true,
-        rng,
-        sensor=setup.sensor,
-        robot_error=setup.robot_error,
-        accuracy_field=setup.accuracy_field,
-        geometry=setup.geometry,
-        reachability=reach,
-        edge_inset_m=setup.edge_inset_m,
-        edge_tolerance_m=setup.edge_tolerance_m,
-    )
-    nan6 = np.full(6, np.nan)
-    failure = ""
-    d_proc = d_fit = nan6
-    try:
-        res = run_stator_procedure(_WORKER["layout"], T_nom, probe, setup.settings)  # type: ignore[arg-type]
-        d_proc = motion_between(T_true, res.T_base_wobj)
-        q = np.array([res.measured_m[k] for k in "ABCDEFGH"])
-        edge = setup.settings.edge_event_offset_m  # the same known edge offset as the procedure
-        q[5] -= edge * res.commands["F"].direction
-        q[7] -= edge * res.commands["H"].direction
-        fit = best_fit(_WORKER["constraints"], q, T_nom, sigma_m=1e-4)  # type: ignore[arg-type]
-        d_fit = motion_between(T_true, fit.T_base_wobj)
-    except ProbeFailedError as exc:
-        failure = f"{exc.point_id}: {exc.reason}"
-    except InputError as exc:  # degenerate measurements: a failed calibration, not a crash
-        failure = f"procedure: {exc}"
-    landings = tuple(f"{e.point_id}: {e.landing}" for e in probe.events if e.landing)
-    return TrialResult(failure, landings, d_proc, d_fit)
-
-
-def _run_chunk(
-    seeds: list[np.random.SeedSequence], reach: ReachabilityHook | None = None
-) -> list[TrialResult]:
-    return [_run_trial(s, reach) for s in seeds]
 
 
 def default_pivot(points: Mapping[str, ProbePoint]) -> FloatArray:
@@ -227,8 +124,6 @@ def validate(
         misplacement = Misplacement(*misplacement)
     robot_error = robot_error or RobotErrorModel()
     sensor = sensor or ProximitySensor()
-    if settings is None:
-        settings = StatorSettings(edge_event_offset_m=sensor.edge_event_offset_m(edge_inset_m))
     pivot = default_pivot(points) if pivot_wobj_m is None else np.asarray(pivot_wobj_m, float)
     setup = SimulationSetup(
         points=dict(points),
@@ -252,11 +147,11 @@ def validate(
         n_workers = 1
     t0 = time.perf_counter()
     T_cell = None if cell is None else cell.T_world_wobj
-    _WORKER["cell"] = cell
+    WORKER["cell"] = cell
     try:
         results = _run_all(setup, part, seeds, n_workers, reachability, progress)
     finally:
-        _WORKER.pop("cell", None)
+        WORKER.pop("cell", None)
         if cell is not None:
             cell.set_work_object(cell.work_object, T_world_wobj=T_cell)
     elapsed = time.perf_counter() - t0
@@ -287,15 +182,15 @@ def _run_all(
     chunks = [seeds[i : i + chunk] for i in range(0, total, chunk)]
     out: list[TrialResult] = []
     if n_workers == 1:
-        _init_worker(setup, mesh)
+        init_worker(setup, mesh)
         for c in chunks:
-            out.extend(_run_chunk(c, reach))
+            out.extend(run_chunk(c, reach))
             if progress is not None:
                 progress(len(out), total)
         return out
     ctx = mp.get_context("fork") if "fork" in mp.get_all_start_methods() else None
-    with ProcessPoolExecutor(n_workers, ctx, _init_worker, (setup, mesh)) as pool:
-        for res in pool.map(_run_chunk, chunks):
+    with ProcessPoolExecutor(n_workers, ctx, init_worker, (setup, mesh)) as pool:
+        for res in pool.map(run_chunk, chunks):
             out.extend(res)
             if progress is not None:
                 progress(len(out), total)

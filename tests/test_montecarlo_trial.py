@@ -1,0 +1,47 @@
+"""One Monte Carlo trial: seeded, and a failed probe becomes a recorded failure."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from calib.probing import SearchSpec
+from planner.demo_cell import nominal_T_base_wobj, stator_ah_points
+from planner.error_models import Misplacement, RobotErrorModel
+from planner.montecarlo import default_pivot
+from planner.montecarlo_trial import SimulationSetup, init_worker, run_trial
+from planner.sensor import ProximitySensor
+from planner.stator import StatorGeometry, build_stator_mesh
+
+G = StatorGeometry.full_section()
+MESH = build_stator_mesh(G)
+
+
+def _setup(points) -> SimulationSetup:  # type: ignore[no-untyped-def]
+    return SimulationSetup(
+        points=points,
+        geometry=G,
+        T_base_wobj_nominal=nominal_T_base_wobj(),
+        sensor=ProximitySensor(),
+        robot_error=RobotErrorModel(),
+        misplacement=Misplacement(),
+        pivot_wobj_m=default_pivot(points),
+    )
+
+
+def test_same_seed_same_trial_and_errors_are_small() -> None:
+    init_worker(_setup(stator_ah_points(G)), MESH)
+    seed = np.random.SeedSequence(42)
+    a, b = run_trial(seed, None), run_trial(seed, None)
+    assert a.failure == "" and np.array_equal(a.delta_procedure, b.delta_procedure)
+    assert np.abs(a.delta_procedure[:3]).max() < 1e-3  # within a millimetre
+    assert np.abs(a.delta_best_fit[:3]).max() < 1e-3
+    other = run_trial(np.random.SeedSequence(43), None)
+    assert not np.array_equal(other.delta_procedure, a.delta_procedure)
+
+
+def test_failed_probe_is_recorded_with_point_and_reason() -> None:
+    points = stator_ah_points(G, approach=SearchSpec("approach", 0.050, 0.060))
+    init_worker(_setup(points), MESH)
+    res = run_trial(np.random.SeedSequence(1), lambda cmd: "unreachable: joint 5 at limit")
+    assert res.failure == "A: unreachable: joint 5 at limit"
+    assert np.all(np.isnan(res.delta_procedure)) and np.all(np.isnan(res.delta_best_fit))
