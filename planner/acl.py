@@ -22,10 +22,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import pybullet as pb
 
 from calib.atomic_io import write_bytes_atomic
 from planner.bodies import BodyLinks
+from planner.pybullet_client import pb
 
 log = logging.getLogger(__name__)
 

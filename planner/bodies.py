@@ -15,12 +15,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import pybullet as pb
 import trimesh
 from numpy.typing import NDArray
 
 from calib.frames import invert_transform
 from planner.errors import MeshError, URDFError
+from planner.pybullet_client import pb
 
 FloatArray = NDArray[np.float64]
 log = logging.getLogger(__name__)

@@ -20,7 +20,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pybullet as pb
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
@@ -35,6 +34,7 @@ from planner.errors import UnknownFrameError
 from planner.fixtures import Fixture, fixture_from_spec
 from planner.kinematics.chain import KinematicChain
 from planner.kinematics.solver import IKSolver, make_ik_solver
+from planner.pybullet_client import connect_direct, pb
 from planner.robot_body import load_robot_body
 from planner.tool import Tool, load_tool
 from planner.urdf import load_urdf
@@ -104,7 +104,7 @@ class Cell:
         self._reach: ReachModel | None = None
         self.work_object: WorkObject | None = None
         self.fixtures: dict[str, Fixture] = {}
-        self._client: int | None = pb.connect(pb.DIRECT)
+        self._client: int | None = connect_direct()
         try:
             self._load_bodies(path)
             self._build_checker(path, acl_samples, acl_rng, use_acl_cache)

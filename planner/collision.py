@@ -16,7 +16,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-import pybullet as pb
 
 from planner.acl import (
     ACL_VERSION,
@@ -29,6 +28,7 @@ from planner.acl import (
     pair,
 )
 from planner.bodies import BodyLinks
+from planner.pybullet_client import pb
 
 log = logging.getLogger(__name__)
 

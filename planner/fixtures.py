@@ -12,7 +12,6 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-import pybullet as pb
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
@@ -20,6 +19,7 @@ from calib.errors import ShapeError
 from calib.frames import check_transform, make_transform
 from calib.validation import check_positive
 from planner.bodies import BodyLinks, mesh_collision_shape, static_body
+from planner.pybullet_client import pb
 from planner.workobject import load_work_object
 
 FloatArray = NDArray[np.float64]

@@ -73,27 +73,6 @@ def resolved_refs(plan: Plan, plan_dir: Path) -> dict[str, str | Path]:
     }
 
 
-def quiet_import(module: str) -> None:
-    """Import ``module`` with the process's stdout pointed at stderr (PyBullet prints its build
-    time on stdout at import, which would spoil ``--json`` output)."""
-    import importlib
-    import os
-    import sys
-
-    if module in sys.modules:
-        return
-    sys.stdout.flush()
-    saved = os.dup(1)
-    try:
-        os.dup2(2, 1)
-        importlib.import_module(module)
-    except ImportError:
-        pass  # require() reports it with context
-    finally:
-        os.dup2(saved, 1)
-        os.close(saved)
-
-
 def open_cell(plan: Plan, plan_dir: Path) -> Any:
     """Build the plan's :class:`planner.cell.Cell` (robot, tool, work object, fixtures).
 
@@ -104,7 +83,6 @@ def open_cell(plan: Plan, plan_dir: Path) -> Any:
         FeatureUnavailableError: ``planner.cell`` is not available.
         InputError: a file of the plan cannot be loaded (named in the message).
     """
-    quiet_import("pybullet")
     cell_mod = require("planner.cell", "checking reachability")
     stator = require("planner.stator", "the built-in stator work object")
     stator.register_stator_builtins()
@@ -143,7 +121,6 @@ def tool_data(plan: Plan, plan_dir: Path) -> tuple[Any, str]:
     """
     from planner.export.common import ToolData
 
-    quiet_import("pybullet")
     tool_mod = require("planner.tool", "exporting the tool data")
     tool = tool_mod.load_tool(str(resolved_refs(plan, plan_dir)["tool"]))
     T_flange_tcp = tool.T_flange_tcp(plan.cell.tool.tcp)
@@ -216,7 +193,6 @@ __all__ = [
     "hultman_points",
     "nominal_T_base_wobj",
     "open_cell",
-    "quiet_import",
     "require",
     "resolved_refs",
     "tool_data",

@@ -12,7 +12,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import pybullet as pb
 from numpy.typing import NDArray
 
 from calib.frames import invert_transform
@@ -20,6 +19,7 @@ from planner.acl import Pair, pair
 from planner.bodies import BodyLinks, load_urdf_body, set_link_pose, world_link_pose
 from planner.errors import URDFError
 from planner.kinematics.chain import KinematicChain
+from planner.pybullet_client import pb
 
 FloatArray = NDArray[np.float64]
 
