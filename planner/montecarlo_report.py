@@ -18,6 +18,7 @@ the bias (mean error) in its own column. Intervals and the signed yz-plane error
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -203,7 +204,7 @@ def build_report(
     for key, label, unit, levels in TABLE1_ROWS:
         scale = _SCALE[unit]
         fractions = [lv / 100.0 for lv in levels]
-        si = "rad" if unit == "deg" else "m"
+        si: Literal["m", "rad"] = "rad" if unit == "deg" else "m"
         nan = [float("nan")] * len(levels)
         hw_p = (
             [r.half_width for r in confidence_intervals(sp[key], label, si, fractions).rows]

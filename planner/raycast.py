@@ -62,7 +62,7 @@ class MeshRayCaster:
         self._offsets = np.einsum("ij,ij->i", self._normals, tri[:, 0])
         self._triangles = tri
         self._sharp = self._sharp_local_edges(mesh)
-        self._has_sharp = self._sharp.any(axis=1)
+        self._has_sharp: NDArray[np.bool_] = np.any(self._sharp, axis=1)
         # inward in-plane normals of the edge opposite each vertex, and their offsets
         edge_dir = tri[:, [2, 0, 1]] - tri[:, [1, 2, 0]]  # (F, 3 edges, 3)
         inward = np.cross(self._normals[:, None, :], edge_dir)

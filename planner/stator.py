@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import trimesh
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import ShapeError
 from calib.validation import check_positive
@@ -131,12 +131,16 @@ class StatorGeometry:
     @property
     def slot_y_m(self) -> FloatArray:
         """``(n_slots,)`` slot-centre y (wobj, m); index j is slot number j + 1."""
-        return -(self.first_slot_offset_m + self.slot_pitch_m * np.arange(self.n_slots))
+        return -(
+            self.first_slot_offset_m + self.slot_pitch_m * np.arange(self.n_slots, dtype=float)
+        )
 
     @property
     def layer_z_m(self) -> FloatArray:
         """``(n_layers,)`` layer-centre z (wobj, m), top layer first."""
-        return -(self.first_layer_depth_m + self.layer_pitch_m * np.arange(self.n_layers))
+        return -(
+            self.first_layer_depth_m + self.layer_pitch_m * np.arange(self.n_layers, dtype=float)
+        )
 
     @property
     def tooth_y_m(self) -> FloatArray:
@@ -155,7 +159,7 @@ class StatorGeometry:
             return -self.first_layer_depth_m
         return float(self.layer_z_m[-1]) - self.layer_pitch_m / 2
 
-    def side_face_offset_m(self, y: FloatArray, z: FloatArray) -> FloatArray:
+    def side_face_offset_m(self, y: ArrayLike, z: ArrayLike) -> FloatArray:
         """Outward bulge of the side face along wobj +x at ``(y, z)`` (broadcast), metres."""
         y_arr, z_arr = np.asarray(y, float), np.asarray(z, float)
         if self.bolt_bulge_m == 0.0 or self.n_layers == 0:
@@ -183,7 +187,7 @@ class StatorGeometry:
             y, z = y[keep], z[keep]
         return np.column_stack([self.side_face_offset_m(y, z), y, z])
 
-    def hole_near(self, y: FloatArray, z: FloatArray) -> NDArray[np.bool_]:
+    def hole_near(self, y: ArrayLike, z: ArrayLike) -> NDArray[np.bool_]:
         """True where side-face point(s) ``(y, z)`` lie inside a slot hole (round, exact)."""
         y_arr, z_arr = np.broadcast_arrays(np.asarray(y, float), np.asarray(z, float))
         if self.n_slots == 0 or self.n_layers == 0:
