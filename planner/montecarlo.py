@@ -39,12 +39,21 @@ from planner.montecarlo_trial import (
     WORKER,
     SimulationSetup,
     TrialResult,
+    default_settings,
     init_worker,
     run_chunk,
 )
 from planner.search_sim import ReachabilityHook, cell_search_hook
 from planner.sensor import ProximitySensor
 from planner.stator import StatorGeometry, build_stator_mesh
+
+__all__ = [
+    "DEFAULT_EDGE_INSET_M",
+    "ValidationReport",
+    "default_pivot",
+    "default_settings",
+    "validate",
+]
 
 FloatArray = NDArray[np.float64]
 log = logging.getLogger(__name__)
@@ -97,7 +106,9 @@ def validate(
         pivot_wobj_m: ``(3,)`` misplacement pivot (default: centroid of the points).
         settings: A-H procedure settings; by default the paper's, with the sensor's analytic
             straight-edge offset (:meth:`ProximitySensor.edge_event_offset_m`) as the known
-            edge-event offset removed from F and H.
+            edge-event offset removed from F and H. Build your own with
+            :func:`default_settings` (``default_settings(sensor, beta1_rad=...)``) to keep that
+            offset: settings with ``edge_event_offset_m = 0`` leave F and H ~6 mm high.
         reachability: optional hook vetting each commanded search (runs in one process).
         cell: optional :class:`planner.cell.Cell` with the part as its work object; each trial
             moves the work object to the true pose and vets every search with

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import trimesh
@@ -31,6 +32,19 @@ FloatArray = NDArray[np.float64]
 
 #: Edge searches run this far inside the face along the sensor axis by default, m.
 DEFAULT_EDGE_INSET_M = 0.003
+
+
+def default_settings(
+    sensor: ProximitySensor, edge_inset_m: float = DEFAULT_EDGE_INSET_M, **kwargs: Any
+) -> StatorSettings:
+    """A-H settings for a simulation: ``kwargs`` (e.g. ``beta1_rad``) plus, unless given, the
+    sensor's analytic straight-edge offset for ``edge_inset_m`` as ``edge_event_offset_m``.
+
+    Without it F and H are taken where the sensor stops detecting, ~6 mm past the edge with the
+    default sensor, and the WOCS z origin is off by as much.
+    """
+    kwargs.setdefault("edge_event_offset_m", sensor.edge_event_offset_m(edge_inset_m))
+    return StatorSettings(**kwargs)
 
 
 @dataclass(frozen=True)
@@ -65,8 +79,7 @@ class SimulationSetup:
 
     def __post_init__(self) -> None:
         if self.settings is None:
-            offset = self.sensor.edge_event_offset_m(self.edge_inset_m)
-            object.__setattr__(self, "settings", StatorSettings(edge_event_offset_m=offset))
+            object.__setattr__(self, "settings", default_settings(self.sensor, self.edge_inset_m))
 
 
 @dataclass(frozen=True)

@@ -45,3 +45,15 @@ def test_failed_probe_is_recorded_with_point_and_reason() -> None:
     res = run_trial(np.random.SeedSequence(1), lambda cmd: "unreachable: joint 5 at limit")
     assert res.failure == "A: unreachable: joint 5 at limit"
     assert np.all(np.isnan(res.delta_procedure)) and np.all(np.isnan(res.delta_best_fit))
+
+
+def test_default_settings_carry_the_sensors_edge_offset() -> None:
+    from calib.stator_procedure import StatorSettings
+    from planner.montecarlo import DEFAULT_EDGE_INSET_M, default_settings
+
+    sensor = ProximitySensor()
+    s = default_settings(sensor, beta1_rad=0.2)
+    assert s.beta1_rad == 0.2
+    assert s.edge_event_offset_m == sensor.edge_event_offset_m(DEFAULT_EDGE_INSET_M) > 0.005
+    assert default_settings(sensor, edge_event_offset_m=0.0) == StatorSettings()
+    assert _setup(stator_ah_points(G)).settings == default_settings(sensor)
