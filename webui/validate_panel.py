@@ -37,6 +37,7 @@ class ValidatePanel:
         self._app = app
         self._worker: CellWorker[None] = CellWorker(None, name="wobjcal-validate")
         self._running = threading.Event()
+        self._start_lock = threading.Lock()
         self.last_report: Any = None
         self.last_markdown = ""
         gui = app.server.gui
@@ -63,13 +64,14 @@ class ValidatePanel:
             InputError: a validation is already running, or the plan is incomplete.
             NotAvailableError: ``planner.montecarlo`` is not available.
         """
-        if self._running.is_set():
-            raise InputError("a validation is already running")
         validation.check_available()
         plan = plan_from_ui(self._app.state.doc)
         validation.check_supported(plan)
         plan_dir = self._app.plan_dir
-        self._running.set()
+        with self._start_lock:  # two tabs may click at once
+            if self._running.is_set():
+                raise InputError("a validation is already running")
+            self._running.set()
         self.button.disabled = True
         self.progress.value = 0.0
         self.progress.visible = True
@@ -90,9 +92,14 @@ class ValidatePanel:
         return fut
 
     def _done(self, fut: Any) -> None:
-        self._running.clear()
-        self.button.disabled = False
-        self.progress.visible = False
+        try:
+            self._show(fut)
+        finally:  # only now is the validation over for whoever watches `running`
+            self.progress.visible = False
+            self.button.disabled = False
+            self._running.clear()
+
+    def _show(self, fut: Any) -> None:
         try:
             summary = fut.result()
         except Exception as exc:

@@ -141,3 +141,17 @@ def test_bad_upload_shows_error_and_changes_nothing(ui: UiSession, tmp_path: Pat
     )
     assert "broken.json" in text
     assert ui.app.state.doc is before
+
+
+def test_second_tab_sees_the_same_session(ui: UiSession, browser: Any) -> None:
+    from ui_helpers import open_page
+
+    other = open_page(browser, ui.app)
+    try:
+        wait_for(lambda: "P1" in other.page.inner_text("body"), what="the plan in tab 2")
+        origin = transform_points(T_WORLD_WOBJ_BOX, [0.0, 0.1, 1.0])
+        ui.app.place_at_ray(origin, T_WORLD_WOBJ_BOX[:3, :3] @ [0, 0, -1.0], point_id="M")
+        wait_for(lambda: "M" in other.page.locator("td").all_inner_texts(), what="M in tab 2")
+        assert len(ui.app.server.get_clients()) >= 2
+    finally:
+        other.page.close()
