@@ -27,11 +27,11 @@ class SensorModel(Strict, frozen=True, kw_only=True):
 
     face_diameter_m: float = 0.018
     sensing_distance_m: float = 0.008
-    decay_length_m: float = 0.003
+    decay_length_m: float = 0.0016
     hysteresis_fraction: float = 0.10
     repeatability_sigma_m: float = 0.00004
     n_rays: int = 256
-    n_scan_rays: int = 37
+    n_scan_rays: int = 19
 
     def __post_init__(self) -> None:
         check_positive(self.face_diameter_m, "face_diameter_m", allow_zero=True)

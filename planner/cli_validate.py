@@ -18,8 +18,6 @@ from calib.plan_procedures import Hultman2013
 from planner.cli_common import read_plan, stderr, stdout
 from planner.plan_io import hultman_points, nominal_T_base_wobj, require
 
-#: Edge searches run this far inside the face (montecarlo's default), m.
-EDGE_INSET_M = 0.002
 #: Built-in work objects validation can simulate, and the StatorGeometry constructor of each.
 SIMULATED_PARTS = {
     "builtin:stator_section": "full_section",
@@ -114,6 +112,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
         )
     plots = require("planner.plots", "validate --plots") if args.plots else None
     mc = require("planner.montecarlo", "validate")
+    edge_inset_m = mc.DEFAULT_EDGE_INSET_M  # edge searches run this far inside the face
     stator = require("planner.stator", "validate")
     sp = require("calib.stator_procedure", "validate")
     geometry = getattr(stator.StatorGeometry, SIMULATED_PARTS[plan.work_object.mesh])()
@@ -127,7 +126,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
     models = _models(plan)
     edge_offset = settings.edge_event_offset_m
     if edge_offset is None:  # the sensor model's straight-edge offset, as montecarlo's default
-        edge_offset = models["sensor"].edge_event_offset_m(EDGE_INSET_M)
+        edge_offset = models["sensor"].edge_event_offset_m(edge_inset_m)
     stator_settings = sp.StatorSettings(
         beta1_rad=settings.beta1_rad,
         p3_height_m=settings.p3_height_m,
@@ -154,7 +153,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
             workers=args.workers,
             progress=lambda done, total: bar.update(task, completed=done, total=total),
             settings=stator_settings,
-            edge_inset_m=EDGE_INSET_M,
+            edge_inset_m=edge_inset_m,
             **models,
         )
     stdout().print(report.to_markdown(), markup=False)
