@@ -157,3 +157,22 @@ def test_mesh_and_urdf_uploads_replace_the_cell(app: WobjcalApp) -> None:
     app.state.undo()
     assert app.state.doc.source is before.source
     np.testing.assert_allclose(app.view.wobj_mesh.extents, [0.6, 0.4, 0.3], atol=1e-9)
+
+
+def test_measurements_upload_draws_calibrated_frame(app: WobjcalApp) -> None:
+    from calib.frames import make_transform
+    from webui.plan_adapter import plan_from_ui
+
+    original = app.plan_dir / "box_plan.json"
+    app.files_panel.upload_plan(original.name, original.read_bytes())  # drop the extra points
+    plan = plan_from_ui(app.state.doc)
+    true = plan.work_object.T_world_wobj.matrix() @ make_transform(None, [0.002, -0.001, 0.0])
+    pts = {p.id: transform_points(true, p.position_m).tolist() for p in plan.points}
+    doc = {"schema": "wobjcal.measurements/1", "frame": "world", "units": "m", "points": pts}
+    out = app.calibrate_panel.calibrate("meas.json", json.dumps(doc).encode())
+    T_world_wobj = plan.cell.robot.T_world_base.matrix() @ out.T_base_wobj
+    np.testing.assert_allclose(T_world_wobj, true, atol=1e-9)
+    assert app.server.scene.get_handle_by_name("/wobj_calibrated") is not None
+    assert "residual" in app.calibrate_panel.result_md.content
+    with pytest.raises(ValueError, match=r"bad\.json"):
+        app.calibrate_panel.calibrate("bad.json", b'{"schema": "wobjcal.measurements/9"}')

@@ -51,7 +51,7 @@ class WobjcalApp:
         plan_dir: Path,
         autosave_path: Path | None = DEFAULT_AUTOSAVE,
     ) -> None:
-        from webui import files_panel, points_panel, validate_panel
+        from webui import calibrate_panel, files_panel, points_panel, validate_panel
 
         self.server = server
         self.plan_dir = Path(plan_dir)
@@ -72,6 +72,7 @@ class WobjcalApp:
         self.points_panel = points_panel.PointsPanel(self)
         self.validate_panel = validate_panel.ValidatePanel(self)
         self.files_panel = files_panel.FilesPanel(self)
+        self.calibrate_panel = calibrate_panel.CalibratePanel(self)
         self.state.subscribe(self._on_change)
         server.on_client_connect(self._on_connect)
         if isinstance(plan.source, Plan):

@@ -8,7 +8,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import msgspec
 import numpy as np
 from numpy.typing import NDArray
 
@@ -72,31 +71,42 @@ def check_supported(plan: Plan) -> None:
 def run_validation(
     plan: Plan, plan_dir: Path, trials: int, progress: Progress
 ) -> ValidationSummary:
-    """Simulate the plan's calibration ``trials`` times with its error models (in-process)."""
+    """Simulate the plan's calibration ``trials`` times with its error models (in-process).
+
+    Mirrors ``wobjcal validate`` (``planner.cli_validate.cmd_validate``): the same models,
+    procedure settings and seed, but one in-process worker (no ``fork()`` of a threaded server).
+    """
     mc = _montecarlo()
     check_supported(plan)
     plan_io = importlib.import_module("planner.plan_io")
     stator = importlib.import_module("planner.stator")
-    sensor_mod = importlib.import_module("planner.sensor")
-    errors = importlib.import_module("planner.error_models")
-    procedure = importlib.import_module("calib.stator_procedure")
-    v = plan.validation
+    sp = importlib.import_module("calib.stator_procedure")
+    cli_validate = importlib.import_module("planner.cli_validate")
+    models = cli_validate._models(plan)  # the plan -> sensor/robot/misplacement mapping
+    edge_inset_m = getattr(mc, "DEFAULT_EDGE_INSET_M", 0.002)
+    settings = plan.procedure
+    edge_offset = getattr(settings, "edge_event_offset_m", None)
+    if edge_offset is None:
+        edge_offset = models["sensor"].edge_event_offset_m(edge_inset_m)
+    stator_settings = sp.StatorSettings(
+        beta1_rad=settings.beta1_rad,  # type: ignore[union-attr]
+        p3_height_m=settings.p3_height_m,  # type: ignore[union-attr]
+        retake_c_d=settings.retake_c_d,  # type: ignore[union-attr]
+        edge_start_from_measured=settings.edge_start_from_measured,  # type: ignore[union-attr]
+        edge_start_offset_m=settings.edge_start_offset_m,  # type: ignore[union-attr]
+        edge_event_offset_m=edge_offset,
+    )
     report = mc.validate(
         plan_io.hultman_points(plan),
         getattr(stator.StatorGeometry, STATOR_MESHES[plan.work_object.mesh])(),
         plan_io.nominal_T_base_wobj(plan),
         int(trials),
-        np.random.default_rng(v.seed),
-        # the plan's error-model structs mirror planner's models field by field
-        sensor=sensor_mod.ProximitySensor(**msgspec.structs.asdict(v.sensor)),
-        robot_error=errors.RobotErrorModel(**msgspec.structs.asdict(v.robot_error)),
-        misplacement=errors.Misplacement(**msgspec.structs.asdict(v.misplacement)),
-        settings=procedure.StatorSettings(
-            beta1_rad=plan.procedure.beta1_rad,  # type: ignore[union-attr]
-            p3_height_m=plan.procedure.p3_height_m,  # type: ignore[union-attr]
-        ),
-        workers=1,  # no fork() of a threaded server process
+        np.random.default_rng(plan.validation.seed),
+        workers=1,
         progress=progress,
+        settings=stator_settings,
+        edge_inset_m=edge_inset_m,
+        **models,
     )
     return summarize(report)
 

@@ -1,0 +1,87 @@
+"""The "Calibrate" panel: upload points measured on the robot, see the calibrated WOCS frame.
+
+Thin over ``planner.plan_calibrate.calibrate_plan`` (what ``wobjcal calibrate`` runs): the
+calibrated frame is drawn beside the nominal one, with the shift and the residual per point.
+"""
+
+from __future__ import annotations
+
+import importlib
+import logging
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from calib.errors import InputError
+from calib.frames import motion_between
+from calib.measurements import measurements_from_json
+from webui.backend import NotAvailableError
+from webui.files_panel import check_upload
+from webui.plan_adapter import plan_from_ui
+
+if TYPE_CHECKING:
+    from webui.app import WobjcalApp
+
+logger = logging.getLogger(__name__)
+
+
+class CalibratePanel:
+    """GUI widgets of the calibration from measured points.
+
+    Args:
+        app: the app whose plan the measurements belong to.
+    """
+
+    def __init__(self, app: WobjcalApp) -> None:
+        self._app = app
+        self.last_output: Any = None
+        gui = app.server.gui
+        with gui.add_folder("Calibrate", expand_by_default=False):
+            self.upload = gui.add_upload_button("Upload measurements (.json)", mime_type=".json")
+            self.result_md = gui.add_markdown(
+                "Upload a `wobjcal.measurements/1` file to compute the calibrated frame."
+            )
+        self.upload.on_upload(self._on_upload)
+
+    def _on_upload(self, event: Any) -> None:
+        f = event.target.value
+        try:
+            self.calibrate(f.name, f.content)
+        except (InputError, NotAvailableError) as exc:
+            self._app.notify("Not calibrated", str(exc), client=event.client)
+        except Exception as exc:  # never a traceback in the browser
+            logger.exception("calibration failed")
+            self._app.notify("Not calibrated", f"{type(exc).__name__}: {exc}", client=event.client)
+
+    def calibrate(self, name: str, content: bytes) -> Any:
+        """Calibrate the session plan with uploaded measurements; draw and describe the result."""
+        check_upload(name, content, (".json",), "measurements file")
+        try:
+            text = content.decode("utf-8")
+        except UnicodeDecodeError:
+            raise InputError(f"{name}: not UTF-8 text, so not a measurements file") from None
+        measurements = measurements_from_json(text, source=name)
+        plan = plan_from_ui(self._app.state.doc)
+        try:
+            mod = importlib.import_module("planner.plan_calibrate")
+        except ImportError as exc:
+            raise NotAvailableError(f"calibration is not available yet ({exc})") from None
+        out = mod.calibrate_plan(plan, measurements)
+        self.last_output = out
+        T_world_base = plan.cell.robot.T_world_base.matrix()
+        self._app.scene.draw_calibrated_frame(T_world_base @ out.T_base_wobj)
+        delta = motion_between(out.T_base_wobj_nominal, out.T_base_wobj)
+        rows = [
+            f"**{out.method}** with {len(out.used_ids)} points",
+            "",
+            f"shift from nominal: {np.round(delta[:3] * 1000.0, 3).tolist()} mm, "
+            f"{np.round(np.degrees(delta[3:]), 4).tolist()} deg (wobj axes)",
+            "",
+            "| point | residual (mm) |",
+            "|---|---|",
+        ]
+        for pid, r in out.residuals_m.items():
+            rows.append(f"| {pid} | {r * 1000.0:+.3f} |")
+        self.result_md.content = "\n".join(rows)
+        self._app.notify("Calibrated", f"{name}: calibrated frame drawn", error=False)
+        return out
