@@ -49,10 +49,11 @@ def test_screenshot_of_demo_cell(demo: UiSession) -> None:
     demo.page.add_style_tag(content=".mantine-Notification-root { display: none !important; }")
     client = demo.client()
     client.camera.up_direction = (0.0, 0.0, 1.0)
-    client.camera.position = (-0.5, -1.9, 2.3)
-    client.camera.look_at = (1.0, -0.2, 0.85)
+    client.camera.fov = 0.8
+    client.camera.position = (0.3, -2.6, 2.1)
+    client.camera.look_at = (0.95, -0.15, 0.85)
     client.flush()
-    demo.app.select("C")
+    demo.app.select("F")  # the robot at F's probe pose, at the start of its edge search
     time.sleep(3.0)  # let SwiftShader render the new view
     ARTIFACT.parent.mkdir(parents=True, exist_ok=True)
     demo.page.screenshot(path=str(ARTIFACT))
