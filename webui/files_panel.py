@@ -75,7 +75,13 @@ class FilesPanel:
         self.urdf_upload.on_upload(lambda ev: self._guard(ev, self.upload_urdf))
         self.download.on_click(lambda ev: self._guard(ev, self.download_plan, ev.client))
         for fmt, button in self.export_buttons.items():
-            button.on_click(lambda ev, f=fmt: self._guard(ev, self.download_export, ev.client, f))
+            button.on_click(self._export_callback(fmt))
+
+    def _export_callback(self, fmt: str) -> Any:
+        def callback(event: Any) -> None:
+            self._guard(event, self.download_export, event.client, fmt)
+
+        return callback
 
     def _guard(self, event: Any, fn: Any, *args: Any) -> None:
         client = getattr(event, "client", None)

@@ -129,7 +129,8 @@ class PointsPanel:
             self.start_mm.value = round(s.start_offset_m * 1000.0, 3)
             self.over_mm.value = round(s.overtravel_m * 1000.0, 3)
             if s.edge_direction is not None:
-                self.edge_dir.value = tuple(round(v, 4) for v in s.edge_direction)
+                dx, dy, dz = (round(v, 4) for v in s.edge_direction)
+                self.edge_dir.value = (dx, dy, dz)
 
     def _update_gizmo(self) -> None:
         sel = self._app.selected

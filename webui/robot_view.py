@@ -30,6 +30,8 @@ class RobotView:
         self._server = server
         self._view = view
         server.scene.add_frame("/robot", show_axes=False, **pose_kwargs(view.T_world_base))
+        if view.robot_urdf is None:
+            raise ValueError("the cell has no robot URDF to draw")
         self._urdf = ViserUrdf(server, Path(view.robot_urdf), root_node_name="/robot/urdf")
         self._tool: ViserUrdf | None = None
         self._tool_frame: viser.FrameHandle | None = None
@@ -37,8 +39,7 @@ class RobotView:
             self._tool_frame = server.scene.add_frame("/tool", show_axes=False)
             if view.tool_urdf is not None:
                 self._tool = ViserUrdf(server, Path(view.tool_urdf), root_node_name="/tool/urdf")
-            else:
-                mesh = view.tool_mesh
+            elif (mesh := view.tool_mesh) is not None:
                 server.scene.add_mesh_simple(
                     "/tool/mesh",
                     np.asarray(mesh.vertices, np.float32),

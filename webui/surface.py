@@ -8,6 +8,7 @@ installed (about a millisecond on a 100,000-triangle mesh), else trimesh's pure-
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import trimesh
@@ -105,7 +106,7 @@ class SurfacePicker:
         return self.project(p)
 
 
-def _make_intersector(mesh: trimesh.Trimesh) -> object:
+def _make_intersector(mesh: trimesh.Trimesh) -> Any:
     try:
         from trimesh.ray.ray_pyembree import RayMeshIntersector
 

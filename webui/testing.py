@@ -61,11 +61,19 @@ def dense_box_mesh(n_triangles: int) -> trimesh.Trimesh:
                 faces = faces[:, ::-1]
             grid = trimesh.Trimesh(verts, faces, process=False)
             parts.append(grid)
-    mesh = trimesh.util.concatenate(parts)
+    mesh = trimesh.Trimesh(*_stack(parts), process=False)
     mesh.merge_vertices()
     mesh.apply_scale(BOX_EXTENTS)
     mesh.apply_translation((0.0, 0.0, -BOX_EXTENTS[2] / 2))
     return mesh
+
+
+def _stack(parts: list[trimesh.Trimesh]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """Vertices and faces of several meshes as one."""
+    offsets = np.cumsum([0] + [len(p.vertices) for p in parts[:-1]])
+    verts = np.vstack([p.vertices for p in parts])
+    faces = np.vstack([p.faces + k for p, k in zip(parts, offsets, strict=True)])
+    return verts, faces
 
 
 def box_plan(folder: Path, n_triangles: int | None = None, name: str = "box_plan") -> Path:
