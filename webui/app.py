@@ -154,12 +154,13 @@ class WobjcalApp:
         with self._lock:
             for pid in [*changed, *(set(before) - set(change.doc.ids))]:
                 self._checks.pop(pid, None)
-        self._redraw(changed)  # grey "pending" markers until the check is back
-        self.recheck(changed)
+        if len(changed) > 2 or not changed:  # grey "pending" markers for bulk changes
+            self._redraw(changed)
+        self.recheck(changed)  # draws the changed points (one round trip per click)
         if self.selected is not None and self.selected not in change.doc.ids:
             self.select(None)
         elif self.selected in changed:
-            self.select(self.selected)
+            self._show_selected()
 
     def show_reachability(self, n_samples: int = 120) -> None:
         """Start the reachability heat map (computed in chunks on the cell worker)."""
@@ -206,12 +207,17 @@ class WobjcalApp:
     def select(self, point_id: str | None) -> None:
         """Select a point: highlight it and show the robot at its probe pose."""
         previous, self.selected = self.selected, point_id
+        ids = self.state.doc.ids
+        self._redraw([i for i in (previous, point_id) if i is not None and i in ids])
+        self._show_selected()
+
+    def _show_selected(self) -> None:
+        """Robot at the selected point's probe pose; its settings in the panel."""
+        point_id = self.selected
         check = None if point_id is None else self.check_of(point_id)
         if self.robot is not None and check is not None and check.q is not None:
             self.robot.stop()
             self.robot.set_q(check.q)
-        ids = self.state.doc.ids
-        self._redraw([i for i in (previous, point_id) if i is not None and i in ids])
         self.points_panel.on_select(point_id)
 
     def _on_mesh_click(self, event: Any) -> None:

@@ -23,6 +23,12 @@ NEXT = "next"
 NONE = "(none)"
 
 
+def _set_options(dropdown: Any, options: tuple[str, ...]) -> None:
+    """Send new dropdown options only when they changed (each update re-renders the panel)."""
+    if tuple(dropdown.options) != options:
+        dropdown.options = options
+
+
 class PointsPanel:
     """GUI widgets for placing, selecting, editing and inspecting points (shared by all tabs).
 
@@ -98,9 +104,9 @@ class PointsPanel:
         checks = self._app.checks()
         with self._programmatic():
             extra = tuple(i for i in doc.ids if i not in PAPER_IDS)
-            self.place.options = (NEXT, *PAPER_IDS, *extra)
-            self.selected.options = (NONE, *doc.ids)
-            self.role.options = doc.roles or PAPER_IDS
+            _set_options(self.place, (NEXT, *PAPER_IDS, *extra))
+            _set_options(self.selected, (NONE, *doc.ids))
+            _set_options(self.role, doc.roles or PAPER_IDS)
             sel = self._app.selected
             self.selected.value = sel if sel in doc.ids else NONE
         rows = ["| point | role | status | reason |", "|---|---|---|---|"]
@@ -111,7 +117,9 @@ class PointsPanel:
             rows.append(f"| {p.id} | {p.role} | {status} | {reason} |")
         if not doc.points:
             rows.append("| - | - | no points yet | |")
-        self.status_md.content = "\n".join(rows)
+        content = "\n".join(rows)
+        if self.status_md.content != content:
+            self.status_md.content = content
         self._update_gizmo()
 
     def on_select(self, point_id: str | None) -> None:
