@@ -176,3 +176,12 @@ def test_measurements_upload_draws_calibrated_frame(app: WobjcalApp) -> None:
     assert "residual" in app.calibrate_panel.result_md.content
     with pytest.raises(ValueError, match=r"bad\.json"):
         app.calibrate_panel.calibrate("bad.json", b'{"schema": "wobjcal.measurements/9"}')
+
+
+def test_play_search_path_ends_at_its_last_pose(app: WobjcalApp) -> None:
+    check = app.place_at_ray(*_ray_to([0.0, -0.05, 0.0]), point_id="PL")
+    if check is None or check.q_path is None or app.robot is None:
+        pytest.skip("no search path computed (feasibility not available)")
+    app.robot.play(check.q_path, duration_s=0.2)
+    assert app.robot.wait(5.0)
+    np.testing.assert_allclose(app.robot.q, check.q_path[-1])

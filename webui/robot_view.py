@@ -103,6 +103,14 @@ class RobotView:
         self._play_thread = threading.Thread(target=run, name="wobjcal-play", daemon=True)
         self._play_thread.start()
 
+    def wait(self, timeout: float | None = None) -> bool:
+        """Wait for a running animation to end; True when none is running any more."""
+        thread = self._play_thread
+        if thread is not None:
+            thread.join(timeout)
+            return not thread.is_alive()
+        return True
+
     def stop(self) -> None:
         """Stop a running animation."""
         self._play_stop.set()
