@@ -124,85 +124,189 @@ def opw_ik(p: OPWParameters, T_opw_ee: FloatArray) -> tuple[FloatArray, BoolArra
     Branch ``k`` has bits ``4 = shoulder back``, ``2 = second elbow solution``,
     ``1 = flipped wrist`` (the geometric meaning of each is in
     :mod:`planner.kinematics.branches`). Written out element by element (no batched 3x3
-    products): about a microsecond per pose for all 8 branches.
+    products): well under a microsecond per pose for all 8 branches.
 
     Returns:
         ``q (N, 8, 6)`` robot joint values wrapped to ``[-pi, pi]`` (NaN where not reachable)
-        (a view of a joint-major array) and ``reachable (N, 8)``: the branch exists (joint limits
-        are not checked here). At a wrist singularity
+        (a view of a branch-major array) and ``reachable (N, 8)``: the branch exists (joint
+        limits are not checked here). At a wrist singularity
         (``theta5 = 0``) ``theta4 = 0`` and ``theta6`` takes the whole rotation.
     """
     T = np.asarray(T_opw_ee, dtype=np.float64)
     N = T.shape[0]
-    flat = np.ascontiguousarray(T.reshape(N, 16).T)  # (16, N): contiguous rows per entry
-    r = [[flat[4 * i + j] for j in range(3)] for i in range(3)]  # R entries, (N,) each
-    Cx, Cy, Cz = (flat[4 * i + 3] - p.c4 * r[i][2] for i in range(3))  # wrist centre
-    r2 = Cx * Cx + Cy * Cy
-    rho = np.sqrt(np.maximum(r2 - p.b**2, 0.0))  # |x1| of the wrist centre in the arm plane
-    phi, lam = np.arctan2(Cy, Cx), np.arctan2(p.b, rho)
+    q, ok8 = opw_ik_entries(p, np.ascontiguousarray(T.reshape(N, 16).T))
+    np.copyto(q, np.nan, where=~ok8[..., None])
+    return q.transpose(1, 0, 2), np.ascontiguousarray(ok8.T)
+
+
+def opw_ik_entries(p: OPWParameters, entries: FloatArray) -> tuple[FloatArray, BoolArray]:
+    """:func:`opw_ik` of poses given entry-major: ``entries[4 i + j]`` is ``T[:, i, j]``, (16, N).
+
+    The layout the arithmetic wants (each matrix entry contiguous). Bit for bit the same joint
+    values as :func:`opw_ik`.
+
+    Returns:
+        ``q (8, N, 6)``: branch-major rows of joint values (branch
+        ``4 * shoulder + 2 * elbow + wrist``), any finite value where not reachable, and
+        ``reachable (8, N)``.
+    """
+    arm = opw_arm(p, entries)
+    N = entries.shape[1]
+    c1, s1 = np.cos(arm.t1)[:, None], np.sin(arm.t1)[:, None]
+    t23 = arm.t2 + arm.t3
+    r = [[entries[4 * i + j] for j in range(3)] for i in range(3)]
+    t4, t5, t6 = wrist_angles(r, c1, s1, np.cos(t23), np.sin(t23))
+    sc, off = p.sign_corrections, p.offsets
+    out = np.empty((2, 2, 2, N, 6))  # shoulder, elbow, wrist, pose, joint
+    tmp = np.empty((2, 2, N))
+    to_q(arm.t1[:, None], sc[0], off[0], tmp[:, :1])
+    out[..., 0] = tmp[:, :1, None]
+    for j, t in ((1, arm.t2), (2, arm.t3)):
+        to_q(t, sc[j], off[j], tmp)
+        out[..., j] = tmp[:, :, None]
+    for w in (0, 1):
+        for j, t in zip((3, 4, 5), flip_wrist(t4, t5, t6) if w else (t4, t5, t6)):
+            to_q(t, sc[j], off[j], tmp)
+            out[:, :, w, :, j] = tmp
+    ok8 = np.empty((2, 2, 2, N), dtype=bool)
+    ok8[:] = arm.ok[:, None, None, :]
+    return out.reshape(8, N, 6), ok8.reshape(8, N)
+
+
+@dataclass(frozen=True)
+class ArmAngles:
+    """Model angles of the arm (axes 1-3) of ``N`` poses, all 4 arm solutions.
+
+    Attributes:
+        t1: ``(2, N)`` theta1, rad: shoulder front, back.
+        t2, t3: ``(2, 2, N)`` theta2, theta3, rad: shoulder, elbow (+acos, -acos).
+        ok: ``(2, N)`` the wrist centre is reachable with that shoulder (both elbows).
+    """
+
+    t1: FloatArray
+    t2: FloatArray
+    t3: FloatArray
+    ok: BoolArray
+
+
+def opw_arm(p: OPWParameters, entries: FloatArray) -> ArmAngles:
+    """The arm part of the IK: axes 1-3 from the wrist centre, entries ``(16, N)`` as in
+    :func:`opw_ik_entries`."""
+    N = entries.shape[1]
+    Cx, Cy, Cz = (entries[4 * i + 3] - p.c4 * entries[4 * i + 2] for i in range(3))
+    r2 = Cx * Cx
+    r2 += Cy * Cy
+    rho = np.maximum(r2 - p.b**2, 0.0)
+    np.sqrt(rho, out=rho)  # |x1| of the wrist centre in the arm plane
+    phi = np.arctan2(Cy, Cx)
     # shoulder front (row 0) and back (row 1): theta1, arm-plane x and z of the wrist centre
-    t1 = np.stack([phi - lam, phi + lam - np.pi])  # (2, N)
-    x = np.stack([rho - p.a1, -rho - p.a1])
+    t1 = np.empty((2, N))
+    if p.b == 0.0:  # atan2(0, rho >= 0) is 0: skip it, same values
+        t1[0] = phi
+        np.subtract(phi, np.pi, out=t1[1])
+    else:
+        lam = np.arctan2(p.b, rho)
+        np.subtract(phi, lam, out=t1[0])
+        np.add(phi, lam, out=t1[1])
+        t1[1] -= np.pi
+    x = np.empty((2, N))
+    np.subtract(rho, p.a1, out=x[0])
+    np.negative(rho, out=x[1])
+    x[1] -= p.a1
     z = Cz - p.c1
     k2 = p.a2**2 + p.c3**2
     k, psi3 = np.sqrt(k2), np.arctan2(p.a2, p.c3)
-    D = (x * x + z * z - p.c2**2 - k2) / (2.0 * p.c2 * k)  # cos(theta3 + psi3)
+    D = x * x
+    D += z * z
+    D -= p.c2**2
+    D -= k2
+    D /= 2.0 * p.c2 * k  # cos(theta3 + psi3), (2, N)
     # clipping |D| <= 1 + 1e-14 moves the wrist centre by < 1e-11 m, so no round trip is needed
-    ok2 = (r2 - p.b**2 >= -1e-18) & (np.abs(D) <= 1.0 + 1e-14)
-    Dc = np.clip(D, -1.0, 1.0)
+    ok2 = np.abs(D) <= 1.0 + 1e-14
+    ok2 &= r2 - p.b**2 >= -1e-18
+    Dc = np.clip(D, -1.0, 1.0, out=D)
     acos_d = np.arccos(Dc)
-    sin_b = np.sqrt(1.0 - Dc * Dc)
-    gamma = np.arctan2(x, z)
-    # arm solutions (4, N): (front, elbow 0), (front, elbow 1), (back, elbow 0), (back, elbow 1)
-    beta = np.stack([acos_d[0], -acos_d[0], acos_d[1], -acos_d[1]])  # theta3 + psi3
-    t2 = np.repeat(gamma, 2, axis=0) - np.arctan2(
-        k * sin_b[[0, 0, 1, 1]] * np.array([1.0, -1.0, 1.0, -1.0])[:, None],
-        p.c2 + k * Dc[[0, 0, 1, 1]],
-    )
-    t3 = beta - psi3
-    t23 = t2 + t3
-    t1_4 = t1[[0, 0, 1, 1]]
-    ok = ok2[[0, 0, 1, 1]]
-    c1, s1 = np.cos(t1), np.sin(t1)
-    t4, t5, t6 = _wrist(r, c1[[0, 0, 1, 1]], s1[[0, 0, 1, 1]], np.cos(t23), np.sin(t23))
-    sc, off = p.sign_corrections, p.offsets
-    out = np.empty((6, 4, 2, N))  # joint-major: contiguous writes
-    for j, t in enumerate((t1_4, t2, t3)):
-        out[j] = wrap_angle(sc[j] * (t + off[j]))[:, None, :]
-    for j, t, t_flip in ((3, t4, t4 + np.pi), (4, t5, -t5), (5, t6, t6 + np.pi)):
-        out[j, :, 0] = wrap_angle(sc[j] * (t + off[j]))
-        out[j, :, 1] = wrap_angle(sc[j] * (t_flip + off[j]))
-    ok8 = np.repeat(ok, 2, axis=0)  # (8, N)
-    q = out.reshape(6, 8, N)
-    np.copyto(q, np.nan, where=~ok8[None])
-    return q.transpose(2, 1, 0), np.ascontiguousarray(ok8.T)
+    sin_b = Dc * Dc
+    np.subtract(1.0, sin_b, out=sin_b)
+    np.sqrt(sin_b, out=sin_b)
+    sin_b *= k
+    # arm solutions (2, 2, N): shoulder (front, back) x elbow (+acos, -acos)
+    den = Dc * k
+    den += p.c2
+    t2 = np.empty((2, 2, N))
+    np.arctan2(sin_b, den, out=t2[:, 0])
+    np.negative(sin_b, out=sin_b)
+    np.arctan2(sin_b, den, out=t2[:, 1])
+    np.subtract(np.arctan2(x, z)[:, None], t2, out=t2)  # gamma - atan2(+-k sin b, c2 + k cos b)
+    t3 = np.empty((2, 2, N))
+    np.subtract(acos_d, psi3, out=t3[:, 0])
+    np.negative(acos_d, out=t3[:, 1])
+    t3[:, 1] -= psi3
+    return ArmAngles(t1, t2, t3, ok2)
 
 
-def _wrist(
+def flip_wrist(
+    t4: FloatArray, t5: FloatArray, t6: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The other wrist solution ``(t4 + pi, -t5, t6 + pi)``, computed in the arrays given."""
+    t4 += np.pi
+    np.negative(t5, out=t5)
+    t6 += np.pi
+    return t4, t5, t6
+
+
+def to_q(theta: FloatArray, sign: float, offset: float, out: FloatArray) -> None:
+    """``out[...] = wrap_angle(sign * (theta + offset))``, computed in ``out``."""
+    np.add(theta, offset, out=out)
+    out *= sign
+    tmp = out * (0.5 / np.pi)
+    np.rint(tmp, out=tmp)
+    tmp *= 2.0 * np.pi
+    out -= tmp
+
+
+def wrist_angles(
     r: list[list[FloatArray]], c1: FloatArray, s1: FloatArray, c23: FloatArray, s23: FloatArray
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """ZYZ angles ``(theta4, theta5 >= 0, theta6)`` of ``M = (Rz(t1) Ry(t23))^T R``.
 
     ``r[i][j]`` are the entries of ``R``; columns of ``Rz(t1) Ry(t23)`` are
-    ``(c1 c23, s1 c23, -s23)``, ``(-s1, c1, 0)``, ``(c1 s23, s1 s23, c23)``.
+    ``(c1 c23, s1 c23, -s23)``, ``(-s1, c1, 0)``, ``(c1 s23, s1 s23, c23)``. ``c1, s1`` are
+    ``(2, 1, N)`` (shoulder), ``c23, s23`` ``(2, 2, N)``: row 1 of ``M`` is computed per
+    shoulder only. The returned arrays are new and may be modified.
     """
     c1c23, s1c23, c1s23, s1s23 = c1 * c23, s1 * c23, c1 * s23, s1 * s23
+    neg_s1 = -s1
+    tmp = np.empty_like(c23)
 
     def row(i: int, j: int) -> FloatArray:
-        if i == 0:
-            return c1c23 * r[0][j] + s1c23 * r[1][j] - s23 * r[2][j]
+        # the same operations, in the same order, as c1c23 * r0 + s1c23 * r1 - s23 * r2 etc.
         if i == 1:
-            return -s1 * r[0][j] + c1 * r[1][j]
-        return c1s23 * r[0][j] + s1s23 * r[1][j] + c23 * r[2][j]
+            m = neg_s1 * r[0][j]
+            m += c1 * r[1][j]
+            return m
+        a, b, c = (c1c23, s1c23, s23) if i == 0 else (c1s23, s1s23, c23)
+        m = a * r[0][j]
+        np.multiply(b, r[1][j], out=tmp)
+        m += tmp
+        np.multiply(c, r[2][j], out=tmp)
+        if i == 0:
+            m -= tmp
+        else:
+            m += tmp
+        return m
 
     m02, m12, m22 = row(0, 2), row(1, 2), row(2, 2)
     s5 = np.hypot(m02, m12)
     t5 = np.arctan2(s5, m22)
     singular = s5 < WRIST_SINGULAR_SIN
-    t4 = np.where(singular, 0.0, np.arctan2(m12, m02))
-    t6 = np.arctan2(row(2, 1), -row(2, 0))
+    t4 = np.arctan2(m12, m02)
+    m20 = row(2, 0)
+    np.negative(m20, out=m20)
+    t6 = np.arctan2(row(2, 1), m20)
     if np.any(singular):
         # theta5 = 0: M = Rz(t4 + t6); theta5 = pi: M = Rz(t4) Ry(pi) Rz(t6), t6 - t4 from M01, M11
+        t4[singular] = 0.0
         t6_sing = np.where(
             m22 > 0,
             np.arctan2(row(1, 0), row(0, 0)),

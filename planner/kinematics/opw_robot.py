@@ -7,17 +7,22 @@ URDF base, the OPW end frame on axis 6, and both constant transforms are derived
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
 
 from calib.frames import invert_transform
 from planner.kinematics.opw import OPWParameters, opw_fk, opw_ik
+from planner.kinematics.opw_limited import opw_ik_within
+from planner.kinematics.packing import JointLimits, assemble, select_rows
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
+
+#: Poses per batch in :meth:`OPWRobot.solve`: its temporaries then fit the CPU cache.
+CHUNK = 4096
 
 
 @dataclass(frozen=True, eq=False)
@@ -60,72 +65,81 @@ class OPWRobot:
 
         Joint limits are not applied; unreachable branches hold NaN.
         """
-        T = np.asarray(T_base_tip, dtype=np.float64)
-        if not np.array_equal(self.T_base_opw, np.eye(4)):
-            T = invert_transform(self.T_base_opw) @ T
-        if not np.array_equal(self.T_ee_tip, np.eye(4)):
-            T = T @ invert_transform(self.T_ee_tip)
-        return opw_ik(self.params, T)
+        return opw_ik(self.params, self._to_opw(np.asarray(T_base_tip, dtype=np.float64)))
 
-    def solve(self, T_base_tip: FloatArray) -> tuple[FloatArray, BoolArray, NDArray[np.int_]]:
+    def solve(
+        self,
+        T_base_tip: FloatArray,
+        config_codes: bool = False,
+        min_k: int = 8,
+        entries: FloatArray | None = None,
+    ) -> tuple[FloatArray, BoolArray, NDArray[np.int_]]:
         """All solutions within joint limits, including the 2*pi variants (see :meth:`expand`).
+
+        Bit for bit the result of ``expand(*ik_branches(T))``, computed faster: the wrist is
+        solved only for arm solutions within the limits of axes 1-3
+        (:func:`planner.kinematics.opw_limited.opw_ik_within`), in batches of ``CHUNK`` poses
+        so that the temporaries stay in the CPU cache.
 
         Args:
             T_base_tip: ``(N, 4, 4)`` tip poses in the base frame.
+            config_codes: ``branch`` holds configuration codes ``(b & 6) + (axis 5 < 0)``
+                (see :class:`planner.kinematics.solver.IKSolutions`) instead of branch indices.
+            min_k: the smallest ``K`` returned.
+            entries: ``T_base_tip`` entry-major, ``(16, N)`` (row ``4 i + j`` is
+                ``T[:, i, j]``), when the caller has it already.
         """
-        return self.expand(*self.ik_branches(T_base_tip))
+        T = np.asarray(T_base_tip, dtype=np.float64)
+        parts = []
+        for s in range(0, T.shape[0], CHUNK):
+            if entries is not None and self._at_base:
+                e = entries[:, s : s + CHUNK]
+            else:
+                Tc = self._to_opw(T[s : s + CHUNK])
+                e = np.ascontiguousarray(Tc.reshape(-1, 16).T)
+            parts.append(opw_ik_within(self.params, e, self._limits, config_codes))
+        return assemble(parts, min_k)
 
     def expand(
-        self, q8: FloatArray, ok8: BoolArray, min_k: int = 8
+        self, q8: FloatArray, ok8: BoolArray, min_k: int = 8, config_codes: bool = False
     ) -> tuple[FloatArray, BoolArray, NDArray[np.int_]]:
         """Add the 2*pi variants to branches ``q8 (N, 8, 6)``, apply the limits, pack the result.
 
         Joints whose limits lie within ``[-pi, pi]`` are checked as they are; the others are
         moved to their lowest value ``>= lower`` (modulo 2*pi) and ``turn_counts`` values
-        ``+ 2*pi*i`` are tried.
+        ``+ 2*pi*i`` are tried (:mod:`planner.kinematics.packing`).
 
         Returns:
             ``q (N, K, 6)``: each pose's valid solutions first, ordered by OPW branch then by
             variant, NaN after them; ``K = max(min_k, most solutions of any pose)``.
             ``valid (N, K)``: reachable and within the joint limits.
-            ``branch (N, K)``: the OPW branch index 0-7 of each solution, -1 where not valid.
+            ``branch (N, K)``: the OPW branch index 0-7 of each solution (or with
+            ``config_codes`` its configuration code), -1 where not valid.
         """
-        counts = self.turn_counts
-        combos = np.array(list(itertools.product(*(range(m) for m in counts))), dtype=int)
-        N, V = q8.shape[0], combos.shape[0]
-        base = np.ascontiguousarray(np.transpose(q8, (2, 1, 0)))  # (6, 8, N), no copy from opw_ik
-        inside = np.ascontiguousarray(ok8.T)  # (8, N): reachable and simple joints in limits
-        multi: list[tuple[int, FloatArray, NDArray[np.bool_]]] = []  # (joint, q_lo, ok (m,8,N))
-        two_pi = 2.0 * np.pi
-        with np.errstate(invalid="ignore"):
-            for j, (lo, hi) in enumerate(zip(self.lower, self.upper)):
-                qj = base[j]
-                if not (np.isfinite(lo) and np.isfinite(hi)):
-                    continue
-                if counts[j] == 1 and lo >= -np.pi and hi <= np.pi:
-                    inside &= (qj >= lo - 1e-12) & (qj <= hi + 1e-12)
-                    continue
-                q_lo = qj - two_pi * np.floor((qj - lo + 1e-12) * (1.0 / two_pi))
-                ok_m = np.stack([q_lo + two_pi * i <= hi + 1e-12 for i in range(counts[j])])
-                multi.append((j, q_lo, ok_m))
-        full = np.broadcast_to(inside[:, None, :], (8, V, N))
-        for j, _, ok_m in multi:
-            full = full & ok_m[combos[:, j]].transpose(1, 0, 2)  # (8, V, N)
-        flat = np.ascontiguousarray(np.transpose(full, (2, 0, 1))).reshape(N, 8 * V)
-        n_idx, kv = np.nonzero(flat)  # row-major: per pose, by branch then variant
-        b_idx, v_idx = kv // V, kv % V
-        per_pose = np.count_nonzero(flat, axis=1)
-        K = max(min_k, int(per_pose.max()) if N else 0)
-        rank = np.arange(n_idx.size) - np.repeat(np.cumsum(per_pose) - per_pose, per_pose)
-        src = b_idx * N + n_idx  # index into a (8, N) plane
-        dest = n_idx * K + rank  # index into an (N, K) plane
-        q = np.full((N * K, 6), np.nan)
-        for j in range(6):
-            q[dest, j] = base[j].ravel()[src]
-        for j, q_lo, _ in multi:
-            q[dest, j] = q_lo.ravel()[src] + two_pi * combos[v_idx, j]
-        valid = np.zeros(N * K, dtype=bool)
-        valid[dest] = True
-        branch = np.full(N * K, -1, dtype=int)
-        branch[dest] = b_idx
-        return q.reshape(N, K, 6), valid.reshape(N, K), branch.reshape(N, K)
+        N = q8.shape[0]
+        rows = np.array(q8, dtype=np.float64).reshape(8 * N, 6)  # select_rows overwrites both
+        inside = np.array(ok8, dtype=bool).reshape(8 * N)
+        pose = np.repeat(np.arange(N), 8)
+        branch = np.tile(np.arange(8), N)
+        sel = select_rows(self._limits, rows, inside, pose, branch, N, config_codes)
+        return assemble([sel], min_k)
+
+    def _to_opw(self, T_base_tip: FloatArray) -> FloatArray:
+        """``T_opw_ee (N, 4, 4)`` of tip poses in the base frame."""
+        T = T_base_tip
+        if not np.array_equal(self.T_base_opw, np.eye(4)):
+            T = invert_transform(self.T_base_opw) @ T
+        if not np.array_equal(self.T_ee_tip, np.eye(4)):
+            T = T @ invert_transform(self.T_ee_tip)
+        return T
+
+    @cached_property
+    def _at_base(self) -> bool:
+        """The OPW frame is the base frame and the end frame is the tip (no transforms)."""
+        return bool(
+            np.array_equal(self.T_base_opw, np.eye(4)) and np.array_equal(self.T_ee_tip, np.eye(4))
+        )
+
+    @cached_property
+    def _limits(self) -> JointLimits:
+        return JointLimits.of(self.lower, self.upper, self.turn_counts)

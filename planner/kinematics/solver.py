@@ -76,42 +76,58 @@ class IKSolutions:
 def check_poses(value: ArrayLike, name: str, tol: float = 1e-6) -> FloatArray:
     """``value`` as ``(N, 4, 4)`` rigid transforms (a single ``(4, 4)`` becomes ``(1, 4, 4)``).
 
-    The same checks as :func:`calib.frames.check_transform`, written element-wise for speed
-    (the IK handles about a million poses per second).
+    The same checks as :func:`calib.frames.check_transform`, written element-wise over the
+    sixteen matrix entries for speed (the IK handles over a million poses per second).
 
     Raises:
         ShapeError: not ``(N, 4, 4)`` or ``(4, 4)``, or the last row is not ``(0, 0, 0, 1)``.
         NonFiniteError: NaN or infinity.
         DegenerateGeometryError: a rotation part is not orthonormal with determinant +1.
     """
+    return check_pose_entries(value, name, tol)[0]
+
+
+def check_pose_entries(
+    value: ArrayLike, name: str, tol: float = 1e-6
+) -> tuple[FloatArray, FloatArray]:
+    """:func:`check_poses`, also returning the entries: ``e[4 i + j]`` is ``T[:, i, j]``."""
     T = as_float_array(value, name)
     if T.ndim == 2:
         T = T[None]
     if T.ndim != 3 or T.shape[1:] != (4, 4):
         raise ShapeError(f"{name} must be (N, 4, 4) or (4, 4), got shape {np.shape(value)}")
     check_finite(T, name)
-    if np.abs(T[:, 3] - (0.0, 0.0, 0.0, 1.0)).max(initial=0.0) > tol:
+    e = np.ascontiguousarray(T.reshape(-1, 16).T)
+    last = max(
+        (float(np.abs(e[12 + j] - (j == 3)).max(initial=0.0)) for j in range(4)), default=0.0
+    )
+    if last > tol:
         raise ShapeError(f"{name} last row must be (0, 0, 0, 1)")
-    c0, c1, c2 = T[:, :3, 0], T[:, :3, 1], T[:, :3, 2]
-    dots = [
-        np.einsum("ni,ni->n", a, b) - e
-        for a, b, e in (
-            (c0, c0, 1),
-            (c1, c1, 1),
-            (c2, c2, 1),
-            (c0, c1, 0),
-            (c0, c2, 0),
-            (c1, c2, 0),
-        )
-    ]
-    worst = max((float(np.abs(d).max(initial=0.0)) for d in dots), default=0.0)
+    c0, c1, c2 = e[0:12:4], e[1:12:4], e[2:12:4]  # the rotation's columns, (3, N) each
+    worst = 0.0
+    for a, b, target in (
+        (c0, c0, 1.0),
+        (c1, c1, 1.0),
+        (c2, c2, 1.0),
+        (c0, c1, 0.0),
+        (c0, c2, 0.0),
+        (c1, c2, 0.0),
+    ):
+        d = a[0] * b[0]
+        d += a[1] * b[1]
+        d += a[2] * b[2]
+        d -= target
+        worst = max(worst, float(np.abs(d).max(initial=0.0)))
     if worst > tol:
         raise DegenerateGeometryError(
             f"{name} rotation part is not orthonormal (max |R^T R - I| = {worst:.3g})"
         )
-    if np.any(np.einsum("ni,ni->n", np.cross(c0, c1), c2) < 0):
+    det = (c0[1] * c1[2] - c0[2] * c1[1]) * c2[0]  # det R = (c0 x c1) . c2
+    det += (c0[2] * c1[0] - c0[0] * c1[2]) * c2[1]
+    det += (c0[0] * c1[1] - c0[1] * c1[0]) * c2[2]
+    if np.any(det < 0):
         raise DegenerateGeometryError(f"{name} rotation part is a reflection (det < 0)")
-    return T
+    return T, e
 
 
 class IKSolver:
@@ -154,17 +170,14 @@ class IKSolver:
             ShapeError, NonFiniteError, DegenerateGeometryError: the poses are not valid
                 rigid transforms (wrong shape, NaN, non-orthonormal rotation).
         """
-        T = check_poses(T_base_flange, "T_base_flange")
+        T, entries = check_pose_entries(T_base_flange, "T_base_flange")
         if self.opw is not None:
-            q8, ok8 = self.opw.ik_branches(T)
-            if not self.opw_exact:
-                q8, ok8 = self._polish(T, q8, ok8)
-            q, valid, b8 = self.opw.expand(q8, ok8)
             # bits 4 and 2 of the OPW branch index are the geometric shoulder / elbow flags
             # (wrist centre behind axis 1 / behind the lower arm); bit 1 is axis 5's sign
-            with np.errstate(invalid="ignore"):
-                branch = np.where(valid, (b8 & 6) + (q[:, :, 4] < 0), -1)
-            return IKSolutions(q, valid, branch)
+            if self.opw_exact:
+                return IKSolutions(*self.opw.solve(T, config_codes=True, entries=entries))
+            q8, ok8 = self._polish(T, *self.opw.ik_branches(T))
+            return IKSolutions(*self.opw.expand(q8, ok8, config_codes=True))
         res = self._numeric.solve(T, seeds)
         branch = np.full(res.valid.shape, -1, dtype=int)
         return IKSolutions(res.q, res.valid, branch)
