@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import trimesh
 
 from calib.atomic_io import write_text_atomic
 from calib.frames import transform_points
@@ -135,12 +136,38 @@ def bench_browser(app: Any, clicks: int, rng: np.random.Generator, info: dict) -
     return out
 
 
+def bench_demo(clicks: int, rng: np.random.Generator) -> dict[str, object]:
+    """Clicks at random surface points of the built-in stator demo (all statuses mixed)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        app = run(None, port=free_port(), block=False, autosave_path=Path(tmp) / "a.json")
+        try:
+            mesh = app.view.wobj_mesh  # type: ignore[union-attr]
+            pts, face = trimesh.sample.sample_surface(mesh, clicks, seed=int(rng.integers(1 << 31)))
+            T = app.view.T_world_wobj  # type: ignore[union-attr]
+            ms, statuses = [], []
+            for k, (p, f) in enumerate(zip(pts, face, strict=True)):
+                n = mesh.face_normals[f]
+                origin = transform_points(T, p + 0.5 * n)
+                direction = T[:3, :3] @ (-n)
+                t0 = time.perf_counter()
+                check = app.place_at_ray(origin, direction, point_id=f"R{k % 4}")
+                ms.append((time.perf_counter() - t0) * 1000.0)
+                statuses.append("miss" if check is None else check.status)
+        finally:
+            app.stop()
+    return _stats(ms) | {
+        "triangles": len(mesh.faces),
+        "statuses": {k: statuses.count(k) for k in sorted(set(statuses))},
+    }
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the benchmark and write ``bench/results/ui_latency.json``."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--clicks", type=int, default=40)
     parser.add_argument("--triangles", type=int, default=100_000)
     parser.add_argument("--browser", action="store_true", help="also click in headless Chromium")
+    parser.add_argument("--demo", action="store_true", help="also click the stator demo at random")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING)
     rng = np.random.default_rng(7)
@@ -166,6 +193,7 @@ def main(argv: list[str] | None = None) -> int:
                 "server_statuses": {k: statuses.count(k) for k in sorted(set(statuses))},
                 "server_unreachable_face": _stats(far_ms),
                 "server_unreachable_statuses": {k: far.count(k) for k in sorted(set(far))},
+                "server_demo_random_surface": bench_demo(args.clicks, rng) if args.demo else None,
                 "browser": _browser_stats(browser_ms, info) if browser_ms else None,
                 "browser_note": "headless Chromium with SwiftShader (software WebGL) on a small "
                 "shared machine: click_to_status includes the browser's own ray pick on the mesh "

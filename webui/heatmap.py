@@ -56,8 +56,10 @@ class HeatMap:
         self.normals: NDArray[np.float64] = np.zeros((0, 3))
         self.scores: list[float] = []
         self.done = threading.Event()
+        self._chunk = 3
+        self._tcp = "sensor"
 
-    def start(self, n_samples: int = 120, chunk: int = 3, seed: int = 0) -> None:
+    def start(self, n_samples: int = 120, chunk: int = 1, seed: int = 0) -> None:
         """Sample the surface and queue the checks in chunks on the cell worker."""
         view = self._app.view
         if view is None or self._app.cell_error:
@@ -66,14 +68,22 @@ class HeatMap:
         pts, nrm, _ = rmap.sample_surface(view.wobj_mesh, n_samples, np.random.default_rng(seed))
         self.points, self.normals = np.asarray(pts, float), np.asarray(nrm, float)
         self.scores, self._stop = [], threading.Event()
-        stop, done = self._stop, self.done
-        done.clear()
-        tcp = self._app.state.doc.source.cell.tool.tcp if self._app.state.doc.source else "sensor"
-        for i in range(0, len(pts), chunk):
-            sl = slice(i, i + chunk)
-            fut = self._app.worker.submit(self._job, self.points[sl], self.normals[sl], tcp, stop)
-            fut.add_done_callback(self._chunk_done)
-        self._app.worker.submit(lambda _s: None).add_done_callback(lambda _f: done.set())
+        self.done = threading.Event()
+        self._chunk = chunk
+        source = self._app.state.doc.source
+        self._tcp = source.cell.tool.tcp if source is not None else "sensor"
+        self._submit_next()
+
+    def _submit_next(self) -> None:
+        """Queue the next chunk; one at a time, so clicks queue between chunks, not after all."""
+        n = len(self.scores)
+        if self._stop.is_set() or n >= len(self.points):
+            self.done.set()
+            return
+        sl = slice(n, n + self._chunk)
+        stop = self._stop
+        fut = self._app.worker.submit(self._job, self.points[sl], self.normals[sl], self._tcp, stop)
+        fut.add_done_callback(lambda f: self._chunk_done(f, stop))
 
     @staticmethod
     def _job(session: Any, pts: Any, nrm: Any, tcp: str, stop: threading.Event) -> list[float]:
@@ -82,20 +92,25 @@ class HeatMap:
         res = session.cell.check_probes(pts, nrm, tcp=tcp)
         return [SCORE.get(str(r.status), 0.0) for r in res]
 
-    def _chunk_done(self, fut: Any) -> None:
-        if self._stop.is_set():
+    def _chunk_done(self, fut: Any, stop: threading.Event) -> None:
+        if stop is not self._stop:  # a chunk of an earlier, stopped map
+            return
+        if stop.is_set():
+            self.done.set()
             return
         try:
             self.scores.extend(fut.result())
         except Exception as exc:
             logger.exception("reachability chunk failed")
             self._stop.set()
+            self.done.set()
             self._app.notify("Reachability map stopped", f"{type(exc).__name__}: {exc}")
             return
         n = len(self.scores)
         self._app.scene.show_heat_map(self.points[:n], heat_rgb(np.asarray(self.scores)))
         if n == len(self.points):
             self._finish()
+        self._submit_next()
 
     def _finish(self) -> None:
         view = self._app.view
