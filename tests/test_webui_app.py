@@ -185,3 +185,24 @@ def test_play_search_path_ends_at_its_last_pose(app: WobjcalApp) -> None:
     app.robot.play(check.q_path, duration_s=0.2)
     assert app.robot.wait(5.0)
     np.testing.assert_allclose(app.robot.q, check.q_path[-1])
+
+
+def test_missing_demo_starts_empty_with_a_message(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    from webui import demo
+    from webui.backend import NotAvailableError
+
+    def missing() -> None:
+        raise NotAvailableError("the built-in stator demo is not available yet (test)")
+
+    monkeypatch.setattr(demo, "demo_plan", missing)
+    a = run(None, port=free_port(), block=False, autosave_path=tmp_path / "a.json")
+    try:
+        assert "not available yet" in a.cell_error and a.state.doc.ids == ()
+        with pytest.raises(ValueError, match="no work object"):
+            a.place_at_ray([0, 0, 1], [0, 0, -1])
+        with pytest.raises(ValueError, match="no plan is loaded"):
+            a.files_panel.plan_bytes()
+    finally:
+        a.stop()

@@ -287,10 +287,11 @@ def run(
     Returns:
         The running app (``app.server`` is the viser server; ``app.stop()`` ends it).
     """
+    message = ""
     if plan_path is not None:
         ui_plan, plan_dir = ui_plan_from_file(Path(plan_path)), Path(plan_path).parent
     else:
-        ui_plan, plan_dir = demo.demo_ui_plan()
+        ui_plan, plan_dir, message = demo.demo_ui_plan()
     server = viser.ViserServer(host=host, port=port, label="wobjcal", verbose=block)
     server.gui.configure_theme(control_width="large", show_share_button=False)
     logger.info("wobjcal UI at http://%s:%d", host, server.get_port())
@@ -300,6 +301,7 @@ def run(
         plan_dir,
         autosave_path=None if autosave_path is None else Path(autosave_path),
     )
+    app.cell_error = app.cell_error or message  # shown to every tab that connects
     if not block:
         return app
     try:

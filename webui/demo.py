@@ -44,11 +44,12 @@ def demo_plan() -> tuple[Plan, Path]:
     raise NotAvailableError(f"the built-in stator demo is not available yet ({why})")
 
 
-def demo_ui_plan() -> tuple[UiPlan, Path]:
-    """The demo plan in editable form; an empty plan (no cell) when it is not available."""
+def demo_ui_plan() -> tuple[UiPlan, Path, str]:
+    """The demo plan in editable form, its folder, and ``""``; or, when the demo is not
+    available, an empty plan (no cell) and the message saying why."""
     try:
         plan, plan_dir = demo_plan()
     except NotAvailableError as exc:
         logger.warning("%s", exc)
-        return UiPlan(name="empty", source=None), REPO_ASSETS / "plans"
-    return ui_plan_from_plan(plan, name=plan.name or "stator_demo"), plan_dir
+        return UiPlan(name="empty", source=None), REPO_ASSETS / "plans", str(exc)
+    return ui_plan_from_plan(plan, name=plan.name or "stator_demo"), plan_dir, ""
