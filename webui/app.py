@@ -13,13 +13,12 @@ import threading
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import viser
 from numpy.typing import ArrayLike
 
 from calib.errors import InputError
 from calib.plan import Plan
-from webui import demo, plan_doc
+from webui import clients, demo, plan_doc
 from webui.backend import CellSession, CellView
 from webui.heatmap import HeatMap
 from webui.plan_adapter import autosave_bytes, ui_plan_from_file
@@ -231,28 +230,16 @@ class WobjcalApp:
 
     # ---- clients ---------------------------------------------------------------------------
     def _on_connect(self, client: viser.ClientHandle) -> None:
-        view = self.view
-        if view is None:
-            if self.cell_error:
-                self.notify("No cell", self.cell_error, client=client, error=True)
-            return
-        target = view.T_world_wobj[:3, 3] + view.T_world_wobj[:3, :3] @ view.wobj_mesh.centroid
-        client.camera.up_direction = (0.0, 0.0, 1.0)
-        client.camera.position = tuple(target + np.array([2.2, -1.6, 1.4]))
-        client.camera.look_at = tuple(target)
+        if self.view is not None:
+            clients.set_default_camera(client, self.view)
         if self.cell_error:
-            self.notify("Feasibility not available", self.cell_error, client=client, error=True)
+            self.notify("Not available", self.cell_error, client=client)
 
     def notify(
         self, title: str, body: str, client: viser.ClientHandle | None = None, error: bool = True
     ) -> None:
-        """Show a notification to one client, or to all clients when ``client`` is None."""
-        logger.info("%s: %s", title, body)
-        clients = [client] if client is not None else list(self.server.get_clients().values())
-        for c in clients:
-            c.add_notification(
-                title, body, color="red" if error else "green", auto_close_seconds=8.0
-            )
+        """Show a notification to one tab, or to every tab when ``client`` is None."""
+        clients.notify(self.server, title, body, client, error)
 
     def stop(self) -> None:
         """Stop the server and the worker."""
