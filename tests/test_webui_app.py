@@ -206,3 +206,22 @@ def test_missing_demo_starts_empty_with_a_message(
             a.files_panel.plan_bytes()
     finally:
         a.stop()
+
+
+def test_gizmo_drag_previews_then_projects_onto_surface(app: WobjcalApp) -> None:
+    from types import SimpleNamespace
+
+    app.place_at_ray(*_ray_to([0.0, 0.0, 0.0]), point_id="G1")
+    app.select("G1")
+    before = app.state.doc
+    app.points_panel.drag.value = True  # shows the gizmo at the point
+    target = SimpleNamespace(position=(0.08, -0.03, 0.04))  # dragged 4 cm above the top face
+    drag = app.points_panel._on_gizmo
+    drag(SimpleNamespace(phase="update", target=target, client=None))
+    assert app.server.scene.get_handle_by_name("/wobj/drag_preview") is not None
+    assert app.state.doc is before, "no plan edit while dragging"
+    drag(SimpleNamespace(phase="end", target=target, client=None))
+    moved = app.state.doc.get("G1").probe.position_m
+    np.testing.assert_allclose(moved, [0.08, -0.03, 0.0], atol=1e-12)
+    assert app.server.scene.get_handle_by_name("/wobj/drag_preview") is None
+    app.points_panel.drag.value = False

@@ -194,9 +194,23 @@ class PointsPanel:
         )
 
     def _on_gizmo(self, event: Any) -> None:
-        if event.phase != "end" or self._app.selected is None:
+        """While dragging, preview where the point lands on the surface; at the end, move it."""
+        scene = self._app.server.scene
+        picker = self._app.picker
+        if self._app.selected is None or picker is None:
             return
         pos = np.asarray(event.target.position, dtype=np.float64)
+        if event.phase != "end":
+            hit = picker.project(pos)
+            scene.add_icosphere(
+                "/wobj/drag_preview",
+                radius=0.01,
+                color=(60, 120, 255),
+                opacity=0.6,
+                position=hit.position_wobj,
+            )
+            return
+        scene.remove_by_name("/wobj/drag_preview")
         self._guard(event, self._app.move_point_to, self._app.selected, pos)
 
     def _on_play(self, event: Any) -> None:
