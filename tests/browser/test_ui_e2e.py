@@ -155,3 +155,14 @@ def test_second_tab_sees_the_same_session(ui: UiSession, browser: Any) -> None:
         assert len(ui.app.server.get_clients()) >= 2
     finally:
         other.page.close()
+
+
+def test_rapid_download_is_the_server_export(ui: UiSession, tmp_path: Path) -> None:
+    wait_for(lambda: "P1" in ui.page.content(), what="page ready")
+    with ui.page.expect_download(timeout=60000) as dl:
+        open_folder(ui, "Download RAPID")
+        ui.page.get_by_role("button", name="Download RAPID").click()
+    saved = tmp_path / dl.value.suggested_filename
+    dl.value.save_as(saved)
+    assert saved.suffix == ".mod"
+    assert "MODULE" in saved.read_text()
