@@ -9,20 +9,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from calib.atomic_io import write_text_atomic
-from calib.plan import Plan, PlanError
-from calib.plan_procedures import Hultman2013
 from planner.cli_common import read_plan, stderr, stdout
-from planner.plan_io import hultman_points, nominal_T_base_wobj, require
-
-#: Built-in work objects validation can simulate, and the StatorGeometry constructor of each.
-SIMULATED_PARTS = {
-    "builtin:stator_section": "full_section",
-    "builtin:stator_prototype": "prototype",
-}
 
 
 def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
@@ -46,31 +36,6 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
     p.add_argument("--json", metavar="FILE", help="also write the report as JSON to FILE")
     p.add_argument("--plots", metavar="DIR", help="also write PNG plots to DIR")
     p.set_defaults(handler=cmd_validate)
-
-
-def _models(plan: Plan) -> dict[str, Any]:
-    sensor_mod = require("planner.sensor", "validate")
-    err_mod = require("planner.error_models", "validate")
-    v = plan.validation
-    s, r, m = v.sensor, v.robot_error, v.misplacement
-    return {
-        "sensor": sensor_mod.ProximitySensor(
-            face_diameter_m=s.face_diameter_m,
-            sensing_distance_m=s.sensing_distance_m,
-            decay_length_m=s.decay_length_m,
-            hysteresis_fraction=s.hysteresis_fraction,
-            repeatability_sigma_m=s.repeatability_sigma_m,
-            n_rays=s.n_rays,
-            n_scan_rays=s.n_scan_rays,
-        ),
-        "robot_error": err_mod.RobotErrorModel(
-            repeatability_sigma_m=r.repeatability_sigma_m,
-            accuracy_amplitude_m=r.accuracy_amplitude_m,
-            accuracy_wavelength_m=r.accuracy_wavelength_m,
-            accuracy_terms=r.accuracy_terms,
-        ),
-        "misplacement": err_mod.Misplacement(m.max_translation_m, m.max_angle_rad),
-    }
 
 
 def report_json(report: Any) -> dict[str, Any]:
@@ -104,37 +69,12 @@ def report_json(report: Any) -> dict[str, Any]:
 
 def cmd_validate(args: argparse.Namespace) -> int:
     """Run the validation with a progress bar and print the report."""
+    from planner.plan_validate import check_simulatable, validate_plan
+
     plan, _ = read_plan(args.plan)
-    if plan.work_object.mesh not in SIMULATED_PARTS:
-        raise PlanError(
-            f"work_object.mesh: validate simulates only {sorted(SIMULATED_PARTS)} for now, "
-            f"got {plan.work_object.mesh!r}"
-        )
-    plots = require("planner.plots", "validate --plots") if args.plots else None
-    mc = require("planner.montecarlo", "validate")
-    edge_inset_m = mc.DEFAULT_EDGE_INSET_M  # edge searches run this far inside the face
-    stator = require("planner.stator", "validate")
-    sp = require("calib.stator_procedure", "validate")
-    geometry = getattr(stator.StatorGeometry, SIMULATED_PARTS[plan.work_object.mesh])()
+    check_simulatable(plan)  # a clear error before the simulation's heavy imports
     trials = plan.validation.trials if args.trials is None else args.trials
     seed = plan.validation.seed if args.seed is None else args.seed
-    settings = plan.procedure
-    if not isinstance(settings, Hultman2013):
-        raise PlanError(
-            f"procedure.method: validate simulates only hultman2013, got {plan.method!r}"
-        )
-    models = _models(plan)
-    edge_offset = settings.edge_event_offset_m
-    if edge_offset is None:  # the sensor model's straight-edge offset, as montecarlo's default
-        edge_offset = models["sensor"].edge_event_offset_m(edge_inset_m)
-    stator_settings = sp.StatorSettings(
-        beta1_rad=settings.beta1_rad,
-        p3_height_m=settings.p3_height_m,
-        retake_c_d=settings.retake_c_d,
-        edge_start_from_measured=settings.edge_start_from_measured,
-        edge_start_offset_m=settings.edge_start_offset_m,
-        edge_event_offset_m=edge_offset,
-    )
     with Progress(
         TextColumn("validating"),
         BarColumn(),
@@ -144,25 +84,22 @@ def cmd_validate(args: argparse.Namespace) -> int:
         transient=True,
     ) as bar:
         task = bar.add_task("trials", total=trials)
-        report = mc.validate(
-            hultman_points(plan),
-            geometry,
-            nominal_T_base_wobj(plan),
-            trials,
-            np.random.default_rng(seed),
+        report = validate_plan(
+            plan,
+            trials=trials,
+            seed=seed,
             workers=args.workers,
             progress=lambda done, total: bar.update(task, completed=done, total=total),
-            settings=stator_settings,
-            edge_inset_m=edge_inset_m,
-            **models,
         )
     stdout().print(report.to_markdown(), markup=False)
     if args.json:
         data = report_json(report) | {"plan": args.plan, "seed": seed}
         write_text_atomic(args.json, json.dumps(data, indent=2, sort_keys=True) + "\n")
-    if plots is not None:
+    if args.plots:
+        from planner.plots import save_validation_plots
+
         out_dir = Path(args.plots)
         out_dir.mkdir(parents=True, exist_ok=True)
-        written = plots.save_validation_plots(report, out_dir)
+        written = save_validation_plots(report, out_dir)
         stderr().print(f"plots: {', '.join(str(p) for p in written)}")
     return 0 if report.n_ok == report.n_trials else 1

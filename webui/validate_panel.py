@@ -15,8 +15,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from calib.errors import InputError
+from planner.plan_validate import check_simulatable
 from webui import validation
-from webui.backend import NotAvailableError
 from webui.plan_adapter import plan_from_ui
 from webui.worker import CellWorker
 
@@ -54,20 +54,18 @@ class ValidatePanel:
         client = getattr(event, "client", None)
         try:
             self.start(int(self.trials.value))
-        except (InputError, NotAvailableError) as exc:
+        except InputError as exc:
             self._app.notify("Validation not started", str(exc), client=client)
 
     def start(self, trials: int) -> Any:
         """Start a validation of the session plan; return a future of the report.
 
         Raises:
-            InputError: a validation is already running, or the plan is incomplete.
-            NotAvailableError: ``planner.montecarlo`` is not available.
+            InputError: a validation is already running, or the plan is incomplete or cannot
+                be simulated (:class:`calib.plan.PlanError` naming the field).
         """
-        validation.check_available()
         plan = plan_from_ui(self._app.state.doc)
-        validation.check_supported(plan)
-        plan_dir = self._app.plan_dir
+        check_simulatable(plan)
         with self._start_lock:  # two tabs may click at once
             if self._running.is_set():
                 raise InputError("a validation is already running")
@@ -85,7 +83,7 @@ class ValidatePanel:
                 self.progress.value = 100.0 * done / max(total, 1)
 
         def job(_res: None) -> Any:
-            return validation.run_validation(plan, plan_dir, trials, progress)
+            return validation.run_validation(plan, trials, progress)
 
         fut = self._worker.submit(job)
         fut.add_done_callback(self._done)

@@ -1,0 +1,178 @@
+"""Monte Carlo validation of a plan: the one entry point the CLI, the UI and scripts share.
+
+:func:`validate_plan` turns a :class:`calib.plan.Plan` into the simulation's models (sensor,
+robot error, misplacement, A-H procedure settings, stator geometry) and runs
+:func:`planner.montecarlo.validate`. ``wobjcal validate`` and the web UI's "Validate" panel both
+call it, so a plan validates the same way everywhere.
+
+Example::
+
+    from calib.plan import load_plan
+    from planner.plan_validate import validate_plan
+
+    report = validate_plan(load_plan("assets/plans/stator_section_ah.json"), trials=50, seed=1)
+    print(report.to_markdown())
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from calib.plan import Plan, PlanError
+from calib.plan_procedures import Hultman2013
+from calib.stator_procedure import StatorSettings
+from planner.error_models import Misplacement, RobotErrorModel
+from planner.montecarlo import DEFAULT_EDGE_INSET_M, ValidationReport, validate
+from planner.plan_io import hultman_points, nominal_T_base_wobj
+from planner.sensor import ProximitySensor
+from planner.stator import StatorGeometry
+
+__all__ = [
+    "SIMULATED_PARTS",
+    "ValidationModels",
+    "check_simulatable",
+    "validate_plan",
+    "validation_models",
+]
+
+#: Built-in work objects the validation can simulate -> the ``StatorGeometry`` constructor.
+SIMULATED_PARTS: dict[str, str] = {
+    "builtin:stator_section": "full_section",
+    "builtin:stator_prototype": "prototype",
+}
+
+#: progress(done_trials, total_trials)
+ProgressCallback = Callable[[int, int], None]
+
+
+@dataclass(frozen=True)
+class ValidationModels:
+    """What the simulation of a plan uses, built from the plan by :func:`validation_models`.
+
+    Attributes:
+        sensor: the proximity-sensor model (``plan.validation.sensor``).
+        robot_error: the robot error model (``plan.validation.robot_error``).
+        misplacement: the part placement tolerance (``plan.validation.misplacement``).
+        settings: the A-H procedure settings; ``edge_event_offset_m`` is the plan's, or when
+            unset the sensor's analytic straight-edge offset at ``edge_inset_m``.
+        geometry: the simulated stator geometry (``plan.work_object.mesh``).
+        edge_inset_m: how far inside the face edge searches run, metres.
+    """
+
+    sensor: ProximitySensor
+    robot_error: RobotErrorModel
+    misplacement: Misplacement
+    settings: StatorSettings
+    geometry: StatorGeometry
+    edge_inset_m: float = DEFAULT_EDGE_INSET_M
+
+
+def check_simulatable(plan: Plan) -> Hultman2013:
+    """Raise unless the validation can simulate ``plan``; return its A-H settings.
+
+    Raises:
+        PlanError: the procedure is not ``hultman2013`` (names ``procedure.method``), or the
+            work object is not a built-in stator (names ``work_object.mesh``).
+    """
+    if not isinstance(plan.procedure, Hultman2013):
+        raise PlanError(
+            f"procedure.method: validation simulates only hultman2013 (the paper's A-H "
+            f"procedure), got {plan.method!r}"
+        )
+    if plan.work_object.mesh not in SIMULATED_PARTS:
+        raise PlanError(
+            f"work_object.mesh: validation simulates only the built-in stators "
+            f"{sorted(SIMULATED_PARTS)}, got {plan.work_object.mesh!r}"
+        )
+    return plan.procedure
+
+
+def validation_models(plan: Plan) -> ValidationModels:
+    """The sensor, robot-error, misplacement, procedure and geometry models of ``plan``.
+
+    Raises:
+        PlanError: the plan cannot be simulated (see :func:`check_simulatable`).
+    """
+    proc = check_simulatable(plan)
+    v = plan.validation
+    s, r, m = v.sensor, v.robot_error, v.misplacement
+    sensor = ProximitySensor(
+        face_diameter_m=s.face_diameter_m,
+        sensing_distance_m=s.sensing_distance_m,
+        decay_length_m=s.decay_length_m,
+        hysteresis_fraction=s.hysteresis_fraction,
+        repeatability_sigma_m=s.repeatability_sigma_m,
+        n_rays=s.n_rays,
+        n_scan_rays=s.n_scan_rays,
+    )
+    edge_inset_m = DEFAULT_EDGE_INSET_M
+    edge_offset = proc.edge_event_offset_m
+    if edge_offset is None:  # the sensor model's straight-edge offset, as montecarlo's default
+        edge_offset = sensor.edge_event_offset_m(edge_inset_m)
+    return ValidationModels(
+        sensor=sensor,
+        robot_error=RobotErrorModel(
+            repeatability_sigma_m=r.repeatability_sigma_m,
+            accuracy_amplitude_m=r.accuracy_amplitude_m,
+            accuracy_wavelength_m=r.accuracy_wavelength_m,
+            accuracy_terms=r.accuracy_terms,
+        ),
+        misplacement=Misplacement(m.max_translation_m, m.max_angle_rad),
+        settings=StatorSettings(
+            beta1_rad=proc.beta1_rad,
+            p3_height_m=proc.p3_height_m,
+            retake_c_d=proc.retake_c_d,
+            edge_start_from_measured=proc.edge_start_from_measured,
+            edge_start_offset_m=proc.edge_start_offset_m,
+            edge_event_offset_m=edge_offset,
+        ),
+        geometry=getattr(StatorGeometry, SIMULATED_PARTS[plan.work_object.mesh])(),
+        edge_inset_m=edge_inset_m,
+    )
+
+
+def validate_plan(
+    plan: Plan,
+    *,
+    trials: int | None = None,
+    seed: int | None = None,
+    workers: int | None = None,
+    progress: ProgressCallback | None = None,
+) -> ValidationReport:
+    """Simulate the calibration of ``plan`` many times and summarise it like Table 1.
+
+    Args:
+        plan: the plan (``hultman2013`` procedure on a built-in stator work object).
+        trials: number of simulated calibrations (>= 2); default ``plan.validation.trials``.
+        seed: seed of the ``numpy.random.Generator``; default ``plan.validation.seed``. The
+            same plan, trials and seed give the same report, whatever ``workers``.
+        workers: worker processes (``None``: up to 2; 1 runs in this process, as the web UI
+            does so as not to fork a threaded server).
+        progress: ``progress(done_trials, total_trials)``, called as trials finish.
+
+    Returns:
+        The :class:`planner.montecarlo_report.ValidationReport`.
+
+    Raises:
+        PlanError: the plan cannot be simulated (the message names the field), or its points
+            lack an A-H role.
+        InputError: ``trials`` < 2 or another argument is out of range.
+    """
+    models = validation_models(plan)
+    return validate(
+        hultman_points(plan),
+        models.geometry,
+        nominal_T_base_wobj(plan),
+        plan.validation.trials if trials is None else int(trials),
+        np.random.default_rng(plan.validation.seed if seed is None else seed),
+        sensor=models.sensor,
+        robot_error=models.robot_error,
+        misplacement=models.misplacement,
+        settings=models.settings,
+        edge_inset_m=models.edge_inset_m,
+        workers=workers,
+        progress=progress,
+    )
