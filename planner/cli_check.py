@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,6 +19,7 @@ from calib.probing import SearchCommand
 from planner.cli_common import print_json, read_plan, stdout
 from planner.export.common import ExportJob, build_job
 from planner.plan_io import FeatureUnavailableError, nominal_T_base_wobj, open_cell, tool_data
+from planner.planar_faces import NoPlanarFaceError, plan_face_reasons
 
 FloatArray = np.ndarray
 
@@ -107,6 +109,8 @@ def check_plan(plan: Plan, plan_dir: Path) -> list[CheckRow]:
     T_nom = nominal_T_base_wobj(plan)
     rows = []
     with open_cell(plan, plan_dir) as cell:
+        wo = cell.work_object  # planar faces: a probe measures a plane
+        faces = plan_face_reasons(wo.mesh, [p.to_probe_point() for p in plan.points], name=wo.name)
         pts = np.array([p.position_m for p in plan.points], dtype=float).reshape(-1, 3)
         normals = np.array([p.normal for p in plan.points], dtype=float).reshape(-1, 3)
         try:
@@ -117,15 +121,15 @@ def check_plan(plan: Plan, plan_dir: Path) -> list[CheckRow]:
             ]
         except ImportError as exc:
             raise FeatureUnavailableError(f"check needs {exc.name}, not available yet") from None
-        for p, res, path in zip(plan.points, results, paths, strict=True):
+        for p, res, path, why in zip(plan.points, results, paths, faces, strict=True):
             T_flange = getattr(res, "T_base_flange", None)
             rows.append(
                 CheckRow(
                     point_id=p.id,
                     role=p.role,
                     kind=p.search.kind,
-                    status=str(res.status),
-                    reason=str(res.reason or ""),
+                    status="infeasible" if why else str(res.status),
+                    reason="; ".join(x for x in (why, str(res.reason or "")) if x),
                     clearance_m=float(getattr(res, "clearance_m", math.nan)),
                     path_feasible=bool(path.feasible),
                     path_reason=str(path.reason or ""),
@@ -191,7 +195,11 @@ def _table(rows: list[CheckRow], title: str) -> Table:
 def cmd_check(args: argparse.Namespace) -> int:
     """Run the check; exit 0 when all points and paths are feasible, else 1."""
     plan, plan_dir = read_plan(args.plan)
-    rows = check_plan(plan, plan_dir)
+    try:
+        rows = check_plan(plan, plan_dir)
+    except NoPlanarFaceError as exc:  # the plan cannot work on this part: a failed check
+        print(f"wobjcal check: {exc}", file=sys.stderr)
+        return 1
     bad = [r for r in rows if not r.feasible]
     if args.json:
         print_json({"plan": args.plan, "feasible": not bad, "points": [r.to_json() for r in rows]})
