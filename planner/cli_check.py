@@ -129,7 +129,7 @@ def check_plan(plan: Plan, plan_dir: Path) -> list[CheckRow]:
                     role=p.role,
                     kind=p.search.kind,
                     status="infeasible" if why else str(res.status),
-                    reason="; ".join(x for x in (why, str(res.reason or "")) if x),
+                    reason="; ".join(x for x in (str(res.reason or ""), why) if x),
                     clearance_m=float(getattr(res, "clearance_m", math.nan)),
                     path_feasible=bool(path.feasible),
                     path_reason=str(path.reason or ""),

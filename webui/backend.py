@@ -179,7 +179,8 @@ class CellSession:
         N = np.array([p.normal for p in points], dtype=np.float64)
         try:
             results = self.cell.check_probes(P, N, tcp=self.plan.cell.tool.tcp)
-            return [self._combine(p, r, t0) for p, r in zip(points, results, strict=True)]
+            checks = [self._combine(p, r, t0) for p, r in zip(points, results, strict=True)]
+            return _with_planar_faces(self.view.wobj_mesh, points, checks)
         except ImportError as exc:  # a part of planner the cell needs is missing
             msg = f"feasibility checks are not available yet ({exc})"
             return [PointCheck(p.id, "unknown", msg) for p in points]
@@ -221,3 +222,16 @@ class CellSession:
         if self.cell is not None and hasattr(self.cell, "close"):
             self.cell.close()
         self.cell = None
+
+
+def _with_planar_faces(
+    mesh: trimesh.Trimesh, points: list[ProbePoint], checks: list[PointCheck]
+) -> list[PointCheck]:
+    """Mark points off a planar face (or with the footprint over a hole/edge) infeasible."""
+    from planner.planar_faces import plan_face_reasons
+
+    reasons = plan_face_reasons(mesh, points, raise_if_none=False)
+    return [
+        c if not why else dataclasses.replace(c, status="infeasible", reason=why)
+        for c, why in zip(checks, reasons, strict=True)
+    ]
