@@ -15,6 +15,7 @@ import msgspec
 from calib.errors import InputError
 
 BUILTIN_PREFIX = "builtin:"
+#: The plan's mesh units: exactly ``calib.units.MESH_UNITS`` (a test keeps them equal).
 MeshUnits = Literal["m", "mm", "cm", "in", "auto"]
 Vec3 = tuple[float, float, float]
 UNIT_TOL = 1e-6

@@ -1,9 +1,9 @@
 """The ``wobjcal`` command line: ``main(argv) -> int``.
 
 Exit codes: 0 success; 1 the plan was checked and something is not feasible (``check``) or a
-validation failed its targets; 2 bad input (file, plan, measurement, argument) or a part of
-wobjcal the command needs is missing. Errors print one line on stderr, never a traceback
-(``--debug`` shows it). Each command lives in ``planner/cli_<command>.py``.
+validation failed its targets; 2 bad input (file, plan, measurement, argument). Errors print
+one line on stderr, never a traceback (``--debug`` shows it). Each command lives in
+``planner/cli_<command>.py``.
 """
 
 from __future__ import annotations

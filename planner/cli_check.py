@@ -18,8 +18,7 @@ from calib.plan import Plan
 from calib.probing import SearchCommand
 from planner.cli_common import print_json, read_plan, stdout
 from planner.export.common import ExportJob, build_job
-from planner.plan_io import FeatureUnavailableError, nominal_T_base_wobj, open_cell, tool_data
-from planner.planar_faces import NoPlanarFaceError, plan_face_reasons
+from planner.plan_io import nominal_T_base_wobj, open_cell, tool_data
 
 FloatArray = np.ndarray
 
@@ -106,6 +105,8 @@ def _confdata(cell: Any, q: Any) -> tuple[int, int, int, int] | None:
 
 def check_plan(plan: Plan, plan_dir: Path) -> list[CheckRow]:
     """Check every point and search path of ``plan`` in its cell (opens a PyBullet cell)."""
+    from planner.planar_faces import plan_face_reasons
+
     T_nom = nominal_T_base_wobj(plan)
     rows = []
     with open_cell(plan, plan_dir) as cell:
@@ -113,14 +114,11 @@ def check_plan(plan: Plan, plan_dir: Path) -> list[CheckRow]:
         faces = plan_face_reasons(wo.mesh, [p.to_probe_point() for p in plan.points], name=wo.name)
         pts = np.array([p.position_m for p in plan.points], dtype=float).reshape(-1, 3)
         normals = np.array([p.normal for p in plan.points], dtype=float).reshape(-1, 3)
-        try:
-            results = cell.check_probes(pts, normals, tcp=plan.cell.tool.tcp) if len(pts) else []
-            paths = [
-                cell.check_search(SearchCommand.from_point(p.to_probe_point(), T_nom))
-                for p in plan.points
-            ]
-        except ImportError as exc:
-            raise FeatureUnavailableError(f"check needs {exc.name}, not available yet") from None
+        results = cell.check_probes(pts, normals, tcp=plan.cell.tool.tcp) if len(pts) else []
+        paths = [
+            cell.check_search(SearchCommand.from_point(p.to_probe_point(), T_nom))
+            for p in plan.points
+        ]
         for p, res, path, why in zip(plan.points, results, paths, faces, strict=True):
             T_flange = getattr(res, "T_base_flange", None)
             rows.append(
@@ -194,6 +192,8 @@ def _table(rows: list[CheckRow], title: str) -> Table:
 
 def cmd_check(args: argparse.Namespace) -> int:
     """Run the check; exit 0 when all points and paths are feasible, else 1."""
+    from planner.planar_faces import NoPlanarFaceError  # trimesh: not for ``wobjcal --help``
+
     plan, plan_dir = read_plan(args.plan)
     try:
         rows = check_plan(plan, plan_dir)

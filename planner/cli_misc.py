@@ -11,7 +11,6 @@ from calib.atomic_io import write_text_atomic
 from calib.plan import load_plan
 from calib.plan_json import json_schema
 from planner.cli_common import DEMO_PLAN, stderr
-from planner.plan_io import FeatureUnavailableError
 
 
 def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
@@ -86,10 +85,8 @@ def cmd_ui(args: argparse.Namespace) -> int:
     if plan is not None:
         load_plan(plan)  # a clear error now, before a server starts
 
-    try:
-        from webui.app import run
-    except ImportError as exc:
-        raise FeatureUnavailableError(f"the web UI (webui.app) is not available: {exc}") from None
+    from webui.app import run  # the one place planner imports webui (viser), lazily
+
     stderr().print(
         f"wobjcal UI on http://{args.host}:{args.port} "
         f"({plan or 'built-in demo ' + DEMO_PLAN.name}); Ctrl-C stops it"

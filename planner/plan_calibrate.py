@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from calib.best_fit import best_fit
 from calib.errors import InputError
 from calib.frames import invert_transform, transform_points
 from calib.measurements import Measurements
@@ -26,7 +27,9 @@ from calib.plan_procedures import (
     BestFit,
     Hultman2013,
 )
-from planner.plan_io import T_base_world, hultman_points, nominal_T_base_wobj, require
+from calib.stator_procedure import StatorSettings, probe_from_measurements, run_stator_procedure
+from calib.three_two_one import ThreeTwoOneLayout, three_two_one
+from planner.plan_io import T_base_world, hultman_points, nominal_T_base_wobj
 
 FloatArray = NDArray[np.float64]
 
@@ -160,7 +163,6 @@ def calibrate_plan(
         return measured[pid][0]
 
     if method == "hultman2013":
-        sp = require("calib.stator_procedure", "calibrate --method hultman2013")
         by_role = hultman_points(plan)
         role_to_id = {p.role: p.id for p in plan.points}
         table = {role: first(pid) for role, pid in role_to_id.items()}
@@ -170,11 +172,11 @@ def calibrate_plan(
                 seq = measured[pid]
                 table[f"{role}2"] = seq[1] if len(seq) > 1 else seq[0]
         settings = plan.procedure if isinstance(plan.procedure, Hultman2013) else Hultman2013()
-        result = sp.run_stator_procedure(
+        result = run_stator_procedure(
             by_role,
             T_nom,
-            sp.probe_from_measurements(table),
-            sp.StatorSettings(
+            probe_from_measurements(table),
+            StatorSettings(
                 beta1_rad=settings.beta1_rad,
                 p3_height_m=settings.p3_height_m,
                 retake_c_d=settings.retake_c_d,
@@ -185,19 +187,17 @@ def calibrate_plan(
         )
         T, used = result.T_base_wobj, tuple(role_to_id[r] for r in by_role)
     elif method == "three_two_one":
-        m = require("calib.three_two_one", "calibrate --method three_two_one")
         roles = assign_three_two_one(plan)
         ordered = roles["primary"] + roles["secondary"] + roles["tertiary"]
-        layout = m.ThreeTwoOneLayout.from_points(
+        layout = ThreeTwoOneLayout.from_points(
             *[[p.to_probe_point() for p in roles[r]] for r in ("primary", "secondary", "tertiary")]
         )
         q = np.array([first(p.id) for p in ordered])
-        T, used = m.three_two_one(layout, q, T_nom).T_base_wobj, tuple(p.id for p in ordered)
+        T, used = three_two_one(layout, q, T_nom).T_base_wobj, tuple(p.id for p in ordered)
     else:
-        m = require("calib.best_fit", "calibrate --method best_fit")
         pts = [p for p in plan.points if p.id in measured]
         settings_bf = plan.procedure if isinstance(plan.procedure, BestFit) else BestFit()
-        res = m.best_fit(
+        res = best_fit(
             [p.to_probe_point() for p in pts],
             np.array([first(p.id) for p in pts]),
             T_nom,

@@ -1,40 +1,27 @@
 """Turn a plan into live objects: nominal frames, resolved files, the cell and the tool data.
 
-The cell (PyBullet) is opened only by :func:`open_cell`. The calibration from measured points
-is in :mod:`planner.plan_calibrate`.
+The cell (PyBullet) is opened only by :func:`open_cell`, which imports it there: the command
+line imports this module, and ``wobjcal --help`` must not load PyBullet. The calibration from
+measured points is in :mod:`planner.plan_calibrate`.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from calib.errors import WobjcalError
 from calib.frames import invert_transform
 from calib.plan import Plan, PlanError, resolve_ref
 from calib.plan_procedures import Hultman2013, check_roles
 from calib.probing import ProbePoint
 
+if TYPE_CHECKING:
+    from planner.cell import Cell
+
 FloatArray = NDArray[np.float64]
-
-
-class FeatureUnavailableError(WobjcalError):
-    """A part of wobjcal this command needs is not installed or not built yet."""
-
-
-def require(module: str, what: str) -> Any:
-    """Import ``module`` or raise :class:`FeatureUnavailableError` saying what needs it."""
-    import importlib
-
-    try:
-        return importlib.import_module(module)
-    except ImportError as exc:
-        raise FeatureUnavailableError(
-            f"{what} needs {module}, which is not available in this installation ({exc})"
-        ) from None
 
 
 def T_base_world(plan: Plan) -> FloatArray:
@@ -73,22 +60,22 @@ def resolved_refs(plan: Plan, plan_dir: Path) -> dict[str, str | Path]:
     }
 
 
-def open_cell(plan: Plan, plan_dir: Path) -> Any:
+def open_cell(plan: Plan, plan_dir: Path) -> Cell:
     """Build the plan's :class:`planner.cell.Cell` (robot, tool, work object, fixtures).
 
     Use it as a context manager (``with open_cell(plan, d) as cell:``) so its PyBullet client
     is released.
 
     Raises:
-        FeatureUnavailableError: ``planner.cell`` is not available.
         InputError: a file of the plan cannot be loaded (named in the message).
     """
-    cell_mod = require("planner.cell", "checking reachability")
-    stator = require("planner.stator", "the built-in stator work object")
-    stator.register_stator_builtins()
+    from planner.cell import Cell  # PyBullet: imported when a cell is opened
+    from planner.stator import register_stator_builtins
+
+    register_stator_builtins()
     refs = resolved_refs(plan, plan_dir)
     robot = plan.cell.robot
-    cell = cell_mod.Cell(
+    cell = Cell(
         robot=str(refs["robot"]),
         tool=str(refs["tool"]),
         T_world_base=robot.T_world_base.matrix(),
@@ -120,9 +107,9 @@ def tool_data(plan: Plan, plan_dir: Path) -> tuple[Any, str]:
         A :class:`planner.export.common.ToolData` and a note (``""``, or what was estimated).
     """
     from planner.export.common import ToolData
+    from planner.tool import load_tool
 
-    tool_mod = require("planner.tool", "exporting the tool data")
-    tool = tool_mod.load_tool(str(resolved_refs(plan, plan_dir)["tool"]))
+    tool = load_tool(str(resolved_refs(plan, plan_dir)["tool"]))
     T_flange_tcp = tool.T_flange_tcp(plan.cell.tool.tcp)
     mass, cog = _urdf_mass(getattr(tool, "urdf_path", None))
     note = ""
@@ -188,12 +175,10 @@ def _urdf_mass(path: Path | None) -> tuple[float, tuple[float, float, float]]:
 
 
 __all__ = [
-    "FeatureUnavailableError",
     "T_base_world",
     "hultman_points",
     "nominal_T_base_wobj",
     "open_cell",
-    "require",
     "resolved_refs",
     "tool_data",
 ]

@@ -1,9 +1,10 @@
 """Work-object meshes: loading any format trimesh reads, units, light repair, PyBullet body.
 
-Units: ``"m"``, ``"mm"``, ``"inch"`` or ``"auto"``. The ``auto`` rule: a mesh whose largest
-bounding-box extent exceeds :data:`AUTO_MM_EXTENT` (20) is taken as millimetres, with a
-warning; otherwise as metres. A 20 m work object is implausible for a robot cell, and a part
-drawn in mm is rarely smaller than 20 mm.
+Units: a name of :data:`calib.units.MESH_UNITS` (``"m"``, ``"mm"``, ``"cm"``, ``"in"``, ``"auto"``)
+or an alias of :data:`calib.units.ALIASES` (e.g. ``"inch"``), the same table the plan uses.
+The ``auto`` rule: a mesh whose largest bounding-box extent exceeds :data:`AUTO_MM_EXTENT` (20)
+is taken as millimetres, with a warning; otherwise as metres. A 20 m work object is implausible
+for a robot cell, and a part drawn in mm is rarely smaller than 20 mm.
 
 Repair is light and reported: merge duplicate vertices, drop degenerate faces (zero area, or
 smaller than (1e-6 x the largest extent)^2) and duplicate faces
@@ -24,6 +25,8 @@ import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
+from calib.errors import InputError
+from calib.units import AUTO, METRES_PER_UNIT, canonical_unit
 from planner.bodies import BodyLinks, mesh_collision_shape, static_body
 from planner.builtins import builtin_mesh, is_builtin
 from planner.errors import MeshError
@@ -31,8 +34,6 @@ from planner.errors import MeshError
 FloatArray = NDArray[np.float64]
 log = logging.getLogger(__name__)
 
-#: Metres per unit.
-UNITS: dict[str, float] = {"m": 1.0, "mm": 1e-3, "inch": 0.0254}
 #: ``units="auto"``: a larger extent than this (in file units) means millimetres.
 AUTO_MM_EXTENT = 20.0
 
@@ -43,7 +44,7 @@ class RepairReport:
 
     Attributes:
         source: file path or name the mesh came from.
-        units: the units used (``"m"``, ``"mm"``, ``"inch"``).
+        units: the canonical unit used (``"m"``, ``"mm"``, ``"cm"``, ``"in"``).
         units_detected: True when ``units`` came from the ``auto`` rule.
         scale: metres per file unit applied.
         merged_vertices: vertices removed by merging duplicates.
@@ -118,7 +119,8 @@ def load_work_object(
     Args:
         source: a mesh file (STL, OBJ, PLY, GLB, ... anything trimesh reads), a
             ``trimesh.Trimesh``, or ``"builtin:<name>"`` (see :mod:`planner.builtins`).
-        units: ``"m"``, ``"mm"``, ``"inch"`` or ``"auto"`` (see the module docstring).
+        units: a unit of :mod:`calib.units` (``"m"``, ``"mm"``, ``"cm"``, ``"in"``, an alias
+            such as ``"inch"``) or ``"auto"`` (see the module docstring).
         name: a short name; default the file stem.
 
     Raises:
@@ -126,21 +128,23 @@ def load_work_object(
             the message names the file.
     """
     mesh, src = _read(source)
-    if units not in (*UNITS, "auto"):
-        raise MeshError(f"units for {src} must be one of {[*UNITS, 'auto']}, got {units!r}")
+    try:
+        units = canonical_unit(units, f"units for {src}")
+    except InputError as exc:
+        raise MeshError(str(exc)) from None
     if len(mesh.faces) == 0 or len(mesh.vertices) == 0:
         raise MeshError(f"mesh {src} is empty (no faces)")
     if not np.all(np.isfinite(mesh.vertices)):
         raise MeshError(f"mesh {src} holds NaN or infinite vertex coordinates")
     warnings: list[str] = []
-    detected = units == "auto"
+    detected = units == AUTO
     if detected:
         extent = float(np.max(mesh.extents))
         units = "mm" if extent > AUTO_MM_EXTENT else "m"
         if units == "mm":
             warnings.append(
                 f"{src}: largest extent {extent:.4g} > {AUTO_MM_EXTENT:g}, taken as millimetres "
-                f"(pass units='m' or 'inch' if wrong)"
+                f"(pass units='m' or 'in' if wrong)"
             )
     n_v, n_f = len(mesh.vertices), len(mesh.faces)
     mesh.merge_vertices()
@@ -164,7 +168,7 @@ def load_work_object(
     boundary = len(trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1))
     if boundary:
         warnings.append(f"{src}: open mesh with {boundary} boundary edges; normals kept as given")
-    scale = UNITS[units]
+    scale = METRES_PER_UNIT[units]
     mesh.apply_scale(scale)
     for w in warnings:
         log.warning(w)

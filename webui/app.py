@@ -62,7 +62,6 @@ class WobjcalApp:
         self.view: CellView | None = None
         self.picker: SurfacePicker | None = None
         self.robot: RobotView | None = None
-        self.cell_error = ""
         self.selected: str | None = None
         self._checks: dict[str, tuple[Any, PointCheck]] = {}
         self._lock = threading.RLock()
@@ -90,7 +89,7 @@ class WobjcalApp:
         picker = SurfacePicker(view.wobj_mesh, view.T_world_wobj)
         with self._lock:
             self.plan_dir = Path(plan_dir)
-            self.view, self.picker, self.cell_error = view, picker, session.cell_error
+            self.view, self.picker = view, picker
             self._cell_key = _cell_key(plan)
             self._checks.clear()
         handle = self.scene.draw_work_object(view.wobj_mesh, view.T_world_wobj)
@@ -232,8 +231,6 @@ class WobjcalApp:
     def _on_connect(self, client: viser.ClientHandle) -> None:
         if self.view is not None:
             clients.set_default_camera(client, self.view)
-        if self.cell_error:
-            self.notify("Not available", self.cell_error, client=client)
 
     def notify(
         self, title: str, body: str, client: viser.ClientHandle | None = None, error: bool = True
@@ -274,11 +271,10 @@ def run(
     Returns:
         The running app (``app.server`` is the viser server; ``app.stop()`` ends it).
     """
-    message = ""
     if plan_path is not None:
         ui_plan, plan_dir = ui_plan_from_file(Path(plan_path)), Path(plan_path).parent
     else:
-        ui_plan, plan_dir, message = demo.demo_ui_plan()
+        ui_plan, plan_dir = demo.demo_ui_plan()
     server = viser.ViserServer(host=host, port=port, label="wobjcal", verbose=block)
     server.gui.configure_theme(control_width="large", show_share_button=False)
     logger.info("wobjcal UI at http://%s:%d", host, server.get_port())
@@ -288,7 +284,6 @@ def run(
         plan_dir,
         autosave_path=None if autosave_path is None else Path(autosave_path),
     )
-    app.cell_error = app.cell_error or message  # shown to every tab that connects
     if not block:
         return app
     try:

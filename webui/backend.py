@@ -1,15 +1,12 @@
 """The UI's only door into ``planner``: build the cell of a plan and check points in it.
 
 A :class:`CellSession` lives on the :class:`webui.worker.CellWorker` thread and owns the
-PyBullet cell. Parts of ``planner`` the UI needs may be missing in a given installation (or not
-written yet); then the session says so in :attr:`CellSession.cell_error` and every check returns
-status ``unknown`` with that message. Nothing is ever faked.
+PyBullet cell (built by :func:`planner.plan_io.open_cell`, as ``wobjcal check`` builds it).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import importlib
 import logging
 import time
 from dataclasses import dataclass, field
@@ -23,24 +20,15 @@ from numpy.typing import ArrayLike, NDArray
 from calib.frames import invert_transform
 from calib.plan import Plan, resolve_ref
 from calib.probing import ProbePoint, SearchCommand
-from planner.errors import MeshError
+from planner.builtins import robot_urdf
+from planner.plan_io import open_cell
+from planner.stator import register_stator_builtins
+from planner.workobject import load_work_object
 from webui.status import PointCheck
 
 logger = logging.getLogger(__name__)
 
 REPO_ASSETS = Path(__file__).resolve().parent.parent / "assets"
-
-
-class NotAvailableError(RuntimeError):
-    """A feature needs a part of ``planner`` that is not available; the message says which."""
-
-
-def optional_import(module: str, what: str) -> Any:
-    """Import ``module`` or raise :class:`NotAvailableError` saying ``what`` is unavailable."""
-    try:
-        return importlib.import_module(module)
-    except ImportError as exc:
-        raise NotAvailableError(f"{what} is not available yet ({module}: {exc})") from None
 
 
 @dataclass(frozen=True)
@@ -85,17 +73,7 @@ def resolve_robot_urdf(ref: str, plan_dir: Path) -> Path | None:
     resolved = resolve_ref(ref, plan_dir)
     if isinstance(resolved, Path):
         return resolved if resolved.is_file() else None
-    try:
-        builtins = importlib.import_module("planner.builtins")
-        return Path(builtins.robot_urdf(ref))
-    except ImportError:
-        name = ref.split(":", 1)[1]
-        candidate = REPO_ASSETS / "robots" / name / f"{name}.urdf"
-        return candidate if candidate.is_file() else None
-
-
-#: Plan mesh units -> ``planner.workobject`` units.
-_WOBJ_UNITS = {"m": "m", "mm": "mm", "in": "inch", "auto": "auto"}
+    return Path(robot_urdf(ref))
 
 
 def load_mesh(ref: str, units: str, plan_dir: Path) -> trimesh.Trimesh:
@@ -103,17 +81,11 @@ def load_mesh(ref: str, units: str, plan_dir: Path) -> trimesh.Trimesh:
 
     Raises:
         MeshError: the file is missing, unreadable or empty, or its units are unknown.
-        NotAvailableError: ``planner.workobject`` is not available.
     """
-    workobject = optional_import("planner.workobject", "work-object mesh loading")
-    if units not in _WOBJ_UNITS:
-        raise MeshError(f"mesh units {units!r} are not supported; use {', '.join(_WOBJ_UNITS)}")
     resolved = resolve_ref(ref, plan_dir)
     if isinstance(resolved, str):  # built-in meshes are registered by the modules making them
-        register = optional_import("planner.stator", resolved).register_stator_builtins
-        register()
-    loaded = workobject.load_work_object(resolved, units=_WOBJ_UNITS[units])
-    return loaded.mesh
+        register_stator_builtins()
+    return load_work_object(resolved, units=units).mesh
 
 
 class CellSession:
@@ -134,21 +106,14 @@ class CellSession:
             T_world_wobj=plan.work_object.T_world_wobj.matrix(),
             fixtures=self._fixture_meshes(),
         )
-        self.cell: Any = None
-        self.cell_error = ""
-        try:
-            self.cell = self._build_cell()
-        except NotAvailableError as exc:
-            self.cell_error = str(exc)
-            logger.warning("%s", exc)
-        else:
-            tool = getattr(self.cell, "tool", None)
-            self.view = dataclasses.replace(
-                self.view,
-                tool_urdf=getattr(tool, "urdf_path", None),
-                tool_mesh=getattr(tool, "mesh", None),
-                chain=getattr(self.cell, "chain", None),
-            )
+        self.cell: Any = open_cell(plan, self.plan_dir)
+        tool = self.cell.tool
+        self.view = dataclasses.replace(
+            self.view,
+            tool_urdf=getattr(tool, "urdf_path", None),
+            tool_mesh=getattr(tool, "mesh", None),
+            chain=self.cell.chain,
+        )
 
     def _fixture_meshes(self) -> dict[str, tuple[trimesh.Trimesh, NDArray[np.float64]]]:
         out = {}
@@ -160,30 +125,16 @@ class CellSession:
             out[f.name] = (mesh, f.T_world_fixture.matrix())
         return out
 
-    def _build_cell(self) -> Any:
-        plan_io = optional_import("planner.plan_io", "the cell (feasibility checks)")
-        try:
-            return plan_io.open_cell(self.plan, self.plan_dir)
-        except (plan_io.FeatureUnavailableError, ImportError) as exc:
-            raise NotAvailableError(f"feasibility checks are not available yet: {exc}") from None
-
     def check_points(self, points: list[ProbePoint]) -> list[PointCheck]:
         """Check the probe poses and search paths of ``points`` (wobj frame) in the cell."""
         if not points:
             return []
-        if self.cell is None:
-            msg = self.cell_error or "the cell is not available"
-            return [PointCheck(p.id, "unknown", msg) for p in points]
         t0 = time.perf_counter()
         P = np.array([p.position_m for p in points], dtype=np.float64)
         N = np.array([p.normal for p in points], dtype=np.float64)
-        try:
-            results = self.cell.check_probes(P, N, tcp=self.plan.cell.tool.tcp)
-            checks = [self._combine(p, r, t0) for p, r in zip(points, results, strict=True)]
-            return _with_planar_faces(self.view.wobj_mesh, points, checks)
-        except ImportError as exc:  # a part of planner the cell needs is missing
-            msg = f"feasibility checks are not available yet ({exc})"
-            return [PointCheck(p.id, "unknown", msg) for p in points]
+        results = self.cell.check_probes(P, N, tcp=self.plan.cell.tool.tcp)
+        checks = [self._combine(p, r, t0) for p, r in zip(points, results, strict=True)]
+        return _with_planar_faces(self.view.wobj_mesh, points, checks)
 
     def _combine(self, point: ProbePoint, res: Any, t0: float) -> PointCheck:
         status, reason = str(res.status), str(res.reason or "")
@@ -206,20 +157,9 @@ class CellSession:
             elapsed_s=time.perf_counter() - t0,
         )
 
-    def reachability(self, n_samples: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Surface samples ``(M, 3)`` (wobj frame) and their reachability score in [0, 1]."""
-        if self.cell is None or not hasattr(self.cell, "reachability_map"):
-            raise NotAvailableError(f"the reachability map is not available: {self.cell_error}")
-        rmap = self.cell.reachability_map(n_samples, np.random.default_rng(0))
-        points = np.asarray(getattr(rmap, "points_wobj", getattr(rmap, "points", None)), float)
-        score = getattr(rmap, "score", None)
-        if score is None:
-            score = np.asarray(getattr(rmap, "feasible", np.zeros(len(points))), float)
-        return points, np.asarray(score, float)
-
     def close(self) -> None:
         """Release the PyBullet client."""
-        if self.cell is not None and hasattr(self.cell, "close"):
+        if self.cell is not None:
             self.cell.close()
         self.cell = None
 

@@ -6,7 +6,6 @@ calibrated frame is drawn beside the nominal one, with the shift and the residua
 
 from __future__ import annotations
 
-import importlib
 import logging
 from typing import TYPE_CHECKING, Any
 
@@ -15,7 +14,7 @@ import numpy as np
 from calib.errors import InputError
 from calib.frames import motion_between
 from calib.measurements import measurements_from_json
-from webui.backend import NotAvailableError
+from planner.plan_calibrate import calibrate_plan
 from webui.files_panel import check_upload
 from webui.plan_adapter import plan_from_ui
 
@@ -47,7 +46,7 @@ class CalibratePanel:
         f = event.target.value
         try:
             self.calibrate(f.name, f.content)
-        except (InputError, NotAvailableError) as exc:
+        except InputError as exc:
             self._app.notify("Not calibrated", str(exc), client=event.client)
         except Exception as exc:  # never a traceback in the browser
             logger.exception("calibration failed")
@@ -62,11 +61,7 @@ class CalibratePanel:
             raise InputError(f"{name}: not UTF-8 text, so not a measurements file") from None
         measurements = measurements_from_json(text, source=name)
         plan = plan_from_ui(self._app.state.doc)
-        try:
-            mod = importlib.import_module("planner.plan_calibrate")
-        except ImportError as exc:
-            raise NotAvailableError(f"calibration is not available yet ({exc})") from None
-        out = mod.calibrate_plan(plan, measurements)
+        out = calibrate_plan(plan, measurements)
         self.last_output = out
         T_world_base = plan.cell.robot.T_world_base.matrix()
         self._app.scene.draw_calibrated_frame(T_world_base @ out.T_base_wobj)

@@ -16,7 +16,7 @@ import msgspec
 
 from calib.errors import InputError
 from calib.plan import Plan, PlanError
-from webui.backend import NotAvailableError
+from calib.units import MESH_UNITS
 from webui.exports import FORMATS, ExportResult, export_program
 from webui.plan_adapter import plan_from_ui, plan_json_from_ui, ui_plan_from_bytes, with_source
 from webui.state import atomic_write_bytes
@@ -63,9 +63,7 @@ class FilesPanel:
         gui = app.server.gui
         with gui.add_folder("Files", expand_by_default=True):
             self.plan_upload = gui.add_upload_button("Upload plan (.json)", mime_type=".json")
-            self.units = gui.add_dropdown(
-                "Mesh units", ("mm", "m", "cm", "in", "auto"), initial_value="mm"
-            )
+            self.units = gui.add_dropdown("Mesh units", MESH_UNITS, initial_value="mm")
             self.mesh_upload = gui.add_upload_button("Upload work-object mesh")
             self.urdf_upload = gui.add_upload_button("Upload robot URDF", mime_type=".urdf")
             self.download = gui.add_button("Download plan JSON")
@@ -89,7 +87,7 @@ class FilesPanel:
             args = (event.target.value.name, event.target.value.content)
         try:
             title = fn(*args)
-        except (InputError, NotAvailableError) as exc:
+        except InputError as exc:
             self._app.notify("File not used", str(exc), client=client)
         except Exception as exc:  # never a traceback in the browser
             logger.exception("file action failed")

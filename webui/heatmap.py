@@ -9,7 +9,6 @@ sample (red: infeasible, amber: marginal, green: feasible).
 
 from __future__ import annotations
 
-import importlib
 import logging
 import threading
 from typing import TYPE_CHECKING, Any
@@ -19,7 +18,8 @@ import trimesh
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
-from webui.backend import NotAvailableError
+from calib.errors import InputError
+from planner.reachability_map import sample_surface
 from webui.scene import heat_rgb
 
 if TYPE_CHECKING:
@@ -62,10 +62,9 @@ class HeatMap:
     def start(self, n_samples: int = 120, chunk: int = 1, seed: int = 0) -> None:
         """Sample the surface and queue the checks in chunks on the cell worker."""
         view = self._app.view
-        if view is None or self._app.cell_error:
-            raise NotAvailableError(f"the reachability map needs the cell: {self._app.cell_error}")
-        rmap = importlib.import_module("planner.reachability_map")
-        pts, nrm, _ = rmap.sample_surface(view.wobj_mesh, n_samples, np.random.default_rng(seed))
+        if view is None:
+            raise InputError("the reachability map needs a work object: load a plan first")
+        pts, nrm, _ = sample_surface(view.wobj_mesh, n_samples, np.random.default_rng(seed))
         self.points, self.normals = np.asarray(pts, float), np.asarray(nrm, float)
         self.scores, self._stop = [], threading.Event()
         self.done = threading.Event()

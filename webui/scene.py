@@ -20,7 +20,8 @@ from calib.probing import SearchCommand
 from webui.plan_doc import UiPlan, UiPoint
 from webui.status import PointCheck
 
-#: RGB colour of each feasibility status (``pending``: being computed; ``unknown``: no cell).
+#: RGB colour of each feasibility status (``pending``: being computed); ``unknown`` is the
+#: fallback colour of any other status.
 STATUS_RGB: dict[str, tuple[int, int, int]] = {
     "feasible": (40, 170, 60),
     "marginal": (240, 165, 0),

@@ -8,7 +8,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-Status = Literal["feasible", "marginal", "infeasible", "pending", "unknown"]
+Status = Literal["feasible", "marginal", "infeasible", "pending"]
 
 
 @dataclass(frozen=True)
@@ -18,7 +18,7 @@ class PointCheck:
     Attributes:
         point_id: id of the point.
         status: ``feasible``, ``marginal`` (reachable with little clearance or near a limit),
-            ``infeasible``; ``unknown`` when no cell check is available.
+            ``infeasible``; ``pending`` while being computed.
         reason: why the point is marginal or infeasible (empty when feasible).
         q: ``(n,)`` joint values at the probe pose, radians, or ``None`` when unreachable.
         q_path: ``(M, n)`` joint values along the search path, radians, or ``None``.

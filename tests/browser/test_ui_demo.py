@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import shutil
 import time
 
@@ -13,8 +14,12 @@ from webui.plan_doc import PAPER_IDS
 
 pytestmark = pytest.mark.browser
 
+#: The README's screenshot: rewritten only when WOBJCAL_UPDATE_SCREENSHOTS=1 (tests leave the
+#: tracked tree alone otherwise).
 SCREENSHOT = REPO / "docs" / "img" / "demo_cell.png"
+#: Where every run writes its screenshot (git-ignored).
 ARTIFACT = REPO / "artifacts" / "demo_cell.png"
+UPDATE_SCREENSHOTS = os.environ.get("WOBJCAL_UPDATE_SCREENSHOTS") == "1"
 
 
 def test_demo_loads_with_ah_points_and_statuses(demo: UiSession) -> None:
@@ -26,7 +31,7 @@ def test_demo_loads_with_ah_points_and_statuses(demo: UiSession) -> None:
         what="the statuses on the page",
     )
     for c in checks.values():
-        assert c.status in {"feasible", "marginal", "infeasible", "unknown"}
+        assert c.status in {"feasible", "marginal", "infeasible"}
         assert c.status == "feasible" or c.reason, f"{c.point_id} gives no reason"
 
 
@@ -57,9 +62,9 @@ def test_screenshot_of_demo_cell(demo: UiSession) -> None:
     time.sleep(3.0)  # let SwiftShader render the new view
     ARTIFACT.parent.mkdir(parents=True, exist_ok=True)
     demo.page.screenshot(path=str(ARTIFACT))
-    SCREENSHOT.parent.mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(ARTIFACT, SCREENSHOT)
     assert ARTIFACT.stat().st_size > 20_000, "the screenshot looks empty"
+    if UPDATE_SCREENSHOTS:
+        shutil.copyfile(ARTIFACT, SCREENSHOT)
     assert np.isfinite(client.camera.fov)
 
 
