@@ -42,6 +42,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from calib.errors import ShapeError
 from calib.probing import ProbePoint
 from calib.validation import check_points
 from planner.errors import MeshError
@@ -244,7 +245,8 @@ def _detect(
     footprint_radius_m: float,
 ) -> PlanarFaces:
     nf = len(mesh.faces)
-    tris = np.asarray(mesh.triangles, dtype=np.float64)
+    shift = np.asarray(mesh.bounds, dtype=np.float64).mean(axis=0)  # less round-off in moments
+    tris = np.asarray(mesh.triangles, dtype=np.float64) - shift
     area = np.asarray(mesh.area_faces, dtype=np.float64)
     normals = np.asarray(mesh.face_normals, dtype=np.float64)
     adj = np.asarray(mesh.face_adjacency, dtype=np.int64).reshape(-1, 2)
@@ -271,6 +273,7 @@ def _detect(
             name, mesh, face_id, (), None, min_area_m2, flatness_tol_m, max_deviation_m
         )
     n, d, area_r, rms = _fit_planes(tris, area, normals, labels)
+    d = d + n @ shift  # back to the mesh frame
     cnt = np.bincount(labels[labels >= 0], minlength=len(area_r))
     cand = np.flatnonzero((area_r >= min_area_m2) & (rms <= flatness_tol_m))
     holds = np.zeros(len(area_r), dtype=bool)
@@ -499,7 +502,7 @@ def check_probe_faces(
     P = check_points(points, "points")
     Nrm = check_points(normals, "normals")
     if Nrm.shape != P.shape:
-        raise MeshError(f"normals must match points {P.shape}, got {Nrm.shape}")
+        raise ShapeError(f"normals must have the shape of points {P.shape}, got {Nrm.shape}")
     if len(P) == 0:
         return []
     unit = Nrm / np.maximum(np.linalg.norm(Nrm, axis=1, keepdims=True), 1e-300)
