@@ -520,16 +520,20 @@ def check_probe_faces(
         good = _footprint_hits(pf.mesh, pf.face_id, p0, n_face, fid[on], footprint_radius_m, tol)
         footprint_ok[on] = good.all(axis=1)
         n_off[on] = (~good).sum(axis=1)
+    offsets = np.array([face.offset_m for face in pf.faces])
     out = []
     for i in range(len(P)):
         f = int(fid[i])
         fn = pf.faces[f].normal if f >= 0 else np.zeros(3)
         ang = math.acos(float(np.clip(unit[i] @ fn, -1, 1))) if f >= 0 else math.nan
-        off_plane = abs(fn @ P[i] - pf.faces[f].offset_m) if f >= 0 else math.inf
-        if dist[i] > max_distance_m and off_plane <= pf.max_deviation_m:
+        in_plane = np.flatnonzero(
+            (np.abs(pf.normals @ P[i] - offsets) <= pf.max_deviation_m)
+            & (pf.normals @ unit[i] >= math.cos(max_normal_angle_rad))
+        )
+        if dist[i] > max_distance_m and len(in_plane):
             reason = (
                 f"footprint over a hole/edge: the point itself lies over a hole or past the "
-                f"edge of planar face {f} ({dist[i] * 1e3:.2f} mm from the surface)"
+                f"edge of planar face {in_plane[0]} ({dist[i] * 1e3:.2f} mm from the surface)"
             )
         elif dist[i] > max_distance_m:
             reason = f"point is {dist[i] * 1e3:.2f} mm from the surface"

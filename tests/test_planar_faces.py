@@ -111,8 +111,12 @@ def test_stator_side_face_and_a_footprint_over_a_slot_hole(stator: trimesh.Trime
 
 
 def test_stator_edge_and_off_surface_points(stator: trimesh.Trimesh) -> None:
-    (corner, off) = check_probe_faces(stator, [[0.0, -0.003, -0.1], [0.05, -0.1, -0.1]], [X, X])
+    g = StatorGeometry.prototype()
+    hole = [0.0, -g.first_slot_offset_m, -g.first_layer_depth_m]  # centre of slot hole 1
+    pts = [[0.0, -0.003, -0.1], [0.05, -0.1, -0.1], hole]
+    corner, off, in_hole = check_probe_faces(stator, pts, [X, X, X])
     assert not corner.ok and corner.reason.startswith("footprint over a hole/edge")
+    assert not in_hole.ok and in_hole.reason.startswith("footprint over a hole/edge: the point")
     assert not off.ok and off.reason.endswith("mm from the surface")
     assert off.distance_m == pytest.approx(0.05, abs=3e-4)  # the bolt bulge is under 0.3 mm
 
@@ -156,3 +160,21 @@ def test_bad_input_is_named() -> None:
         check_probe_faces(box, [[0.05, 0, 0]], [X, X])
     with pytest.raises(MeshError, match="flatness_tol_m"):
         find_planar_faces(box, flatness_tol_m=-1.0)
+
+
+def test_ui_marks_points_off_planar_faces_infeasible() -> None:
+    from webui.backend import _with_planar_faces
+    from webui.status import PointCheck
+
+    box = trimesh.creation.box(extents=EXTENTS)
+    probes = [
+        ProbePoint("A", (0.05, 0.0, 0.0), (1.0, 0.0, 0.0)),
+        ProbePoint("B", (0.05, 0.095, 0.0), (1.0, 0.0, 0.0)),  # 5 mm from an edge
+    ]
+    checks = [PointCheck("A", "feasible"), PointCheck("B", "feasible")]
+    a, b = _with_planar_faces(box, probes, checks)
+    assert a == checks[0]
+    assert b.status == "infeasible" and b.reason.startswith("footprint over a hole/edge")
+    sphere = trimesh.creation.icosphere(subdivisions=3, radius=0.05)
+    for c in _with_planar_faces(sphere, probes, checks):
+        assert c.status == "infeasible" and "no planar face" in c.reason
