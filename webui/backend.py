@@ -28,8 +28,6 @@ from webui.status import PointCheck
 
 logger = logging.getLogger(__name__)
 
-REPO_ASSETS = Path(__file__).resolve().parent.parent / "assets"
-
 
 @dataclass(frozen=True)
 class CellView:
