@@ -218,7 +218,8 @@ def _fit_planes(
     n = v[:, :, 0]
     n = np.where((np.einsum("ki,ki->k", n, Nsum) < 0)[:, None], -n, n)
     d = np.einsum("ki,ki->k", n, c)
-    return n, d, A, np.sqrt(np.clip(w[:, 0], 0.0, None))
+    rms = np.sqrt(np.clip(w[:, 0], 0.0, None))
+    return n.astype(np.float64), d.astype(np.float64), A.astype(np.float64), rms
 
 
 def _stats(
@@ -283,7 +284,7 @@ def _detect(
     remap = np.full(len(area_r), -1, dtype=np.int64)
     remap[good] = np.arange(len(good))
     face_id[labels >= 0] = remap[labels[labels >= 0]]
-    faces = tuple(_stats(n, d, area_r, rms, cnt, holds, i) for i in good)
+    faces = tuple(_stats(n, d, area_r, rms, cnt, holds, int(i)) for i in good)
     largest = _stats(n, d, area_r, rms, cnt, holds, int(np.argmax(area_r)))
     return PlanarFaces(
         name, mesh, face_id, faces, largest, min_area_m2, flatness_tol_m, max_deviation_m
@@ -319,8 +320,9 @@ def _holds_footprint(
         centres.append(c - (c @ n[r] - d[r])[:, None] * n[r])
         ids.append(np.full(len(pick), r))
     at, region = np.vstack(centres), np.concatenate(ids)
-    ok = _footprint_hits(mesh, labels, at, n[region], region, radius_m, tol_m).all(axis=1)
-    return np.array([ok[region == r].any() for r in regions])
+    hits = _footprint_hits(mesh, labels, at, n[region], region, radius_m, tol_m)
+    ok = np.all(hits, axis=1)
+    return np.array([bool(np.any(ok[region == r])) for r in regions], dtype=bool)
 
 
 _cache: OrderedDict[tuple[object, ...], PlanarFaces] = OrderedDict()
@@ -371,9 +373,9 @@ def find_planar_faces(
         "max_deviation_m": max_deviation_m,
         "footprint_radius_m": footprint_radius_m,
     }
-    for key, val in tols.items():
+    for tol_name, val in tols.items():
         if not (math.isfinite(val) and val > 0):
-            raise MeshError(f"{key} must be a positive number, got {val!r}")
+            raise MeshError(f"{tol_name} must be a positive number, got {val!r}")
     label = name or str((mesh.metadata or {}).get("name") or "work object")
     key = (mesh_digest(mesh), label, *tols.values())
     with _cache_lock:
