@@ -86,7 +86,8 @@ class RegionStats:
         area_m2: region area, m^2.
         rms_m: area-weighted RMS distance of the region's surface from its plane, metres.
         n_triangles: triangles in the region.
-        holds_footprint: some spot of the region holds the whole sensor footprint.
+        holds_footprint: some spot of the region holds the whole sensor footprint (only tested
+            for regions large and flat enough; ``False`` for the others).
     """
 
     normal: FloatArray
@@ -135,6 +136,17 @@ class PlanarFaces:
         _, _, tri = trimesh.proximity.closest_point(self.mesh, pts)
         return self.face_id[np.asarray(tri, dtype=np.int64)]
 
+    def _why_not(self, region: RegionStats) -> str:
+        """Why ``region`` is not a planar face, in words."""
+        why = []
+        if region.rms_m > self.flatness_tol_m:
+            why.append("too rough")
+        if region.area_m2 < self.min_area_m2:
+            why.append("too small")
+        if not why and not region.holds_footprint:
+            why.append("no spot of it holds the sensor face")
+        return " and ".join(why) or "a planar face"
+
     def require_any(self) -> None:
         """Raise :class:`NoPlanarFaceError` (with the numbers) when there is no planar face."""
         if self.faces:
@@ -150,7 +162,7 @@ class PlanarFaces:
             found = (
                 f"largest flat region {big.area_m2 * 1e6:.1f} mm^2 "
                 f"({big.n_triangles} triangles), RMS {big.rms_m * 1e3:.3f} mm"
-                + ("" if big.holds_footprint else ", too narrow for the sensor face")
+                + f", {self._why_not(big)}"
             )
         raise NoPlanarFaceError(f"{self.name}: no planar face: {found}; {need}")
 

@@ -178,3 +178,18 @@ def test_ui_marks_points_off_planar_faces_infeasible() -> None:
     sphere = trimesh.creation.icosphere(subdivisions=3, radius=0.05)
     for c in _with_planar_faces(sphere, probes, checks):
         assert c.status == "infeasible" and "no planar face" in c.reason
+
+
+@pytest.mark.parametrize(
+    ("extents", "why"),
+    [
+        ((0.012, 0.012, 0.012), "144.0 mm^2 (2 triangles), RMS 0.000 mm, too small"),
+        ((0.030, 0.014, 0.014), "no spot of it holds the sensor face"),  # 420 mm^2, 14 mm wide
+    ],
+)
+def test_small_or_narrow_faces_cannot_hold_the_sensor(extents: tuple[float, ...], why: str) -> None:
+    pf = find_planar_faces(trimesh.creation.box(extents=extents), name="block")
+    assert pf.faces == ()
+    with pytest.raises(NoPlanarFaceError, match=r"^block: no planar face: largest flat") as err:
+        pf.require_any()
+    assert why in str(err.value)
