@@ -189,9 +189,10 @@ def calibrate_plan(
     elif method == "three_two_one":
         roles = assign_three_two_one(plan)
         ordered = roles["primary"] + roles["secondary"] + roles["tertiary"]
-        layout = ThreeTwoOneLayout.from_points(
-            *[[p.to_probe_point() for p in roles[r]] for r in ("primary", "secondary", "tertiary")]
+        primary, secondary, tertiary = (
+            [p.to_probe_point() for p in roles[r]] for r in ("primary", "secondary", "tertiary")
         )
+        layout = ThreeTwoOneLayout.from_points(primary, secondary, tertiary)
         q = np.array([first(p.id) for p in ordered])
         T, used = three_two_one(layout, q, T_nom).T_base_wobj, tuple(p.id for p in ordered)
     else:
