@@ -19,7 +19,6 @@ from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.stats import norm
 
 from calib.errors import ShapeError
 from calib.frames import check_transform, invert_transform, motion_between, transform_points
@@ -132,7 +131,9 @@ def confidence_intervals(
     if lv.ndim != 1 or np.any(~np.isfinite(lv)) or np.any((lv <= 0) | (lv >= 1)):
         raise ShapeError(f"levels must be fractions in (0, 1), got {list(levels)}")
     mean, std = float(x.mean()), float(x.std(ddof=1))
-    z = norm.ppf(0.5 + lv / 2.0)
+    from scipy.special import ndtri  # lighter than scipy.stats (about 0.8 s to import)
+
+    z = ndtri(0.5 + lv / 2.0)
     emp = np.quantile(np.abs(x - mean), lv)
     rows = tuple(
         ConfidenceRow(

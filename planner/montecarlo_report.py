@@ -151,6 +151,13 @@ class ValidationReport:
                 f"| {r.procedure_bias:+.{digits}f} | ± {r.best_fit:.{digits}f} {r.unit} "
                 f"| {r.best_fit_bias:+.{digits}f} | {paper} |"
             )
+        lines += [
+            "",
+            "The paper's rotation rows (+-0.0002 deg about x, ...) are about 100x smaller than its"
+            " own origin and epsilon rows imply (0.02 deg about x); they look like quaternion"
+            " components rather than degrees: compare the origin and epsilon rows"
+            " (docs/simulation.md).",
+        ]
         lines += ["", "Failures:" if self.failures else "Failures: none"]
         lines += [f"- {k}: {v}" for k, v in sorted(self.failures.items())]
         lines += ["", "Landings:" if self.landings else "Landings: none over holes or off faces"]

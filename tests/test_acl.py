@@ -12,8 +12,6 @@ import planner.acl as acl_module
 from planner.acl import AllowedCollisions, pair, sample_configurations
 from planner.cell import Cell
 
-REFERENCE = Path(__file__).resolve().parents[2] / "shared" / "reference"
-
 
 @pytest.fixture(scope="module")
 def cell() -> Iterator[Cell]:
@@ -22,10 +20,8 @@ def cell() -> Iterator[Cell]:
 
 
 @pytest.fixture(scope="module")
-def ur5() -> Iterator[Cell]:
-    if not REFERENCE.is_dir():
-        pytest.skip(f"reference data not found at {REFERENCE}")
-    with Cell(REFERENCE / "robots" / "ur5" / "ur5.urdf", use_acl_cache=False) as c:
+def ur5(reference_dir: Path) -> Iterator[Cell]:
+    with Cell(reference_dir / "robots" / "ur5" / "ur5.urdf", use_acl_cache=False) as c:
         yield c
 
 

@@ -13,8 +13,6 @@ from calib.frames import make_transform
 from planner.cell import Cell
 from planner.fixtures import table
 
-REFERENCE = Path(__file__).resolve().parents[2] / "shared" / "reference"
-
 
 @pytest.fixture(scope="module")
 def cell() -> Iterator[Cell]:
@@ -23,17 +21,9 @@ def cell() -> Iterator[Cell]:
 
 
 @pytest.fixture(scope="module")
-def ur5(reference_dir_module) -> Iterator[Cell]:
-    with Cell(reference_dir_module / "robots" / "ur5" / "ur5.urdf", use_acl_cache=False) as c:
+def ur5(reference_dir: Path) -> Iterator[Cell]:
+    with Cell(reference_dir / "robots" / "ur5" / "ur5.urdf", use_acl_cache=False) as c:
         yield c
-
-
-@pytest.fixture(scope="module")
-def reference_dir_module() -> Path:
-    """Module-scoped twin of conftest's ``reference_dir`` (a Cell per module is enough)."""
-    if not REFERENCE.is_dir():
-        pytest.skip(f"reference data not found at {REFERENCE}")
-    return REFERENCE
 
 
 def test_ur5_upper_arm_into_the_base_is_a_self_collision(ur5: Cell) -> None:
