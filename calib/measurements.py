@@ -24,7 +24,13 @@ from numpy.typing import ArrayLike, NDArray
 from calib.atomic_io import write_text_atomic
 from calib.errors import InputError
 from calib.frames import transform_points
-from calib.plan_json import canonical_json, check_schema_tag, convert_strict, parse_json_text
+from calib.plan_json import (
+    canonical_json,
+    check_schema_tag,
+    convert_strict,
+    parse_json_text,
+    read_text_file,
+)
 
 MEASUREMENTS_SCHEMA: Final = "wobjcal.measurements/1"
 SUPPORTED_MEASUREMENTS_SCHEMAS = (MEASUREMENTS_SCHEMA,)
@@ -153,7 +159,7 @@ def measurements_from_json(text: str, source: str = "measurements") -> Measureme
 def load_measurements(path: str | Path) -> Measurements:
     """Read a measurements file strictly (see :func:`measurements_from_json`)."""
     p = Path(path)
-    return measurements_from_json(p.read_text(encoding="utf-8"), source=str(p))
+    return measurements_from_json(read_text_file(p, MeasurementsError), source=str(p))
 
 
 def save_measurements(measurements: Measurements, path: str | Path) -> Path:

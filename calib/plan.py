@@ -41,7 +41,13 @@ from calib.plan_cell import (
     ToolSpec,
     WorkObjectSpec,
 )
-from calib.plan_json import canonical_json, check_schema_tag, convert_strict, parse_json_text
+from calib.plan_json import (
+    canonical_json,
+    check_schema_tag,
+    convert_strict,
+    parse_json_text,
+    read_text_file,
+)
 from calib.plan_models import Misplacement, RobotErrorModel, SensorModel, ValidationSpec
 from calib.plan_procedures import METHODS, Procedure, check_roles, method_of
 from calib.probing import ProbePoint, SearchSpec
@@ -304,7 +310,7 @@ def load_plan(path: str | Path, check_files: bool = True) -> Plan:
         OSError: the file cannot be read.
     """
     p = Path(path)
-    text = p.read_text(encoding="utf-8")
+    text = read_text_file(p, PlanError)
     plan = plan_from_json(text, source=str(p))
     if check_files:
         check_plan_files(plan, p.parent, source=str(p))

@@ -19,6 +19,7 @@ import json
 import math
 import re
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import Any, TypeVar
 
 import msgspec
@@ -86,6 +87,22 @@ def _find_non_finite(value: Any, path: str) -> tuple[str, str] | None:
         if found:
             return found
     return None
+
+
+def read_text_file(path: Path, error: type[InputError]) -> str:
+    """Read a UTF-8 text file, or raise ``error`` naming it when it is binary or not UTF-8.
+
+    Raises:
+        OSError: the file cannot be read (missing, permissions).
+    """
+    data = path.read_bytes()
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise error(
+            f"{path}: not a UTF-8 text file (byte {exc.start}): expected a JSON document, "
+            "got a binary file (a mesh or an archive?)"
+        ) from None
 
 
 def parse_json_text(text: str, error: type[InputError], source: str) -> Any:

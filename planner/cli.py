@@ -9,12 +9,15 @@ one line on stderr, never a traceback (``--debug`` shows it). Each command lives
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
+import os
 import sys
 from collections.abc import Callable, Sequence
 
 from calib._version import __version__
 from calib.errors import WobjcalError
+from planner.cli_common import native_output_to_stderr
 
 EXIT_OK, EXIT_FAIL, EXIT_INPUT = 0, 1, 2
 
@@ -82,7 +85,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help(sys.stdout)
         return EXIT_OK
     try:
-        return _run(args)
+        with native_output_to_stderr():
+            return _run(args)
+    except BrokenPipeError:  # e.g. `wobjcal check --json plan.json | head`: the reader left
+        with contextlib.suppress(OSError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
     except (WobjcalError, OSError) as exc:
         if debug:
             raise

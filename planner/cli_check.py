@@ -75,6 +75,11 @@ class CheckRow:
         """The point and its path are both feasible (marginal counts as feasible)."""
         return self.status != "infeasible" and self.path_feasible
 
+    @property
+    def overall_status(self) -> str:
+        """``status`` of the point, or ``infeasible`` when its search path is blocked."""
+        return self.status if self.path_feasible else "infeasible"
+
     def to_json(self) -> dict[str, Any]:
         """A JSON-ready dict (distances in metres)."""
         return {
@@ -92,15 +97,16 @@ class CheckRow:
 
 
 def _confdata(cell: Any, q: Any) -> tuple[int, int, int, int] | None:
-    """ABB confdata of joint values ``q`` through whatever the cell's IK solver offers."""
-    for owner in (cell, getattr(cell, "ik_solver", None), getattr(cell, "solver", None)):
-        fn = getattr(owner, "abb_confdata", None)
-        if fn is not None and q is not None:
-            try:
-                return tuple(int(c) for c in fn(np.asarray(q, float)))  # type: ignore[return-value]
-            except Exception:  # a non-OPW robot has no ABB configuration
-                return None
-    return None
+    """ABB confdata of joint values ``q``; ``None`` for robots that are not OPW arms."""
+    from planner.kinematics.opw_from_urdf import NotOPWError
+
+    if q is None or cell.solver.opw is None:
+        return None
+    try:
+        cf1, cf4, cf6, cfx = cell.solver.abb_confdata(np.asarray(q, float))
+    except NotOPWError:
+        return None
+    return int(cf1), int(cf4), int(cf6), int(cfx)
 
 
 def check_plan(plan: Plan, plan_dir: Path) -> list[CheckRow]:
@@ -199,6 +205,8 @@ def cmd_check(args: argparse.Namespace) -> int:
         rows = check_plan(plan, plan_dir)
     except NoPlanarFaceError as exc:  # the plan cannot work on this part: a failed check
         print(f"wobjcal check: {exc}", file=sys.stderr)
+        if args.json:
+            print_json({"plan": args.plan, "feasible": False, "error": str(exc), "points": []})
         return 1
     bad = [r for r in rows if not r.feasible]
     if args.json:
@@ -210,7 +218,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         out.print(_table(rows, f"wobjcal check {args.plan}"))
         for r in bad:
             reason = "; ".join(x for x in (r.reason, r.path_reason) if x) or "not feasible"
-            out.print(f"[red]point {r.point_id}: {r.status}: {reason}[/]")
+            out.print(f"[red]point {r.point_id}: {r.overall_status}: {reason}[/]")
         out.print(
             f"{len(rows) - len(bad)} of {len(rows)} points feasible"
             + ("" if not bad else f"; not feasible: {', '.join(r.point_id for r in bad)}")

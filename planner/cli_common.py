@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import argparse
+import contextlib
 import json
+import os
 import sys
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +19,55 @@ from calib.plan import Plan, load_plan
 PLANS_DIR = Path(__file__).resolve().parent.parent / "assets" / "plans"
 #: The built-in demo plan (the paper's A-H plan on the built-in stator cell).
 DEMO_PLAN = PLANS_DIR / "stator_section_ah.json"
+
+
+def count_arg(minimum: int) -> Callable[[str], int]:
+    """An argparse ``type`` for whole numbers ``>= minimum`` (clear message otherwise)."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"must be >= {minimum}, got {value}")
+        return value
+
+    return parse
+
+
+@contextlib.contextmanager
+def native_output_to_stderr() -> Iterator[None]:
+    """Send what native code prints on file descriptor 1 to stderr for the duration.
+
+    PyBullet's URDF loader prints warnings (``b3Warning ... No inertial data``) with C
+    ``printf``; in ``--json`` output they would corrupt the document. Python's ``sys.stdout``
+    keeps writing to the real standard output through a private duplicate. Does nothing when
+    ``sys.stdout`` is not the process's file descriptor 1 (e.g. captured by a test).
+    """
+    try:
+        real = sys.stdout is not None and sys.stdout.fileno() == 1
+    except (AttributeError, OSError, ValueError):
+        real = False
+    if not real:
+        yield
+        return
+    sys.stdout.flush()
+    saved_fd = os.dup(1)
+    private = os.fdopen(os.dup(saved_fd), "w", encoding=sys.stdout.encoding, errors="replace")
+    old_stdout = sys.stdout
+    os.dup2(2, 1)
+    sys.stdout = private
+    try:
+        yield
+    finally:
+        with contextlib.suppress(BrokenPipeError, OSError, ValueError):
+            private.flush()
+        sys.stdout = old_stdout
+        os.dup2(saved_fd, 1)
+        os.close(saved_fd)
+        with contextlib.suppress(BrokenPipeError, OSError):
+            private.close()
 
 
 def stdout() -> Console:

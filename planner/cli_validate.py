@@ -12,7 +12,7 @@ from typing import Any
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from calib.atomic_io import write_text_atomic
-from planner.cli_common import read_plan, stderr, stdout
+from planner.cli_common import count_arg, read_plan, stderr, stdout
 
 
 def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
@@ -30,9 +30,9 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "wobjcal validate plan.json --json report.json --plots plots/",
     )
     p.add_argument("plan", metavar="PLAN", help="plan file (wobjcal.plan/1)")
-    p.add_argument("--trials", type=int, help="number of trials (default: the plan's)")
-    p.add_argument("--seed", type=int, help="random seed (default: the plan's)")
-    p.add_argument("--workers", type=int, help="worker processes (default: up to 2)")
+    p.add_argument("--trials", type=count_arg(1), help="number of trials (default: the plan's)")
+    p.add_argument("--seed", type=count_arg(0), help="random seed >= 0 (default: the plan's)")
+    p.add_argument("--workers", type=count_arg(1), help="worker processes (default: up to 2)")
     p.add_argument("--json", metavar="FILE", help="also write the report as JSON to FILE")
     p.add_argument("--plots", metavar="DIR", help="also write PNG plots to DIR")
     p.set_defaults(handler=cmd_validate)

@@ -147,12 +147,19 @@ def calibrate_plan(
         method: ``hultman2013``, ``three_two_one`` or ``best_fit``; default: the plan's.
 
     Raises:
-        InputError: unknown method, missing measurements, a layout the method cannot use.
+        InputError: unknown method, a measured id the plan does not have, missing
+            measurements, a layout the method cannot use.
         ProbeFailedError: the A-H replay needs a point that was not measured.
     """
     method = method or plan.method
     if method not in METHODS:
         raise InputError(f"method must be one of {list(METHODS)}, got {method!r}")
+    known = {p.id for p in plan.points}
+    unknown = sorted(set(measurements.points) - known)
+    if unknown:
+        raise InputError(
+            f"measurements: points {unknown} are not in the plan (its points: {sorted(known)})"
+        )
     T_nom = nominal_T_base_wobj(plan)
     T_bw = T_base_world(plan)
     measured = {pid: measurements.sequence_m(pid, T_bw) for pid in measurements.points}

@@ -108,3 +108,11 @@ def test_three_two_one_roles_are_picked_from_faces() -> None:
     assert ids["tertiary"] == ["C"]
     small = assign_three_two_one(load_plan(SMALL))
     assert [p.id for p in small["secondary"]] == ["S1", "S2"]
+
+
+def test_measured_point_not_in_plan_is_an_error() -> None:
+    plan = load_plan(STATOR)
+    m = _measure(plan, nominal_T_base_wobj(plan))
+    extra = Measurements(points={**m.points, "Z": (1.0, 2.0, 3.0)})
+    with pytest.raises(InputError, match=r"points \['Z'\] are not in the plan"):
+        calibrate_plan(plan, extra, "best_fit")
