@@ -18,7 +18,14 @@ area on its surface (seeded), with their face normals, and checked two ways in t
 Reported: checks (points) per second of each, their ratio on the same points, how many points
 each finds feasible, and the points where the two disagree (with our reason).
 
-Run: ``python -m bench.bench_feasibility [--n 300] [--pybullet-n 100] [--seed 0]``; writes
+3. The worst case (:func:`run_worst_case`): in the demo cell (stator section on a table)
+   ``--worst-n`` stator samples; the points whose every candidate collides are checked one
+   per call (a UI click), staged and with one whole clearance query per candidate
+   (``staged=False``: the check as it was), and by the plain loop; likewise the feasible
+   points; then the heat map per sample. Ratios, and whether the answers are the same.
+
+Run: ``python -m bench.bench_feasibility [--n 300] [--pybullet-n 100] [--seed 0] [--worst-n 40]``;
+writes
 ``bench/results/feasibility.json``.
 """
 
@@ -82,7 +89,9 @@ def run_plain_loop(cell: Cell, pts: np.ndarray, nrm: np.ndarray) -> dict[str, ob
     sensor = {i for i, name in tool.names.items() if name in cell.tool.sensor_links}
     angles = np.radians(np.arange(0, 360, 15))
     T_world = (
-        T_WORLD_WOBJ @ tcp_frames(pts, nrm, angles) @ invert_transform(cell.T_flange_tcp("sensor"))
+        cell.T_world_wobj
+        @ tcp_frames(pts, nrm, angles)
+        @ invert_transform(cell.T_flange_tcp("sensor"))
     )
     lo, hi = cell.chain.lower, cell.chain.upper
     feasible = 0
@@ -143,12 +152,94 @@ def run_plain_loop(cell: Cell, pts: np.ndarray, nrm: np.ndarray) -> dict[str, ob
     }
 
 
+def _timed_points(cell: Cell, pts: np.ndarray, nrm: np.ndarray, staged: bool) -> dict:
+    """Each point checked alone (one UI click each): per-point seconds and the answers."""
+    seconds, answers = [], []
+    for i in range(len(pts)):
+        t0 = time.perf_counter()
+        (r,) = cell.check_probes(pts[i : i + 1], nrm[i : i + 1], staged=staged)
+        seconds.append(time.perf_counter() - t0)
+        answers.append((r.status, r.reason))
+    return {"seconds": seconds, "answers": answers}
+
+
+def _summary(seconds: list[float]) -> dict[str, float]:
+    s = np.asarray(seconds) * 1e3
+    return {"median_ms": float(np.median(s)), "max_ms": float(s.max()), "mean_ms": float(s.mean())}
+
+
+def run_worst_case(n_samples: int, seed: int, with_loop: bool) -> dict[str, object]:
+    """The demo cell (stator on a table): points that collide in every candidate pose.
+
+    ``n_samples`` points are sampled on the stator; those whose answer is a collision (every
+    candidate collides: the slow case of a UI click) are the worst-case set, the feasible ones
+    the typical set. Each point is checked alone, staged and with one whole query per
+    candidate (``staged=False``, the check as it was), and by the plain PyBullet loop (which
+    tries all 24 rotations before it gives up); then all samples as one heat-map batch.
+    """
+    from planner.demo_cell import make_demo_cell
+    from planner.reachability_map import reachability_map
+
+    with make_demo_cell() as cell:
+        pts, nrm, _ = sample_surface(cell.work_object.mesh, n_samples, np.random.default_rng(seed))
+        cell.check_probes(pts[:2], nrm[:2])  # warm-up
+        first = _timed_points(cell, pts, nrm, staged=True)
+        worst = [i for i, (_, why) in enumerate(first["answers"]) if " hits " in why]
+        typical = [i for i, (st, _) in enumerate(first["answers"]) if st == "feasible"]
+        out: dict[str, object] = {"samples": n_samples, "worst_points": len(worst)}
+        for name, idx in (("worst", worst), ("typical", typical)):
+            staged = _timed_points(cell, pts[idx], nrm[idx], staged=True)
+            whole = _timed_points(cell, pts[idx], nrm[idx], staged=False)
+            row = {"staged": _summary(staged["seconds"]), "whole_query": _summary(whole["seconds"])}
+            row["same_answers"] = staged["answers"] == whole["answers"]
+            row["ratio_median"] = row["whole_query"]["median_ms"] / row["staged"]["median_ms"]
+            row["ratio_max"] = row["whole_query"]["max_ms"] / row["staged"]["max_ms"]
+            if with_loop and idx:
+                loop = run_plain_loop(cell, pts[idx], nrm[idx])
+                row["pybullet_loop_ms_per_point"] = 1e3 * loop["seconds"] / len(idx)
+            out[name] = row
+        heat = {}
+        for staged_flag in (True, False):
+            t0 = time.perf_counter()
+            reachability_map(cell, n_samples, np.random.default_rng(seed), staged=staged_flag)
+            heat["staged" if staged_flag else "whole_query"] = (
+                1e3 * (time.perf_counter() - t0) / n_samples
+            )
+        heat["ratio"] = heat["whole_query"] / heat["staged"]
+        out["heat_map_ms_per_sample"] = heat
+    return out
+
+
+def _print_worst(w: dict) -> None:
+    table = Table(title=f"demo cell, one point per call ({w['samples']} stator samples)")
+    for col in ("points", "n", "staged median/max ms", "whole-query median/max ms", "ratio"):
+        table.add_column(col)
+    for name in ("worst", "typical"):
+        r = w[name]
+        table.add_row(
+            name,
+            str(w["worst_points"]) if name == "worst" else "",
+            f"{r['staged']['median_ms']:.1f} / {r['staged']['max_ms']:.0f}",
+            f"{r['whole_query']['median_ms']:.1f} / {r['whole_query']['max_ms']:.0f}",
+            f"{r['ratio_median']:.1f}x (max {r['ratio_max']:.1f}x)",
+        )
+    Console().print(table)
+    h = w["heat_map_ms_per_sample"]
+    Console().print(
+        f"heat map: {h['staged']:.1f} ms/sample staged, {h['whole_query']:.1f} whole-query "
+        f"({h['ratio']:.1f}x); same answers: {w['worst']['same_answers']}, "
+        f"{w['typical']['same_answers']}"
+    )
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=300, help="probe points for wobjcal")
     ap.add_argument("--pybullet-n", type=int, default=100, help="points for the plain loop")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", type=Path, default=RESULTS)
+    ap.add_argument("--worst-n", type=int, default=40, help="demo samples for the worst case")
+    ap.add_argument("--worst-no-loop", action="store_true", help="skip the loop on those")
     args = ap.parse_args(argv)
     rng = np.random.default_rng(args.seed)
     mesh = work_object()
@@ -178,6 +269,7 @@ def main(argv: list[str] | None = None) -> int:
         "ours_on_loop_points": ours_same,
         "pybullet_plain_loop": loop,
         "ratio_checks_per_s": ours_same["checks_per_s"] / loop["checks_per_s"],
+        "worst_case_demo": run_worst_case(args.worst_n, args.seed, not args.worst_no_loop),
         "machine": {"python": platform.python_version(), "cpu": platform.processor()},
     }
     args.out.parent.mkdir(parents=True, exist_ok=True)
@@ -204,6 +296,7 @@ def main(argv: list[str] | None = None) -> int:
         f"{loop['feasible']}/{k}",
     )
     Console().print(table)
+    _print_worst(result["worst_case_demo"])
     Console().print(
         f"ratio: {result['ratio_checks_per_s']:.1f}x; only the loop finds feasible (our "
         f"reasons): {result['only_loop_feasible_our_reasons']}; only we find feasible: "

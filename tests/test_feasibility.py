@@ -15,6 +15,7 @@ from calib.frames import make_transform, matrix_from_rotvec
 from planner.cell import Cell
 from planner.errors import UnknownFrameError
 from planner.feasibility import tcp_frames
+from planner.pybullet_client import pb
 
 BOX = 0.4  # edge of the work-object cube, m
 T_WORLD_WOBJ = make_transform(p=[1.4, 0.0, 0.4])  # top face at z = 0.6, 1.2 m in front
@@ -196,3 +197,73 @@ def test_answers_do_not_depend_on_where_the_cell_stands(cell: Cell) -> None:
         assert (a.status, a.reason) == (b.status, b.reason)
         np.testing.assert_equal(a.rotation_rad, b.rotation_rad)  # NaN == NaN here
         np.testing.assert_allclose(a.clearance_m, b.clearance_m, atol=1e-4)
+
+
+def _same_answers(a: list, b: list) -> None:
+    """Staged and plain checks agree (the tool stands at the planned flange pose in the staged
+    one, at PyBullet's single-precision FK in the plain one: ~1e-8 m apart)."""
+    assert len(a) == len(b)
+    for x, y in zip(a, b):
+        assert (x.status, x.reason, x.branch) == (y.status, y.reason, y.branch)
+        np.testing.assert_equal(x.rotation_rad, y.rotation_rad)
+        np.testing.assert_allclose(x.clearance_m, y.clearance_m, atol=1e-6)
+        np.testing.assert_array_equal(x.q, y.q)
+
+
+@pytest.mark.parametrize(
+    ("height_m", "reason"),
+    [
+        (0.02, "sensor_body hits plate (clearance -17.0 mm)"),
+        (0.05, "guide_tube_1 hits plate (clearance -27.0 mm)"),
+        (0.10, "sensor_bracket hits plate (clearance -53.0 mm)"),
+    ],
+)
+def test_tool_blocked_by_a_plate_in_every_rotation(cell: Cell, monkeypatch, height_m, reason):
+    """A plate over the point blocks the tool in every rotation: still infeasible, naming the
+    plate and the least-bad clearance, as the plain check says, for fewer queries.
+
+    The sensor face lies 8 mm over the point (z 0.608 m); the 10 mm plate is centred
+    ``height_m`` over it. 20 mm: the sensor body must rise 17 mm to clear the plate's top;
+    50 mm: the tube ends (20 mm behind the face) 27 mm; 100 mm: the bracket (40-140 mm behind
+    the face) must drop 53 mm below the plate."""
+    T_plate = make_transform(p=[1.4, 0.0, 0.6 + height_m])
+    cell.add_fixture("plate", size_m=(0.6, 0.6, 0.01), T_world_fixture=T_plate)
+    calls = {"n": 0}
+    closest = pb.getClosestPoints
+
+    def counted(*args, **kwargs):
+        calls["n"] += 1
+        return closest(*args, **kwargs)
+
+    monkeypatch.setattr(pb, "getClosestPoints", counted)
+    try:
+        (staged,) = cell.check_probes(TOP, UP)
+        n_staged, calls["n"] = calls["n"], 0
+        (plain,) = cell.check_probes(TOP, UP, staged=False)
+        n_plain = calls["n"]
+    finally:
+        cell.remove_fixture("plate")
+    assert staged.status == "infeasible" and staged.reason == reason
+    _same_answers([staged], [plain])
+    assert n_staged <= n_plain // 2  # one tool query per rotation, not per candidate
+
+
+@pytest.fixture(scope="module")
+def demo() -> Iterator[Cell]:
+    from planner.demo_cell import make_demo_cell
+
+    with make_demo_cell(use_acl_cache=False) as c:
+        yield c
+
+
+def test_demo_points_that_collide_in_every_pose_keep_their_answers(demo: Cell) -> None:
+    """Stator points whose every candidate collides (the slow case of the web UI), a
+    feasible yoke point, and a point the table blocks: staged answers equal the plain ones."""
+    pts = np.array([[-0.135, -0.635, -0.069], [-0.122, -0.444, -0.067], [0.0, -0.6, -0.1375]])
+    nrm = np.array([[0.0, -1.0, 0.0], [0.0, -0.866, -0.5], [1.0, 0.0, 0.0]])
+    staged = demo.check_probes(pts, nrm)
+    plain = demo.check_probes(pts, nrm, staged=False)
+    assert [r.status for r in staged] == ["infeasible", "infeasible", "feasible"]
+    assert staged[0].reason.startswith("link_5 hits work object")
+    assert "hits" in staged[1].reason
+    _same_answers(staged, plain)
