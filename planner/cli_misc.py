@@ -86,10 +86,12 @@ def cmd_ui(args: argparse.Namespace) -> int:
         load_plan(plan)  # a clear error now, before a server starts
 
     from webui.app import run  # the one place planner imports webui (viser), lazily
+    from webui.state import default_autosave_path
 
     stderr().print(
         f"wobjcal UI on http://{args.host}:{args.port} "
-        f"({plan or 'built-in demo ' + DEMO_PLAN.name}); Ctrl-C stops it"
+        f"({plan or 'built-in demo ' + DEMO_PLAN.name}); Ctrl-C stops it\n"
+        f"the session plan autosaves to {default_autosave_path(plan, args.port)}"
     )
     run(plan, host=args.host, port=args.port, block=True)
     return 0

@@ -25,7 +25,7 @@ from webui.plan_adapter import autosave_bytes, ui_plan_from_file
 from webui.plan_doc import UiPlan
 from webui.robot_view import RobotView
 from webui.scene import PlanScene
-from webui.state import DEFAULT_AUTOSAVE, Change, SessionState
+from webui.state import DEFAULT_AUTOSAVE, Change, SessionState, default_autosave_path
 from webui.status import PointCheck
 from webui.surface import SurfacePicker
 from webui.worker import CellWorker
@@ -257,7 +257,7 @@ def run(
     host: str = "127.0.0.1",
     port: int = 8080,
     block: bool = True,
-    autosave_path: str | Path | None = DEFAULT_AUTOSAVE,
+    autosave_path: str | Path | None = "auto",
 ) -> WobjcalApp:
     """Start the wobjcal UI on ``http://host:port`` with a plan file or the built-in demo.
 
@@ -266,7 +266,9 @@ def run(
         host: interface to bind; 127.0.0.1 (this machine only) unless told otherwise.
         port: TCP port.
         block: serve until interrupted (Ctrl-C), then stop; ``False`` returns at once.
-        autosave_path: where the session plan autosaves; ``None`` disables autosave.
+        autosave_path: where the session plan autosaves; ``"auto"`` (default): one file per
+            plan and port under ``~/.cache/wobjcal/autosave/`` (see
+            :func:`webui.state.default_autosave_path`); ``None`` disables autosave.
 
     Returns:
         The running app (``app.server`` is the viser server; ``app.stop()`` ends it).
@@ -275,9 +277,13 @@ def run(
         ui_plan, plan_dir = ui_plan_from_file(Path(plan_path)), Path(plan_path).parent
     else:
         ui_plan, plan_dir = demo.demo_ui_plan()
+    if autosave_path == "auto":
+        autosave_path = default_autosave_path(plan_path, port)
     server = viser.ViserServer(host=host, port=port, label="wobjcal", verbose=block)
     server.gui.configure_theme(control_width="large", show_share_button=False)
     logger.info("wobjcal UI at http://%s:%d", host, server.get_port())
+    if autosave_path is not None:
+        logger.info("the session plan autosaves to %s", autosave_path)
     app = WobjcalApp(
         server,
         ui_plan,
