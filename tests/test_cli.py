@@ -111,7 +111,9 @@ def test_export_writes_files(fmt: str, tmp_path: Path, capsys: pytest.CaptureFix
     if fmt == "json":
         assert text == plan_to_json(load_plan(STATOR))
     elif fmt == "rapid":
-        assert text.startswith("MODULE WobjcalStatorSectionAh") and text.count("SearchL") == 8
+        assert (
+            text.startswith("MODULE WobjcalStatorSectionAh") and text.count("SearchL\\SStop") == 10
+        )
     elif fmt == "krl":
         dat = (tmp_path / "prog.dat").read_text()
         assert len(re.findall(r"DECL E6POS x\w+_(?:start|end)=", dat)) == 16

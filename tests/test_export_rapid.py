@@ -48,11 +48,12 @@ def parse_rapid(text: str) -> dict[str, object]:
     assert tool and wobj
     targets = {}
     for m in re.finditer(
-        r"CONST robtarget p(\w+)_(start|end):=\[\[([^\]]*)\],\[([^\]]*)\],\[([^\]]*)\],", text
+        r"CONST robtarget p(\w+)_(start|end|safe|face):=\[\[([^\]]*)\],\[([^\]]*)\],\[([^\]]*)\],",
+        text,
     ):
         conf = tuple(int(c) for c in m.group(5).split(","))
         targets[(m.group(1), m.group(2))] = (_pose(m.group(3), m.group(4)), conf)
-    searches = re.findall(r"SearchL\\SStop,diSensor( \\NegFlank)?,pMeas,p(\w+)_end", text)
+    searches = re.findall(r"SearchL\\SStop,diSensor(\\NegFlank)?,pMeas,p\w+,vSearch_p(\w+),", text)
     return {
         "tool": _pose(tool.group(1), tool.group(2)),
         "wobj": _pose(wobj.group(1), wobj.group(2)),

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 from calib.frames import check_transform, make_transform
 from calib.plan import Plan
 from calib.probing import SearchCommand
+from planner.export.safety import SafetySpec
 
 FloatArray = NDArray[np.float64]
 #: ABB ``confdata`` (cf1, cf4, cf6, cfx).
@@ -37,6 +38,13 @@ class TargetPair:
         T_wobj_end: ``(4, 4)`` sensor-TCP pose at the end of the search travel, wobj frame, m.
         speed_m_s: search speed, m/s.
         confdata: ABB configuration (cf1, cf4, cf6, cfx) of the IK branch, or ``None``.
+        normal_wobj: ``(3,)`` outward normal of the face the sensor looks at, wobj frame.
+        T_wobj_safe: ``(4, 4)`` where the program starts the (first) approach search, wobj
+            frame, m: the plan's start moved out along the normal to the safe clearance
+            (:class:`planner.export.safety.SafetySpec`); for an edge search, the edge start
+            moved out along the normal (the approach to the face the edge search runs along).
+        T_wobj_face: ``(4, 4)`` end of that approach search, wobj frame, m (for an approach
+            point the plan's end, for an edge point past the face by the safe overtravel).
     """
 
     point_id: str
@@ -46,6 +54,25 @@ class TargetPair:
     T_wobj_end: FloatArray
     speed_m_s: float
     confdata: ConfData | None = None
+    normal_wobj: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    T_wobj_safe: FloatArray | None = None
+    T_wobj_face: FloatArray | None = None
+
+    @property
+    def safe_start(self) -> FloatArray:
+        """``(4, 4)`` start of the (first) approach search, wobj frame (the plan's if unset)."""
+        return self.T_wobj_start if self.T_wobj_safe is None else self.T_wobj_safe
+
+    @property
+    def face_end(self) -> FloatArray:
+        """``(4, 4)`` end of the (first) approach search, wobj frame (the plan's if unset)."""
+        return self.T_wobj_end if self.T_wobj_face is None else self.T_wobj_face
+
+    @property
+    def edge_direction_wobj(self) -> FloatArray:
+        """``(3,)`` unit direction of the search, start to end, wobj frame."""
+        d = self.T_wobj_end[:3, 3] - self.T_wobj_start[:3, 3]
+        return d / np.linalg.norm(d)
 
     @property
     def length_m(self) -> float:
@@ -69,6 +96,33 @@ class ToolData:
 
 
 @dataclass(frozen=True)
+class AdaptiveSpec:
+    """The paper's A-H procedure as the program runs it (``hultman2013`` plans).
+
+    Attributes:
+        index: ``{role: i}`` the target index (0-based, plan order) of each role ``A``..``H``.
+        beta1_rad: assumed inclination of the side face (eq. 12), rad.
+        p3_height_m: height of P3 above B (eq. 12), m.
+        retake_c_d: C and D are measured again at the end (``C2``, ``D2``).
+        edge_start_from_measured: F and H start at the measured E and G (else at an approach
+            search of the face at the plan's edge start).
+        edge_start_offset_m: offset of that start along the estimated +x, m.
+        edge_event_offset_m: how far past the edge the sensor reports it, m (0 when the plan
+            leaves it unset, as ``wobjcal calibrate`` does).
+        face_coords_wobj: x of the side face, y of the short side, z of the top, wobj, m.
+    """
+
+    index: dict[str, int]
+    beta1_rad: float
+    p3_height_m: float
+    retake_c_d: bool
+    edge_start_from_measured: bool
+    edge_start_offset_m: float
+    edge_event_offset_m: float
+    face_coords_wobj: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
 class ExportJob:
     """Everything an exporter writes.
 
@@ -80,6 +134,9 @@ class ExportJob:
         tool: the sensor tool.
         targets: one :class:`TargetPair` per point, in plan order.
         sensor_input: name of the sensor's digital input (RAPID signal, KRL/UR input number).
+        safety: the misplacement tolerance the safe starts are computed for.
+        adaptive: the A-H procedure for ``hultman2013`` plans (searches commanded in the frame
+            estimated so far), or ``None``: every search in the nominal frame.
     """
 
     name: str
@@ -89,6 +146,8 @@ class ExportJob:
     tool: ToolData
     targets: tuple[TargetPair, ...]
     sensor_input: str = "diSensor"
+    safety: SafetySpec = field(default_factory=SafetySpec)
+    adaptive: AdaptiveSpec | None = None
 
 
 def identifier(text: str, prefix: str = "p") -> str:
@@ -147,6 +206,7 @@ def build_job(
     T = check_transform(T_base_wobj, "T_base_wobj")
     rotations = rotations_wobj or {}
     confs = confdata or {}
+    safety = safety_spec(plan)
     targets = []
     for p in plan.points:
         cmd = SearchCommand.from_point(p.to_probe_point(), np.eye(4))
@@ -155,6 +215,16 @@ def build_job(
             R = default_sensor_rotation(p.normal, p.search.edge_direction)
         R = np.asarray(R, dtype=float)
         end = cmd.start_m + cmd.length_m * cmd.direction
+        n = np.asarray(p.normal, dtype=float)
+        # the face point the first approach search looks for: the point, or the edge start
+        face = np.asarray(p.position_m, float) if p.search.kind == "approach" else cmd.start_m
+        clear = safety.start_clearance_m(face)
+        if p.search.kind == "approach":
+            safe = face + max(clear, p.search.start_offset_m) * n
+            face_end = end
+        else:
+            safe = face + clear * n
+            face_end = face - safety.overtravel_m(face) * n
         targets.append(
             TargetPair(
                 point_id=p.id,
@@ -164,6 +234,9 @@ def build_job(
                 T_wobj_end=make_transform(R, end),
                 speed_m_s=p.search.speed_m_s,
                 confdata=confs.get(p.id),
+                normal_wobj=(float(n[0]), float(n[1]), float(n[2])),
+                T_wobj_safe=make_transform(R, safe),
+                T_wobj_face=make_transform(R, face_end),
             )
         )
     return ExportJob(
@@ -174,6 +247,49 @@ def build_job(
         tool=tool,
         targets=tuple(targets),
         sensor_input=sensor_input,
+        safety=safety,
+        adaptive=adaptive_spec(plan),
+    )
+
+
+def safety_spec(plan: Plan) -> SafetySpec:
+    """The misplacement tolerance and sensing distance of ``plan``'s validation settings.
+
+    The rotation pivot is the centroid of the probe points, as in ``wobjcal validate``.
+    """
+    v = plan.validation
+    pivot = np.mean([p.position_m for p in plan.points], axis=0) if plan.points else np.zeros(3)
+    return SafetySpec(
+        max_translation_m=v.misplacement.max_translation_m,
+        max_angle_rad=v.misplacement.max_angle_rad,
+        pivot_wobj_m=(float(pivot[0]), float(pivot[1]), float(pivot[2])),
+        sensing_distance_m=v.sensor.sensing_distance_m,
+    )
+
+
+def adaptive_spec(plan: Plan) -> AdaptiveSpec | None:
+    """The A-H procedure of a complete ``hultman2013`` plan, else ``None``."""
+    if plan.method != "hultman2013":
+        return None
+    from calib.plan_procedures import Hultman2013
+    from calib.stator_layout import check_stator_points
+    from planner.plan_io import hultman_points
+
+    roles = [p.role for p in plan.points]
+    if sorted(roles) != sorted("ABCDEFGH"):
+        return None
+    layout = check_stator_points(hultman_points(plan))
+    proc = plan.procedure if isinstance(plan.procedure, Hultman2013) else Hultman2013()
+    face = layout.face_coords_wobj
+    return AdaptiveSpec(
+        index={r: i for i, r in enumerate(roles)},
+        beta1_rad=proc.beta1_rad,
+        p3_height_m=proc.p3_height_m,
+        retake_c_d=proc.retake_c_d,
+        edge_start_from_measured=proc.edge_start_from_measured,
+        edge_start_offset_m=proc.edge_start_offset_m,
+        edge_event_offset_m=proc.edge_event_offset_m or 0.0,
+        face_coords_wobj=(float(face[0]), float(face[1]), float(face[2])),
     )
 
 

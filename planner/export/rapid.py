@@ -31,6 +31,9 @@ from planner.export.common import ExportJob, TargetPair, fmt, identifier
 
 EXTAX = "[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]"
 MEASURED_FILE = "wobjcal_measured.json"
+#: The wobjdata every search is commanded in.
+WOBJ = "wobjCal"
+BS = "\\"
 
 
 def pose_text(T: np.ndarray) -> str:
@@ -56,17 +59,22 @@ def _string(text: str) -> str:
 def _declarations(job: ExportJob, names: list[str]) -> list[str]:
     tool = job.tool
     cog = ",".join(fmt(v * 1000.0, 3) for v in tool.cog_m)
-    n = len(job.targets)
-    ids = ",".join(_string(t.point_id) for t in job.targets)
+    slots = measured_slots(job)
+    n = len(slots)
+    ids = ",".join(_string(pid) for pid, _ in slots)
+    retake = ",".join("TRUE" if r else "FALSE" for _, r in slots)
     empty = ",".join(['""'] * n)
+    nominal = f'[FALSE,TRUE,"",{pose_text(job.T_base_wobj)},[[0,0,0],[1,0,0,0]]]'
     lines = [
         f"    PERS tooldata tSensor:=[TRUE,{pose_text(tool.T_flange_tcp)},"
         f"[{fmt(tool.mass_kg, 3)},[{cog}],[1,0,0,0],0,0,0]];",
-        f'    PERS wobjdata wobjNominal:=[FALSE,TRUE,"",{pose_text(job.T_base_wobj)},'
-        "[[0,0,0],[1,0,0,0]]];",
+        f"    PERS wobjdata wobjNominal:={nominal};",
+        "    ! the frame the searches are commanded in (updated step by step when adaptive)",
+        f"    PERS wobjdata {WOBJ}:={nominal};",
         "    CONST speeddata vApproach:=[100,50,5000,1000];",
         f"    CONST num nPoints:={n};",
         f"    PERS string measuredId{{{n}}}:=[{ids}];",
+        f"    PERS bool measuredRetake{{{n}}}:=[{retake}];",
         f"    PERS pos measured{{{n}}}:=[{','.join(['[0,0,0]'] * n)}];",
         f"    PERS bool measuredOk{{{n}}}:=[{','.join(['FALSE'] * n)}];",
         f"    PERS string measuredErr{{{n}}}:=[{empty}];",
@@ -82,49 +90,163 @@ def _declarations(job: ExportJob, names: list[str]) -> list[str]:
             f"    CONST robtarget {name}_start:={robtarget_text(t.T_wobj_start, t.confdata)};"
             + note,
             f"    CONST robtarget {name}_end:={robtarget_text(t.T_wobj_end, t.confdata)};",
-            f"    CONST speeddata vSearch_{name}:=[{fmt(t.speed_m_s * 1000.0, 3)},30,5000,1000];",
+            f"    CONST robtarget {name}_safe:={robtarget_text(t.safe_start, t.confdata)};",
         ]
+        if t.kind == "edge":
+            d = t.edge_direction_wobj
+            n_w = t.normal_wobj
+            lines += [
+                f"    CONST robtarget {name}_face:={robtarget_text(t.face_end, t.confdata)};",
+                f"    CONST pos {name}_dir:=[{','.join(fmt(v, 9) for v in d)}];",
+                f"    CONST pos {name}_normal:=[{','.join(fmt(v, 9) for v in n_w)}];",
+            ]
+        lines.append(
+            f"    CONST speeddata vSearch_{name}:=[{fmt(t.speed_m_s * 1000.0, 3)},30,5000,1000];"
+        )
     return lines
 
 
-def _probe_proc(i: int, t: TargetPair, name: str) -> list[str]:
-    flank = " \\NegFlank" if t.kind == "edge" else ""
-    level = (
-        "not detecting at the start (not over the face)"
-        if t.kind == "edge"
-        else ("already detecting at the start")
-    )
-    length = fmt(t.length_m * 1000.0, 1)
-    missed = (
-        f"edge not found within {length} mm (sensor kept detecting)"
-        if t.kind == "edge"
-        else f"no detection within {length} mm"
-    )
-    wobj = "tSensor\\WObj:=wobjNominal"
+def measured_slots(job: ExportJob) -> list[tuple[str, bool]]:
+    """``(point id, is a retake)`` of each entry of the RAPID ``measured`` array, in order."""
+    slots = [(t.point_id, False) for t in job.targets]
+    a = job.adaptive
+    if a is not None and a.retake_c_d:
+        slots += [(job.targets[a.index[r]].point_id, True) for r in ("C", "D")]
+    return slots
+
+
+def _store(i: str) -> list[str]:
+    """Store the search point: ``pMeas`` is in ``WOBJ``; ``measured`` is in the base frame."""
     return [
-        f"    PROC Probe_{name}()",
-        f"        MoveJ {name}_start,vApproach,fine,{wobj};",
-        f"        SearchL\\SStop,diSensor{flank},pMeas,{name}_end,vSearch_{name},{wobj};",
-        f"        measured{{{i}}}:=PoseVect(wobjNominal.uframe,"
-        "PoseVect(wobjNominal.oframe,pMeas.trans));",
+        f"        measured{{{i}}}:=PoseVect({WOBJ}.uframe,PoseVect({WOBJ}.oframe,pMeas.trans));",
         f"        measuredOk{{{i}}}:=TRUE;",
         f'        measuredErr{{{i}}}:="";',
-        f"        MoveL {name}_start,vApproach,fine,{wobj};",
+    ]
+
+
+def _handler(t: TargetPair, safe: str, edge_stage: bool) -> list[str]:
+    length = fmt(t.length_m * 1000.0, 1)
+    if edge_stage:
+        missed = (
+            f'IF nStage=1 THEN measuredErr{{i}}:="face not found before the edge search"; '
+            f'ELSE measuredErr{{i}}:="edge not found within {length} mm"; ENDIF'
+        )
+        level = (
+            'IF nStage=1 THEN measuredErr{i}:="sensor already detecting at the start"; '
+            'ELSE measuredErr{i}:="sensor not detecting at the start (not over the face)"; ENDIF'
+        )
+    else:
+        missed = f'measuredErr{{i}}:="no detection within {length} mm";'
+        level = 'measuredErr{i}:="sensor already detecting at the start";'
+    wobj = f"tSensor{BS}WObj:={WOBJ}"
+    return [
         "    ERROR",
         "        IF ERRNO=ERR_WHLSEARCH THEN",
-        f'            measuredErr{{{i}}}:="{missed}";',
+        *_block(missed, 12),
         "        ELSEIF ERRNO=ERR_SIGSUPSEARCH THEN",
-        f'            measuredErr{{{i}}}:="sensor {level}";',
+        *_block(level, 12),
         "        ELSE",
         "            RAISE;",
         "        ENDIF",
-        f"        measuredOk{{{i}}}:=FALSE;",
-        f'        TPWrite "wobjcal: point {t.point_id} failed: "+measuredErr{{{i}}};',
-        f"        MoveL {name}_start,vApproach,fine,{wobj};",
+        "        measuredOk{i}:=FALSE;",
+        f'        TPWrite "wobjcal: point {t.point_id} failed: "+measuredErr{{i}};',
+        f"        MoveL {safe},vApproach,fine,{wobj};",
         "        IF bStopOnFail Stop;",
         "        RETURN;",
         "    ENDPROC",
         "",
+    ]
+
+
+def _block(text: str, indent: int) -> list[str]:
+    """Lay out ``IF c THEN a; ELSE b; ENDIF`` (or one statement) one statement per line."""
+    pad = " " * indent
+    if not text.startswith("IF "):
+        return [pad + text]
+    head, rest = text.split(" THEN ", 1)
+    then, rest = rest.split(" ELSE ", 1)
+    other = rest.rsplit(" ENDIF", 1)[0]
+    return [
+        f"{pad}{head} THEN",
+        f"{pad}    {then}",
+        f"{pad}ELSE",
+        f"{pad}    {other}",
+        f"{pad}ENDIF",
+    ]
+
+
+def _probe_proc(t: TargetPair, name: str, from_measured: float | None) -> list[str]:
+    """The ``PROC Probe_<name>(num i)`` that measures the point into ``measured{i}``.
+
+    Args:
+        t: the target.
+        name: its RAPID name.
+        from_measured: for an edge search that starts at an already measured point
+            (``edge_start_from_measured``): the offset of the start along the face normal,
+            m; the proc then takes ``pos startBase`` (base frame, mm) and skips the approach
+            to the face. ``None``: approach the face first and start from the measured point.
+    """
+    wobj = f"tSensor{BS}WObj:={WOBJ}"
+    safe = f"{name}_safe"
+    if t.kind == "approach":
+        return [
+            f"    PROC Probe_{name}(num i)",
+            f"        MoveJ {safe},vApproach,fine,{wobj};",
+            f"        SearchL{BS}SStop,diSensor,pMeas,{name}_end,vSearch_{name},{wobj};",
+            *_store("i"),
+            f"        MoveL {safe},vApproach,fine,{wobj};",
+            *_handler(t, safe, False),
+        ]
+    params = "num i" if from_measured is None else "num i,pos startBase"
+    lines = [
+        f"    PROC Probe_{name}({params})",
+        "        VAR robtarget pStart;",
+        "        VAR robtarget pEnd;",
+        "        VAR num nStage:=1;",
+        f"        pStart:={name}_start;",
+    ]
+    if from_measured is None:  # approach the face the edge search runs along, from outside
+        lines += [
+            f"        MoveJ {safe},vApproach,fine,{wobj};",
+            f"        SearchL{BS}SStop,diSensor,pMeas,{name}_face,vSearch_{name},{wobj};",
+            "        ! the edge search starts at the measured face point (TCP at the face)",
+            "        pStart.trans:=pMeas.trans;",
+        ]
+    else:  # start at the measured point (base) plus the offset along the face normal
+        lines += [
+            f"        MoveJ {safe},vApproach,fine,{wobj};",
+            f"        pStart.trans:=PoseVect(PoseInv({WOBJ}.uframe),startBase)"
+            f"+{fmt(from_measured * 1000.0, 4)}*{name}_normal;",
+        ]
+    lines += [
+        f"        MoveL pStart,vApproach,fine,{wobj};",
+        "        ! run along the search direction up to where the plan's search ends",
+        f"        pEnd:={name}_end;",
+        f"        pEnd.trans:=pStart.trans+DotProd({name}_end.trans-pStart.trans,{name}_dir)"
+        f"*{name}_dir;",
+        "        nStage:=2;",
+        f"        SearchL{BS}SStop,diSensor{BS}NegFlank,pMeas,pEnd,vSearch_{name},{wobj};",
+        *_store("i"),
+        f"        MoveL {safe},vApproach,fine,{wobj};",
+        *_handler(t, safe, True),
+    ]
+    return lines
+
+
+def _write_points(cond: str, left: str, right: str) -> list[str]:
+    """Write ``"id": [x, y, z]`` (mm) of the entries where ``cond`` holds, comma-separated."""
+    q = '""'
+    return [
+        '        sep:="";',
+        "        FOR i FROM 1 TO nPoints DO",
+        f"            IF {cond} THEN",
+        f'                Write file,sep+"{q}"+measuredId{{i}}+"{q}: {left}"\\NoNewLine;',
+        '                Write file,NumToStr(measured{i}.x,4)+", "\\NoNewLine;',
+        '                Write file,NumToStr(measured{i}.y,4)+", "\\NoNewLine;',
+        f'                Write file,NumToStr(measured{{i}}.z,4)+"{right}"\\NoNewLine;',
+        '                sep:=", ";',
+        "            ENDIF",
+        "        ENDFOR",
     ]
 
 
@@ -139,19 +261,13 @@ def _write_proc() -> list[str]:
         f'        Write file,"{{{q}schema{q}: {q}wobjcal.measurements/1{q}, '
         f'{q}frame{q}: {q}base{q}, {q}units{q}: {q}mm{q},";',
         f'        Write file," {q}points{q}: {{"\\NoNewLine;',
-        "        FOR i FROM 1 TO nPoints DO",
-        "            IF measuredOk{i} THEN",
-        f'                Write file,sep+"{q}"+measuredId{{i}}+"{q}: ["\\NoNewLine;',
-        '                Write file,NumToStr(measured{i}.x,4)+", "\\NoNewLine;',
-        '                Write file,NumToStr(measured{i}.y,4)+", "\\NoNewLine;',
-        '                Write file,NumToStr(measured{i}.z,4)+"]"\\NoNewLine;',
-        '                sep:=", ";',
-        "            ENDIF",
-        "        ENDFOR",
+        *_write_points("measuredOk{i} AND NOT measuredRetake{i}", "[", "]"),
+        f'        Write file,"}}, {q}retakes{q}: {{"\\NoNewLine;',
+        *_write_points("measuredOk{i} AND measuredRetake{i}", "[[", "]]"),
         f'        Write file,"}}, {q}failed{q}: {{"\\NoNewLine;',
         '        sep:="";',
         "        FOR i FROM 1 TO nPoints DO",
-        "            IF NOT measuredOk{i} THEN",
+        "            IF NOT measuredOk{i} AND NOT measuredRetake{i} THEN",
         f'                Write file,sep+"{q}"+measuredId{{i}}+"{q}: {q}"\\NoNewLine;',
         f'                Write file,measuredErr{{i}}+"{q}"\\NoNewLine;',
         '                sep:=", ";',
@@ -166,31 +282,63 @@ def _write_proc() -> list[str]:
 
 def export_rapid(job: ExportJob) -> str:
     """The RAPID module text of ``job``."""
+    from planner.export.rapid_adaptive import adaptive_header, adaptive_main, adaptive_procs
+
     names = _unique_names([t.point_id for t in job.targets])
+    a = job.adaptive
     lines = [
         f"MODULE {job.name}",
         f"    ! Generated by wobjcal {__version__} from plan {job.plan_name!r} "
         f"(procedure {job.method}).",
         "    ! Probes each point with the proximity sensor on digital input diSensor.",
-        "    ! Units mm; quaternions [q1,q2,q3,q4] = w, x, y, z; robtargets in wobjNominal.",
+        *(adaptive_header() if a is not None else _nominal_header()),
+        *_comment("SAFE FOR: " + job.safety.describe() + ";"),
+        "    ! every search starts at least that far outside the nominal surface (the plan's",
+        "    ! start or farther); edge searches first approach the face they run along and",
+        "    ! start from the measured face point. ASSUMES: the moves between the points are",
+        "    ! clear of the part and fixtures (checked by `wobjcal check`, not here).",
+        f"    ! Units mm; quaternions [q1,q2,q3,q4] = w, x, y, z; robtargets in {WOBJ}.",
         "    ! wobjNominal.uframe = nominal work object in the world frame (= robot base).",
         "    ! confdata [cf1,cf4,cf6,cfx] from the IK branch chosen by `wobjcal check`.",
-        "    ! Results: measured{i} (base frame, mm) of point measuredId{i}, and",
+        "    ! Results: measured{i} (base frame, mm; SearchL gives pMeas in the wobj, converted",
+        f"    ! with {WOBJ}.uframe and .oframe) of point measuredId{{i}}, and",
         f"    ! HOME:/{MEASURED_FILE} for `wobjcal calibrate PLAN MEASURED`.",
         *_declarations(job, names),
+        *(adaptive_procs(job) if a is not None else []),
         "",
         "    PROC main()",
         *_conf_lines(job),
-        *[f"        Probe_{name};" for name in names],
+        f"        {WOBJ}:=wobjNominal;",
+        *(
+            adaptive_main(job, names)
+            if a is not None
+            else [f"        Probe_{name} {i};" for i, name in enumerate(names, start=1)]
+        ),
         "        WriteMeasurements;",
         "    ENDPROC",
         "",
     ]
-    for i, (t, name) in enumerate(zip(job.targets, names, strict=True), start=1):
-        lines += _probe_proc(i, t, name)
+    for t, name in zip(job.targets, names, strict=True):
+        start_at = None
+        if a is not None and a.edge_start_from_measured and t.role in ("F", "H"):
+            start_at = a.edge_start_offset_m
+        lines += _probe_proc(t, name, start_at)
     lines += _write_proc()
     lines.append("ENDMODULE")
     return "\n".join(lines) + "\n"
+
+
+def _comment(text: str, width: int = 92) -> list[str]:
+    """``text`` as RAPID comment lines of at most ``width`` characters."""
+    import textwrap
+
+    return ["    ! " + line for line in textwrap.wrap(text, width - 6)]
+
+
+def _nominal_header() -> list[str]:
+    return [
+        f"    ! NOMINAL FRAME: every search is commanded in {WOBJ} = wobjNominal (not adaptive).",
+    ]
 
 
 def _conf_lines(job: ExportJob) -> list[str]:
