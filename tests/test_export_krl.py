@@ -86,7 +86,8 @@ def test_program_structure() -> None:
     assert len(re.findall(r"^\s*IF .* THEN$", src, re.M)) == src.count("ENDIF")
     edge = [p.id for p in plan.points if p.search.kind == "edge"]
     assert len(re.findall(r"^ +SEARCH_FALL\(x", src, re.M)) == len(edge)
-    assert len(re.findall(r"^ +SEARCH_RISE\(x", src, re.M)) == len(plan.points) - len(edge)
+    # every point starts with an approach search (edge points: to the face they run along)
+    assert len(re.findall(r"^ +SEARCH_RISE\(x", src, re.M)) == len(plan.points)
     assert "INTERRUPT DECL 20 WHEN diSensor==TRUE" in src
     assert "INTERRUPT DECL 21 WHEN diSensor==FALSE" in src
     assert "xHit=$POS_INT" in src and "RESUME" in src

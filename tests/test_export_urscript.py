@@ -73,7 +73,7 @@ def test_script_structure() -> None:
     script = text[".script"]
     assert script.startswith("def wobjcalthreetwoonesmall():\n")
     assert "get_standard_digital_in(SENSOR_IN)" in script
-    assert "pose_trans(wobj, start_wobj)" in script
+    assert "pose_trans(wobj, safe_wobj)" in script and "pose_inv(wobj)" in script
     # block structure: every def/thread/if/while is closed by an end
     opens = len(re.findall(r"^\s*(def |thread |if |while )", script, re.M))
     assert opens == len(re.findall(r"^\s*end$", script, re.M))

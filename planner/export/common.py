@@ -293,6 +293,23 @@ def adaptive_spec(plan: Plan) -> AdaptiveSpec | None:
     )
 
 
+def safety_header(job: ExportJob, prefix: str, width: int = 92) -> list[str]:
+    """Header comment lines of a program that runs every search in the nominal frame."""
+    import textwrap
+
+    text = (
+        "NOMINAL FRAME: every search is commanded in the nominal work object (not adaptive: "
+        "the A-H frame update runs only in the RAPID export); compute the frame afterwards with "
+        "`wobjcal calibrate`. SAFE FOR: "
+        + job.safety.describe()
+        + ". Every search starts at least that far outside the nominal surface (the plan's "
+        "start or farther); edge searches first approach the face they run along and start "
+        "from the measured face point. ASSUMES: the moves between the points are clear of "
+        "the part and fixtures (checked by `wobjcal check`, not here)."
+    )
+    return [prefix + line for line in textwrap.wrap(text, width - len(prefix))]
+
+
 def fmt(x: float, decimals: int = 4) -> str:
     """A number for program text: fixed decimals, no ``-0``, trailing zeros trimmed."""
     s = f"{x:.{decimals}f}".rstrip("0").rstrip(".")
