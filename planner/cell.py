@@ -103,6 +103,7 @@ class Cell:
         self._T_world_wobj = np.eye(4)
         self._reach: ReachModel | None = None
         self.work_object: WorkObject | None = None
+        self._wobj_links: BodyLinks | None = None
         self.fixtures: dict[str, Fixture] = {}
         self._client: int | None = connect_direct()
         try:
@@ -307,9 +308,22 @@ class Cell:
         body = wobj.create_body(self.client, T)
         self.checker.wobj_body = body.body_id
         self.checker.environment[body.body_id] = wobj.name
-        self.work_object, self._T_world_wobj = wobj, T
+        self.work_object, self._T_world_wobj, self._wobj_links = wobj, T, body
         self.checker.log_static_contacts(body.body_id)
         return wobj
+
+    def move_work_object(self, T_world_wobj: ArrayLike) -> None:
+        """Move the loaded work object to ``T_world_wobj`` without rebuilding its mesh body
+        (the Monte Carlo validation moves the part every trial).
+
+        Raises:
+            UnknownFrameError: no work object is loaded.
+        """
+        if self.work_object is None or self._wobj_links is None:
+            raise UnknownFrameError("move_work_object: the cell has no work object yet")
+        T = check_transform(T_world_wobj, "T_world_wobj")
+        set_link_pose(self.client, self._wobj_links, T)
+        self._T_world_wobj = T
 
     def add_fixture(self, fixture: Fixture | str, **kwargs: Any) -> Fixture:
         """Add a fixture: a :class:`Fixture`, or a name and ``size_m=`` (box), ``radius_m=`` +

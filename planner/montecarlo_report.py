@@ -112,6 +112,8 @@ class ValidationReport:
         landings: ``"<point>: over slot hole|off face"`` -> number of such approaches.
         elapsed_s: wall time, seconds.
         workers: worker processes used.
+        reach_checked: how many trials (the first ones) also vetted every commanded search for
+            reachability and collisions in the cell; 0 when no cell was given.
     """
 
     n_trials: int
@@ -125,6 +127,7 @@ class ValidationReport:
     landings: dict[str, int]
     elapsed_s: float
     workers: int
+    reach_checked: int = 0
 
     def row(self, key: str, level_percent: float) -> IntervalRow:
         """The row ``key`` at ``level_percent``; raises KeyError when absent."""
@@ -157,6 +160,13 @@ class ValidationReport:
             " own origin and epsilon rows imply (0.02 deg about x); they look like quaternion"
             " components rather than degrees: compare the origin and epsilon rows"
             " (docs/simulation.md).",
+        ]
+        lines += [
+            "",
+            f"Reachability and collisions of the displaced searches checked in the cell on "
+            f"{self.reach_checked} of {self.n_trials} trials."
+            if self.reach_checked
+            else "Reachability and collisions of the displaced searches: not checked.",
         ]
         lines += ["", "Failures:" if self.failures else "Failures: none"]
         lines += [f"- {k}: {v}" for k, v in sorted(self.failures.items())]
@@ -197,6 +207,7 @@ def build_report(
     landings: dict[str, int],
     elapsed_s: float,
     workers: int,
+    reach_checked: int = 0,
 ) -> ValidationReport:
     """Summarise per-trial frame errors ``(n, 6)`` (NaN rows: failed trials) as Table 1."""
     ok = np.all(np.isfinite(delta_procedure), axis=1) & np.all(np.isfinite(delta_best_fit), axis=1)
@@ -249,4 +260,5 @@ def build_report(
         landings=landings,
         elapsed_s=elapsed_s,
         workers=workers,
+        reach_checked=reach_checked,
     )

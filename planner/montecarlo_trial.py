@@ -117,8 +117,8 @@ def run_trial(seed: np.random.SeedSequence, reach: ReachabilityHook | None) -> T
     T_nom = setup.T_base_wobj_nominal
     T_true = T_nom @ setup.misplacement.sample(rng, setup.pivot_wobj_m)
     cell = WORKER.get("cell")
-    if cell is not None:  # the cell's part goes where the part really is
-        cell.set_work_object(cell.work_object, T_world_wobj=cell.T_world_base @ T_true)  # type: ignore[attr-defined]
+    if cell is not None and reach is not None:  # the cell's part goes where it really is
+        cell.move_work_object(cell.T_world_base @ T_true)  # type: ignore[attr-defined]
     probe = SimulatedProbe(
         WORKER["caster"],  # type: ignore[arg-type]
         T_true,

@@ -81,3 +81,13 @@ def test_mesh_work_object_names_the_mesh() -> None:
     wo = msgspec.structs.replace(plan.work_object, mesh="part.stl")
     with pytest.raises(PlanError, match=r"^work_object\.mesh: .*builtin:stator_section.*part\.stl"):
         validate_plan(msgspec.structs.replace(plan, work_object=wo), trials=2, seed=0)
+
+
+def test_reach_checked_trials_draw_the_same_numbers() -> None:
+    """Vetting the first trials in the cell changes what is checked, not what is drawn."""
+    plan = load_plan(STATOR)
+    plain = validate_plan(plan, trials=60, seed=5)
+    vetted = validate_plan(plan, trials=60, seed=5, reach_trials=3, plan_dir=STATOR.parent)
+    assert plain.reach_checked == 0 and vetted.reach_checked == 3
+    assert "checked in the cell on 3 of 60 trials" in vetted.to_markdown()
+    np.testing.assert_array_equal(plain.delta_procedure, vetted.delta_procedure)
