@@ -24,7 +24,8 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "and the ABB confdata of each target come from the same reachability check as\n"
         "'wobjcal check' (when the cell is available; else a default orientation and no\n"
         "confdata, noted in the program). rapid: one .mod; krl: FILE (.src) and a .dat next\n"
-        "to it; urscript: one .script.",
+        "to it; urscript: one .script. Exit 1 (nothing written) when the check finds an\n"
+        "infeasible point, naming it; --force writes the program anyway.",
         "wobjcal export plan.json --format rapid -o WobjcalStator.mod\n"
         "wobjcal export plan.json --format krl -o wobjcal_stator.src",
     )
@@ -35,6 +36,11 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "--no-check",
         action="store_true",
         help="do not run the reachability check (default orientations, no confdata)",
+    )
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="write the program even when the check finds infeasible points (exit 0)",
     )
     p.set_defaults(handler=cmd_export)
 
@@ -47,8 +53,16 @@ def cmd_export(args: argparse.Namespace) -> int:
         write_text_atomic(out, plan_to_json(plan))
         stderr().print(f"wrote {out}")
         return 0
-    from planner.cli_check import export_job_for
+    from planner.cli_check import check_plan, export_job_for
 
+    if not args.no_check and not args.force:
+        bad = [r for r in check_plan(plan, plan_dir) if not r.feasible]
+        if bad:
+            for r in bad:
+                why = "; ".join(x for x in (r.reason, r.path_reason) if x) or r.status
+                stderr().print(f"error: point {r.point_id} is not feasible: {why}")
+            stderr().print("nothing written; fix the plan, or export anyway with --force")
+            return 1
     job, note = export_job_for(plan, plan_dir, run_check=not args.no_check)
     if note:
         stderr().print(f"note: {note}")
