@@ -121,9 +121,9 @@ def check_plan(plan: Plan, plan_dir: Path) -> list[CheckRow]:
         pts = np.array([p.position_m for p in plan.points], dtype=float).reshape(-1, 3)
         normals = np.array([p.normal for p in plan.points], dtype=float).reshape(-1, 3)
         results = cell.check_probes(pts, normals, tcp=plan.cell.tool.tcp) if len(pts) else []
-        paths = [
-            cell.check_search(SearchCommand.from_point(p.to_probe_point(), T_nom))
-            for p in plan.points
+        paths = [  # start each path from the probe pose's solution when there is one
+            cell.check_search(SearchCommand.from_point(p.to_probe_point(), T_nom), q_ref=res.q)
+            for p, res in zip(plan.points, results, strict=True)
         ]
         for p, res, path, why in zip(plan.points, results, paths, faces, strict=True):
             T_flange = getattr(res, "T_base_flange", None)

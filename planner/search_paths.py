@@ -120,7 +120,8 @@ def check_search(
     # T_base_tcp of every (rotation, sample): normals are -axis, points along the path
     points = start + s[:, None] * direction
     T_start = tcp_frames(start[None], -axis[None], angles)[0]  # (R, 4, 4)
-    starts = cell.solver.solve(T_start @ T_tcp_flange)
+    # a numeric solver starts from q_ref (e.g. the probe pose's solution) besides its seeds
+    starts = cell.solver.solve(T_start @ T_tcp_flange, seeds=None if q_ref is None else ref[None])
     K = starts.valid.shape[1]
     q0 = starts.q
     ok0 = starts.valid.copy()

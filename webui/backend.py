@@ -140,7 +140,7 @@ class CellSession:
         q_path = None
         if status != "infeasible":
             cmd = SearchCommand.from_point(point, self.view.T_base_wobj)
-            path = self.cell.check_search(cmd)
+            path = self.cell.check_search(cmd, q_ref=q)
             q_path = None if path.q_path is None else np.asarray(path.q_path, dtype=np.float64)
             if not path.feasible:
                 status = "infeasible"
