@@ -267,7 +267,7 @@ def _write_proc() -> list[str]:
         f'        Write file,"}}, {q}failed{q}: {{"\\NoNewLine;',
         '        sep:="";',
         "        FOR i FROM 1 TO nPoints DO",
-        "            IF NOT measuredOk{i} AND NOT measuredRetake{i} THEN",
+        '            IF NOT measuredOk{i} AND NOT measuredRetake{i} AND measuredErr{i}<>"" THEN',
         f'                Write file,sep+"{q}"+measuredId{{i}}+"{q}: {q}"\\NoNewLine;',
         f'                Write file,measuredErr{{i}}+"{q}"\\NoNewLine;',
         '                sep:=", ";',
@@ -309,6 +309,11 @@ def export_rapid(job: ExportJob) -> str:
         "    PROC main()",
         *_conf_lines(job),
         f"        {WOBJ}:=wobjNominal;",
+        "        ! PERS values survive a previous run: start from nothing measured",
+        "        FOR i FROM 1 TO nPoints DO",
+        "            measuredOk{i}:=FALSE;",
+        '            measuredErr{i}:="";',
+        "        ENDFOR",
         *(
             adaptive_main(job, names)
             if a is not None
