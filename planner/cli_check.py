@@ -89,6 +89,8 @@ class CheckRow:
             "status": self.status,
             "reason": self.reason,
             "clearance_m": self.clearance_m if math.isfinite(self.clearance_m) else None,
+            "clearance_is_lower_bound": math.isfinite(self.clearance_m)
+            and _clearance_capped(self.clearance_m),
             "path_feasible": self.path_feasible,
             "path_reason": self.path_reason,
             "confdata": list(self.confdata) if self.confdata else None,
@@ -176,6 +178,20 @@ def export_job_for(plan: Plan, plan_dir: Path, run_check: bool = True) -> tuple[
     return build_job(plan, T_nom, tool, rotations, confs), note
 
 
+def _clearance_capped(clearance_m: float) -> bool:
+    """True when the clearance is the query's look-ahead distance (nothing nearer found)."""
+    from planner.cell import DEFAULT_MARGIN_M
+    from planner.collision import report_distance_m
+
+    return clearance_m >= report_distance_m(DEFAULT_MARGIN_M) - 1e-6
+
+
+def _clearance_text(clearance_m: float) -> str:
+    if not math.isfinite(clearance_m):
+        return "-"
+    return ("≥ " if _clearance_capped(clearance_m) else "") + f"{clearance_m * 1e3:.1f} mm"
+
+
 def _table(rows: list[CheckRow], title: str) -> Table:
     table = Table(title=title)
     for col in ("point", "role", "search", "status", "clearance", "path", "confdata", "reason"):
@@ -188,7 +204,7 @@ def _table(rows: list[CheckRow], title: str) -> Table:
             r.role,
             r.kind,
             f"[{colour.get(r.status, 'white')}]{r.status}[/]",
-            f"{r.clearance_m * 1e3:.1f} mm" if math.isfinite(r.clearance_m) else "-",
+            _clearance_text(r.clearance_m),
             "ok" if r.path_feasible else "[red]blocked[/]",
             str(list(r.confdata)) if r.confdata else "-",
             reason,

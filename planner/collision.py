@@ -52,6 +52,15 @@ __all__ = [
 ]
 
 
+def report_distance_m(margin_m: float) -> float:
+    """How far clearance queries look, metres: ``2 * margin_m + 5 mm``.
+
+    Clearances are exact below it; a clearance equal to it means "at least this much" (nothing
+    nearer was found), which reports should show as ``>= ...``.
+    """
+    return 2.0 * margin_m + 0.005
+
+
 @dataclass
 class CollisionChecker:
     """The fast clearance query of a cell (built by :class:`planner.cell.Cell`).
@@ -186,7 +195,7 @@ class CollisionChecker:
         Per environment body: each moving robot link, then each tool link; then the
         self-collision part. Static robot links are left out (they were never reported).
         """
-        look = report_m if report_m is not None else 2.0 * margin_m + 0.005
+        look = report_m if report_m is not None else report_distance_m(margin_m)
         look = max(look, margin_m, self_margin_m) + 1e-9
         moving = [i for i in self._robot_links() if i not in self.static_links]
         parts: list[QueryPart] = []

@@ -109,6 +109,17 @@ def limit_margin(chain: KinematicChain, q: FloatArray) -> FloatArray:
         return np.min(np.minimum(q - chain.lower, chain.upper - q), axis=-1)
 
 
+def _near_limit_reason(chain: KinematicChain, q: FloatArray) -> str:
+    """E.g. ``joint 3 near its upper limit (joint_3, 4.3 deg to go)`` for one ``q (n,)``."""
+    to_lower, to_upper = q - chain.lower, chain.upper - q
+    j = int(np.argmin(np.minimum(to_lower, to_upper)))
+    side, left = ("lower", to_lower[j]) if to_lower[j] < to_upper[j] else ("upper", to_upper[j])
+    return (
+        f"joint {j + 1} near its {side} limit ({chain.joint_names[j]}, "
+        f"{math.degrees(float(left)):.1f} deg to go)"
+    )
+
+
 def singular(cell: Cell, q: FloatArray) -> tuple[NDArray[np.bool_], str]:
     """Mask ``(M,)`` of configurations ``q (M, n)`` too near a singularity, and the reason."""
     if cell.solver.kind == "opw" and q.shape[1] == 6:
@@ -237,7 +248,7 @@ def check_probes(
                 reason = (
                     f"small clearance: {cl.describe()}"
                     if cl.slack_m < margin
-                    else f"joint near limit (margin {math.degrees(margin_all[i, c]):.1f} deg)"
+                    else _near_limit_reason(cell.chain, q_all[i, c])
                 )
             else:
                 reason = cl.describe()
