@@ -119,6 +119,8 @@ def check_plan(plan: Plan, plan_dir: Path) -> list[CheckRow]:
     rows = []
     with open_cell(plan, plan_dir) as cell:
         wo = cell.work_object  # planar faces: a probe measures a plane
+        if wo is None:  # open_cell always loads the plan's work object
+            raise RuntimeError("the plan's cell has no work object")
         faces = plan_face_reasons(wo.mesh, [p.to_probe_point() for p in plan.points], name=wo.name)
         pts = np.array([p.position_m for p in plan.points], dtype=float).reshape(-1, 3)
         normals = np.array([p.normal for p in plan.points], dtype=float).reshape(-1, 3)

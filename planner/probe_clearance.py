@@ -163,7 +163,7 @@ class ProbeClearance:
                     key = self._pose_key(part)
                     known = self._robot_results.get(key, False)
                     if known is not False:  # evaluated in full at this very link pose
-                        if known is not None and known.slack_m <= settled_at:
+                        if isinstance(known, Clearance) and known.slack_m <= settled_at:
                             return True
                         continue
                     if self._robot_below.get(key, math.inf) <= settled_at:

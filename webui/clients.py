@@ -31,8 +31,8 @@ def set_default_camera(client: viser.ClientHandle, view: CellView) -> None:
     """Point a newly connected tab's camera at the cell (z up)."""
     position, look_at = default_camera(view)
     client.camera.up_direction = (0.0, 0.0, 1.0)
-    client.camera.position = tuple(float(v) for v in position)
-    client.camera.look_at = tuple(float(v) for v in look_at)
+    client.camera.position = (float(position[0]), float(position[1]), float(position[2]))
+    client.camera.look_at = (float(look_at[0]), float(look_at[1]), float(look_at[2]))
 
 
 def notify(
