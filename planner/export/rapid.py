@@ -2,23 +2,27 @@
 
 Layout of the module:
 
+- a header comment: adaptive or nominal frame, the misplacement tolerance the search starts
+  are safe for (:mod:`planner.export.safety`) and what the program assumes;
 - ``PERS tooldata tSensor``: the sensor TCP on the flange (mm, quaternion ``[q1..q4]`` = w, x, y,
   z), with the tool's mass and centre of gravity;
 - ``PERS wobjdata wobjNominal``: the nominal work object. ``uframe`` holds ``T_base_wobj`` (the
   controller's world frame is taken to be the robot base, ABB's default for one robot) and
-  ``oframe`` is identity, so re-running with a calibrated ``uframe`` needs no other change;
-- per point a start and an end ``robtarget`` in ``wobjNominal`` with the ``confdata``
+  ``oframe`` is identity; ``PERS wobjdata wobjCal``: the frame every search is commanded in,
+  set to ``wobjNominal`` at the start. For ``hultman2013`` plans the program updates
+  ``wobjCal.uframe`` after every step of the A-H procedure (:mod:`planner.export.rapid_adaptive`)
+  and ends with the calibrated work object in it; otherwise it stays nominal;
+- per point ``_start``/``_end`` (the plan's search), ``_safe`` (the safe start) and for edge
+  points ``_face``, ``_dir``, ``_normal``, all in ``wobjCal`` with the ``confdata``
   ``[cf1, cf4, cf6, cfx]`` of the IK branch ``wobjcal check`` chose (``[0, 0, 0, 0]`` and a
-  comment when unknown) and a ``PROC`` that moves to the start, runs
-  ``SearchL \\SStop, diSensor, ...`` (approach: rising flank) or
-  ``SearchL \\SStop, diSensor \\NegFlank, ...`` (edge: the sensor stops detecting where the face
-  ends), stores the search point in the base frame and retreats to the start;
-- an ``ERROR`` handler per search: ``ERR_WHLSEARCH`` (no detection on the whole path) and
-  ``ERR_SIGSUPSEARCH`` (the input already at the searched level at the start) record the failure,
-  ``TPWrite`` it, retreat, and go on (or ``Stop`` when ``bStopOnFail`` is TRUE);
-- ``PERS pos measured{N}`` with ``measuredId``/``measuredOk``/``measuredErr``, and
-  ``WriteMeasurements`` writing ``HOME:/wobjcal_measured.json`` in the
-  ``wobjcal.measurements/1`` format, ready for ``wobjcal calibrate``.
+  comment when unknown), and a ``PROC Probe_<name>(num i)`` (:mod:`planner.export.rapid_probe`)
+  with an ``ERROR`` handler for ``ERR_WHLSEARCH`` and ``ERR_SIGSUPSEARCH`` that records the
+  failure, ``TPWrite``-s it, retreats and goes on (``Stop`` when ``bStopOnFail``; the adaptive
+  program stops at the first failure);
+- ``PERS pos measured{N}`` (base frame, mm; the adaptive program adds the retakes of C and D)
+  with ``measuredId``/``measuredRetake``/``measuredOk``/``measuredErr``, and
+  ``WriteMeasurements`` (:mod:`planner.export.rapid_write`) writing
+  ``HOME:/wobjcal_measured.json`` in the ``wobjcal.measurements/1`` format.
 """
 
 from __future__ import annotations
@@ -27,13 +31,11 @@ import numpy as np
 
 from calib._version import __version__
 from calib.frames import quat_wxyz_from_matrix
-from planner.export.common import ExportJob, TargetPair, fmt, identifier
+from planner.export.common import ExportJob, fmt, identifier
+from planner.export.rapid_probe import WOBJ, probe_proc
+from planner.export.rapid_write import MEASURED_FILE, write_proc
 
 EXTAX = "[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]"
-MEASURED_FILE = "wobjcal_measured.json"
-#: The wobjdata every search is commanded in.
-WOBJ = "wobjCal"
-BS = "\\"
 
 
 def pose_text(T: np.ndarray) -> str:
@@ -115,171 +117,6 @@ def measured_slots(job: ExportJob) -> list[tuple[str, bool]]:
     return slots
 
 
-def _store(i: str) -> list[str]:
-    """Store the search point: ``pMeas`` is in ``WOBJ``; ``measured`` is in the base frame."""
-    return [
-        f"        measured{{{i}}}:=PoseVect({WOBJ}.uframe,PoseVect({WOBJ}.oframe,pMeas.trans));",
-        f"        measuredOk{{{i}}}:=TRUE;",
-        f'        measuredErr{{{i}}}:="";',
-    ]
-
-
-def _handler(t: TargetPair, safe: str, edge_stage: bool) -> list[str]:
-    length = fmt(t.length_m * 1000.0, 1)
-    if edge_stage:
-        missed = (
-            f'IF nStage=1 THEN measuredErr{{i}}:="face not found before the edge search"; '
-            f'ELSE measuredErr{{i}}:="edge not found within {length} mm"; ENDIF'
-        )
-        level = (
-            'IF nStage=1 THEN measuredErr{i}:="sensor already detecting at the start"; '
-            'ELSE measuredErr{i}:="sensor not detecting at the start (not over the face)"; ENDIF'
-        )
-    else:
-        missed = f'measuredErr{{i}}:="no detection within {length} mm";'
-        level = 'measuredErr{i}:="sensor already detecting at the start";'
-    wobj = f"tSensor{BS}WObj:={WOBJ}"
-    return [
-        "    ERROR",
-        "        IF ERRNO=ERR_WHLSEARCH THEN",
-        *_block(missed, 12),
-        "        ELSEIF ERRNO=ERR_SIGSUPSEARCH THEN",
-        *_block(level, 12),
-        "        ELSE",
-        "            RAISE;",
-        "        ENDIF",
-        "        measuredOk{i}:=FALSE;",
-        f'        TPWrite "wobjcal: point {t.point_id} failed: "+measuredErr{{i}};',
-        f"        MoveL {safe},vApproach,fine,{wobj};",
-        "        IF bStopOnFail Stop;",
-        "        RETURN;",
-        "    ENDPROC",
-        "",
-    ]
-
-
-def _block(text: str, indent: int) -> list[str]:
-    """Lay out ``IF c THEN a; ELSE b; ENDIF`` (or one statement) one statement per line."""
-    pad = " " * indent
-    if not text.startswith("IF "):
-        return [pad + text]
-    head, rest = text.split(" THEN ", 1)
-    then, rest = rest.split(" ELSE ", 1)
-    other = rest.rsplit(" ENDIF", 1)[0]
-    return [
-        f"{pad}{head} THEN",
-        f"{pad}    {then}",
-        f"{pad}ELSE",
-        f"{pad}    {other}",
-        f"{pad}ENDIF",
-    ]
-
-
-def _probe_proc(t: TargetPair, name: str, from_measured: float | None) -> list[str]:
-    """The ``PROC Probe_<name>(num i)`` that measures the point into ``measured{i}``.
-
-    Args:
-        t: the target.
-        name: its RAPID name.
-        from_measured: for an edge search that starts at an already measured point
-            (``edge_start_from_measured``): the offset of the start along the face normal,
-            m; the proc then takes ``pos startBase`` (base frame, mm) and skips the approach
-            to the face. ``None``: approach the face first and start from the measured point.
-    """
-    wobj = f"tSensor{BS}WObj:={WOBJ}"
-    safe = f"{name}_safe"
-    if t.kind == "approach":
-        return [
-            f"    PROC Probe_{name}(num i)",
-            f"        MoveJ {safe},vApproach,fine,{wobj};",
-            f"        SearchL{BS}SStop,diSensor,pMeas,{name}_end,vSearch_{name},{wobj};",
-            *_store("i"),
-            f"        MoveL {safe},vApproach,fine,{wobj};",
-            *_handler(t, safe, False),
-        ]
-    params = "num i" if from_measured is None else "num i,pos startBase"
-    lines = [
-        f"    PROC Probe_{name}({params})",
-        "        VAR robtarget pStart;",
-        "        VAR robtarget pEnd;",
-        "        VAR num nStage:=1;",
-        f"        pStart:={name}_start;",
-    ]
-    if from_measured is None:  # approach the face the edge search runs along, from outside
-        lines += [
-            f"        MoveJ {safe},vApproach,fine,{wobj};",
-            f"        SearchL{BS}SStop,diSensor,pMeas,{name}_face,vSearch_{name},{wobj};",
-            "        ! the edge search starts at the measured face point (TCP at the face)",
-            "        pStart.trans:=pMeas.trans;",
-        ]
-    else:  # start at the measured point (base) plus the offset along the face normal
-        lines += [
-            f"        MoveJ {safe},vApproach,fine,{wobj};",
-            f"        pStart.trans:=PoseVect(PoseInv({WOBJ}.uframe),startBase)"
-            f"+{fmt(from_measured * 1000.0, 4)}*{name}_normal;",
-        ]
-    lines += [
-        f"        MoveL pStart,vApproach,fine,{wobj};",
-        "        ! run along the search direction up to where the plan's search ends",
-        f"        pEnd:={name}_end;",
-        f"        pEnd.trans:=pStart.trans+DotProd({name}_end.trans-pStart.trans,{name}_dir)"
-        f"*{name}_dir;",
-        "        nStage:=2;",
-        f"        SearchL{BS}SStop,diSensor{BS}NegFlank,pMeas,pEnd,vSearch_{name},{wobj};",
-        *_store("i"),
-        f"        MoveL {safe},vApproach,fine,{wobj};",
-        *_handler(t, safe, True),
-    ]
-    return lines
-
-
-def _write_points(cond: str, left: str, right: str) -> list[str]:
-    """Write ``"id": [x, y, z]`` (mm) of the entries where ``cond`` holds, comma-separated."""
-    q = '""'
-    return [
-        '        sep:="";',
-        "        FOR i FROM 1 TO nPoints DO",
-        f"            IF {cond} THEN",
-        f'                Write file,sep+"{q}"+measuredId{{i}}+"{q}: {left}"\\NoNewLine;',
-        '                Write file,NumToStr(measured{i}.x,4)+", "\\NoNewLine;',
-        '                Write file,NumToStr(measured{i}.y,4)+", "\\NoNewLine;',
-        f'                Write file,NumToStr(measured{{i}}.z,4)+"{right}"\\NoNewLine;',
-        '                sep:=", ";',
-        "            ENDIF",
-        "        ENDFOR",
-    ]
-
-
-def _write_proc() -> list[str]:
-    q = '""'
-    return [
-        "    ! Write the measurements as wobjcal.measurements/1 for `wobjcal calibrate`",
-        "    PROC WriteMeasurements()",
-        "        VAR iodev file;",
-        '        VAR string sep:="";',
-        f'        Open "HOME:"\\File:="{MEASURED_FILE}",file\\Write;',
-        f'        Write file,"{{{q}schema{q}: {q}wobjcal.measurements/1{q}, '
-        f'{q}frame{q}: {q}base{q}, {q}units{q}: {q}mm{q},";',
-        f'        Write file," {q}points{q}: {{"\\NoNewLine;',
-        *_write_points("measuredOk{i} AND NOT measuredRetake{i}", "[", "]"),
-        f'        Write file,"}}, {q}retakes{q}: {{"\\NoNewLine;',
-        *_write_points("measuredOk{i} AND measuredRetake{i}", "[[", "]]"),
-        f'        Write file,"}}, {q}failed{q}: {{"\\NoNewLine;',
-        '        sep:="";',
-        "        FOR i FROM 1 TO nPoints DO",
-        '            IF NOT measuredOk{i} AND NOT measuredRetake{i} AND measuredErr{i}<>"" THEN',
-        f'                Write file,sep+"{q}"+measuredId{{i}}+"{q}: {q}"\\NoNewLine;',
-        f'                Write file,measuredErr{{i}}+"{q}"\\NoNewLine;',
-        '                sep:=", ";',
-        "            ENDIF",
-        "        ENDFOR",
-        '        Write file,"}}";',
-        "        Close file;",
-        f'        TPWrite "wobjcal: measurements written to HOME:/{MEASURED_FILE}";',
-        "    ENDPROC",
-    ]
-
-
 def export_rapid(job: ExportJob) -> str:
     """The RAPID module text of ``job``."""
     from planner.export.rapid_adaptive import adaptive_header, adaptive_main, adaptive_procs
@@ -327,8 +164,8 @@ def export_rapid(job: ExportJob) -> str:
         start_at = None
         if a is not None and a.edge_start_from_measured and t.role in ("F", "H"):
             start_at = a.edge_start_offset_m
-        lines += _probe_proc(t, name, start_at)
-    lines += _write_proc()
+        lines += probe_proc(t, name, start_at)
+    lines += write_proc()
     lines.append("ENDMODULE")
     return "\n".join(lines) + "\n"
 

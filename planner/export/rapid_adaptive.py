@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 
 from planner.export.common import ExportJob, fmt
-from planner.export.rapid import WOBJ
+from planner.export.rapid_probe import WOBJ
 
 
 def adaptive_header() -> list[str]:
