@@ -302,10 +302,13 @@ def safety_header(job: ExportJob, prefix: str, width: int = 92) -> list[str]:
         "the A-H frame update runs only in the RAPID export); compute the frame afterwards with "
         "`wobjcal calibrate`. SAFE FOR: "
         + job.safety.describe()
-        + ". Every search starts at least that far outside the nominal surface (the plan's "
-        "start or farther); edge searches first approach the face they run along and start "
+        + ". Every search starts outside the nominal surface by at least the largest "
+        "misplacement of its face plus the sensing distance (the plan's start or farther); "
+        "edge searches first approach the face they run along and start "
         "from the measured face point. ASSUMES: the moves between the points are clear of "
-        "the part and fixtures (checked by `wobjcal check`, not here)."
+        "the part and fixtures (checked by `wobjcal check`, not here). An edge search runs "
+        "along the nominal direction: on a tilted part its track leaves the face by up to "
+        "travel * sin(angle)."
     )
     return [prefix + line for line in textwrap.wrap(text, width - len(prefix))]
 

@@ -6,7 +6,11 @@ alpha, beta, gamma of eq. 7-9, :func:`calib.frames.tait_bryan_zyx_from_matrix`).
 work object goes to ``BASE_DATA[10]`` (relative to ``$WORLD``, taken to be the robot base,
 ``$ROBROOT`` = 0), the sensor TCP to ``TOOL_DATA[10]`` and the tool load to ``LOAD_DATA[10]``;
 the targets are ``E6POS`` in that base without S and T (the controller keeps the current
-status and turn; check the first run in T1). A search moves ``LIN`` to the end point with
+status and turn; check the first run in T1). Every search runs in the nominal base (not
+adaptive; the frame comes from ``wobjcal calibrate``) and starts at ``x<ID>_safe``, outside
+the nominal surface by the safe clearance of :mod:`planner.export.safety`; an edge point first
+runs an approach search to ``x<ID>_face`` and then the edge search from the measured face point
+along the plan's direction. A search moves ``LIN`` to the end point with
 ``INTERRUPT ... WHEN diSensor==TRUE`` (approach) or ``==FALSE`` (edge); the interrupt routine
 brakes, stores ``$POS_INT`` and ``RESUME``-s. ``xMeas[i]`` holds point i in the robot base
 (``BASE_DATA[10]:xHit``, mm), ``nFail[i]`` is 0 (measured), 1 (no detection on the path) or 2

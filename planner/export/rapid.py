@@ -129,11 +129,16 @@ def export_rapid(job: ExportJob) -> str:
         f"(procedure {job.method}).",
         "    ! Probes each point with the proximity sensor on digital input diSensor.",
         *(adaptive_header() if a is not None else _nominal_header()),
-        *_comment("SAFE FOR: " + job.safety.describe() + ";"),
-        "    ! every search starts at least that far outside the nominal surface (the plan's",
-        "    ! start or farther); edge searches first approach the face they run along and",
-        "    ! start from the measured face point. ASSUMES: the moves between the points are",
-        "    ! clear of the part and fixtures (checked by `wobjcal check`, not here).",
+        *_comment(
+            "SAFE FOR: "
+            + job.safety.describe()
+            + ". Every search starts outside the nominal surface by at least the largest "
+            "misplacement of its face plus the sensing distance (the plan's start or farther); "
+            "edge searches first approach the face they run along "
+            "and start from the measured face point. ASSUMES: the moves between the points "
+            "are clear of the part and fixtures (checked by `wobjcal check`, not here), and "
+            "all moves end in fine points (wobjCal changes between them)."
+        ),
         f"    ! Units mm; quaternions [q1,q2,q3,q4] = w, x, y, z; robtargets in {WOBJ}.",
         "    ! wobjNominal.uframe = nominal work object in the world frame (= robot base).",
         "    ! confdata [cf1,cf4,cf6,cfx] from the IK branch chosen by `wobjcal check`.",

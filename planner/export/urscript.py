@@ -3,7 +3,10 @@
 Conventions: metres and rotation vectors, poses ``p[x, y, z, rx, ry, rz]``. The nominal work
 object is the pose ``wobj`` (robot base frame); each target is written in the work-object frame
 and moved to the base with ``pose_trans(wobj, target)``, so replacing ``wobj`` with the
-calibrated frame is a one-line change. A search runs ``movel`` to the end point in a thread
+calibrated frame is a one-line change. Every search runs in that nominal frame (not adaptive)
+and starts at the safe start of :mod:`planner.export.safety`; an edge point first approaches
+its face and runs the edge search from the measured face point (``probe``'s ``safe_wobj`` and
+``face_wobj``). A search runs ``movel`` to the end point in a thread
 while the main loop polls ``get_standard_digital_in(SENSOR_IN)`` every control cycle; at the
 switching event it reads ``get_actual_tcp_pose()``, kills the thread and ``stopl``-s.
 ``meas_<ID>`` holds ``[code, x, y, z]`` of each point: code 0 measured (x, y, z in the base
