@@ -23,8 +23,14 @@ from __future__ import annotations
 
 import math
 
-from planner.export.common import ExportJob, fmt
+from planner.export.common import AdaptiveSpec, ExportJob, fmt
 from planner.export.rapid_probe import WOBJ
+
+
+def _adaptive(job: ExportJob) -> AdaptiveSpec:
+    if job.adaptive is None:
+        raise ValueError(f"export job {job.name!r} has no A-H procedure (plan method {job.method})")
+    return job.adaptive
 
 
 def adaptive_header() -> list[str]:
