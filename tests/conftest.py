@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -37,3 +39,24 @@ def reference_dir() -> Path:
             pytest.fail(f"{message} (required under CI)")
         pytest.skip(message)
     return REFERENCE
+
+
+@pytest.fixture(scope="module")
+def cell() -> Iterator[Any]:
+    """The built-in cell (IRB 4400 + cable feeder), allowed-collision list computed afresh.
+
+    Test modules that need another cell define their own ``cell`` fixture.
+    """
+    from planner.cell import Cell  # PyBullet only for the tests that use a cell
+
+    with Cell(use_acl_cache=False) as c:
+        yield c
+
+
+@pytest.fixture(scope="module")
+def ur5(reference_dir: Path) -> Iterator[Any]:
+    """A cell with the vendor UR5 URDF from ``../shared/reference`` (numeric IK path)."""
+    from planner.cell import Cell
+
+    with Cell(reference_dir / "robots" / "ur5" / "ur5.urdf", use_acl_cache=False) as c:
+        yield c

@@ -2,27 +2,11 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from pathlib import Path
-
 import numpy as np
-import pytest
 
 import planner.acl as acl_module
 from planner.acl import AllowedCollisions, pair, sample_configurations
 from planner.cell import Cell
-
-
-@pytest.fixture(scope="module")
-def cell() -> Iterator[Cell]:
-    with Cell(use_acl_cache=False) as c:
-        yield c
-
-
-@pytest.fixture(scope="module")
-def ur5(reference_dir: Path) -> Iterator[Cell]:
-    with Cell(reference_dir / "robots" / "ur5" / "ur5.urdf", use_acl_cache=False) as c:
-        yield c
 
 
 def test_builtin_acl_allows_adjacent_links_and_the_tool_mount(cell: Cell) -> None:

@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from pathlib import Path
-
 import numpy as np
 import pytest
 import trimesh
@@ -12,18 +9,6 @@ import trimesh
 from calib.frames import make_transform
 from planner.cell import Cell
 from planner.fixtures import table
-
-
-@pytest.fixture(scope="module")
-def cell() -> Iterator[Cell]:
-    with Cell(use_acl_cache=False) as c:
-        yield c
-
-
-@pytest.fixture(scope="module")
-def ur5(reference_dir: Path) -> Iterator[Cell]:
-    with Cell(reference_dir / "robots" / "ur5" / "ur5.urdf", use_acl_cache=False) as c:
-        yield c
 
 
 def test_ur5_upper_arm_into_the_base_is_a_self_collision(ur5: Cell) -> None:

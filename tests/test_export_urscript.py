@@ -8,25 +8,13 @@ from pathlib import Path
 import numpy as np
 
 from calib.frames import make_transform, matrix_from_rotvec, random_transform
-from calib.plan import Plan, load_plan
+from calib.plan import load_plan
 from planner.export import export_files
 from planner.export.common import ToolData, build_job, default_sensor_rotation
+from tests.export_helpers import expected_ends_wobj
 
 VALID = Path(__file__).resolve().parent / "data" / "plans" / "valid_three_two_one.json"
 POSE = r"p\[([^\]]*)\]"
-
-
-def expected_ends_wobj(plan: Plan) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Start and end TCP positions (m, wobj frame) computed from the plan's fields."""
-    out = {}
-    for p in plan.points:
-        pos, n, s = np.array(p.position_m), np.array(p.normal), p.search
-        if s.kind == "approach":
-            out[p.id] = (pos + s.start_offset_m * n, pos - s.overtravel_m * n)
-        else:
-            d = np.array(s.edge_direction)
-            out[p.id] = (pos - s.start_offset_m * d, pos + s.overtravel_m * d)
-    return out
 
 
 def parse_pose(text: str) -> np.ndarray:
