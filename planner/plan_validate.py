@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import msgspec
 import numpy as np
 
 from calib.plan import Plan, PlanError
@@ -101,28 +102,16 @@ def validation_models(plan: Plan) -> ValidationModels:
     proc = check_simulatable(plan)
     v = plan.validation
     s, r, m = v.sensor, v.robot_error, v.misplacement
-    sensor = ProximitySensor(
-        face_diameter_m=s.face_diameter_m,
-        sensing_distance_m=s.sensing_distance_m,
-        decay_length_m=s.decay_length_m,
-        hysteresis_fraction=s.hysteresis_fraction,
-        repeatability_sigma_m=s.repeatability_sigma_m,
-        n_rays=s.n_rays,
-        n_scan_rays=s.n_scan_rays,
-    )
+    # the plan's models mirror the simulation's field by field (tests/test_plan_models.py)
+    sensor = ProximitySensor(**msgspec.structs.asdict(s))
     edge_inset_m = DEFAULT_EDGE_INSET_M
     edge_offset = proc.edge_event_offset_m
     if edge_offset is None:  # the sensor model's straight-edge offset, as montecarlo's default
         edge_offset = sensor.edge_event_offset_m(edge_inset_m)
     return ValidationModels(
         sensor=sensor,
-        robot_error=RobotErrorModel(
-            repeatability_sigma_m=r.repeatability_sigma_m,
-            accuracy_amplitude_m=r.accuracy_amplitude_m,
-            accuracy_wavelength_m=r.accuracy_wavelength_m,
-            accuracy_terms=r.accuracy_terms,
-        ),
-        misplacement=Misplacement(m.max_translation_m, m.max_angle_rad),
+        robot_error=RobotErrorModel(**msgspec.structs.asdict(r)),
+        misplacement=Misplacement(**msgspec.structs.asdict(m)),
         settings=StatorSettings(
             beta1_rad=proc.beta1_rad,
             p3_height_m=proc.p3_height_m,
