@@ -49,10 +49,10 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 
 from calib.atomic_io import write_text_atomic
 from calib.frames import invert_transform, make_transform
-from planner.bodies import pb_pose
-from planner.cell import DEFAULT_MARGIN_M, Cell
-from planner.feasibility import tcp_frames
-from planner.reachability_map import sample_surface
+from planner.cell.bodies import pb_pose
+from planner.cell.cell import DEFAULT_MARGIN_M, Cell
+from planner.cell.feasibility import tcp_frames
+from planner.cell.reachability_map import sample_surface
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench/results/feasibility.json"
@@ -177,8 +177,8 @@ def run_worst_case(n_samples: int, seed: int, with_loop: bool) -> dict[str, obje
     candidate (``staged=False``, the check as it was), and by the plain PyBullet loop (which
     tries all 24 rotations before it gives up); then all samples as one heat-map batch.
     """
-    from planner.demo_cell import make_demo_cell
-    from planner.reachability_map import reachability_map
+    from planner.cell.reachability_map import reachability_map
+    from planner.parts.stator_demo import make_demo_cell
 
     with make_demo_cell() as cell:
         pts, nrm, _ = sample_surface(cell.work_object.mesh, n_samples, np.random.default_rng(seed))

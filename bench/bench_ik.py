@@ -42,8 +42,8 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from calib.atomic_io import write_text_atomic
-from planner.kinematics.chain import KinematicChain
-from planner.kinematics.solver import make_ik_solver
+from planner.robot.kinematics.chain import KinematicChain
+from planner.robot.kinematics.solver import make_ik_solver
 
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_ROBOT = ROOT / "assets/robots/irb4400/irb4400.urdf"

@@ -1,4 +1,4 @@
-"""Ray casting for the sensor model: Embree (``planner.raycast``) against PyBullet rayTestBatch.
+"""Ray casting for the sensor model: Embree (``planner.sim.raycast``) against PyBullet rayTestBatch.
 
 Both cast the same sensor-like ray bundles (rays along -x from just in front of the side face of
 the full stator section, the mesh the Monte Carlo validation uses) in batches of the sizes the
@@ -20,8 +20,8 @@ import numpy as np
 import pybullet as pb
 
 from calib.atomic_io import write_text_atomic
-from planner.raycast import MeshRayCaster
-from planner.stator import StatorGeometry, build_stator_mesh
+from planner.parts.stator import StatorGeometry, build_stator_mesh
+from planner.sim.raycast import MeshRayCaster
 
 RESULTS = Path(__file__).resolve().parent / "results"
 

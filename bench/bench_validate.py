@@ -23,11 +23,11 @@ from pathlib import Path
 import numpy as np
 
 from calib.atomic_io import write_text_atomic
-from planner.demo_cell import nominal_T_base_wobj, stator_ah_points
-from planner.montecarlo import validate
-from planner.raycast import MeshRayCaster
-from planner.sensor import ProximitySensor
-from planner.stator import StatorGeometry, build_stator_mesh
+from planner.parts.stator import StatorGeometry, build_stator_mesh
+from planner.parts.stator_demo import nominal_T_base_wobj, stator_ah_points
+from planner.sim.montecarlo import validate
+from planner.sim.proximity import ProximitySensor
+from planner.sim.raycast import MeshRayCaster
 
 RESULTS = Path(__file__).resolve().parent / "results"
 

@@ -8,19 +8,19 @@ The public API, by module:
 * :mod:`calib.frames` - transforms, Tait-Bryan z-y'-x'' angles (paper eq. 7-9), quaternions.
 * :mod:`calib.probing` - :class:`ProbePoint`, :class:`SearchCommand`, :class:`ProbeResult`,
   the :data:`Probe` callback contract.
-* :mod:`calib.hultman` - the paper's equations 1-12.
-* :mod:`calib.xoffset` - the x-offset matrix (eq. 13-14) and the slot-hole target function.
-* :mod:`calib.stator_procedure` - the paper's A-H procedure driven by a probe callback.
-* :mod:`calib.three_two_one` - general 3-2-1 alignment (any non-parallel faces).
-* :mod:`calib.best_fit` - least-squares point-to-plane fit with the 6x6 covariance.
-* :mod:`calib.observability` - does a point layout constrain all 6 DOF, and if not, what moves.
-* :mod:`calib.procedures` - step-by-step 3-2-1 and best-fit runners driven by a probe.
+* :mod:`calib.paper.hultman` - the paper's equations 1-12.
+* :mod:`calib.paper.xoffset` - the x-offset matrix (eq. 13-14) and the slot-hole target function.
+* :mod:`calib.paper.stator_procedure` - the paper's A-H procedure driven by a probe callback.
+* :mod:`calib.estimators.three_two_one` - general 3-2-1 alignment (any non-parallel faces).
+* :mod:`calib.estimators.best_fit` - least-squares point-to-plane fit with the 6x6 covariance.
+* :mod:`calib.estimators.observability` - does a point layout constrain all 6 DOF, and if not, what
+moves.
+* :mod:`calib.estimators.runners` - step-by-step 3-2-1 and best-fit runners driven by a probe.
 * :mod:`calib.stats` - Table-1 confidence intervals.
-* :mod:`calib.plan`, :mod:`calib.measurements` - the versioned JSON files.
+* :mod:`calib.plan.file`, :mod:`calib.plan.measurements` - the versioned JSON files.
 """
 
 from calib._version import __version__
-from calib.best_fit import BestFitResult, best_fit, best_fit_many
 from calib.errors import (
     DegenerateGeometryError,
     InputError,
@@ -30,14 +30,15 @@ from calib.errors import (
     UnobservableError,
     WobjcalError,
 )
-from calib.hultman import adjust_origin, orientation_from_three_points, p3_estimate
-from calib.observability import ObservabilityReport, analyze_layout, require_observable
+from calib.estimators.best_fit import BestFitResult, best_fit, best_fit_many
+from calib.estimators.observability import ObservabilityReport, analyze_layout, require_observable
+from calib.estimators.runners import run_best_fit, run_three_two_one
+from calib.estimators.three_two_one import ThreeTwoOneLayout, ThreeTwoOneResult, three_two_one
+from calib.paper.hultman import adjust_origin, orientation_from_three_points, p3_estimate
+from calib.paper.stator_procedure import StatorSettings, run_stator_procedure
+from calib.paper.xoffset import SlotGrid, slot_target, xoffset_matrix
 from calib.probing import Probe, ProbePoint, ProbeResult, SearchCommand, SearchSpec
-from calib.procedures import run_best_fit, run_three_two_one
-from calib.stator_procedure import StatorSettings, run_stator_procedure
 from calib.stats import ConfidenceTable, confidence_intervals, to_markdown
-from calib.three_two_one import ThreeTwoOneLayout, ThreeTwoOneResult, three_two_one
-from calib.xoffset import SlotGrid, slot_target, xoffset_matrix
 
 __all__ = [
     "BestFitResult",

@@ -23,7 +23,7 @@ BUILTIN_ROBOTS: dict[str, Path] = {
     "irb4400": ASSETS / "robots" / "irb4400" / "irb4400.urdf",
 }
 
-#: Built-in tools: name -> tool description JSON (see :mod:`planner.tool`).
+#: Built-in tools: name -> tool description JSON (see :mod:`planner.cell.tool`).
 BUILTIN_TOOLS: dict[str, Path] = {
     "cable_feeder": ASSETS / "tools" / "cable_feeder" / "tool.json",
 }

@@ -47,7 +47,7 @@ def cell() -> Iterator[Any]:
 
     Test modules that need another cell define their own ``cell`` fixture.
     """
-    from planner.cell import Cell  # PyBullet only for the tests that use a cell
+    from planner.cell.cell import Cell  # PyBullet only for the tests that use a cell
 
     with Cell(use_acl_cache=False) as c:
         yield c
@@ -56,7 +56,7 @@ def cell() -> Iterator[Any]:
 @pytest.fixture(scope="module")
 def ur5(reference_dir: Path) -> Iterator[Any]:
     """A cell with the vendor UR5 URDF from ``../shared/reference`` (numeric IK path)."""
-    from planner.cell import Cell
+    from planner.cell.cell import Cell
 
     with Cell(reference_dir / "robots" / "ur5" / "ur5.urdf", use_acl_cache=False) as c:
         yield c

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from calib.plan import Plan
+from calib.plan.file import Plan
 
 
 def expected_ends_wobj(plan: Plan) -> dict[str, tuple[np.ndarray, np.ndarray]]:

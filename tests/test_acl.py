@@ -1,12 +1,12 @@
-"""Tests of planner.acl: the sampled allowed-collision list and its cache."""
+"""Tests of planner.cell.acl: the sampled allowed-collision list and its cache."""
 
 from __future__ import annotations
 
 import numpy as np
 
-import planner.acl as acl_module
-from planner.acl import AllowedCollisions, pair, sample_configurations
-from planner.cell import Cell
+import planner.cell.acl as acl_module
+from planner.cell.acl import AllowedCollisions, pair, sample_configurations
+from planner.cell.cell import Cell
 
 
 def test_builtin_acl_allows_adjacent_links_and_the_tool_mount(cell: Cell) -> None:

@@ -8,8 +8,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from calib.best_fit import best_fit, best_fit_many
 from calib.errors import NonFiniteError, ShapeError, UnobservableError
+from calib.estimators.best_fit import best_fit, best_fit_many
+from calib.estimators.layout import constraint_set, random_face_layout
+from calib.estimators.three_two_one import ThreeTwoOneLayout, three_two_one
 from calib.frames import (
     invert_transform,
     motion_between,
@@ -17,9 +19,7 @@ from calib.frames import (
     small_motion,
     transform_points,
 )
-from calib.layout import constraint_set, random_face_layout
 from calib.probing import ProbePoint
-from calib.three_two_one import ThreeTwoOneLayout, three_two_one
 
 seeds = st.integers(min_value=0, max_value=2**32 - 1)
 

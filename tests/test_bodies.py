@@ -1,4 +1,4 @@
-"""Tests of planner.bodies: pose conversions and link frames vs PyBullet's inertial frames."""
+"""Tests of planner.cell.bodies: pose conversions and link frames vs PyBullet's inertial frames."""
 
 from __future__ import annotations
 
@@ -10,7 +10,13 @@ import pybullet_data
 import pytest
 
 from calib.frames import make_transform, matrix_from_rotvec, random_transform
-from planner.bodies import load_urdf_body, pb_pose, pb_transform, set_link_pose, world_link_pose
+from planner.cell.bodies import (
+    load_urdf_body,
+    pb_pose,
+    pb_transform,
+    set_link_pose,
+    world_link_pose,
+)
 
 
 def test_pose_round_trip(rng) -> None:

@@ -1,4 +1,4 @@
-"""Tests of planner.cell: the Cell's client, frames, joint state, scene and bad input."""
+"""Tests of planner.cell.cell: the Cell's client, frames, joint state, scene and bad input."""
 
 from __future__ import annotations
 
@@ -12,9 +12,9 @@ import trimesh
 
 from calib.errors import NonFiniteError, ShapeError
 from calib.frames import invert_transform, make_transform, matrix_from_rotvec
-from planner.cell import Cell
+from planner.cell.cell import Cell
+from planner.cell.tool import Tool
 from planner.errors import MeshError, UnknownFrameError, URDFError
-from planner.tool import Tool
 
 T_WORLD_BASE = make_transform(matrix_from_rotvec([0, 0, 0.3]), [0.5, -0.2, 0.1])
 

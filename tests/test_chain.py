@@ -12,8 +12,8 @@ import pytest
 
 from calib.errors import NonFiniteError, ShapeError
 from planner.errors import UnknownFrameError
-from planner.kinematics.chain import KinematicChain
-from planner.urdf import transform_from_xyz_rpy
+from planner.robot.kinematics.chain import KinematicChain
+from planner.robot.urdf import transform_from_xyz_rpy
 
 IRB4400 = Path(__file__).resolve().parent.parent / "assets/robots/irb4400/irb4400.urdf"
 IIWA = Path(pybullet_data.getDataPath()) / "kuka_iiwa/model.urdf"
@@ -172,7 +172,7 @@ PRISMATIC = """<robot name="slide">
 
 
 def test_prismatic_and_continuous_joints() -> None:
-    from planner.urdf import parse_urdf
+    from planner.robot.urdf import parse_urdf
 
     chain = KinematicChain.from_model(parse_urdf(PRISMATIC))
     assert chain.tip_link == "tip" and chain.joint_types == ("prismatic", "continuous")
@@ -188,7 +188,7 @@ def test_prismatic_and_continuous_joints() -> None:
 
 def test_floating_joint_in_the_chain_is_refused() -> None:
     from planner.errors import URDFError
-    from planner.urdf import parse_urdf
+    from planner.robot.urdf import parse_urdf
 
     text = PRISMATIC.replace('type="prismatic"', 'type="floating"')
     with pytest.raises(URDFError, match="joint 'slide' is floating"):

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 from calib.frames import motion_between, random_transform, transform_points
-from calib.measurements import Measurements, save_measurements
-from calib.plan import load_plan, plan_to_json
-from planner.cli import main
-from planner.plan_io import nominal_T_base_wobj
+from calib.plan.file import load_plan, plan_to_json
+from calib.plan.measurements import Measurements, save_measurements
+from planner.cli.main import main
+from planner.plan_cell import nominal_T_base_wobj
 
 REPO = Path(__file__).resolve().parent.parent
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"

@@ -9,11 +9,11 @@ from typing import Any
 
 import pytest
 
-from calib.plan import load_plan
-from planner.cli import main
-from planner.planar_faces import plan_face_reasons
-from planner.stator import register_stator_builtins
-from planner.workobject import load_work_object
+from calib.plan.file import load_plan
+from planner.cell.workobject import load_work_object
+from planner.cli.main import main
+from planner.faces.checks import plan_face_reasons
+from planner.parts.stator import register_stator_builtins
 
 REPO = Path(__file__).resolve().parent.parent
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"

@@ -1,4 +1,4 @@
-"""Tests of planner.collision: clearance queries (pairs, distances, sensor rule, base pose)."""
+"""Tests of planner.cell.collision: clearance queries (pairs, distances, sensor rule, base pose)."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ import pytest
 import trimesh
 
 from calib.frames import make_transform
-from planner.cell import Cell
-from planner.fixtures import table
+from planner.cell.cell import Cell
+from planner.cell.fixtures import table
 
 
 def test_ur5_upper_arm_into_the_base_is_a_self_collision(ur5: Cell) -> None:

@@ -8,9 +8,14 @@ import numpy as np
 import pytest
 
 from calib.frames import check_transform
-from calib.stator_procedure import check_stator_points
-from planner.demo_cell import BETA1_RAD, make_demo_cell, nominal_T_base_wobj, stator_ah_points
-from planner.stator import StatorGeometry
+from calib.paper.stator_procedure import check_stator_points
+from planner.parts.stator import StatorGeometry
+from planner.parts.stator_demo import (
+    BETA1_RAD,
+    make_demo_cell,
+    nominal_T_base_wobj,
+    stator_ah_points,
+)
 
 GEOM = StatorGeometry.full_section()
 
@@ -62,7 +67,7 @@ def test_demo_cell_holds_the_stator_at_the_nominal_pose() -> None:
 
 
 def test_demo_points_are_reachable() -> None:
-    pytest.importorskip("planner.feasibility")
+    pytest.importorskip("planner.cell.feasibility")
     pts = stator_ah_points(GEOM)
     cell = make_demo_cell(GEOM)
     try:

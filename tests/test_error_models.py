@@ -9,7 +9,7 @@ import pytest
 
 from calib.errors import ShapeError
 from calib.frames import rotvec_from_matrix
-from planner.error_models import Misplacement, RobotErrorModel
+from planner.sim.error_models import Misplacement, RobotErrorModel
 
 
 def test_misplacement_stays_within_tolerance_and_turns_about_the_pivot(rng) -> None:

@@ -13,9 +13,9 @@ from calib.frames import (
     matrix_from_tait_bryan_zyx,
     random_transform,
 )
-from calib.plan import load_plan
+from calib.plan.file import load_plan
 from planner.export import export_files
-from planner.export.common import ToolData, build_job, default_sensor_rotation
+from planner.export.job import ToolData, build_job, default_sensor_rotation
 from tests.export_helpers import expected_ends_wobj
 
 VALID = Path(__file__).resolve().parent / "data" / "plans" / "valid_three_two_one.json"

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from calib.frames import make_transform, matrix_from_quat_wxyz, matrix_from_rotvec, random_transform
-from calib.plan import load_plan
-from planner.export.common import ToolData, build_job, default_sensor_rotation
+from calib.plan.file import load_plan
+from planner.export.job import ToolData, build_job, default_sensor_rotation
 from planner.export.rapid import export_rapid
 from tests.export_helpers import expected_ends_wobj
 

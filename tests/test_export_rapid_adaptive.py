@@ -1,5 +1,6 @@
 """The adaptive A-H RAPID program, run in a RAPID interpreter against an ideal part, does what
-:func:`calib.stator_procedure.run_stator_procedure` does; and no search starts near the part."""
+:func:`calib.paper.stator_procedure.run_stator_procedure` does; and no search starts near the
+part."""
 
 from __future__ import annotations
 
@@ -10,13 +11,13 @@ import numpy as np
 import pytest
 
 from calib.frames import invert_transform, make_transform, transform_points
-from calib.measurements import measurements_from_json
-from calib.plan import load_plan
+from calib.paper.stator_procedure import StatorSettings, run_stator_procedure
+from calib.plan.file import load_plan
+from calib.plan.measurements import measurements_from_json
 from calib.probing import SearchCommand
-from calib.stator_procedure import StatorSettings, run_stator_procedure
-from planner.export.common import ToolData, build_job
+from planner.export.job import ToolData, build_job
 from planner.export.rapid import export_rapid
-from planner.plan_io import hultman_points, nominal_T_base_wobj
+from planner.plan_cell import hultman_points, nominal_T_base_wobj
 from tests.box_part import BoxProbe, distance_to_box
 from tests.rapid_interp import Machine
 

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from calib.frames import invert_transform, make_transform, matrix_from_rotvec, transform_points
-from calib.plan import load_plan
+from calib.plan.file import load_plan
 from planner.export import export_files
-from planner.export.common import ToolData, build_job
+from planner.export.job import ToolData, build_job
 from planner.export.rapid import export_rapid
 from planner.export.safety import SafetySpec
 from tests.box_part import BoxProbe, distance_to_box

@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 
 from calib.frames import make_transform, matrix_from_rotvec, random_transform
-from calib.plan import load_plan
+from calib.plan.file import load_plan
 from planner.export import export_files
-from planner.export.common import ToolData, build_job, default_sensor_rotation
+from planner.export.job import ToolData, build_job, default_sensor_rotation
 from tests.export_helpers import expected_ends_wobj
 
 VALID = Path(__file__).resolve().parent / "data" / "plans" / "valid_three_two_one.json"

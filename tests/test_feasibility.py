@@ -1,4 +1,4 @@
-"""Tests of planner.feasibility against known geometry: boxes, a blocking plate, a slot."""
+"""Tests of planner.cell.feasibility against known geometry: boxes, a blocking plate, a slot."""
 
 from __future__ import annotations
 
@@ -12,10 +12,10 @@ import trimesh
 
 from calib.errors import DegenerateGeometryError, NonFiniteError, ShapeError
 from calib.frames import make_transform, matrix_from_rotvec
-from planner.cell import Cell
+from planner.cell.cell import Cell
+from planner.cell.feasibility import tcp_frames
+from planner.cell.pybullet_client import pb
 from planner.errors import UnknownFrameError
-from planner.feasibility import tcp_frames
-from planner.pybullet_client import pb
 
 BOX = 0.4  # edge of the work-object cube, m
 T_WORLD_WOBJ = make_transform(p=[1.4, 0.0, 0.4])  # top face at z = 0.6, 1.2 m in front
@@ -250,7 +250,7 @@ def test_tool_blocked_by_a_plate_in_every_rotation(cell: Cell, monkeypatch, heig
 
 @pytest.fixture(scope="module")
 def demo() -> Iterator[Cell]:
-    from planner.demo_cell import make_demo_cell
+    from planner.parts.stator_demo import make_demo_cell
 
     with make_demo_cell(use_acl_cache=False) as c:
         yield c

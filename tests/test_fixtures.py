@@ -1,4 +1,4 @@
-"""Tests of planner.fixtures: primitive and mesh fixtures at known poses."""
+"""Tests of planner.cell.fixtures: primitive and mesh fixtures at known poses."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import trimesh
 
 from calib.errors import DegenerateGeometryError, ShapeError
 from calib.frames import make_transform, matrix_from_rotvec
+from planner.cell.fixtures import Fixture, fixture_from_spec, table
 from planner.errors import MeshError
-from planner.fixtures import Fixture, fixture_from_spec, table
 
 
 def _distance_to_point(fixture: Fixture, p: list[float]) -> float:

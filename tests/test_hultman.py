@@ -10,9 +10,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from calib import hultman
 from calib.errors import DegenerateGeometryError, NonFiniteError, ShapeError
 from calib.frames import make_transform, matrix_from_tait_bryan_zyx
+from calib.paper import hultman
 
 seeds = st.integers(0, 2**32 - 1)
 

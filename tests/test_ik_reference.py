@@ -16,10 +16,10 @@ import numpy as np
 import pytest
 
 from calib.frames import invert_transform
-from planner.kinematics.chain import KinematicChain
-from planner.kinematics.opw import OPWParameters, opw_fk
-from planner.kinematics.opw_robot import OPWRobot
-from planner.kinematics.solver import make_ik_solver
+from planner.robot.kinematics.chain import KinematicChain
+from planner.robot.kinematics.opw import OPWParameters, opw_fk
+from planner.robot.kinematics.opw_robot import OPWRobot
+from planner.robot.kinematics.solver import make_ik_solver
 
 ROOT = Path(__file__).resolve().parent.parent
 IRB4400 = ROOT / "assets/robots/irb4400/irb4400.urdf"
@@ -169,7 +169,7 @@ def test_multi_turn_and_continuous_joints_match_the_reference(rng: np.random.Gen
 def test_chunks_do_not_change_the_result(
     rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import planner.kinematics.opw_robot as opw_robot
+    import planner.robot.kinematics.opw_robot as opw_robot
 
     chain = KinematicChain.from_urdf(IRB4400)
     solver = make_ik_solver(chain)

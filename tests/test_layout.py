@@ -7,8 +7,7 @@ import numpy as np
 import pytest
 
 from calib.errors import DegenerateGeometryError, ShapeError
-from calib.frames import invert_transform, small_motion, transform_points
-from calib.layout import (
+from calib.estimators.layout import (
     MIN_SCALE_M,
     axis_name,
     constraint_jacobian,
@@ -18,6 +17,7 @@ from calib.layout import (
     random_face_layout,
     small_motion_matrix,
 )
+from calib.frames import invert_transform, small_motion, transform_points
 from calib.probing import ProbePoint, SearchSpec
 
 

@@ -1,4 +1,4 @@
-"""Tests of calib.measurements: strict loading, units and frames, sequences of retakes."""
+"""Tests of calib.plan.measurements: strict loading, units and frames, sequences of retakes."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from calib.frames import invert_transform, random_transform, transform_points
-from calib.measurements import (
+from calib.plan.measurements import (
     Measurements,
     MeasurementsError,
     load_measurements,

@@ -10,11 +10,11 @@ import pytest
 
 from calib.errors import InputError, ShapeError
 from calib.probing import SearchSpec
-from planner.demo_cell import nominal_T_base_wobj, stator_ah_points
-from planner.error_models import RobotErrorModel
-from planner.montecarlo import validate
-from planner.sensor import ProximitySensor
-from planner.stator import StatorGeometry, build_stator_mesh
+from planner.parts.stator import StatorGeometry, build_stator_mesh
+from planner.parts.stator_demo import nominal_T_base_wobj, stator_ah_points
+from planner.sim.error_models import RobotErrorModel
+from planner.sim.montecarlo import validate
+from planner.sim.proximity import ProximitySensor
 
 GEOM = StatorGeometry.full_section()
 POINTS = stator_ah_points(GEOM)
@@ -85,7 +85,7 @@ def test_bad_arguments_are_named() -> None:
 
 
 def test_cell_vets_every_search_and_counts_unreachable_ones() -> None:
-    from planner.demo_cell import make_demo_cell
+    from planner.parts.stator_demo import make_demo_cell
 
     cell = make_demo_cell(GEOM)
     try:

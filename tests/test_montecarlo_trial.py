@@ -5,12 +5,12 @@ from __future__ import annotations
 import numpy as np
 
 from calib.probing import SearchSpec
-from planner.demo_cell import nominal_T_base_wobj, stator_ah_points
-from planner.error_models import Misplacement, RobotErrorModel
-from planner.montecarlo import default_pivot
-from planner.montecarlo_trial import SimulationSetup, init_worker, run_trial
-from planner.sensor import ProximitySensor
-from planner.stator import StatorGeometry, build_stator_mesh
+from planner.parts.stator import StatorGeometry, build_stator_mesh
+from planner.parts.stator_demo import nominal_T_base_wobj, stator_ah_points
+from planner.sim.error_models import Misplacement, RobotErrorModel
+from planner.sim.montecarlo import default_pivot
+from planner.sim.proximity import ProximitySensor
+from planner.sim.trial import SimulationSetup, init_worker, run_trial
 
 G = StatorGeometry.full_section()
 MESH = build_stator_mesh(G)
@@ -48,8 +48,8 @@ def test_failed_probe_is_recorded_with_point_and_reason() -> None:
 
 
 def test_default_settings_carry_the_sensors_edge_offset() -> None:
-    from calib.stator_procedure import StatorSettings
-    from planner.montecarlo import DEFAULT_EDGE_INSET_M, default_settings
+    from calib.paper.stator_procedure import StatorSettings
+    from planner.sim.montecarlo import DEFAULT_EDGE_INSET_M, default_settings
 
     sensor = ProximitySensor()
     s = default_settings(sensor, beta1_rad=0.2)

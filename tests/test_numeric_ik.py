@@ -9,8 +9,8 @@ import pybullet_data
 import pytest
 
 from calib.errors import NonFiniteError, ShapeError
-from planner.kinematics.chain import KinematicChain
-from planner.kinematics.numeric_ik import NumericIK
+from planner.robot.kinematics.chain import KinematicChain
+from planner.robot.kinematics.numeric_ik import NumericIK
 
 IIWA = Path(pybullet_data.getDataPath()) / "kuka_iiwa/model.urdf"
 

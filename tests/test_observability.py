@@ -8,11 +8,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from calib.best_fit import best_fit
 from calib.errors import DegenerateGeometryError, NonFiniteError, ShapeError, UnobservableError
+from calib.estimators.best_fit import best_fit
+from calib.estimators.layout import random_face_layout
+from calib.estimators.observability import WEAK_NOISE_GAIN, analyze_layout, require_observable
 from calib.frames import random_transform, transform_directions, transform_points
-from calib.layout import random_face_layout
-from calib.observability import WEAK_NOISE_GAIN, analyze_layout, require_observable
 from calib.probing import ProbePoint
 
 

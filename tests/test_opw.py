@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from planner.kinematics.chain import KinematicChain
-from planner.kinematics.opw import OPWParameters, opw_fk, opw_ik, wrist_centre
+from planner.robot.kinematics.chain import KinematicChain
+from planner.robot.kinematics.opw import OPWParameters, opw_fk, opw_ik, wrist_centre
 
 IRB4400 = Path(__file__).resolve().parent.parent / "assets/robots/irb4400/irb4400.urdf"
 # datasheet figures; axis 3's zero has the forearm horizontal: theta3 = q3 + 90 deg

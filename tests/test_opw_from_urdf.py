@@ -8,10 +8,10 @@ import numpy as np
 import pybullet_data
 import pytest
 
-from planner.kinematics.chain import KinematicChain
-from planner.kinematics.opw_from_urdf import NotOPWError, opw_from_chain, why_not_opw
-from planner.kinematics.opw_robot import OPWRobot
-from planner.urdf import parse_urdf
+from planner.robot.kinematics.chain import KinematicChain
+from planner.robot.kinematics.opw_from_urdf import NotOPWError, opw_from_chain, why_not_opw
+from planner.robot.kinematics.opw_robot import OPWRobot
+from planner.robot.urdf import parse_urdf
 
 ROOT = Path(__file__).resolve().parent.parent
 IRB4400 = ROOT / "assets/robots/irb4400/irb4400.urdf"

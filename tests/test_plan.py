@@ -1,4 +1,5 @@
-"""Tests of calib.plan: strict loading, canonical byte-identical saving, the checked-in schema."""
+"""Tests of calib.plan.file: strict loading, canonical byte-identical saving, the checked-in
+schema."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ import numpy as np
 import pytest
 
 from calib.frames import random_transform
-from calib.plan import (
+from calib.plan.file import (
     PLAN_SCHEMA,
     Plan,
     PlanError,
@@ -25,8 +26,8 @@ from calib.plan import (
     resolve_ref,
     save_plan,
 )
-from calib.plan_json import json_schema
-from calib.plan_procedures import BestFit, Hultman2013, ThreeTwoOne
+from calib.plan.json_io import json_schema
+from calib.plan.procedures import BestFit, Hultman2013, ThreeTwoOne
 from calib.probing import ProbePoint, SearchSpec
 
 DATA = Path(__file__).resolve().parent / "data" / "plans"
@@ -191,7 +192,7 @@ def test_defaults_make_a_valid_plan() -> None:
     ],
 )
 def test_checked_in_schema_matches_types(type_name: str, file_name: str) -> None:
-    from calib.measurements import Measurements
+    from calib.plan.measurements import Measurements
 
     type_ = Plan if type_name == "plan" else Measurements
     assert (SCHEMA_FILE / file_name).read_text() == json_schema(type_), (

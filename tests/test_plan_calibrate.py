@@ -1,4 +1,4 @@
-"""Tests of planner.plan_calibrate: calibration from measured points with all three methods."""
+"""Tests of planner.calibrate: calibration from measured points with all three methods."""
 
 from __future__ import annotations
 
@@ -9,10 +9,10 @@ import pytest
 
 from calib.errors import InputError
 from calib.frames import invert_transform, motion_between, random_transform, transform_points
-from calib.measurements import Measurements, MeasurementsError
-from calib.plan import PlanError, load_plan
-from planner.plan_calibrate import assign_three_two_one, calibrate_plan
-from planner.plan_io import nominal_T_base_wobj
+from calib.plan.file import PlanError, load_plan
+from calib.plan.measurements import Measurements, MeasurementsError
+from planner.calibrate import assign_three_two_one, calibrate_plan
+from planner.plan_cell import nominal_T_base_wobj
 
 REPO = Path(__file__).resolve().parent.parent
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
@@ -70,7 +70,7 @@ def test_unknown_method_and_missing_point() -> None:
 def test_world_frame_measurements_use_T_world_base(rng: np.random.Generator) -> None:
     import msgspec
 
-    from calib.plan import Pose
+    from calib.plan.file import Pose
 
     plan = load_plan(STATOR)
     T_world_base = random_transform(rng, 1.0, 1.0)

@@ -1,4 +1,4 @@
-"""Tests of planner.plan_io: frames of the plan, the tool data, the cell built from a plan."""
+"""Tests of planner.plan_cell: frames of the plan, the tool data, the cell built from a plan."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 
 from calib.frames import invert_transform
-from calib.plan import load_plan
-from planner.plan_io import T_base_world, nominal_T_base_wobj, open_cell, tool_data
+from calib.plan.file import load_plan
+from planner.plan_cell import T_base_world, nominal_T_base_wobj, open_cell, tool_data
 
 REPO = Path(__file__).resolve().parent.parent
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"

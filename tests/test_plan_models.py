@@ -1,6 +1,6 @@
 """The plan's validation models mirror the simulation's own models field by field.
 
-``calib.plan_models`` cannot import ``planner`` (layer rule), so its defaults are a copy; this
+``calib.plan.models`` cannot import ``planner`` (layer rule), so its defaults are a copy; this
 test keeps the copy honest: a default changed on one side only fails here.
 """
 
@@ -11,8 +11,9 @@ import dataclasses
 import msgspec
 import pytest
 
-from calib.plan_models import Misplacement, RobotErrorModel, SensorModel
-from planner import error_models, sensor
+from calib.plan.models import Misplacement, RobotErrorModel, SensorModel
+from planner.sim import error_models
+from planner.sim import proximity as sensor
 
 
 @pytest.mark.parametrize(

@@ -1,4 +1,4 @@
-"""Tests of ``planner.plan_validate``: the one validation entry point of the CLI and the UI."""
+"""Tests of ``planner.validate``: the one validation entry point of the CLI and the UI."""
 
 from __future__ import annotations
 
@@ -9,11 +9,11 @@ import msgspec
 import numpy as np
 import pytest
 
-from calib.plan import PlanError, load_plan
-from planner.cli import main
-from planner.cli_validate import report_json
-from planner.montecarlo import DEFAULT_EDGE_INSET_M
-from planner.plan_validate import validate_plan, validation_models
+from calib.plan.file import PlanError, load_plan
+from planner.cli.main import main
+from planner.cli.validate import report_json
+from planner.sim.montecarlo import DEFAULT_EDGE_INSET_M
+from planner.validate import validate_plan, validation_models
 
 REPO = Path(__file__).resolve().parent.parent
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"

@@ -12,15 +12,11 @@ from scipy.spatial.transform import Rotation
 
 from calib.errors import ShapeError
 from calib.probing import ProbePoint, SearchSpec
+from planner.cell.workobject import load_work_object
 from planner.errors import MeshError
-from planner.planar_faces import (
-    NoPlanarFaceError,
-    check_plan_faces,
-    check_probe_faces,
-    find_planar_faces,
-)
-from planner.stator import StatorGeometry, build_stator_mesh
-from planner.workobject import load_work_object
+from planner.faces.checks import check_plan_faces, check_probe_faces
+from planner.faces.detection import NoPlanarFaceError, find_planar_faces
+from planner.parts.stator import StatorGeometry, build_stator_mesh
 
 EXTENTS = (0.10, 0.20, 0.30)
 X = np.array([1.0, 0.0, 0.0])

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from planner.demo_cell import nominal_T_base_wobj, stator_ah_points
-from planner.montecarlo import validate
-from planner.plots import histogram_figure, save_validation_plots, scatter_figure
-from planner.stator import EPSILON_M, StatorGeometry
+from planner.parts.stator import EPSILON_M, StatorGeometry
+from planner.parts.stator_demo import nominal_T_base_wobj, stator_ah_points
+from planner.sim.montecarlo import validate
+from planner.sim.plots import histogram_figure, save_validation_plots, scatter_figure
 
 
 @pytest.fixture(scope="module")

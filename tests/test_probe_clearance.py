@@ -1,4 +1,4 @@
-"""Tests of planner.probe_clearance: staged candidate queries against the whole query."""
+"""Tests of planner.cell.probe_clearance: staged candidate queries against the whole query."""
 
 from __future__ import annotations
 
@@ -9,10 +9,10 @@ import pytest
 import trimesh
 
 from calib.frames import make_transform
-from planner.cell import DEFAULT_MARGIN_M, Cell
-from planner.clearance import Clearance
-from planner.probe_clearance import ProbeClearance
-from planner.pybullet_client import pb
+from planner.cell.cell import DEFAULT_MARGIN_M, Cell
+from planner.cell.clearance import Clearance
+from planner.cell.probe_clearance import ProbeClearance
+from planner.cell.pybullet_client import pb
 
 MARGIN = DEFAULT_MARGIN_M
 

@@ -11,6 +11,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from calib.errors import ProbeFailedError, ShapeError, UnobservableError
+from calib.estimators.layout import FaceLayout, random_face_layout
+from calib.estimators.runners import run_best_fit, run_three_two_one
+from calib.estimators.three_two_one import ThreeTwoOneLayout
 from calib.frames import (
     invert_transform,
     make_transform,
@@ -19,10 +22,7 @@ from calib.frames import (
     small_motion,
     transform_directions,
 )
-from calib.layout import FaceLayout, random_face_layout
 from calib.probing import ProbeResult, SearchCommand
-from calib.procedures import run_best_fit, run_three_two_one
-from calib.three_two_one import ThreeTwoOneLayout
 
 seeds = st.integers(min_value=0, max_value=2**32 - 1)
 

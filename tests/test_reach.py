@@ -1,4 +1,5 @@
-"""Tests of planner.reach: the reach model and the no-IK reasons, against the arm's geometry."""
+"""Tests of planner.cell.reach: the reach model and the no-IK reasons, against the arm's
+geometry."""
 
 from __future__ import annotations
 
@@ -10,9 +11,9 @@ import pytest
 
 from calib.frames import make_transform
 from planner.builtins import robot_urdf
-from planner.kinematics.chain import KinematicChain
-from planner.kinematics.solver import make_ik_solver
-from planner.reach import opw_wrist_reason, reach_model
+from planner.cell.reach import opw_wrist_reason, reach_model
+from planner.robot.kinematics.chain import KinematicChain
+from planner.robot.kinematics.solver import make_ik_solver
 
 # IRB 4400 figures (assets/robots/irb4400/README.md)
 A1, C1, C2, C3, A2, C4 = 0.200, 0.680, 0.890, 0.880, 0.150, 0.140

@@ -1,4 +1,5 @@
-"""Tests of planner.reachability_map: area-weighted surface samples and per-sample feasibility."""
+"""Tests of planner.cell.reachability_map: area-weighted surface samples and per-sample
+feasibility."""
 
 from __future__ import annotations
 
@@ -8,8 +9,8 @@ import trimesh
 
 from calib.errors import ShapeError
 from calib.frames import make_transform
-from planner.cell import Cell
-from planner.reachability_map import FEASIBLE, INFEASIBLE, sample_surface
+from planner.cell.cell import Cell
+from planner.cell.reachability_map import FEASIBLE, INFEASIBLE, sample_surface
 
 
 def test_samples_lie_on_the_surface_with_face_normals(rng) -> None:

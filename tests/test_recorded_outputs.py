@@ -18,7 +18,7 @@ from typing import Any
 
 import pytest
 
-from planner.cli import main
+from planner.cli.main import main
 
 ROOT = Path(__file__).resolve().parent.parent
 PLAN = "assets/plans/stator_section_ah.json"

@@ -1,4 +1,4 @@
-"""Tests of planner.robot_body: PyBullet indices, static links and adjacency of real URDFs."""
+"""Tests of planner.cell.robot_body: PyBullet indices, static links and adjacency of real URDFs."""
 
 from __future__ import annotations
 
@@ -7,11 +7,11 @@ import pybullet as pb
 import pytest
 
 from calib.frames import make_transform, matrix_from_rotvec
-from planner.acl import pair
-from planner.bodies import world_link_pose
 from planner.builtins import robot_urdf
-from planner.kinematics.chain import KinematicChain
-from planner.robot_body import load_robot_body
+from planner.cell.acl import pair
+from planner.cell.bodies import world_link_pose
+from planner.cell.robot_body import load_robot_body
+from planner.robot.kinematics.chain import KinematicChain
 
 
 @pytest.fixture

@@ -7,8 +7,8 @@ from types import SimpleNamespace
 import numpy as np
 
 from calib.probing import ProbePoint, SearchCommand
-from planner.search_events import cell_search_hook, footprint_landing
-from planner.stator import StatorGeometry
+from planner.parts.stator import StatorGeometry
+from planner.sim.search_events import cell_search_hook, footprint_landing
 
 G = StatorGeometry.full_section()
 SIDE = np.array([-1.0, 0.0, 0.0])  # sensor axis looking at the side face (normal +x)

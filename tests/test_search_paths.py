@@ -1,4 +1,4 @@
-"""Tests of planner.search_paths: approach and edge searches on a box, blocked by a clamp."""
+"""Tests of planner.cell.search_paths: approach and edge searches on a box, blocked by a clamp."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import trimesh
 from calib.errors import DegenerateGeometryError, NonFiniteError
 from calib.frames import make_transform
 from calib.probing import ProbePoint, SearchCommand, SearchSpec
-from planner.cell import Cell
+from planner.cell.cell import Cell
 
 BOX = 0.4
 X0 = 1.6  # box centre, world x: far enough for the front face to keep joint 3 off its limit

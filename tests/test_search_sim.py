@@ -10,10 +10,10 @@ import trimesh
 
 from calib.frames import make_transform, matrix_from_rotvec
 from calib.probing import ProbePoint, SearchCommand, SearchSpec
-from planner.error_models import RobotErrorModel
-from planner.raycast import MeshRayCaster
-from planner.search_sim import SimulatedProbe
-from planner.sensor import ProximitySensor
+from planner.sim.error_models import RobotErrorModel
+from planner.sim.probe import SimulatedProbe
+from planner.sim.proximity import ProximitySensor
+from planner.sim.raycast import MeshRayCaster
 
 # a 0.4 x 0.4 x 0.2 m block whose top face is z = 0 and whose +y edge face is y = 0
 BOX = trimesh.creation.box(extents=(0.4, 0.4, 0.2))

@@ -9,11 +9,11 @@ import pytest
 
 from calib.errors import ShapeError
 from calib.probing import ProbePoint, SearchCommand
-from planner.error_models import RobotErrorModel
-from planner.raycast import MeshRayCaster
-from planner.search_sim import SimulatedProbe
-from planner.sensor import ProximitySensor, sunflower_disk
-from planner.stator import StatorGeometry, build_stator_mesh
+from planner.parts.stator import StatorGeometry, build_stator_mesh
+from planner.sim.error_models import RobotErrorModel
+from planner.sim.probe import SimulatedProbe
+from planner.sim.proximity import ProximitySensor, sunflower_disk
+from planner.sim.raycast import MeshRayCaster
 
 
 def test_full_flat_target_switches_at_sensing_distance() -> None:

@@ -10,11 +10,11 @@ import pybullet_data
 import pytest
 
 from calib.errors import DegenerateGeometryError, NonFiniteError, ShapeError
-from planner.kinematics.branches import abb_confdata, branch_codes, classify, quadrant
-from planner.kinematics.chain import KinematicChain
-from planner.kinematics.opw_from_urdf import NotOPWError
-from planner.kinematics.solver import IKSolutions, make_ik_solver
-from planner.urdf import parse_urdf
+from planner.robot.kinematics.branches import abb_confdata, branch_codes, classify, quadrant
+from planner.robot.kinematics.chain import KinematicChain
+from planner.robot.kinematics.opw_from_urdf import NotOPWError
+from planner.robot.kinematics.solver import IKSolutions, make_ik_solver
+from planner.robot.urdf import parse_urdf
 
 IRB4400 = Path(__file__).resolve().parent.parent / "assets/robots/irb4400/irb4400.urdf"
 IIWA = Path(pybullet_data.getDataPath()) / "kuka_iiwa/model.urdf"

@@ -9,8 +9,13 @@ import numpy as np
 import pytest
 
 from calib.errors import ShapeError
-from planner.raycast import MeshRayCaster
-from planner.stator import EPSILON_M, StatorGeometry, build_stator_mesh, register_stator_builtins
+from planner.parts.stator import (
+    EPSILON_M,
+    StatorGeometry,
+    build_stator_mesh,
+    register_stator_builtins,
+)
+from planner.sim.raycast import MeshRayCaster
 
 
 @pytest.fixture(scope="module")

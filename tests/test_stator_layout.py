@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 
 from calib.errors import DegenerateGeometryError, ShapeError
-from calib.probing import ProbePoint, SearchSpec
-from calib.stator_layout import (
+from calib.paper.stator_layout import (
     STATOR_POINT_IDS,
     check_stator_points,
     example_stator_points,
     relabel_point,
 )
+from calib.probing import ProbePoint, SearchSpec
 
 
 def _with(point_id: str, **changes) -> dict[str, ProbePoint]:

@@ -21,21 +21,21 @@ from calib.frames import (
     random_transform,
     transform_points,
 )
-from calib.probing import ProbeResult, SearchCommand
-from calib.stator_procedure import (
+from calib.paper.stator_procedure import (
     StatorSettings,
     check_stator_points,
     example_stator_points,
     probe_from_measurements,
     run_stator_procedure,
 )
+from calib.probing import ProbeResult, SearchCommand
 from tests.box_part import BoxProbe
 
 
 def nominal_pose(alpha_rad: float, position_m, robot_at_plus_x: bool = False) -> np.ndarray:
     """The preliminary WOCS: side face inclined by the paper's beta1 = 15 deg, top leaning
     towards base +x; WOCS y along base +y, or along base -y when the robot is at +x (as in
-    ``planner.demo_cell``: WOCS x towards the robot at the base origin)."""
+    ``planner.parts.stator_demo``: WOCS x towards the robot at the base origin)."""
     beta = math.radians(15.0)
     if robot_at_plus_x:
         return make_transform(

@@ -11,15 +11,15 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from calib.errors import DegenerateGeometryError, NonFiniteError, ShapeError
+from calib.estimators.layout import random_face_layout
+from calib.estimators.three_two_one import ThreeTwoOneLayout, three_two_one
 from calib.frames import (
     invert_transform,
     motion_between,
     random_transform,
     transform_points,
 )
-from calib.layout import random_face_layout
 from calib.probing import ProbePoint, SearchSpec
-from calib.three_two_one import ThreeTwoOneLayout, three_two_one
 
 seeds = st.integers(min_value=0, max_value=2**32 - 1)
 

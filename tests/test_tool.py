@@ -1,4 +1,4 @@
-"""Tests of planner.tool: the built-in cable-feeder tool, TCP frames, tool loading errors."""
+"""Tests of planner.cell.tool: the built-in cable-feeder tool, TCP frames, tool loading errors."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import trimesh
 
 from calib.errors import ShapeError
 from calib.frames import make_transform
+from planner.cell.tool import Tool, load_tool
 from planner.errors import MeshError, UnknownFrameError, URDFError
-from planner.tool import Tool, load_tool
 
 
 @pytest.fixture(scope="module")

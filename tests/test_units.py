@@ -11,10 +11,10 @@ import pytest
 import trimesh
 
 from calib.errors import InputError
-from calib.plan import PlanError, load_plan, plan_from_json, resolve_ref
-from calib.plan_base import MeshUnits
+from calib.plan.base import MeshUnits
+from calib.plan.file import PlanError, load_plan, plan_from_json, resolve_ref
 from calib.units import ALIASES, MESH_UNITS, METRES_PER_UNIT, canonical_unit, metres_per_unit
-from planner.workobject import load_work_object
+from planner.cell.workobject import load_work_object
 from webui.backend import load_mesh
 
 REPO = Path(__file__).resolve().parent.parent

@@ -9,7 +9,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from planner.errors import URDFError
-from planner.urdf import URDFWarning, load_urdf, matrix_from_rpy, parse_urdf
+from planner.robot.urdf import URDFWarning, load_urdf, matrix_from_rpy, parse_urdf
 
 IRB4400 = Path(__file__).resolve().parent.parent / "assets/robots/irb4400/irb4400.urdf"
 

@@ -24,10 +24,10 @@ import pytest
 import trimesh
 
 from calib.frames import make_transform
-from planner.cell import Cell
-from planner.kinematics.chain import KinematicChain
-from planner.kinematics.solver import make_ik_solver
-from planner.urdf import load_urdf
+from planner.cell.cell import Cell
+from planner.robot.kinematics.chain import KinematicChain
+from planner.robot.kinematics.solver import make_ik_solver
+from planner.robot.urdf import load_urdf
 
 PACKAGE = "abb_irb2400_support"
 #: Published OPW parameters of the ABB IRB 2400/10 (a1, a2, b, c1, c2, c3, c4), m.

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from calib.frames import transform_points
-from calib.plan import plan_from_json
+from calib.plan.file import plan_from_json
 from webui.app import WobjcalApp, run
 from webui.testing import T_WORLD_WOBJ_BOX, box_plan, free_port
 

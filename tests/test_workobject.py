@@ -1,4 +1,5 @@
-"""Tests of planner.workobject: formats, units, repair, errors and the concave PyBullet body."""
+"""Tests of planner.cell.workobject: formats, units, repair, errors and the concave PyBullet
+body."""
 
 from __future__ import annotations
 
@@ -11,13 +12,13 @@ import trimesh
 
 from calib.frames import make_transform
 from planner.builtins import register_builtin_mesh
+from planner.cell.workobject import AUTO_MM_EXTENT, load_work_object
 from planner.errors import MeshError
-from planner.workobject import AUTO_MM_EXTENT, load_work_object
 
 
 def test_plate_in_mm_is_detected_with_a_warning(reference_dir, caplog) -> None:
     path = reference_dir / "parts" / "plate_holes.STL"
-    with caplog.at_level(logging.WARNING, logger="planner.workobject"):
+    with caplog.at_level(logging.WARNING, logger="planner.cell.workobject"):
         wobj = load_work_object(path)
     r = wobj.report
     assert (r.units, r.units_detected, r.scale) == ("mm", True, 1e-3)
@@ -134,10 +135,10 @@ def test_concave_body_does_not_fill_holes() -> None:
 
 def test_large_mesh_goes_through_a_file(monkeypatch) -> None:
     """Above the inline vertex limit the body is built from a temporary OBJ, same geometry."""
-    import planner.bodies
+    import planner.cell.bodies
 
     box = trimesh.creation.box([0.5, 0.5, 0.5]).subdivide().subdivide()
-    monkeypatch.setattr(planner.bodies, "MAX_INLINE_VERTICES", 10)
+    monkeypatch.setattr(planner.cell.bodies, "MAX_INLINE_VERTICES", 10)
     wobj = load_work_object(box, units="m")
     client = pb.connect(pb.DIRECT)
     try:

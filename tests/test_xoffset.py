@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from calib.errors import DegenerateGeometryError, NonFiniteError, ShapeError
 from calib.frames import invert_transform, make_transform, random_transform, transform_points
-from calib.xoffset import (
+from calib.paper.xoffset import (
     SlotGrid,
     slot_positions_wobj,
     slot_target,

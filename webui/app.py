@@ -17,7 +17,7 @@ import viser
 from numpy.typing import ArrayLike
 
 from calib.errors import InputError
-from calib.plan import Plan
+from calib.plan.file import Plan
 from webui import clients, demo, plan_doc
 from webui.backend import CellSession, CellView
 from webui.heatmap import HeatMap

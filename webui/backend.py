@@ -1,7 +1,7 @@
 """The UI's only door into ``planner``: build the cell of a plan and check points in it.
 
 A :class:`CellSession` lives on the :class:`webui.worker.CellWorker` thread and owns the
-PyBullet cell (built by :func:`planner.plan_io.open_cell`, as ``wobjcal check`` builds it).
+PyBullet cell (built by :func:`planner.plan_cell.open_cell`, as ``wobjcal check`` builds it).
 """
 
 from __future__ import annotations
@@ -18,12 +18,12 @@ import trimesh
 from numpy.typing import ArrayLike, NDArray
 
 from calib.frames import invert_transform
-from calib.plan import Plan, resolve_ref
+from calib.plan.file import Plan, resolve_ref
 from calib.probing import ProbePoint, SearchCommand
 from planner.builtins import robot_urdf
-from planner.plan_io import open_cell
-from planner.stator import register_stator_builtins
-from planner.workobject import load_work_object
+from planner.cell.workobject import load_work_object
+from planner.parts.stator import register_stator_builtins
+from planner.plan_cell import open_cell
 from webui.status import PointCheck
 
 logger = logging.getLogger(__name__)
@@ -75,7 +75,7 @@ def resolve_robot_urdf(ref: str, plan_dir: Path) -> Path | None:
 
 
 def load_mesh(ref: str, units: str, plan_dir: Path) -> trimesh.Trimesh:
-    """A work-object or fixture mesh in metres, loaded and repaired by ``planner.workobject``.
+    """A work-object or fixture mesh in metres, loaded and repaired by ``planner.cell.workobject``.
 
     Raises:
         MeshError: the file is missing, unreadable or empty, or its units are unknown.
@@ -166,7 +166,7 @@ def _with_planar_faces(
     mesh: trimesh.Trimesh, points: list[ProbePoint], checks: list[PointCheck]
 ) -> list[PointCheck]:
     """Mark points off a planar face (or with the footprint over a hole/edge) infeasible."""
-    from planner.planar_faces import plan_face_reasons
+    from planner.faces.checks import plan_face_reasons
 
     reasons = plan_face_reasons(mesh, points, raise_if_none=False)
     return [

@@ -1,6 +1,6 @@
 """The "Calibrate" panel: upload points measured on the robot, see the calibrated WOCS frame.
 
-Thin over ``planner.plan_calibrate.calibrate_plan`` (what ``wobjcal calibrate`` runs): the
+Thin over ``planner.calibrate.calibrate_plan`` (what ``wobjcal calibrate`` runs): the
 calibrated frame is drawn beside the nominal one, with the shift and the residual per point.
 """
 
@@ -13,8 +13,8 @@ import numpy as np
 
 from calib.errors import InputError
 from calib.frames import motion_between
-from calib.measurements import measurements_from_json
-from planner.plan_calibrate import calibrate_plan
+from calib.plan.measurements import measurements_from_json
+from planner.calibrate import calibrate_plan
 from webui.files_panel import check_upload
 from webui.plan_adapter import plan_from_ui
 

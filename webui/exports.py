@@ -1,6 +1,6 @@
 """Between the files panel and ``planner.export``: robot programs of the session plan.
 
-The job is built exactly as ``wobjcal export`` builds it (``planner.cli_check.export_job_for``:
+The job is built exactly as ``wobjcal export`` builds it (``planner.cli.check.export_job_for``:
 orientations and configurations from the cell check when it can run), then formatted by
 ``planner.export.export_files``. Call :func:`export_program` on the cell worker: the check opens
 a PyBullet client.
@@ -12,8 +12,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from calib.errors import InputError
-from calib.plan import Plan
-from planner.cli_check import export_job_for
+from calib.plan.file import Plan
+from planner.cli.check import export_job_for
 from planner.export import export_files
 
 #: UI name -> ``planner.export`` format name.

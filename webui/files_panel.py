@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 import msgspec
 
 from calib.errors import InputError
-from calib.plan import Plan, PlanError
+from calib.plan.file import Plan, PlanError
 from calib.units import MESH_UNITS
 from webui.exports import FORMATS, ExportResult, export_program
 from webui.plan_adapter import plan_from_ui, plan_json_from_ui, ui_plan_from_bytes, with_source

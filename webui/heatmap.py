@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from calib.errors import InputError
-from planner.reachability_map import sample_surface
+from planner.cell.reachability_map import sample_surface
 from webui.scene import heat_rgb
 
 if TYPE_CHECKING:

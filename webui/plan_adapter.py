@@ -1,6 +1,6 @@
-"""Between the plan file (:mod:`calib.plan`, ``wobjcal.plan/1``) and the UI's editable points.
+"""Between the plan file (:mod:`calib.plan.file`, ``wobjcal.plan/1``) and the UI's editable points.
 
-The strict :class:`calib.plan.Plan` refuses a plan whose points do not fit its procedure (e.g.
+The strict :class:`calib.plan.file.Plan` refuses a plan whose points do not fit its procedure (e.g.
 the A-H procedure needs each role A-H exactly once), but a plan being edited is often incomplete.
 So the UI edits a :class:`webui.plan_doc.UiPlan`; :func:`plan_from_ui` builds the strict plan for
 downloads and exports (its error says what is missing), and :func:`autosave_bytes` writes the
@@ -15,9 +15,9 @@ from typing import Any
 
 import msgspec
 
-from calib.plan import Plan, PlanError, PlanPoint, load_plan, plan_from_json, plan_to_json
-from calib.plan_json import canonical_json
-from calib.plan_procedures import (
+from calib.plan.file import Plan, PlanError, PlanPoint, load_plan, plan_from_json, plan_to_json
+from calib.plan.json_io import canonical_json
+from calib.plan.procedures import (
     BEST_FIT_ROLE,
     HULTMAN_ROLES,
     THREE_TWO_ONE_ROLES,

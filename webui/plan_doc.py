@@ -30,7 +30,7 @@ class UiPoint:
     Attributes:
         probe: the nominal point, normal and search, wobj frame (metres).
         role: what the point is for in the procedure (e.g. ``"A"`` for the paper's A-H
-            procedure, ``"primary"`` for 3-2-1); see ``calib.plan_procedures``.
+            procedure, ``"primary"`` for 3-2-1); see ``calib.plan.procedures``.
         speed_m_s: search speed written into robot programs, m/s.
     """
 
@@ -52,7 +52,7 @@ class UiPlan:
         points: the probe points, in procedure order.
         name: a short name of the plan for titles and file names.
         roles: the roles the plan's procedure allows, offered in the role dropdown.
-        source: the loaded plan object (``calib.plan``) the points came from, or ``None``.
+        source: the loaded plan object (``calib.plan.file``) the points came from, or ``None``.
     """
 
     points: tuple[UiPoint, ...] = ()

@@ -15,7 +15,7 @@ from calib.frames import (
     matrix_from_rotvec,
     quat_wxyz_from_matrix,
 )
-from calib.plan import (
+from calib.plan.file import (
     CellSpec,
     Plan,
     PlanPoint,
@@ -25,7 +25,7 @@ from calib.plan import (
     file_sha256,
     save_plan,
 )
-from calib.plan_procedures import ThreeTwoOne
+from calib.plan.procedures import ThreeTwoOne
 from calib.probing import ProbePoint
 
 #: Size of the test box, metres (x, y, z); its top face is z = 0 and it lies in z < 0.

@@ -2,7 +2,7 @@
 
 Validation runs on its own thread (:class:`webui.worker.CellWorker` without a shared resource),
 not on the cell worker: point checks from any tab stay fast while it runs. Whatever simulator
-state ``planner.montecarlo`` needs it builds itself, inside that thread.
+state ``planner.sim.montecarlo`` needs it builds itself, inside that thread.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from calib.errors import InputError
-from planner.plan_validate import check_simulatable
+from planner.validate import check_simulatable
 from webui import validation
 from webui.plan_adapter import plan_from_ui
 from webui.worker import CellWorker
@@ -62,7 +62,7 @@ class ValidatePanel:
 
         Raises:
             InputError: a validation is already running, or the plan is incomplete or cannot
-                be simulated (:class:`calib.plan.PlanError` naming the field).
+                be simulated (:class:`calib.plan.file.PlanError` naming the field).
         """
         plan = plan_from_ui(self._app.state.doc)
         check_simulatable(plan)

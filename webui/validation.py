@@ -1,4 +1,4 @@
-"""Between the validate panel and ``planner.plan_validate``: run it, shape its report for the UI."""
+"""Between the validate panel and ``planner.validate``: run it, shape its report for the UI."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from calib.plan import Plan
-from planner.plan_validate import validate_plan
+from calib.plan.file import Plan
+from planner.validate import validate_plan
 
 Progress = Callable[[int, int], None]
 
@@ -20,7 +20,7 @@ class ValidationSummary:
     """What the validate panel shows.
 
     Attributes:
-        report: the ``planner.montecarlo`` report object, as returned.
+        report: the ``planner.sim.montecarlo`` report object, as returned.
         markdown: Table-1-style markdown (confidence intervals) and the per-point failures.
         histograms: ``(title, bin_edges (B+1,), counts (B,))`` for each error histogram.
         headline: one line for the notification.
@@ -37,7 +37,7 @@ class ValidationSummary:
 def run_validation(plan: Plan, trials: int, progress: Progress) -> ValidationSummary:
     """Simulate the plan's calibration ``trials`` times with its error models and seed.
 
-    The same :func:`planner.plan_validate.validate_plan` as ``wobjcal validate``, with one
+    The same :func:`planner.validate.validate_plan` as ``wobjcal validate``, with one
     in-process worker (no ``fork()`` of a threaded server).
 
     Raises:
@@ -54,7 +54,7 @@ def _histogram(samples: Any, scale: float, bins: int = 30) -> tuple[Any, Any]:
 
 
 def summarize(report: Any) -> ValidationSummary:
-    """Shape a ``planner.montecarlo_report.ValidationReport`` for the panel."""
+    """Shape a ``planner.sim.report.ValidationReport`` for the panel."""
     markdown = report.to_markdown()
     units = {r.key: r.unit for r in report.rows}
     labels = {r.key: r.label for r in report.rows}

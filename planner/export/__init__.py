@@ -1,12 +1,12 @@
 """Export a plan to robot programs: ABB RAPID, KUKA KRL, URScript (and plan JSON).
 
-Each exporter formats an :class:`planner.export.common.ExportJob`; :func:`export_text` picks one
+Each exporter formats an :class:`planner.export.job.ExportJob`; :func:`export_text` picks one
 by name and returns ``{file name suffix: text}`` (KRL writes a ``.src`` and a ``.dat``).
 """
 
 from __future__ import annotations
 
-from planner.export.common import ExportJob, TargetPair, ToolData, build_job
+from planner.export.job import ExportJob, TargetPair, ToolData, build_job
 
 FORMATS = ("rapid", "krl", "urscript", "json")
 

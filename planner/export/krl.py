@@ -23,7 +23,7 @@ import numpy as np
 
 from calib._version import __version__
 from calib.frames import tait_bryan_zyx_from_matrix
-from planner.export.common import ExportJob, TargetPair, fmt, identifier, safety_header
+from planner.export.job import ExportJob, TargetPair, fmt, identifier, safety_header
 
 BASE_NO = 10
 TOOL_NO = 10

@@ -31,7 +31,7 @@ import numpy as np
 
 from calib._version import __version__
 from calib.frames import quat_wxyz_from_matrix
-from planner.export.common import ExportJob, fmt, identifier
+from planner.export.job import ExportJob, fmt, identifier
 from planner.export.rapid_probe import WOBJ, probe_proc
 from planner.export.rapid_write import MEASURED_FILE, write_proc
 

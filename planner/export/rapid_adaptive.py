@@ -1,7 +1,7 @@
 """The paper's A-H procedure (section 3.2) in RAPID: the frame update after every step.
 
 Every search robtarget is a constant in ``wobjCal``; the program rewrites ``wobjCal.uframe``
-after each step exactly as :func:`calib.stator_procedure.run_stator_procedure` updates its
+after each step exactly as :func:`calib.paper.stator_procedure.run_stator_procedure` updates its
 estimate, so every later ``SearchL`` is commanded in the work-object frame estimated so far:
 
 1. A, B in the preliminary (nominal) frame; ``EstimateP3`` (eq. 11-12); ``SetRotation`` with
@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 
-from planner.export.common import AdaptiveSpec, ExportJob, fmt
+from planner.export.job import AdaptiveSpec, ExportJob, fmt
 from planner.export.rapid_probe import WOBJ
 
 

@@ -11,7 +11,7 @@ a measured point passed in (``startBase``, base frame). ``measured{i}`` is in th
 
 from __future__ import annotations
 
-from planner.export.common import TargetPair, fmt
+from planner.export.job import TargetPair, fmt
 
 #: The wobjdata every search is commanded in.
 WOBJ = "wobjCal"

@@ -3,7 +3,7 @@ misplaced within the plan's tolerance never has the sensor inside or against it.
 
 A misplacement is a rigid motion of the part: a translation up to ``max_translation_m`` and a
 rotation up to ``max_angle_rad`` about a pivot (by default the centroid of the probe points, as
-:func:`planner.montecarlo.default_pivot`). A nominal surface point ``p`` moves by at most
+:func:`planner.sim.montecarlo.default_pivot`). A nominal surface point ``p`` moves by at most
 ``t + |p - c| * angle`` and the face tilts by at most ``angle``, so along the nominal normal the
 true face lies within ``(t + |p - c| * angle) / cos(angle)`` of the nominal one
 (:func:`surface_shift_bound_m`). A search whose sensor TCP starts ``bound + sensing_distance /

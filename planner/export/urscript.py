@@ -20,7 +20,7 @@ import numpy as np
 
 from calib._version import __version__
 from calib.frames import rotvec_from_matrix
-from planner.export.common import ExportJob, fmt, identifier, safety_header
+from planner.export.job import ExportJob, fmt, identifier, safety_header
 
 SENSOR_IN = 0
 

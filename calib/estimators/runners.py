@@ -1,0 +1,244 @@
+"""Step-by-step runners of the general methods (3-2-1 and best fit), driven by a probe callback.
+
+A runner never moves anything. For each point it builds
+:meth:`calib.probing.SearchCommand.from_point` in the current estimate of ``T_base_wobj`` and
+calls the :data:`calib.probing.Probe`; as measurements come in it re-estimates the frame so the
+remaining points are commanded where the part really is. The same code drives a simulation
+(``planner``) or a real robot.
+
+Between the closed-form steps a runner updates the estimate with the *smallest* motion (rotation
+about the layout centroid, scaled by the layout size) that puts the points measured so far on
+their faces: after the primary points of a 3-2-1 this fixes the primary plane and leaves the
+rest of the estimate alone, as the paper does step by step.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from calib.errors import ProbeFailedError, ShapeError
+from calib.estimators.best_fit import BestFitResult, best_fit
+from calib.estimators.layout import ConstraintSet, constraint_jacobian, constraint_set
+from calib.estimators.observability import require_observable
+from calib.estimators.three_two_one import ThreeTwoOneLayout, ThreeTwoOneResult, three_two_one
+from calib.frames import check_transform, small_motion
+from calib.probing import Probe, ProbePoint, SearchCommand
+from calib.validation import check_vector3
+
+FloatArray = NDArray[np.float64]
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class ProbeStep:
+    """One measurement of a procedure.
+
+    Attributes:
+        point_id: id of the probe point.
+        round: pass over the layout the measurement belongs to (0-based).
+        command: the search as commanded, built from the estimate at that moment (base frame).
+        measured_m: ``(3,)`` the measured point, robot base frame, metres.
+    """
+
+    point_id: str
+    round: int
+    command: SearchCommand
+    measured_m: FloatArray
+
+
+@dataclass(frozen=True)
+class ProcedureResult:
+    """Outcome of a calibration procedure.
+
+    Attributes:
+        T_base_wobj: ``(4, 4)`` the final estimate of the work-object frame, base frame.
+        steps: every measurement in the order taken.
+        estimates: ``(K, 4, 4)`` the estimate after each update, in order (the last one is
+            ``T_base_wobj``).
+        fit: the final fit (its residuals and, for a best fit, covariance).
+        point_ids: ids of the layout's points, in layout order.
+    """
+
+    T_base_wobj: FloatArray
+    steps: tuple[ProbeStep, ...]
+    estimates: FloatArray
+    fit: ThreeTwoOneResult | BestFitResult
+    point_ids: tuple[str, ...]
+
+    @property
+    def n_probes(self) -> int:
+        """Number of searches run."""
+        return len(self.steps)
+
+    @property
+    def measured_base(self) -> FloatArray:
+        """``(N, 3)`` the last measurement of each point, in layout order, base frame, metres."""
+        last = {s.point_id: s.measured_m for s in self.steps}
+        return np.array([last[i] for i in self.point_ids])
+
+
+def probe_point(
+    probe: Probe, point: ProbePoint, T_base_wobj: FloatArray, round_index: int = 0
+) -> ProbeStep:
+    """Command one search for ``point`` in the estimate ``T_base_wobj`` and check the result.
+
+    Raises:
+        ProbeFailedError: the probe reported a failure (its reason is kept).
+        ShapeError: the probe returned something that is not a finite ``(3,)`` point.
+    """
+    command = SearchCommand.from_point(point, T_base_wobj)
+    result = probe(command)
+    if not result.ok:
+        raise ProbeFailedError(point.id, result.reason or "no reason given")
+    q = check_vector3(np.asarray(result.point_m), f"probe result for point {point.id!r}")
+    logger.debug("probed %s (round %d): %s", point.id, round_index, q)
+    return ProbeStep(point.id, round_index, command, q)
+
+
+def min_norm_update(
+    cs: ConstraintSet,
+    measured_base: ArrayLike,
+    T_base_wobj: ArrayLike,
+    pivot_m: FloatArray | None = None,
+    scale_m: float | None = None,
+    iterations: int = 10,
+) -> FloatArray:
+    """Move ``T_base_wobj`` by the smallest motion that puts the measured points on their faces.
+
+    The motion is measured with rotations about ``pivot_m`` (default: the layout centroid) scaled
+    by ``scale_m`` (default: the layout size); constraints that the points do not fix are left
+    as they were. With a full-rank layout this is the least-squares best fit.
+
+    Args:
+        cs: constraints of the points measured so far.
+        measured_base: ``(N, 3)`` their measurements, base frame, metres.
+        T_base_wobj: ``(4, 4)`` current estimate.
+        pivot_m: ``(3,)`` wobj point the rotations are taken about.
+        scale_m: length that converts rotations to translations, metres.
+        iterations: Gauss-Newton iterations (the step is min-norm in each).
+    """
+    T = check_transform(T_base_wobj, "T_base_wobj").copy()
+    q = np.asarray(measured_base, dtype=np.float64)[cs.point_index]
+    c = cs.centroid_m if pivot_m is None else pivot_m
+    L = cs.scale_m if scale_m is None else scale_m
+    for _ in range(iterations):
+        x = (q - T[:3, 3]) @ T[:3, :3]
+        r = np.einsum("ij,ij->i", cs.normals, x - cs.nominal_m)
+        J = constraint_jacobian(cs.normals, x - c)
+        J[:, 3:] /= L
+        step = -np.linalg.pinv(J, rcond=1e-9) @ r
+        w = step[3:] / L
+        T = T @ small_motion(np.concatenate([step[:3] - np.cross(w, c), w]))
+        if float(np.max(np.abs(step))) < 1e-14:
+            break
+    return T
+
+
+def run_three_two_one(
+    layout: ThreeTwoOneLayout,
+    probe: Probe,
+    T_base_wobj_start: ArrayLike,
+    *,
+    rounds: int = 1,
+) -> ProcedureResult:
+    """Run a 3-2-1 alignment step by step.
+
+    Round by round: probe the three primary points in the current estimate and fix the primary
+    plane (smallest motion); probe the two secondary points in that estimate and fix both
+    planes; probe the tertiary point and solve the 3-2-1 in closed form. Later rounds repeat
+    all six probes in the latest estimate, so each point lands nearer its nominal spot.
+
+    Args:
+        layout: the roles.
+        probe: runs one search (see :data:`calib.probing.Probe`).
+        T_base_wobj_start: ``(4, 4)`` start estimate (e.g. the nominal part placement).
+        rounds: number of passes over the six points (>= 1).
+
+    Raises:
+        ProbeFailedError: a probe failed.
+        DegenerateGeometryError: the measured points cannot define a frame.
+    """
+    T = check_transform(T_base_wobj_start, "T_base_wobj_start").copy()
+    _check_rounds(rounds)
+    all_cs = constraint_set(layout.points, "3-2-1 layout")
+    groups = (layout.primary, layout.primary + layout.secondary)
+    steps: list[ProbeStep] = []
+    estimates: list[FloatArray] = []
+    fit: ThreeTwoOneResult | None = None
+    for rnd in range(rounds):
+        done: list[ProbeStep] = []
+        for group, new in zip(groups, (layout.primary, layout.secondary)):
+            done += [probe_point(probe, p, T, rnd) for p in new]
+            cs = constraint_set(group)
+            q = np.array([s.measured_m for s in done])
+            T = min_norm_update(cs, q, T, all_cs.centroid_m, all_cs.scale_m)
+            estimates.append(T)
+        done.append(probe_point(probe, layout.tertiary[0], T, rnd))
+        fit = three_two_one(layout, np.array([s.measured_m for s in done]), T_base_wobj_guess=T)
+        T = fit.T_base_wobj
+        estimates.append(T)
+        steps += done
+        logger.info("3-2-1 round %d done", rnd)
+    assert fit is not None  # rounds >= 1 is checked above
+    return ProcedureResult(T, tuple(steps), np.array(estimates), fit, all_cs.point_ids)
+
+
+def run_best_fit(
+    points: Sequence[ProbePoint],
+    probe: Probe,
+    T_base_wobj_start: ArrayLike,
+    *,
+    rounds: int = 2,
+    progressive: bool = True,
+    sigma_m: float | None = None,
+) -> ProcedureResult:
+    """Probe all points, fit, and re-probe in the new estimate, for ``rounds`` passes.
+
+    Args:
+        points: the probe points (must constrain all 6 DOF).
+        probe: runs one search.
+        T_base_wobj_start: ``(4, 4)`` start estimate.
+        rounds: number of passes over all points (>= 1).
+        progressive: in the first pass, update the estimate (smallest motion) after every
+            measurement, so later points are commanded where the part really is.
+        sigma_m: measurement standard deviation for the covariance, metres (``None``: estimated
+            from the residuals).
+
+    Raises:
+        UnobservableError: the layout leaves a motion unconstrained (checked before probing).
+        ProbeFailedError: a probe failed.
+    """
+    T = check_transform(T_base_wobj_start, "T_base_wobj_start").copy()
+    _check_rounds(rounds)
+    cs = constraint_set(points)
+    require_observable(cs)
+    pts = tuple(points)
+    steps: list[ProbeStep] = []
+    estimates: list[FloatArray] = []
+    fit: BestFitResult | None = None
+    for rnd in range(rounds):
+        done: list[ProbeStep] = []
+        for k, p in enumerate(pts):
+            done.append(probe_point(probe, p, T, rnd))
+            if progressive and rnd == 0 and k + 1 < len(pts):
+                sub = constraint_set(pts[: k + 1])
+                q = np.array([s.measured_m for s in done])
+                T = min_norm_update(sub, q, T, cs.centroid_m, cs.scale_m)
+                estimates.append(T)
+        fit = best_fit(cs, np.array([s.measured_m for s in done]), T, sigma_m=sigma_m)
+        T = fit.T_base_wobj
+        estimates.append(T)
+        steps += done
+        logger.info("best-fit round %d: rms %.3g mm", rnd, fit.rms_m * 1e3)
+    assert fit is not None  # rounds >= 1 is checked above
+    return ProcedureResult(T, tuple(steps), np.array(estimates), fit, cs.point_ids)
+
+
+def _check_rounds(rounds: int) -> None:
+    if not isinstance(rounds, int | np.integer) or isinstance(rounds, bool) or rounds < 1:
+        raise ShapeError(f"rounds must be an integer >= 1, got {rounds!r}")

@@ -1,0 +1,141 @@
+"""The cell and work-object parts of a plan: poses, robot, tool, fixtures, work object.
+
+Poses are ``{"position_m": [x, y, z], "quat_wxyz": [w, x, y, z]}`` meaning ``T_parent_child``;
+file references are paths relative to the plan file or ``builtin:NAME``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from calib.frames import (
+    check_transform,
+    make_transform,
+    matrix_from_quat_wxyz,
+    quat_wxyz_from_matrix,
+)
+from calib.plan.base import (
+    MeshUnits,
+    PlanError,
+    Strict,
+    Vec3,
+    check_finite,
+    check_sha256,
+    check_unit,
+)
+
+
+class Pose(Strict, frozen=True, kw_only=True):
+    """A rigid transform ``T_parent_child``.
+
+    Attributes:
+        position_m: ``(3,)`` origin of the child frame in the parent frame, metres.
+        quat_wxyz: ``(4,)`` unit quaternion (w, x, y, z) of the child's rotation in the parent.
+    """
+
+    position_m: Vec3 = (0.0, 0.0, 0.0)
+    quat_wxyz: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        check_finite(self.position_m, "position_m")
+        check_unit(self.quat_wxyz, "quat_wxyz")
+
+    def matrix(self) -> NDArray[np.float64]:
+        """The 4x4 transform ``T_parent_child``."""
+        return make_transform(matrix_from_quat_wxyz(self.quat_wxyz), self.position_m)
+
+    @classmethod
+    def from_matrix(cls, T: ArrayLike) -> Pose:
+        """The pose of a 4x4 rigid transform (quaternion with ``w >= 0``)."""
+        T_arr = check_transform(T, "T")
+        q = quat_wxyz_from_matrix(T_arr[:3, :3])
+        p = T_arr[:3, 3]
+        return cls(
+            position_m=(float(p[0]), float(p[1]), float(p[2])),
+            quat_wxyz=(float(q[0]), float(q[1]), float(q[2]), float(q[3])),
+        )
+
+
+class RobotSpec(Strict, frozen=True, kw_only=True):
+    """The robot: ``urdf`` is a path relative to the plan or ``builtin:irb4400``.
+
+    Attributes:
+        urdf: URDF file or built-in name.
+        T_world_base: pose of the robot base in the cell (world) frame.
+        base_link: URDF base link (``None``: the URDF's root).
+        tip_link: URDF flange link (``None``: ``tool0`` or the single leaf).
+    """
+
+    urdf: str = "builtin:irb4400"
+    T_world_base: Pose = Pose()
+    base_link: str | None = None
+    tip_link: str | None = None
+
+
+class ToolSpec(Strict, frozen=True, kw_only=True):
+    """The robot-held tool: ``name`` is a URDF path or ``builtin:cable_feeder``; ``tcp`` is the
+    probing TCP (the proximity sensor at its sensing distance)."""
+
+    name: str = "builtin:cable_feeder"
+    tcp: str = "sensor"
+
+
+class FixtureSpec(Strict, frozen=True, kw_only=True):
+    """A fixed obstacle (table, fixture) for collision checks: a mesh or a box.
+
+    Attributes:
+        name: unique fixture name.
+        mesh: mesh file (relative to the plan) or ``builtin:NAME``; ``None`` for a box.
+        box_size_m: ``(3,)`` edge lengths of a box centred on its frame, m; ``None`` for a mesh.
+        units: length unit of the mesh file.
+        sha256: hex digest of the mesh file, checked on load (``None``: not checked).
+        T_world_fixture: pose of the mesh (or box centre) frame in the world frame.
+    """
+
+    name: str
+    mesh: str | None = None
+    box_size_m: Vec3 | None = None
+    units: MeshUnits = "m"
+    sha256: str | None = None
+    T_world_fixture: Pose = Pose()
+
+    def __post_init__(self) -> None:
+        if (self.mesh is None) == (self.box_size_m is None):
+            raise PlanError("mesh: give exactly one of mesh and box_size_m")
+        if self.box_size_m is not None:
+            if not all(math.isfinite(v) and v > 0 for v in self.box_size_m):
+                raise PlanError(f"box_size_m: must be 3 lengths > 0, got {list(self.box_size_m)}")
+            if self.sha256 is not None:
+                raise PlanError("sha256: must be null for a box")
+        else:
+            check_sha256(self.sha256, self.mesh or "", "sha256")
+
+
+class CellSpec(Strict, frozen=True, kw_only=True):
+    """Robot, tool and fixtures of the cell."""
+
+    robot: RobotSpec = RobotSpec()
+    tool: ToolSpec = ToolSpec()
+    fixtures: list[FixtureSpec] = []  # noqa: RUF012 (msgspec copies empty defaults)
+
+
+class WorkObjectSpec(Strict, frozen=True, kw_only=True):
+    """The work object: its mesh, the mesh unit, the file digest and its nominal pose.
+
+    Attributes:
+        mesh: mesh file (relative to the plan) or ``builtin:stator_section``.
+        units: length unit of the mesh file (``auto`` lets the loader guess).
+        sha256: hex digest of the mesh file; a mismatch on load is an error naming the file.
+        T_world_wobj: nominal pose of the work-object frame (WOCS) in the world frame.
+    """
+
+    mesh: str = "builtin:stator_section"
+    units: MeshUnits = "m"
+    sha256: str | None = None
+    T_world_wobj: Pose = Pose()
+
+    def __post_init__(self) -> None:
+        check_sha256(self.sha256, self.mesh, "sha256")

@@ -1,0 +1,322 @@
+"""The measurement plan ``wobjcal.plan/1``: typed, strict, versioned JSON.
+
+A plan holds everything needed to check, validate, export and evaluate one work-object
+calibration: the cell (robot, tool and probing TCP, fixtures), the work object and its nominal
+pose, the probe points, the procedure and its settings, and the error models used for validation.
+The file format is described in ``docs/plan_format.md``; the JSON Schema generated from these
+types is checked in at ``assets/schema/wobjcal.plan-1.schema.json``.
+
+Conventions: metres and radians (field names end in ``_m``, ``_rad``, ``_m_s``), poses as
+``{"position_m": [x, y, z], "quat_wxyz": [w, x, y, z]}`` meaning ``T_parent_child``. Paths to
+files (URDF, meshes) are relative to the plan file, or ``builtin:NAME``. This module is pure:
+msgspec and numpy only, no simulator.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+from typing import Final, Literal, get_args
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from calib.atomic_io import write_text_atomic
+from calib.plan.base import (
+    BUILTIN_PREFIX,
+    UNIT_TOL,
+    MeshUnits,
+    PlanError,
+    Strict,
+    Vec3,
+    check_finite,
+    check_positive,
+    check_unit,
+)
+from calib.plan.cell import (
+    CellSpec,
+    FixtureSpec,
+    Pose,
+    RobotSpec,
+    ToolSpec,
+    WorkObjectSpec,
+)
+from calib.plan.json_io import (
+    canonical_json,
+    check_schema_tag,
+    convert_strict,
+    parse_json_text,
+    read_text_file,
+)
+from calib.plan.models import Misplacement, RobotErrorModel, SensorModel, ValidationSpec
+from calib.plan.procedures import METHODS, Procedure, check_roles, method_of
+from calib.probing import ProbePoint, SearchSpec
+
+__all__ = [
+    "BUILTIN_PREFIX",
+    "PLAN_SCHEMA",
+    "SUPPORTED_PLAN_SCHEMAS",
+    "CellSpec",
+    "FixtureSpec",
+    "Misplacement",
+    "Plan",
+    "PlanError",
+    "PlanPoint",
+    "Pose",
+    "RobotErrorModel",
+    "RobotSpec",
+    "Search",
+    "SensorModel",
+    "ToolSpec",
+    "ValidationSpec",
+    "WorkObjectSpec",
+    "check_plan_files",
+    "file_sha256",
+    "load_plan",
+    "plan_from_json",
+    "plan_to_json",
+    "resolve_ref",
+    "save_plan",
+]
+
+PLAN_SCHEMA: Final = "wobjcal.plan/1"
+SUPPORTED_PLAN_SCHEMAS = (PLAN_SCHEMA,)
+
+
+class Search(Strict, frozen=True, kw_only=True):
+    """How a point is searched for; see :class:`calib.probing.SearchSpec`.
+
+    Attributes:
+        kind: ``approach`` (along ``-normal``) or ``edge`` (along ``edge_direction``).
+        start_offset_m: start distance before the nominal point, metres.
+        overtravel_m: allowed travel past the nominal point, metres.
+        edge_direction: ``(3,)`` unit direction of an edge search, wobj frame; ``None`` otherwise.
+        speed_m_s: search speed for the exported robot programs, m/s.
+    """
+
+    kind: Literal["approach", "edge"] = "approach"
+    start_offset_m: float = 0.030
+    overtravel_m: float = 0.020
+    edge_direction: Vec3 | None = None
+    speed_m_s: float = 0.010
+
+    def __post_init__(self) -> None:
+        check_positive(self.start_offset_m, "start_offset_m")
+        check_positive(self.overtravel_m, "overtravel_m")
+        check_positive(self.speed_m_s, "speed_m_s")
+        if self.kind == "edge" and self.edge_direction is None:
+            raise PlanError("edge_direction: required for an edge search")
+        if self.kind == "approach" and self.edge_direction is not None:
+            raise PlanError("edge_direction: must be null for an approach search")
+        check_unit(self.edge_direction, "edge_direction")
+
+
+class PlanPoint(Strict, frozen=True, kw_only=True):
+    """A probe point; the plan-file form of :class:`calib.probing.ProbePoint`.
+
+    Attributes:
+        id: unique name, e.g. ``"A"``.
+        role: the point's role in the procedure (see ``calib.plan.procedures``).
+        position_m: ``(3,)`` nominal surface (or edge) point, wobj frame, metres.
+        normal: ``(3,)`` unit outward normal of the face, wobj frame.
+        search: how the point is searched for.
+        edge_normal: ``(3,)`` unit normal of the face whose end an edge search finds, or ``None``.
+    """
+
+    id: str
+    role: str
+    position_m: Vec3
+    normal: Vec3
+    search: Search = Search()
+    edge_normal: Vec3 | None = None
+
+    def __post_init__(self) -> None:
+        if not self.id or not self.id.strip():
+            raise PlanError("id: must be a non-empty string")
+        check_finite(self.position_m, "position_m")
+        check_unit(self.normal, "normal")
+        check_unit(self.edge_normal, "edge_normal")
+        if self.search.edge_direction is not None:
+            dot = float(np.dot(self.search.edge_direction, self.normal))
+            if abs(dot) > UNIT_TOL:
+                raise PlanError(
+                    f"search.edge_direction: must be perpendicular to normal, got dot = {dot:.3g}"
+                )
+
+    def to_probe_point(self) -> ProbePoint:
+        """The :class:`ProbePoint` used by procedures and the cell."""
+        s = self.search
+        return ProbePoint(
+            id=self.id,
+            position_m=self.position_m,
+            normal=self.normal,
+            search=SearchSpec(
+                kind=s.kind,
+                start_offset_m=s.start_offset_m,
+                overtravel_m=s.overtravel_m,
+                edge_direction=s.edge_direction,
+            ),
+            edge_normal=self.edge_normal,
+        )
+
+    @classmethod
+    def from_probe_point(cls, point: ProbePoint, role: str, speed_m_s: float = 0.010) -> PlanPoint:
+        """The plan form of ``point`` with its ``role`` (numbers converted to plain floats)."""
+
+        def vec(v: ArrayLike | None) -> Vec3 | None:
+            if v is None:
+                return None
+            a = np.asarray(v, dtype=float)
+            return (float(a[0]), float(a[1]), float(a[2]))
+
+        s = point.search
+        return cls(
+            id=point.id,
+            role=role,
+            position_m=vec(point.position_m),  # type: ignore[arg-type]
+            normal=vec(point.normal),  # type: ignore[arg-type]
+            search=Search(
+                kind=s.kind,
+                start_offset_m=float(s.start_offset_m),
+                overtravel_m=float(s.overtravel_m),
+                edge_direction=vec(s.edge_direction),
+                speed_m_s=speed_m_s,
+            ),
+            edge_normal=vec(point.edge_normal),
+        )
+
+
+class Plan(Strict, frozen=True, kw_only=True):
+    """A complete measurement plan (file format ``wobjcal.plan/1``)."""
+
+    schema: Literal["wobjcal.plan/1"] = PLAN_SCHEMA
+    name: str = ""
+    description: str = ""
+    cell: CellSpec = CellSpec()
+    work_object: WorkObjectSpec = WorkObjectSpec()
+    points: list[PlanPoint] = []  # noqa: RUF012 (msgspec copies empty defaults)
+    procedure: Procedure
+    validation: ValidationSpec = ValidationSpec()
+
+    def __post_init__(self) -> None:
+        seen: dict[str, int] = {}
+        for i, p in enumerate(self.points):
+            if p.id in seen:
+                raise PlanError(
+                    f"points[{i}].id: duplicate id {p.id!r} (also points[{seen[p.id]}])"
+                )
+            seen[p.id] = i
+        names = [f.name for f in self.cell.fixtures]
+        if len(set(names)) != len(names):
+            raise PlanError(f"cell.fixtures: duplicate fixture names in {names}")
+        msg = check_roles(self.procedure, [p.role for p in self.points], complete=False)
+        if msg:
+            raise PlanError(msg)
+
+    @property
+    def method(self) -> str:
+        """The procedure's method: ``hultman2013``, ``three_two_one`` or ``best_fit``."""
+        return method_of(self.procedure)
+
+    def require_complete(self) -> None:
+        """Raise :class:`PlanError` unless the points have all roles the procedure needs."""
+        msg = check_roles(self.procedure, [p.role for p in self.points], complete=True)
+        if msg:
+            raise PlanError(msg)
+
+    def point(self, point_id: str) -> PlanPoint:
+        """The point named ``point_id``; the error lists the valid ids."""
+        for p in self.points:
+            if p.id == point_id:
+                return p
+        raise PlanError(f"no point {point_id!r} in the plan (ids: {[p.id for p in self.points]})")
+
+    def probe_points(self) -> dict[str, ProbePoint]:
+        """All points as :class:`ProbePoint`, by id, in plan order."""
+        return {p.id: p.to_probe_point() for p in self.points}
+
+    def roles(self) -> dict[str, str]:
+        """Role of each point, by id."""
+        return {p.id: p.role for p in self.points}
+
+
+def file_sha256(path: str | Path) -> str:
+    """Hex SHA-256 digest of a file's bytes."""
+    digest = hashlib.sha256()
+    with Path(path).open("rb") as handle:
+        for block in iter(lambda: handle.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def resolve_ref(ref: str, plan_dir: str | Path) -> str | Path:
+    """A file reference of the plan: ``builtin:NAME`` unchanged, else a path under ``plan_dir``."""
+    if ref.startswith(BUILTIN_PREFIX):
+        return ref
+    path = Path(ref)
+    return path if path.is_absolute() else Path(plan_dir) / path
+
+
+_CHOICES = {
+    "units": get_args(MeshUnits),
+    "method": METHODS,
+    "kind": ("approach", "edge"),
+}
+
+
+def plan_from_json(text: str, source: str = "plan") -> Plan:
+    """Parse and validate plan JSON text (no file checks); errors name ``source`` and the path."""
+    raw = parse_json_text(text, PlanError, source)
+    check_schema_tag(raw, SUPPORTED_PLAN_SCHEMAS, PlanError, source)
+    return convert_strict(raw, Plan, PlanError, source, _CHOICES)
+
+
+def plan_to_json(plan: Plan) -> str:
+    """The canonical JSON text of ``plan`` (sorted keys, indent 2, trailing newline)."""
+    return canonical_json(plan)
+
+
+def check_plan_files(plan: Plan, plan_dir: str | Path, source: str = "plan") -> None:
+    """Check that referenced files exist and match their ``sha256``; errors name the file."""
+    refs = [("work_object", plan.work_object.mesh, plan.work_object.sha256)]
+    refs += [
+        (f"cell.fixtures[{i}]", f.mesh, f.sha256)
+        for i, f in enumerate(plan.cell.fixtures)
+        if f.mesh is not None
+    ]
+    for where, ref, sha in refs:
+        path = resolve_ref(ref, plan_dir)
+        if isinstance(path, str):
+            continue
+        if not path.is_file():
+            raise PlanError(f"{source}: {where}.mesh: file not found: {path}")
+        if sha is not None and file_sha256(path) != sha:
+            raise PlanError(
+                f"{source}: {where}.sha256: {path} has digest {file_sha256(path)}, "
+                f"the plan says {sha} (the file changed since the plan was made)"
+            )
+
+
+def load_plan(path: str | Path, check_files: bool = True) -> Plan:
+    """Read a plan file strictly.
+
+    Args:
+        path: the plan JSON file.
+        check_files: also check referenced mesh files and their sha256 digests.
+
+    Raises:
+        PlanError: malformed JSON, unsupported schema, wrong field, or a file mismatch; the
+            message names the file and the JSON path.
+        OSError: the file cannot be read.
+    """
+    p = Path(path)
+    text = read_text_file(p, PlanError)
+    plan = plan_from_json(text, source=str(p))
+    if check_files:
+        check_plan_files(plan, p.parent, source=str(p))
+    return plan
+
+
+def save_plan(plan: Plan, path: str | Path) -> Path:
+    """Write ``plan`` atomically as canonical JSON; return the path."""
+    return write_text_atomic(path, plan_to_json(plan))

@@ -1,0 +1,109 @@
+"""Reach of a robot, and why a pose has no IK solution: out of reach, or a joint at a limit.
+
+The reasons name numbers a person can check: the flange's (or, for OPW arms, the wrist
+centre's) distance from the shoulder against the arm's reach, or the joint that breaks its
+limit in most of the analytic branches.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from calib.frames import invert_transform
+
+if TYPE_CHECKING:
+    from planner.cell.cell import Cell
+    from planner.robot.kinematics.chain import KinematicChain
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class ReachModel:
+    """Where the shoulder is and how far the flange gets from it.
+
+    Attributes:
+        axis_origin_m: ``(3,)`` a point on joint 1's axis, base frame, m.
+        axis: ``(3,)`` joint 1's unit axis, base frame.
+        shoulder_m: ``(3,)`` the shoulder (joint 2's origin) at zero, base frame, m.
+        reach_m: largest flange distance from the shoulder over 20,000 random in-limit
+            configurations (the shoulder turning with joint 1), m.
+    """
+
+    axis_origin_m: FloatArray
+    axis: FloatArray
+    shoulder_m: FloatArray
+    reach_m: float
+
+    def shoulder_towards(self, p: FloatArray) -> FloatArray:
+        """``(M, 3)``: the shoulder turned about joint 1's axis towards points ``p (M, 3)``."""
+        o, a = self.axis_origin_m, self.axis
+        s = self.shoulder_m - o
+        s_ax = (s @ a) * a
+        r_s = float(np.linalg.norm(s - s_ax))
+        v = p - o
+        r_p = v - np.outer(v @ a, a)
+        norm = np.linalg.norm(r_p, axis=1, keepdims=True)
+        unit = np.divide(r_p, norm, out=np.zeros_like(r_p), where=norm > 1e-12)
+        return o + s_ax + r_s * unit
+
+
+def reach_model(chain: KinematicChain, rng: np.random.Generator) -> ReachModel:
+    """The :class:`ReachModel` of ``chain`` (uses ``rng`` for the sampled configurations)."""
+    lo = np.where(np.isfinite(chain.lower), chain.lower, -np.pi)
+    hi = np.where(np.isfinite(chain.upper), chain.upper, np.pi)
+    zero = chain.joint_frames(np.clip(np.zeros(chain.n_joints), lo, hi))[0]
+    k = min(1, chain.n_joints - 1)
+    axis = zero[0, :3, :3] @ chain.axes[0]
+    q = rng.uniform(lo, hi, size=(20_000, chain.n_joints))
+    frames = chain.joint_frames(q)
+    tip = frames[:, -1] @ chain.T_last_tip
+    reach = float(np.max(np.linalg.norm(tip[:, :3, 3] - frames[:, k, :3, 3], axis=1)))
+    return ReachModel(zero[0, :3, 3].copy(), axis, zero[k, :3, 3].copy(), reach)
+
+
+def no_ik_reason(cell: Cell, T_flange: FloatArray) -> str:
+    """Why ``(R, 4, 4)`` flange poses of one point have no valid IK solution."""
+    model = cell.reach_model
+    p = T_flange[:, :3, 3]
+    dist = float(np.min(np.linalg.norm(p - model.shoulder_towards(p), axis=1)))
+    where = f"{dist:.2f} m from the shoulder, reach {model.reach_m:.2f} m"
+    if dist > model.reach_m:
+        return f"out of reach ({where})"
+    opw = getattr(cell.solver, "opw", None)
+    if opw is not None:
+        q8, ok8 = opw.ik_branches(T_flange)
+        if not ok8.any():
+            return opw_wrist_reason(opw, T_flange)
+        q = q8[ok8]
+        lo, hi = cell.chain.lower, cell.chain.upper
+        two_pi = 2 * np.pi
+        with np.errstate(invalid="ignore"):
+            best = np.full(q.shape, np.inf)  # violation of each joint over its 2*pi variants
+            for k in (-2, -1, 0, 1, 2):
+                qk = q + k * two_pi
+                best = np.minimum(best, np.maximum(lo - qk, 0) + np.maximum(qk - hi, 0))
+        worst = np.argmax(best, axis=1)  # each candidate's worst joint
+        j = int(np.bincount(worst, minlength=q.shape[1]).argmax())
+        return f"joint {j + 1} at limit ({cell.chain.joint_names[j]})"
+    return f"no IK solution within joint limits ({where})"
+
+
+def opw_wrist_reason(opw: Any, T_flange: FloatArray) -> str:
+    """Why an OPW arm reaches none of the flange poses ``(R, 4, 4)``: the wrist centre's
+    distance from the shoulder against the arm's range ``|c2 - k| .. c2 + k``."""
+    P = opw.params
+    T = invert_transform(opw.T_base_opw) @ T_flange @ invert_transform(opw.T_ee_tip)
+    c = T[:, :3, 3] - P.c4 * T[:, :3, 2]
+    radial = np.sqrt(np.maximum(c[:, 0] ** 2 + c[:, 1] ** 2 - P.b**2, 0.0))
+    k = math.hypot(P.c3, P.a2)
+    d = np.minimum(np.hypot(radial - P.a1, c[:, 2] - P.c1), np.hypot(radial + P.a1, c[:, 2] - P.c1))
+    i = int(np.argmin(np.abs(d - np.clip(d, abs(P.c2 - k), P.c2 + k))))
+    if d[i] < abs(P.c2 - k):
+        return f"too close (wrist centre {d[i]:.2f} m from the shoulder, min {abs(P.c2 - k):.2f} m)"
+    return f"out of reach (wrist centre {d[i]:.2f} m from the shoulder, reach {P.c2 + k:.2f} m)"

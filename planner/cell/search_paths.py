@@ -1,0 +1,238 @@
+"""Search-path feasibility: can the robot run a whole approach or edge search?
+
+A search (:class:`calib.probing.SearchCommand`, base frame) moves the sensor TCP from
+``start_m`` along ``direction`` for ``length_m``, the sensor axis fixed. The path is sampled at
+``<= step_m``; the rotation about the sensor axis and the IK branch are chosen at the start
+(candidates in order of least joint motion), and every later sample takes the solution of the
+same branch nearest to the previous one. A sample fails when it has no solution on that
+branch within limits, a joint jumps more than ``max_joint_jump_rad``, it is near a singularity,
+or it collides. The sensor may come as close as contact to the work object (not the margin).
+Past the nominal point of an approach search, robot and tool are not checked against the work
+object at all, only against fixtures and themselves: the real search stops at the surface, and
+a part lying farther away has moved its surface away by just as much, so the geometry at the
+stop is the one checked at the nominal point.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from calib.errors import DegenerateGeometryError
+from calib.frames import invert_transform
+from calib.validation import check_positive, check_shape, check_vector3
+from planner.cell.feasibility import (
+    MARGINAL_LIMIT_RAD,
+    limit_margin,
+    singular,
+    tcp_frames,
+)
+from planner.cell.reach import no_ik_reason
+
+if TYPE_CHECKING:
+    from calib.probing import SearchCommand
+    from planner.cell.cell import Cell
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class PathFeasibility:
+    """Feasibility of one search path.
+
+    Attributes:
+        feasible: True when the whole path passes.
+        reason: empty when feasible; else why, with the distance, e.g. ``"at 23.0 mm: link_5
+            hits clamp (clearance 2.1 mm)"``.
+        fail_at_m: distance along the path of the first failing sample, m (NaN if feasible).
+        s_m: ``(M,)`` distances of the samples from the start, m.
+        q_path: ``(M', n)`` joint values of the samples that passed (all ``M`` when feasible),
+            rad.
+        rotation_rad: the rotation about the sensor axis used (see
+            :func:`planner.cell.feasibility.tcp_frames`), rad; NaN when no start was found.
+        branch: IK branch of the path (OPW configuration 0-7), -1 when unknown.
+        min_clearance_m: smallest clearance along the checked samples, m (NaN if none).
+    """
+
+    feasible: bool
+    reason: str
+    fail_at_m: float
+    s_m: FloatArray
+    q_path: FloatArray
+    rotation_rad: float
+    branch: int
+    min_clearance_m: float
+
+
+def check_search(
+    cell: Cell,
+    command: SearchCommand,
+    step_m: float = 0.001,
+    max_joint_jump_rad: float = math.radians(5.0),
+    tcp: str = "sensor",
+    margin_m: float | None = None,
+    rotation_step_deg: float = 15.0,
+    q_ref: ArrayLike | None = None,
+    max_starts: int = 6,
+) -> PathFeasibility:
+    """Check the search ``command`` in ``cell`` (see the module docstring).
+
+    Args:
+        cell: the cell.
+        command: the search, base frame.
+        step_m: largest distance between samples, m.
+        max_joint_jump_rad: largest joint change between samples, rad.
+        tcp: the TCP that runs the search.
+        margin_m: clearance to work object and fixtures, m (default the cell's 5 mm).
+        rotation_step_deg: step of the rotations about the sensor axis tried at the start.
+        q_ref: ``(n,)`` reference configuration for the start choice (default home).
+        max_starts: start candidates (rotation, branch) tried before giving up.
+
+    Returns:
+        The first start candidate whose whole path passes, else the one that got farthest.
+        The cell's joint state is restored afterwards.
+
+    Raises:
+        ShapeError, NonFiniteError: bad vectors in the command; DegenerateGeometryError:
+        zero direction or sensor axis; UnknownFrameError: unknown TCP.
+    """
+    from planner.cell.cell import DEFAULT_MARGIN_M
+
+    start = check_vector3(command.start_m, "command.start_m")
+    direction = _unit(command.direction, "command.direction")
+    axis = _unit(command.sensor_axis, "command.sensor_axis")
+    length = check_positive(command.length_m, "command.length_m")
+    step = check_positive(step_m, "step_m")
+    jump = check_positive(max_joint_jump_rad, "max_joint_jump_rad")
+    margin = DEFAULT_MARGIN_M if margin_m is None else check_positive(margin_m, "margin_m", True)
+    nominal = check_vector3(command.nominal_m, "command.nominal_m")
+    ref = cell.home_q if q_ref is None else check_shape(q_ref, (cell.chain.n_joints,), "q_ref")
+    T_tcp_flange = invert_transform(cell.T_flange_tcp(tcp))
+    s = np.linspace(0.0, length, math.ceil(length / step - 1e-9) + 1)
+    s_nominal = float((nominal - start) @ direction)
+    skip_from = s_nominal + 1e-9 if command.kind == "approach" else np.inf
+    rot_step = math.radians(check_positive(rotation_step_deg, "rotation_step_deg"))
+    angles = np.arange(0.0, 2 * np.pi - 1e-9, rot_step)
+    # T_base_tcp of every (rotation, sample): normals are -axis, points along the path
+    points = start + s[:, None] * direction
+    T_start = tcp_frames(start[None], -axis[None], angles)[0]  # (R, 4, 4)
+    # a numeric solver starts from q_ref (e.g. the probe pose's solution) besides its seeds
+    starts = cell.solver.solve(T_start @ T_tcp_flange, seeds=None if q_ref is None else ref[None])
+    K = starts.valid.shape[1]
+    q0 = starts.q
+    ok0 = starts.valid.copy()
+    if ok0.any():
+        sing, _ = singular(cell, q0[ok0])
+        ok0[ok0] = ~sing
+    empty = np.zeros((0, cell.chain.n_joints))
+    if not ok0.any():
+        reason = (
+            no_ik_reason(cell, T_start @ T_tcp_flange)
+            if not starts.valid.any()
+            else ("singular at the start")
+        )
+        return PathFeasibility(False, f"at 0.0 mm: {reason}", 0.0, s, empty, math.nan, -1, math.nan)
+    motion = np.where(ok0, np.linalg.norm(np.nan_to_num(q0 - ref), axis=-1), np.inf)
+    near = limit_margin(cell.chain, np.nan_to_num(q0)) < MARGINAL_LIMIT_RAD
+    order = np.lexsort((motion.ravel(), near.ravel(), ~ok0.ravel()))[: int(ok0.sum())]
+    order = order[:max_starts]
+    best: PathFeasibility | None = None
+    with cell.saved_state():
+        for flat in order:
+            r, k = divmod(int(flat), K)
+            T_path = T_start[r].copy()[None].repeat(s.size, axis=0)
+            T_path[:, :3, 3] = points
+            res = _walk(
+                cell,
+                T_path @ T_tcp_flange,
+                q0[r, k],
+                int(starts.branch[r, k]),
+                s,
+                jump,
+                margin,
+                skip_from,
+                float(angles[r]),
+            )
+            if res.feasible:
+                return res
+            if best is None or res.fail_at_m > best.fail_at_m:
+                best = res
+    if best is None:  # order is non-empty because ok0.any()
+        raise RuntimeError("no start candidate was tried")
+    return best
+
+
+def _walk(
+    cell: Cell,
+    T_flange: FloatArray,
+    q_start: FloatArray,
+    branch: int,
+    s: FloatArray,
+    jump: float,
+    margin: float,
+    skip_from: float,
+    rotation: float,
+) -> PathFeasibility:
+    """Follow one start solution along the sampled path (see the module docstring)."""
+    sol = cell.solver.solve(T_flange, seeds=q_start[None])
+    M = s.size
+    q_path = np.empty((M, q_start.size))
+    prev = q_start
+    fail_j, reason = M, ""
+    for j in range(M):
+        ok = sol.valid[j] & ((sol.branch[j] == branch) if branch >= 0 else True)
+        if not ok.any():
+            fail_j = j
+            why = (
+                no_ik_reason(cell, T_flange[j : j + 1])
+                if not sol.valid[j].any()
+                else (f"leaves IK branch {branch}")
+            )
+            reason = why
+            break
+        d = np.where(ok, np.abs(sol.q[j] - prev).max(axis=-1), np.inf)
+        k = int(np.argmin(d))
+        if j > 0 and d[k] > jump:
+            fail_j = j
+            jj = int(np.argmax(np.abs(sol.q[j, k] - prev)))
+            reason = f"joint {jj + 1} jumps {math.degrees(d[k]):.1f} deg"
+            break
+        q_path[j] = prev = sol.q[j, k]
+    if fail_j > 0:
+        sing, why = singular(cell, q_path[:fail_j])
+        if sing.any():
+            fail_j, reason = int(np.argmax(sing)), why
+    min_cl = math.inf
+    for j in range(fail_j):
+        cell.set_joint_positions(q_path[j])
+        cl = cell.clearance(margin, sensor_wobj_allowed=True, skip_wobj=s[j] > skip_from)
+        min_cl = min(min_cl, cl.clearance_m)
+        if not cl.ok:
+            fail_j, reason = j, cl.describe()
+            break
+    min_cl = min_cl if math.isfinite(min_cl) else math.nan
+    if fail_j == M:
+        return PathFeasibility(True, "", math.nan, s, q_path, rotation, branch, min_cl)
+    at = float(s[fail_j])
+    return PathFeasibility(
+        False,
+        f"at {at * 1e3:.1f} mm: {reason}",
+        at,
+        s,
+        q_path[:fail_j].copy(),
+        rotation,
+        branch,
+        min_cl,
+    )
+
+
+def _unit(v: ArrayLike, name: str) -> FloatArray:
+    a = check_vector3(v, name)
+    n = float(np.linalg.norm(a))
+    if n < 1e-12:
+        raise DegenerateGeometryError(f"{name} must not be the zero vector")
+    return a / n

@@ -1,0 +1,244 @@
+"""The tool on the robot flange and its TCP frames.
+
+A :class:`Tool` is either a URDF (links joined by fixed joints, root link = the flange mount;
+TCPs are named links) or a mesh in the flange frame with a dict of TCP frames. The built-in
+``builtin:cable_feeder`` models the paper's cable-feeder tool (Hultman & Leijon 2013, Fig. 5):
+a body on the flange with two cable guiding tubes and an 18 mm cylindrical proximity sensor
+(8 mm sensing distance) on top. Its dimensions are assumed (see ``docs/cell.md``).
+
+The ``sensor`` TCP lies at the sensing distance in front of the sensor face; its +z axis is
+the sensor axis, pointing from the sensor into the surface (``calib.frames`` conventions).
+"""
+
+from __future__ import annotations
+
+import json
+import xml.etree.ElementTree as ET
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+
+import numpy as np
+import trimesh
+from numpy.typing import ArrayLike, NDArray
+
+from calib.frames import check_transform, make_transform, matrix_from_tait_bryan_zyx
+from planner.builtins import is_builtin, tool_description
+from planner.cell.bodies import BodyLinks, load_urdf_body, mesh_collision_shape, static_body
+from planner.errors import MeshError, UnknownFrameError, URDFError
+
+FloatArray = NDArray[np.float64]
+
+#: Name of the flange frame; always a valid TCP (identity).
+FLANGE = "flange"
+
+
+@dataclass(frozen=True)
+class Tool:
+    """A tool on the flange.
+
+    Attributes:
+        name: tool name, e.g. ``"cable_feeder"``.
+        tcps: TCP name -> ``T_flange_tcp`` (4, 4), m. Does not list ``"flange"`` (always valid).
+        urdf_path: the tool URDF (root link frame = flange frame), or ``None`` for a mesh tool.
+        mesh: the tool mesh in the flange frame, m (mesh tools; collision uses its convex hull).
+        sensor_tcp: name of the proximity-sensor TCP, or ``None`` when the tool has no sensor.
+        sensor_links: links of the sensor body; they may come closer to the work object than
+            the clearance margin (down to contact), as the sensor face must be within its
+            sensing distance of the surface.
+        sensing_distance_m: distance from the sensor face to the ``sensor`` TCP, m.
+        sensor_diameter_m: sensor diameter, m.
+    """
+
+    name: str
+    tcps: Mapping[str, FloatArray]
+    urdf_path: Path | None = None
+    mesh: trimesh.Trimesh | None = field(default=None, repr=False)
+    sensor_tcp: str | None = None
+    sensor_links: tuple[str, ...] = ()
+    sensing_distance_m: float = 0.008
+    sensor_diameter_m: float = 0.018
+
+    @property
+    def tcp_names(self) -> list[str]:
+        """Valid TCP names: ``"flange"`` and the tool's TCPs, sorted."""
+        return sorted({FLANGE, *self.tcps})
+
+    def T_flange_tcp(self, tcp: str) -> FloatArray:
+        """``T_flange_tcp`` (4, 4) of TCP ``tcp``.
+
+        Raises:
+            UnknownFrameError: no such TCP (the message lists the valid names).
+        """
+        if tcp == FLANGE:
+            return np.eye(4)
+        if tcp not in self.tcps:
+            raise UnknownFrameError(
+                f"tcp {tcp!r} is not a TCP of tool {self.name!r}; valid: {self.tcp_names}"
+            )
+        return self.tcps[tcp].copy()
+
+    @classmethod
+    def from_urdf(
+        cls,
+        path: str | Path,
+        tcps: list[str] | None = None,
+        sensor_tcp: str | None = None,
+        sensor_links: tuple[str, ...] = (),
+        sensing_distance_m: float = 0.008,
+        sensor_diameter_m: float = 0.018,
+    ) -> Tool:
+        """A tool from a URDF whose links are joined by fixed joints; TCPs are named links.
+
+        Args:
+            path: the URDF; its root link frame is the flange frame.
+            tcps: link names to offer as TCPs; default every link but the root.
+            sensor_tcp: the proximity-sensor TCP, if any.
+            sensor_links: links of the sensor body (may approach the work object to contact).
+            sensing_distance_m: sensing distance, m.
+            sensor_diameter_m: sensor diameter, m.
+
+        Raises:
+            URDFError: missing, malformed, not a tree of fixed joints, or a TCP name is not a link.
+        """
+        path = Path(path)
+        poses = _fixed_link_poses(path)
+        names = list(poses)[1:] if tcps is None else list(tcps)
+        for n in [*names, *sensor_links, *([sensor_tcp] if sensor_tcp else [])]:
+            if n not in poses:
+                raise URDFError(f"tool URDF {path} has no link {n!r}; links: {sorted(poses)}")
+        return cls(
+            name=path.stem,
+            tcps=MappingProxyType({n: poses[n] for n in names}),
+            urdf_path=path,
+            sensor_tcp=sensor_tcp,
+            sensor_links=tuple(sensor_links),
+            sensing_distance_m=float(sensing_distance_m),
+            sensor_diameter_m=float(sensor_diameter_m),
+        )
+
+    @classmethod
+    def from_mesh(
+        cls,
+        mesh: trimesh.Trimesh,
+        tcps: Mapping[str, ArrayLike],
+        name: str = "tool",
+        sensor_tcp: str | None = None,
+        sensing_distance_m: float = 0.008,
+    ) -> Tool:
+        """A tool from a mesh in the flange frame (metres) and TCP frames ``T_flange_tcp``.
+
+        Collision checking uses the mesh's convex hull, so give a mesh whose hull is a fair
+        stand-in, or write a URDF with several parts.
+
+        Raises:
+            MeshError: the mesh is empty or not finite.
+            ShapeError, NonFiniteError, DegenerateGeometryError: a TCP frame is not a transform.
+        """
+        if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
+            raise MeshError(f"tool mesh {name!r} is empty or not a trimesh.Trimesh")
+        if not np.all(np.isfinite(mesh.vertices)):
+            raise MeshError(f"tool mesh {name!r} holds NaN or infinite vertices")
+        frames = {k: check_transform(v, f"tcps[{k!r}]") for k, v in tcps.items()}
+        if sensor_tcp is not None and sensor_tcp not in frames:
+            raise UnknownFrameError(f"sensor_tcp {sensor_tcp!r} is not in tcps {sorted(frames)}")
+        return cls(
+            name=name,
+            tcps=MappingProxyType(frames),
+            mesh=mesh,
+            sensor_tcp=sensor_tcp,
+            sensing_distance_m=float(sensing_distance_m),
+        )
+
+    def fingerprint(self) -> bytes:
+        """Bytes that change when the tool's geometry changes (for cache keys)."""
+        if self.urdf_path is not None:
+            return self.urdf_path.read_bytes()
+        if self.mesh is None:
+            return b""
+        return self.mesh.vertices.tobytes() + self.mesh.faces.tobytes()
+
+    def create_body(self, client: int) -> BodyLinks:
+        """Load the tool into PyBullet client ``client`` at the world origin."""
+        if self.urdf_path is not None:
+            return load_urdf_body(client, self.urdf_path, np.eye(4), "tool")
+        if self.mesh is None:
+            raise MeshError(f"tool {self.name!r} has neither a URDF nor a mesh")
+        shape = mesh_collision_shape(client, self.mesh, concave=False, source=f"tool {self.name}")
+        return static_body(client, shape, np.eye(4), self.name)
+
+
+def load_tool(spec: str | Path | Tool) -> Tool:
+    """A tool from ``"builtin:<name>"``, a tool description ``.json``, a ``.urdf`` or a Tool.
+
+    A description JSON holds ``urdf`` (relative to the JSON), ``tcps``, ``sensor_tcp``,
+    ``sensor_links``, ``sensing_distance_m`` and ``sensor_diameter_m``.
+
+    Raises:
+        UnknownFrameError: unknown built-in name.
+        URDFError: the file is missing or malformed.
+    """
+    if isinstance(spec, Tool):
+        return spec
+    path = tool_description(str(spec)) if is_builtin(spec) else Path(spec)
+    if path.suffix.lower() == ".urdf":
+        return Tool.from_urdf(path)
+    if not path.is_file():
+        raise URDFError(f"tool description not found: {path}")
+    try:
+        desc = json.loads(path.read_text())
+        tool = Tool.from_urdf(
+            path.parent / desc["urdf"],
+            tcps=list(desc["tcps"]),
+            sensor_tcp=desc.get("sensor_tcp"),
+            sensor_links=tuple(desc.get("sensor_links", ())),
+            sensing_distance_m=float(desc.get("sensing_distance_m", 0.008)),
+            sensor_diameter_m=float(desc.get("sensor_diameter_m", 0.018)),
+        )
+    except (json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
+        if isinstance(exc, URDFError):
+            raise
+        raise URDFError(f"malformed tool description {path}: {exc!r}") from None
+    return Tool(**{**tool.__dict__, "name": desc.get("name", tool.name)})
+
+
+def _origin(elem: ET.Element | None) -> FloatArray:
+    if elem is None:
+        return np.eye(4)
+    xyz = [float(v) for v in elem.get("xyz", "0 0 0").split()]
+    r, p, y = (float(v) for v in elem.get("rpy", "0 0 0").split())
+    return make_transform(matrix_from_tait_bryan_zyx(y, p, r), xyz)
+
+
+def _fixed_link_poses(path: Path) -> dict[str, FloatArray]:
+    """``T_root_link`` of every link of a fixed-joint tree, root first."""
+    if not path.is_file():
+        raise URDFError(f"tool URDF not found: {path}")
+    try:
+        root = ET.parse(path).getroot()
+        links = [lk.attrib["name"] for lk in root.iter("link")]
+        joints = []
+        for j in root.iter("joint"):
+            if j.get("type") != "fixed":
+                raise URDFError(f"tool URDF {path}: joint {j.get('name')!r} is not fixed")
+            parent = j.find("parent").attrib["link"]  # type: ignore[union-attr]
+            child = j.find("child").attrib["link"]  # type: ignore[union-attr]
+            joints.append((parent, child, _origin(j.find("origin"))))
+    except (ET.ParseError, KeyError, AttributeError, ValueError) as exc:
+        raise URDFError(f"malformed tool URDF {path}: {exc}") from None
+    children = {c for _, c, _ in joints}
+    roots = [lk for lk in links if lk not in children]
+    if len(roots) != 1:
+        raise URDFError(f"tool URDF {path} must have exactly one root link, found {roots}")
+    poses = {roots[0]: np.eye(4)}
+    pending = list(joints)
+    while pending:
+        ready = [jt for jt in pending if jt[0] in poses]
+        if not ready:
+            raise URDFError(f"tool URDF {path}: joints do not form a tree from {roots[0]!r}")
+        for parent, child, T in ready:
+            poses[child] = poses[parent] @ T
+        done = {id(jt) for jt in ready}
+        pending = [jt for jt in pending if id(jt) not in done]
+    return poses

@@ -1,0 +1,92 @@
+"""Helpers shared by the ``wobjcal`` commands: consoles, plan loading, JSON output."""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import os
+import sys
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+from rich.console import Console
+
+from calib.plan.file import Plan, load_plan
+from planner.builtins import ASSETS
+
+#: Where the shipped plans live.
+PLANS_DIR = ASSETS / "plans"
+#: The built-in demo plan (the paper's A-H plan on the built-in stator cell).
+DEMO_PLAN = PLANS_DIR / "stator_section_ah.json"
+
+
+def count_arg(minimum: int) -> Callable[[str], int]:
+    """An argparse ``type`` for whole numbers ``>= minimum`` (clear message otherwise)."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"must be >= {minimum}, got {value}")
+        return value
+
+    return parse
+
+
+@contextlib.contextmanager
+def native_output_to_stderr() -> Iterator[None]:
+    """Send what native code prints on file descriptor 1 to stderr for the duration.
+
+    PyBullet's URDF loader prints warnings (``b3Warning ... No inertial data``) with C
+    ``printf``; in ``--json`` output they would corrupt the document. Python's ``sys.stdout``
+    keeps writing to the real standard output through a private duplicate. Does nothing when
+    ``sys.stdout`` is not the process's file descriptor 1 (e.g. captured by a test).
+    """
+    try:
+        real = sys.stdout is not None and sys.stdout.fileno() == 1
+    except (AttributeError, OSError, ValueError):
+        real = False
+    if not real:
+        yield
+        return
+    sys.stdout.flush()
+    saved_fd = os.dup(1)
+    private = os.fdopen(os.dup(saved_fd), "w", encoding=sys.stdout.encoding, errors="replace")
+    old_stdout = sys.stdout
+    os.dup2(2, 1)
+    sys.stdout = private
+    try:
+        yield
+    finally:
+        with contextlib.suppress(BrokenPipeError, OSError, ValueError):
+            private.flush()
+        sys.stdout = old_stdout
+        os.dup2(saved_fd, 1)
+        os.close(saved_fd)
+        with contextlib.suppress(BrokenPipeError, OSError):
+            private.close()
+
+
+def stdout() -> Console:
+    """A console on the current ``sys.stdout`` (tests capture it); no colour when piped."""
+    return Console(file=sys.stdout, highlight=False, soft_wrap=True)
+
+
+def stderr() -> Console:
+    """A console on the current ``sys.stderr`` for progress and notes."""
+    return Console(file=sys.stderr, highlight=False)
+
+
+def read_plan(path: str) -> tuple[Plan, Path]:
+    """Load the plan at ``path`` strictly; return it and its directory (for relative paths)."""
+    p = Path(path)
+    return load_plan(p), p.resolve().parent
+
+
+def print_json(obj: Any) -> None:
+    """Print ``obj`` as indented JSON on stdout (keys sorted, finite numbers only)."""
+    sys.stdout.write(json.dumps(obj, indent=2, sort_keys=True, allow_nan=False) + "\n")

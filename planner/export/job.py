@@ -1,0 +1,319 @@
+"""What every robot-program exporter needs, independent of the robot language.
+
+An :class:`ExportJob` holds the nominal work object, the sensor tool and, per probe point, the
+sensor-TCP pose at the start and at the end of its search, all in the wobj frame (metres), with
+the IK branch's ABB configuration when known. The exporters (``rapid``, ``krl``, ``urscript``)
+only format it. :func:`build_job` makes a job from a plan, the tool's TCP and (optionally) the
+orientations and configurations chosen by ``wobjcal check``.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from calib.frames import check_transform, make_transform
+from calib.plan.file import Plan
+from calib.probing import SearchCommand
+from planner.export.safety import SafetySpec
+
+FloatArray = NDArray[np.float64]
+#: ABB ``confdata`` (cf1, cf4, cf6, cfx).
+ConfData = tuple[int, int, int, int]
+
+
+@dataclass(frozen=True)
+class TargetPair:
+    """The search of one probe point, as the robot program runs it.
+
+    Attributes:
+        point_id: the plan's point id, e.g. ``"A"``.
+        role: the point's role in the procedure.
+        kind: ``"approach"`` or ``"edge"``.
+        T_wobj_start: ``(4, 4)`` sensor-TCP pose at the start of the search, wobj frame, m.
+        T_wobj_end: ``(4, 4)`` sensor-TCP pose at the end of the search travel, wobj frame, m.
+        speed_m_s: search speed, m/s.
+        confdata: ABB configuration (cf1, cf4, cf6, cfx) of the IK branch, or ``None``.
+        normal_wobj: ``(3,)`` outward normal of the face the sensor looks at, wobj frame.
+        T_wobj_safe: ``(4, 4)`` where the program starts the (first) approach search, wobj
+            frame, m: the plan's start moved out along the normal to the safe clearance
+            (:class:`planner.export.safety.SafetySpec`); for an edge search, the edge start
+            moved out along the normal (the approach to the face the edge search runs along).
+        T_wobj_face: ``(4, 4)`` end of that approach search, wobj frame, m (for an approach
+            point the plan's end, for an edge point past the face by the safe overtravel).
+    """
+
+    point_id: str
+    role: str
+    kind: str
+    T_wobj_start: FloatArray
+    T_wobj_end: FloatArray
+    speed_m_s: float
+    confdata: ConfData | None = None
+    normal_wobj: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    T_wobj_safe: FloatArray | None = None
+    T_wobj_face: FloatArray | None = None
+
+    @property
+    def safe_start(self) -> FloatArray:
+        """``(4, 4)`` start of the (first) approach search, wobj frame (the plan's if unset)."""
+        return self.T_wobj_start if self.T_wobj_safe is None else self.T_wobj_safe
+
+    @property
+    def face_end(self) -> FloatArray:
+        """``(4, 4)`` end of the (first) approach search, wobj frame (the plan's if unset)."""
+        return self.T_wobj_end if self.T_wobj_face is None else self.T_wobj_face
+
+    @property
+    def edge_direction_wobj(self) -> FloatArray:
+        """``(3,)`` unit direction of the search, start to end, wobj frame."""
+        d = self.T_wobj_end[:3, 3] - self.T_wobj_start[:3, 3]
+        return d / np.linalg.norm(d)
+
+    @property
+    def length_m(self) -> float:
+        """Search travel, metres."""
+        return float(np.linalg.norm(self.T_wobj_end[:3, 3] - self.T_wobj_start[:3, 3]))
+
+
+@dataclass(frozen=True)
+class ToolData:
+    """The robot-held sensor tool.
+
+    Attributes:
+        T_flange_tcp: ``(4, 4)`` pose of the sensor TCP in the flange frame, m.
+        mass_kg: tool mass, kg.
+        cog_m: ``(3,)`` centre of gravity in the flange frame, m.
+    """
+
+    T_flange_tcp: FloatArray
+    mass_kg: float = 5.0
+    cog_m: tuple[float, float, float] = (0.0, 0.0, 0.1)
+
+
+@dataclass(frozen=True)
+class AdaptiveSpec:
+    """The paper's A-H procedure as the program runs it (``hultman2013`` plans).
+
+    Attributes:
+        index: ``{role: i}`` the target index (0-based, plan order) of each role ``A``..``H``.
+        beta1_rad: assumed inclination of the side face (eq. 12), rad.
+        p3_height_m: height of P3 above B (eq. 12), m.
+        retake_c_d: C and D are measured again at the end (``C2``, ``D2``).
+        edge_start_from_measured: F and H start at the measured E and G (else at an approach
+            search of the face at the plan's edge start).
+        edge_start_offset_m: offset of that start along the estimated +x, m.
+        edge_event_offset_m: how far past the edge the sensor reports it, m (0 when the plan
+            leaves it unset, as ``wobjcal calibrate`` does).
+        face_coords_wobj: x of the side face, y of the short side, z of the top, wobj, m.
+    """
+
+    index: dict[str, int]
+    beta1_rad: float
+    p3_height_m: float
+    retake_c_d: bool
+    edge_start_from_measured: bool
+    edge_start_offset_m: float
+    edge_event_offset_m: float
+    face_coords_wobj: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class ExportJob:
+    """Everything an exporter writes.
+
+    Attributes:
+        name: identifier-safe program/module name, e.g. ``"WobjcalStatorSectionAh"``.
+        plan_name: the plan's name (for comments).
+        method: the plan's procedure.
+        T_base_wobj: ``(4, 4)`` nominal work-object frame in the robot base frame, m.
+        tool: the sensor tool.
+        targets: one :class:`TargetPair` per point, in plan order.
+        sensor_input: name of the sensor's digital input (RAPID signal, KRL/UR input number).
+        safety: the misplacement tolerance the safe starts are computed for.
+        adaptive: the A-H procedure for ``hultman2013`` plans (searches commanded in the frame
+            estimated so far), or ``None``: every search in the nominal frame.
+    """
+
+    name: str
+    plan_name: str
+    method: str
+    T_base_wobj: FloatArray
+    tool: ToolData
+    targets: tuple[TargetPair, ...]
+    sensor_input: str = "diSensor"
+    safety: SafetySpec = field(default_factory=SafetySpec)
+    adaptive: AdaptiveSpec | None = None
+
+
+def identifier(text: str, prefix: str = "p") -> str:
+    """A robot-language identifier made of ``text``: letters, digits and ``_`` only."""
+    ident = re.sub(r"\W", "_", text)
+    if not ident or not ident[0].isalpha():
+        ident = prefix + ident
+    return ident
+
+
+def module_name(plan_name: str) -> str:
+    """``"stator_section_ah"`` -> ``"WobjcalStatorSectionAh"`` (max 32 characters)."""
+    words = re.split(r"[^A-Za-z0-9]+", plan_name)
+    return ("Wobjcal" + "".join(w[:1].upper() + w[1:] for w in words if w))[:32]
+
+
+def default_sensor_rotation(
+    normal: ArrayLike, edge_direction: ArrayLike | None = None
+) -> FloatArray:
+    """Sensor orientation in the wobj frame when no check chose one.
+
+    The sensor +z looks into the surface (``-normal``); its +x is the edge direction for an edge
+    search, else the wobj axis least aligned with the normal (z, then y) made perpendicular.
+    """
+    z = -np.asarray(normal, dtype=float)
+    z /= np.linalg.norm(z)
+    if edge_direction is not None:
+        ref = np.asarray(edge_direction, dtype=float)
+    else:
+        ref = np.array([0.0, 0.0, 1.0]) if abs(z[2]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    x = ref - (ref @ z) * z
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    return np.column_stack([x, y, z])
+
+
+def build_job(
+    plan: Plan,
+    T_base_wobj: ArrayLike,
+    tool: ToolData,
+    rotations_wobj: Mapping[str, ArrayLike] | None = None,
+    confdata: Mapping[str, ConfData] | None = None,
+    sensor_input: str = "diSensor",
+) -> ExportJob:
+    """The export job of ``plan``.
+
+    Args:
+        plan: the plan.
+        T_base_wobj: ``(4, 4)`` nominal work object in the robot base frame.
+        tool: the sensor tool.
+        rotations_wobj: ``{id: (3, 3)}`` sensor-TCP orientation in the wobj frame per point (from
+            the check); missing points get :func:`default_sensor_rotation`.
+        confdata: ``{id: (cf1, cf4, cf6, cfx)}`` per point (from the check), or ``None``.
+        sensor_input: name of the sensor input.
+    """
+    T = check_transform(T_base_wobj, "T_base_wobj")
+    rotations = rotations_wobj or {}
+    confs = confdata or {}
+    safety = safety_spec(plan)
+    targets = []
+    for p in plan.points:
+        cmd = SearchCommand.from_point(p.to_probe_point(), np.eye(4))
+        R = rotations.get(p.id)
+        if R is None:
+            R = default_sensor_rotation(p.normal, p.search.edge_direction)
+        R = np.asarray(R, dtype=float)
+        end = cmd.start_m + cmd.length_m * cmd.direction
+        n = np.asarray(p.normal, dtype=float)
+        # the face point the first approach search looks for: the point, or the edge start
+        face = np.asarray(p.position_m, float) if p.search.kind == "approach" else cmd.start_m
+        clear = safety.start_clearance_m(face)
+        if p.search.kind == "approach":
+            safe = face + max(clear, p.search.start_offset_m) * n
+            face_end = end
+        else:
+            safe = face + clear * n
+            face_end = face - safety.overtravel_m(face) * n
+        targets.append(
+            TargetPair(
+                point_id=p.id,
+                role=p.role,
+                kind=p.search.kind,
+                T_wobj_start=make_transform(R, cmd.start_m),
+                T_wobj_end=make_transform(R, end),
+                speed_m_s=p.search.speed_m_s,
+                confdata=confs.get(p.id),
+                normal_wobj=(float(n[0]), float(n[1]), float(n[2])),
+                T_wobj_safe=make_transform(R, safe),
+                T_wobj_face=make_transform(R, face_end),
+            )
+        )
+    return ExportJob(
+        name=module_name(plan.name or "plan"),
+        plan_name=plan.name,
+        method=plan.method,
+        T_base_wobj=T,
+        tool=tool,
+        targets=tuple(targets),
+        sensor_input=sensor_input,
+        safety=safety,
+        adaptive=adaptive_spec(plan),
+    )
+
+
+def safety_spec(plan: Plan) -> SafetySpec:
+    """The misplacement tolerance and sensing distance of ``plan``'s validation settings.
+
+    The rotation pivot is the centroid of the probe points, as in ``wobjcal validate``.
+    """
+    v = plan.validation
+    pivot = np.mean([p.position_m for p in plan.points], axis=0) if plan.points else np.zeros(3)
+    return SafetySpec(
+        max_translation_m=v.misplacement.max_translation_m,
+        max_angle_rad=v.misplacement.max_angle_rad,
+        pivot_wobj_m=(float(pivot[0]), float(pivot[1]), float(pivot[2])),
+        sensing_distance_m=v.sensor.sensing_distance_m,
+    )
+
+
+def adaptive_spec(plan: Plan) -> AdaptiveSpec | None:
+    """The A-H procedure of a complete ``hultman2013`` plan, else ``None``."""
+    if plan.method != "hultman2013":
+        return None
+    from calib.paper.stator_layout import check_stator_points
+    from calib.plan.procedures import Hultman2013
+    from planner.plan_cell import hultman_points
+
+    roles = [p.role for p in plan.points]
+    if sorted(roles) != sorted("ABCDEFGH"):
+        return None
+    layout = check_stator_points(hultman_points(plan))
+    proc = plan.procedure if isinstance(plan.procedure, Hultman2013) else Hultman2013()
+    face = layout.face_coords_wobj
+    return AdaptiveSpec(
+        index={r: i for i, r in enumerate(roles)},
+        beta1_rad=proc.beta1_rad,
+        p3_height_m=proc.p3_height_m,
+        retake_c_d=proc.retake_c_d,
+        edge_start_from_measured=proc.edge_start_from_measured,
+        edge_start_offset_m=proc.edge_start_offset_m,
+        edge_event_offset_m=proc.edge_event_offset_m or 0.0,
+        face_coords_wobj=(float(face[0]), float(face[1]), float(face[2])),
+    )
+
+
+def safety_header(job: ExportJob, prefix: str, width: int = 92) -> list[str]:
+    """Header comment lines of a program that runs every search in the nominal frame."""
+    import textwrap
+
+    text = (
+        "NOMINAL FRAME: every search is commanded in the nominal work object (not adaptive: "
+        "the A-H frame update runs only in the RAPID export); compute the frame afterwards with "
+        "`wobjcal calibrate`. SAFE FOR: "
+        + job.safety.describe()
+        + ". Every search starts outside the nominal surface by at least the largest "
+        "misplacement of its face plus the sensing distance (the plan's start or farther); "
+        "edge searches first approach the face they run along and start "
+        "from the measured face point. ASSUMES: the moves between the points are clear of "
+        "the part and fixtures (checked by `wobjcal check`, not here). An edge search runs "
+        "along the nominal direction: on a tilted part its track leaves the face by up to "
+        "travel * sin(angle)."
+    )
+    return [prefix + line for line in textwrap.wrap(text, width - len(prefix))]
+
+
+def fmt(x: float, decimals: int = 4) -> str:
+    """A number for program text: fixed decimals, no ``-0``, trailing zeros trimmed."""
+    s = f"{x:.{decimals}f}".rstrip("0").rstrip(".")
+    return "0" if s in ("-0", "") else s

@@ -1,0 +1,113 @@
+"""The sensor's round footprint on a mesh: samples in a plane, and ray tests onto a planar face.
+
+A proximity sensor's face (18 mm diameter for the paper's sensor) must lie wholly over one planar
+face. The footprint is sampled at its centre, on its rim and on a ring at half the radius; a ray
+cast down the face normal from just above each sample tells whether the sample lies on the face
+(a hole lets the ray through, an edge or a step makes it miss or hit another face).
+
+Used by detection (:mod:`planner.faces.detection`: does a region hold the footprint anywhere?) and
+by the per-point checks (:mod:`planner.faces.checks`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import trimesh
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+#: Sensor face diameter of the paper's proximity sensor, metres.
+SENSOR_DIAMETER_M = 0.018
+#: Footprint samples: this many on the rim, half as many at half the radius, and the centre.
+N_RIM_SAMPLES = 12
+#: Footprint rays start this far above the face's plane, m.
+RAY_LIFT_M = 0.002
+#: Candidate footprint centres per region: its largest triangles, and as many spread over it.
+_N_CANDIDATES = 16
+
+
+def footprint_offsets(radius_m: float) -> FloatArray:
+    """``(S, 2)`` in-plane sample offsets: the centre, the rim and a ring at half the radius."""
+    rim = np.linspace(0.0, 2 * math.pi, N_RIM_SAMPLES, endpoint=False)
+    inner = np.linspace(0.0, 2 * math.pi, N_RIM_SAMPLES // 2, endpoint=False) + math.pi / 6
+    ang = np.concatenate([rim, inner])
+    r = np.concatenate([np.full(len(rim), radius_m), np.full(len(inner), radius_m / 2)])
+    offs = np.stack([r * np.cos(ang), r * np.sin(ang)], axis=1)
+    return np.vstack([np.zeros((1, 2)), offs])
+
+
+def plane_basis(n: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Two unit vectors ``(K, 3)`` spanning the planes with normals ``n (K, 3)``."""
+    helper = np.where(np.abs(n[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    u = np.cross(n, helper)
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    return u, np.cross(n, u)
+
+
+def footprint_hits(
+    mesh: trimesh.Trimesh,
+    face_id: IntArray,
+    centres: FloatArray,
+    normals: FloatArray,
+    ids: IntArray,
+    radius_m: float,
+    tol_m: float,
+) -> NDArray[np.bool_]:
+    """``(K, S)``: footprint sample ``s`` around centre ``k`` lies on face ``ids[k]``.
+
+    The samples lie in the plane through ``centres[k]`` with unit normal ``normals[k]``. From
+    :data:`RAY_LIFT_M` above each, a ray is cast down the normal: the sample is on the face when
+    the first hit is a triangle of that face within ``tol_m`` of the plane (a hole lets the ray
+    through, an edge or a step makes it miss or hit another face).
+    """
+    offs = footprint_offsets(radius_m)
+    u, v = plane_basis(normals)
+    S = centres[:, None, :] + offs[None, :, :1] * u[:, None, :] + offs[None, :, 1:] * v[:, None, :]
+    dirs = np.repeat(-normals, len(offs), axis=0)
+    origins = S.reshape(-1, 3) - RAY_LIFT_M * dirs
+    tri, ray, loc = mesh.ray.intersects_id(
+        origins, dirs, multiple_hits=False, return_locations=True
+    )
+    good = np.zeros(len(origins), dtype=bool)
+    t = np.einsum("ki,ki->k", np.asarray(loc) - origins[ray], dirs[ray])
+    flat_ids = np.repeat(ids, len(offs))
+    good[ray] = (face_id[tri] == flat_ids[ray]) & (np.abs(t - RAY_LIFT_M) <= tol_m)
+    return good.reshape(len(centres), len(offs))
+
+
+def holds_footprint(
+    mesh: trimesh.Trimesh,
+    labels: IntArray,
+    regions: IntArray,
+    n: FloatArray,
+    d: FloatArray,
+    radius_m: float,
+    tol_m: float,
+) -> NDArray[np.bool_]:
+    """Whether each region has a spot where the whole sensor footprint lies on it.
+
+    Tries the centroids of the region's largest triangles and of triangles spread over it.
+    """
+    if len(regions) == 0:
+        return np.zeros(0, dtype=bool)
+    area = np.asarray(mesh.area_faces)
+    centres, ids = [], []
+    order = np.argsort(labels, kind="stable")
+    starts = np.searchsorted(labels[order], regions, side="left")
+    ends = np.searchsorted(labels[order], regions, side="right")
+    for r, lo, hi in zip(regions, starts, ends, strict=True):
+        tri = order[lo:hi]
+        big = tri[np.argsort(-area[tri], kind="stable")[:_N_CANDIDATES]]
+        spread = tri[np.linspace(0, len(tri) - 1, min(len(tri), _N_CANDIDATES)).astype(int)]
+        pick = np.unique(np.concatenate([big, spread]))
+        c = np.asarray(mesh.triangles_center[pick])
+        centres.append(c - (c @ n[r] - d[r])[:, None] * n[r])
+        ids.append(np.full(len(pick), r))
+    at, region = np.vstack(centres), np.concatenate(ids)
+    hits = footprint_hits(mesh, labels, at, n[region], region, radius_m, tol_m)
+    ok = np.all(hits, axis=1)
+    return np.array([bool(np.any(ok[region == r])) for r in regions], dtype=bool)

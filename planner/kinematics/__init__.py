@@ -1,5 +1,0 @@
-"""Robot kinematics: URDF chains, forward kinematics, analytic OPW and numeric inverse kinematics.
-
-Entry points: :class:`planner.kinematics.chain.KinematicChain` and
-:func:`planner.kinematics.solver.make_ik_solver`; see ``docs/kinematics.md``.
-"""

@@ -1,0 +1,260 @@
+"""Simulated searches: a :data:`calib.probing.Probe` that runs against the true, misplaced part.
+
+The robot moves the sensor TCP along the commanded straight path; where it really is differs by
+its repeatability (a fresh offset per search) and, optionally, a smooth absolute-accuracy field.
+The sensor model (:mod:`planner.sim.proximity`) decides where it switches, from a ray bundle cast
+against the true part. The probe returns what the robot controller records: the *commanded*
+TCP position at the switching event, in the base frame.
+
+- Approach search (motion along the sensor axis): every ray shortens by the travel, so the
+  switching travel is solved in closed form from one ray cast (no stepping).
+- Edge search ("move until the sensor stops detecting"): a coarse scan with few rays finds the
+  step where the signal drops below the switch-off level, then the full bundle refines it
+  (regula falsi on the log signal), re-casting only the rays whose surface changes.
+
+Failures are returned as :class:`~calib.probing.ProbeResult` with a reason, never as a number:
+no detection within the search length, already detecting at the start, not detecting at the
+start of an edge search, the face touching the part, or an unreachable commanded path (when a
+reachability hook is given).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from calib.frames import check_transform, invert_transform
+from calib.probing import ProbeResult, SearchCommand
+from planner.parts.stator import StatorGeometry
+from planner.sim.error_models import AccuracyField, RobotErrorModel
+from planner.sim.proximity import ProximitySensor
+from planner.sim.raycast import MeshRayCaster
+from planner.sim.search_events import (
+    ProbeEvent,
+    ReachabilityHook,
+    cell_search_hook,
+    footprint_landing,
+)
+
+__all__ = ["ProbeEvent", "ReachabilityHook", "SimulatedProbe", "cell_search_hook"]
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass
+class SimulatedProbe:
+    """A probe callback against the true part at ``T_base_wobj_true``.
+
+    Args:
+        caster: ray caster of the part mesh in its own (wobj) frame.
+        T_base_wobj_true: ``(4, 4)`` where the part really is, base frame.
+        rng: random generator for robot and sensor noise.
+        sensor: the sensor model.
+        robot_error: robot repeatability (per search) and accuracy model.
+        accuracy_field: this robot's accuracy field (``robot_error.sample_field``), or None.
+        geometry: the stator geometry, to classify landings over slot holes or off the face.
+        reachability: optional hook that vets the path each successful search really ran (the
+            command cut at the switching event); its reason fails the probe.
+        edge_inset_m: an edge search runs its track this far inside the commanded path along
+            the sensor axis (so the sensor detects the face it slides over); the reported point
+            stays on the commanded path, i.e. on the face (the contract of the A-H procedure).
+        scan_step_m: step of the coarse edge scan, m.
+        edge_tolerance_m: bisection tolerance of the edge event, m.
+    """
+
+    caster: MeshRayCaster
+    T_base_wobj_true: ArrayLike
+    rng: np.random.Generator
+    sensor: ProximitySensor = field(default_factory=ProximitySensor)
+    robot_error: RobotErrorModel = field(default_factory=RobotErrorModel)
+    accuracy_field: AccuracyField | None = None
+    geometry: StatorGeometry | None = None
+    reachability: ReachabilityHook | None = None
+    edge_inset_m: float = 0.003
+    scan_step_m: float = 0.0025
+    edge_tolerance_m: float = 2e-5
+    events: list[ProbeEvent] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.T_base_wobj_true = check_transform(self.T_base_wobj_true, "T_base_wobj_true")
+        self._T_wobj_base = invert_transform(self.T_base_wobj_true)
+
+    # -- helpers ---------------------------------------------------------------------------
+    def _to_part(self, p_base: FloatArray) -> FloatArray:
+        T = self._T_wobj_base
+        return p_base @ T[:3, :3].T + T[:3, 3]
+
+    def _distances(self, tcp_base: FloatArray, axis: FloatArray, offsets: FloatArray) -> FloatArray:
+        """Face-to-metal distances ``(K, n)`` for TCP positions ``(K, 3)`` (base frame)."""
+        centres = tcp_base - self.sensor.sensing_distance_m * axis
+        origins = (centres[:, None, :] + offsets).reshape(-1, 3)
+        d_part = np.broadcast_to(self._T_wobj_base[:3, :3] @ axis, origins.shape)
+        return self.caster.first_hits(self._to_part(origins), d_part).reshape(len(tcp_base), -1)
+
+    def _signal_of(self, dist: FloatArray) -> FloatArray:
+        """Signal ``(K,)`` from distances ``(K, n)``; ``-1`` where the face is inside the part."""
+        return np.where(np.any(dist <= 0.0, axis=1), -1.0, self.sensor.signal(dist))
+
+    def _fail(self, cmd: SearchCommand, reason: str) -> ProbeResult:
+        self.events.append(ProbeEvent(cmd.point_id, cmd.kind, reason=reason))
+        return ProbeResult(point_m=None, reason=reason)
+
+    def _succeed(self, cmd: SearchCommand, tcp0: FloatArray, travel: float) -> ProbeResult:
+        if self.reachability is not None:  # the path the robot really ran: start to the event
+            why = self.reachability(replace(cmd, length_m=max(travel, 1e-6)))
+            if why:
+                return self._fail(cmd, why)
+        landing = ""
+        if self.geometry is not None and cmd.kind == "approach":
+            tcp_w = self._to_part((tcp0 + travel * cmd.direction)[None])[0]
+            axis_w = self._T_wobj_base[:3, :3] @ cmd.sensor_axis
+            landing = footprint_landing(self.geometry, tcp_w, axis_w, self.sensor.radius_m)
+        self.events.append(ProbeEvent(cmd.point_id, cmd.kind, landing=landing, travel_m=travel))
+        point = np.asarray(cmd.start_m, float) + travel * np.asarray(cmd.direction, float)
+        return ProbeResult(point_m=point, travel_m=travel)
+
+    # -- the probe -------------------------------------------------------------------------
+    def __call__(self, cmd: SearchCommand) -> ProbeResult:
+        """Run one commanded search against the true part."""
+        start = np.asarray(cmd.start_m, float)
+        offset = self.robot_error.sample_repeatability_m(self.rng)
+        if self.accuracy_field is not None:
+            offset = offset + self.accuracy_field(start)
+        axis = np.asarray(cmd.sensor_axis, float)
+        tcp0 = start + offset + (self.edge_inset_m * axis if cmd.kind == "edge" else 0.0)
+        direction = np.asarray(cmd.direction, float)
+        length = float(cmd.length_m)
+        if cmd.kind == "approach" and float(direction @ axis) > 1.0 - 1e-12:
+            return self._approach_along_axis(cmd, tcp0, axis, length)
+        return self._scan(cmd, tcp0, axis, direction, length, want_on=cmd.kind == "approach")
+
+    def _approach_along_axis(
+        self, cmd: SearchCommand, tcp0: FloatArray, axis: FloatArray, length: float
+    ) -> ProbeResult:
+        origins = self._to_part(self.sensor.ray_origins(tcp0, axis))
+        axis_part = np.broadcast_to(self._T_wobj_base[:3, :3] @ axis, origins.shape)
+        dist = self.caster.first_hits(origins, axis_part)
+        if np.any(dist <= 0.0):
+            return self._fail(cmd, "sensor face inside the part at start")
+        travel = self.sensor.switch_travel_m(dist, self.sensor.sample_jitter_m(self.rng))
+        if travel <= 0.0:
+            return self._fail(cmd, "sensor already detecting at start")
+        if not math.isfinite(travel) or travel > length:
+            return self._fail(cmd, f"no detection within {length * 1e3:.0f} mm")
+        if travel >= float(dist.min()):
+            return self._fail(cmd, "sensor face touched the part before switching")
+        return self._succeed(cmd, tcp0, travel)
+
+    def _scan(
+        self,
+        cmd: SearchCommand,
+        tcp0: FloatArray,
+        axis: FloatArray,
+        direction: FloatArray,
+        length: float,
+        want_on: bool,
+    ) -> ProbeResult:
+        """Stepping search for the first travel where the sensor turns on (or off)."""
+        on = self.sensor.on_level(self.sensor.sample_jitter_m(self.rng))
+        off = self.sensor.off_level(self.sensor.sample_jitter_m(self.rng))
+
+        def event(sig: FloatArray) -> NDArray[np.bool_]:
+            return (sig >= on) if want_on else (sig < off)
+
+        fine_off = self.sensor.face_offsets_m(axis)
+        coarse_off = self.sensor.face_offsets_m(axis, coarse=True)
+        n_fine = len(fine_off)
+        n_steps = max(1, math.ceil(length / self.scan_step_m))
+        s_grid = np.linspace(0.0, length, n_steps + 1)
+        tcps = tcp0 + s_grid[:, None] * direction
+        # one cast: the full bundle at the start and the coarse bundle along the path
+        centres = tcps - self.sensor.sensing_distance_m * axis
+        origins = np.concatenate(
+            [
+                (centres[:1, None, :] + fine_off)[0],
+                (centres[:, None, :] + coarse_off).reshape(-1, 3),
+            ]
+        )
+        d_part = np.broadcast_to(self._T_wobj_base[:3, :3] @ axis, origins.shape)
+        dist = self.caster.first_hits(self._to_part(origins), d_part)
+        s0 = float(self._signal_of(dist[None, :n_fine])[0])
+        coarse = self._signal_of(dist[n_fine:].reshape(len(s_grid), -1))
+        if s0 < 0:
+            return self._fail(cmd, "sensor face inside the part at start")
+        if want_on and s0 >= on:
+            return self._fail(cmd, "sensor already detecting at start")
+        if not want_on and s0 < on:
+            return self._fail(cmd, "sensor not detecting at start of edge search")
+        if np.any(coarse < 0):
+            first_hit = int(np.argmax(coarse < 0))
+            if not np.any(event(coarse[1:first_hit])):
+                return self._fail(cmd, "sensor face collided with the part during the search")
+        hits = np.flatnonzero(event(coarse[1:]) & (coarse[1:] >= 0)) + 1
+        k = int(hits[0]) if len(hits) else n_steps
+
+        def full(travels: list[float]) -> FloatArray:
+            return self._distances(tcp0 + np.asarray(travels)[:, None] * direction, axis, fine_off)
+
+        # the bracket [s_grid[k-1], s_grid[k]] with the full bundle (step back or on if needed)
+        d_lo, d_hi = full([float(s_grid[k - 1]), float(s_grid[k])])
+        while k > 1 and event(self._signal_of(d_lo[None]))[0]:
+            k -= 1
+            d_hi, d_lo = d_lo, full([float(s_grid[k - 1])])[0]
+        while k <= n_steps and not event(self._signal_of(d_hi[None]))[0]:
+            k += 1
+            if k > n_steps:
+                what = "detection" if want_on else "edge (sensor still detecting)"
+                return self._fail(cmd, f"no {what} within {length * 1e3:.0f} mm")
+            d_lo, d_hi = d_hi, full([float(s_grid[k])])[0]
+        lo0, hi0 = float(s_grid[k - 1]), float(s_grid[k])
+        # rays that see the same surface at both ends keep seeing it in between (the bracket is
+        # shorter than any hole): interpolate them, cast only the rays that change
+        finite = np.isfinite(d_lo) & np.isfinite(d_hi)
+        jump = np.zeros_like(d_lo)
+        np.subtract(d_lo, d_hi, out=jump, where=finite)
+        changing = np.flatnonzero(
+            (np.isinf(d_lo) != np.isinf(d_hi))
+            | (np.abs(jump) > 1e-4)
+            | (d_lo <= 0.0)
+            | (d_hi <= 0.0)
+        )
+        steady_lo, steady_hi = d_lo.copy(), d_hi.copy()
+        both_inf = np.isinf(d_lo) & np.isinf(d_hi)
+        steady_lo[both_inf] = steady_hi[both_inf] = 0.0
+        sub_off = fine_off[changing]
+
+        def fine(s: float) -> float:
+            f = (s - lo0) / (hi0 - lo0)
+            d = steady_lo + f * (steady_hi - steady_lo)
+            d[both_inf] = np.inf
+            if len(changing):
+                d[changing] = self._distances((tcp0 + s * direction)[None], axis, sub_off)[0]
+            return float(self._signal_of(d[None])[0])
+
+        def margin(sig: float) -> float:  # log distance from the switching level, < 0 = event
+            log_s = math.log(max(sig, 1e-300))
+            return math.log(on) - log_s if want_on else log_s - math.log(off)
+
+        lo, hi = lo0, hi0
+        s_lo = float(self._signal_of(d_lo[None])[0])
+        s_hi = float(self._signal_of(d_hi[None])[0])
+        g_lo, g_hi = margin(s_lo), margin(s_hi)
+        it = 0
+        while hi - lo > self.edge_tolerance_m:
+            it += 1
+            width = hi - lo
+            if it % 3 == 0 or not 0 < g_lo - g_hi < 50:  # bisect every third step, or when
+                s = lo + 0.5 * width  # a side saw no metal at all: sure progress
+            else:  # regula falsi on the log signal, kept 5 % inside the bracket
+                s = lo + width * min(max(g_lo / (g_lo - g_hi), 0.05), 0.95)
+            sig = fine(s)
+            if event(np.array([sig]))[0]:
+                hi, g_hi, s_hi = s, margin(sig), sig
+            else:
+                lo, g_lo = s, margin(sig)
+        if s_hi < 0:
+            return self._fail(cmd, "sensor face collided with the part during the search")
+        return self._succeed(cmd, tcp0, hi)
