@@ -50,7 +50,8 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 from calib.atomic_io import write_text_atomic
 from calib.frames import invert_transform, make_transform
 from planner.cell.bodies import pb_pose
-from planner.cell.cell import DEFAULT_MARGIN_M, Cell
+from planner.cell.cell import Cell
+from planner.cell.collision import DEFAULT_MARGIN_M
 from planner.cell.feasibility import tcp_frames
 from planner.cell.reachability_map import sample_surface
 

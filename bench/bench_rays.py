@@ -20,7 +20,8 @@ import numpy as np
 import pybullet as pb
 
 from calib.atomic_io import write_text_atomic
-from planner.parts.stator import StatorGeometry, build_stator_mesh
+from planner.parts.stator import StatorGeometry
+from planner.parts.stator_mesh import build_stator_mesh
 from planner.sim.raycast import MeshRayCaster
 
 RESULTS = Path(__file__).resolve().parent / "results"

@@ -23,8 +23,9 @@ from pathlib import Path
 import numpy as np
 
 from calib.atomic_io import write_text_atomic
-from planner.parts.stator import StatorGeometry, build_stator_mesh
+from planner.parts.stator import StatorGeometry
 from planner.parts.stator_demo import nominal_T_base_wobj, stator_ah_points
+from planner.parts.stator_mesh import build_stator_mesh
 from planner.sim.montecarlo import validate
 from planner.sim.proximity import ProximitySensor
 from planner.sim.raycast import MeshRayCaster

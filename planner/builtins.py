@@ -1,21 +1,32 @@
-"""Built-in assets by name: ``builtin:irb4400`` (robot), ``builtin:cable_feeder`` (tool), and
-built-in work-object meshes that other modules register.
+"""Built-in assets by name: robots, tools and work-object parts, in static tables.
 
-A string that starts with ``builtin:`` names an asset shipped in ``assets/`` or a mesh made by
-a registered factory; any other string is a file path. Other parts extend the mesh registry
-with :func:`register_builtin_mesh`, e.g. the stator module registers ``builtin:stator_section``.
+A string that starts with ``builtin:`` names a built-in; any other string is a file path.
+
+- robots (:data:`BUILTIN_ROBOTS`): name -> URDF shipped in ``assets/robots``;
+- tools (:data:`BUILTIN_TOOLS`): name -> tool description JSON in ``assets/tools``
+  (see :mod:`planner.cell.tool`);
+- parts (:data:`BUILTIN_PARTS`): name -> ``"module:function"`` of a factory that returns the
+  part's mesh in metres, in its own (wobj) frame. The module is imported when the part is first
+  asked for, so listing the parts costs nothing and this module imports no part.
+
+Adding a built-in part is one module with a factory plus one entry here::
+
+    BUILTIN_PARTS["bracket"] = "planner.parts.bracket:bracket_mesh"
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import importlib
 from pathlib import Path
-
-import trimesh
+from typing import TYPE_CHECKING
 
 from planner.errors import UnknownFrameError
 
+if TYPE_CHECKING:
+    import trimesh
+
 PREFIX = "builtin:"
+#: The repository's data folder (robots, tools, plans, schemas).
 ASSETS = Path(__file__).resolve().parent.parent / "assets"
 
 #: Built-in robots: name -> URDF path.
@@ -28,8 +39,12 @@ BUILTIN_TOOLS: dict[str, Path] = {
     "cable_feeder": ASSETS / "tools" / "cable_feeder" / "tool.json",
 }
 
-#: Built-in work-object meshes: name -> factory returning a mesh in metres (wobj frame).
-_MESH_FACTORIES: dict[str, Callable[[], trimesh.Trimesh]] = {}
+#: Built-in work-object parts: name -> ``"module:function"`` returning a ``trimesh.Trimesh``
+#: in metres, wobj frame.
+BUILTIN_PARTS: dict[str, str] = {
+    "stator_section": "planner.parts.stator_mesh:full_section_mesh",
+    "stator_prototype": "planner.parts.stator_mesh:prototype_mesh",
+}
 
 
 def is_builtin(name: object) -> bool:
@@ -41,12 +56,9 @@ def _strip(name: str) -> str:
     return name[len(PREFIX) :] if name.startswith(PREFIX) else name
 
 
-def _lookup(kind: str, name: str, table: dict[str, Path]) -> Path:
-    key = _strip(name)
-    if key not in table:
-        valid = ", ".join(PREFIX + k for k in sorted(table)) or "(none)"
-        raise UnknownFrameError(f"unknown built-in {kind} {name!r}; valid names: {valid}")
-    return table[key]
+def _unknown(kind: str, name: str, names: list[str]) -> UnknownFrameError:
+    valid = ", ".join(PREFIX + k for k in sorted(names)) or "(none)"
+    return UnknownFrameError(f"unknown built-in {kind} {name!r}; valid names: {valid}")
 
 
 def robot_urdf(name: str) -> Path:
@@ -55,7 +67,10 @@ def robot_urdf(name: str) -> Path:
     Raises:
         UnknownFrameError: no such built-in robot (the message lists the valid names).
     """
-    return _lookup("robot", name, BUILTIN_ROBOTS)
+    key = _strip(name)
+    if key not in BUILTIN_ROBOTS:
+        raise _unknown("robot", name, list(BUILTIN_ROBOTS))
+    return BUILTIN_ROBOTS[key]
 
 
 def tool_description(name: str) -> Path:
@@ -64,36 +79,27 @@ def tool_description(name: str) -> Path:
     Raises:
         UnknownFrameError: no such built-in tool (the message lists the valid names).
     """
-    return _lookup("tool", name, BUILTIN_TOOLS)
-
-
-def register_builtin_mesh(name: str, factory: Callable[[], trimesh.Trimesh]) -> None:
-    """Register a work-object mesh factory under ``builtin:<name>``.
-
-    Args:
-        name: the name without or with the ``builtin:`` prefix, e.g. ``"stator_section"``.
-        factory: called with no arguments; returns a ``trimesh.Trimesh`` in metres, in the
-            work object's own frame (wobj). Registering a name again replaces the factory.
-    """
     key = _strip(name)
-    if not key:
-        raise UnknownFrameError("a built-in mesh needs a non-empty name")
-    _MESH_FACTORIES[key] = factory
+    if key not in BUILTIN_TOOLS:
+        raise _unknown("tool", name, list(BUILTIN_TOOLS))
+    return BUILTIN_TOOLS[key]
 
 
-def builtin_mesh_names() -> list[str]:
-    """Sorted names (with prefix) of the registered built-in meshes."""
-    return [PREFIX + k for k in sorted(_MESH_FACTORIES)]
+def builtin_part_names() -> list[str]:
+    """Sorted names (with prefix) of the built-in parts."""
+    return [PREFIX + k for k in sorted(BUILTIN_PARTS)]
 
 
 def builtin_mesh(name: str) -> trimesh.Trimesh:
-    """A fresh mesh (metres, wobj frame) from the factory registered as ``name``.
+    """A fresh mesh (metres, wobj frame) of the built-in part ``name``.
 
     Raises:
-        UnknownFrameError: no such built-in mesh (the message lists the valid names).
+        UnknownFrameError: no such built-in part (the message lists the valid names).
     """
     key = _strip(name)
-    if key not in _MESH_FACTORIES:
-        valid = ", ".join(builtin_mesh_names()) or "(none registered)"
-        raise UnknownFrameError(f"unknown built-in mesh {name!r}; valid names: {valid}")
-    return _MESH_FACTORIES[key]()
+    if key not in BUILTIN_PARTS:
+        raise _unknown("part", name, list(BUILTIN_PARTS))
+    module, _, function = BUILTIN_PARTS[key].partition(":")
+    factory = getattr(importlib.import_module(module), function)
+    mesh: trimesh.Trimesh = factory()
+    return mesh

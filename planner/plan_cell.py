@@ -70,9 +70,6 @@ def open_cell(plan: Plan, plan_dir: Path) -> Cell:
         InputError: a file of the plan cannot be loaded (named in the message).
     """
     from planner.cell.cell import Cell  # PyBullet: imported when a cell is opened
-    from planner.parts.stator import register_stator_builtins
-
-    register_stator_builtins()
     refs = resolved_refs(plan, plan_dir)
     robot = plan.cell.robot
     cell = Cell(

@@ -13,7 +13,6 @@ from calib.plan.file import load_plan
 from planner.cell.workobject import load_work_object
 from planner.cli.main import main
 from planner.faces.checks import plan_face_reasons
-from planner.parts.stator import register_stator_builtins
 
 REPO = Path(__file__).resolve().parent.parent
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
@@ -38,7 +37,6 @@ def _point(raw: dict[str, Any], point_id: str) -> dict[str, Any]:
 
 
 def test_shipped_plan_points_all_lie_on_planar_faces(capsys: pytest.CaptureFixture[str]) -> None:
-    register_stator_builtins()
     plan = load_plan(STATOR)
     wo = load_work_object(plan.work_object.mesh, units=plan.work_object.units)
     reasons = plan_face_reasons(wo.mesh, [p.to_probe_point() for p in plan.points])

@@ -10,8 +10,9 @@ import pytest
 
 from calib.errors import InputError, ShapeError
 from calib.probing import SearchSpec
-from planner.parts.stator import StatorGeometry, build_stator_mesh
+from planner.parts.stator import StatorGeometry
 from planner.parts.stator_demo import nominal_T_base_wobj, stator_ah_points
+from planner.parts.stator_mesh import build_stator_mesh
 from planner.sim.error_models import RobotErrorModel
 from planner.sim.montecarlo import validate
 from planner.sim.proximity import ProximitySensor

@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from calib.probing import SearchSpec
-from planner.parts.stator import StatorGeometry, build_stator_mesh
+from planner.parts.stator import StatorGeometry
 from planner.parts.stator_demo import nominal_T_base_wobj, stator_ah_points
+from planner.parts.stator_mesh import build_stator_mesh
 from planner.sim.error_models import Misplacement, RobotErrorModel
 from planner.sim.montecarlo import default_pivot
 from planner.sim.proximity import ProximitySensor

@@ -16,7 +16,8 @@ from planner.cell.workobject import load_work_object
 from planner.errors import MeshError
 from planner.faces.checks import check_plan_faces, check_probe_faces
 from planner.faces.detection import NoPlanarFaceError, find_planar_faces
-from planner.parts.stator import StatorGeometry, build_stator_mesh
+from planner.parts.stator import StatorGeometry
+from planner.parts.stator_mesh import build_stator_mesh
 
 EXTENTS = (0.10, 0.20, 0.30)
 X = np.array([1.0, 0.0, 0.0])

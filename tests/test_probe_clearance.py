@@ -9,8 +9,9 @@ import pytest
 import trimesh
 
 from calib.frames import make_transform
-from planner.cell.cell import DEFAULT_MARGIN_M, Cell
+from planner.cell.cell import Cell
 from planner.cell.clearance import Clearance
+from planner.cell.collision import DEFAULT_MARGIN_M
 from planner.cell.probe_clearance import ProbeClearance
 from planner.cell.pybullet_client import pb
 

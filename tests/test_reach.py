@@ -1,4 +1,4 @@
-"""Tests of planner.cell.reach: the reach model and the no-IK reasons, against the arm's
+"""Tests of planner.robot.reach: the reach model and the no-IK reasons, against the arm's
 geometry."""
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ import pytest
 
 from calib.frames import make_transform
 from planner.builtins import robot_urdf
-from planner.cell.reach import opw_wrist_reason, reach_model
 from planner.robot.kinematics.chain import KinematicChain
 from planner.robot.kinematics.solver import make_ik_solver
+from planner.robot.reach import opw_wrist_reason, reach_model
 
 # IRB 4400 figures (assets/robots/irb4400/README.md)
 A1, C1, C2, C3, A2, C4 = 0.200, 0.680, 0.890, 0.880, 0.150, 0.140

@@ -9,7 +9,8 @@ import pytest
 
 from calib.errors import ShapeError
 from calib.probing import ProbePoint, SearchCommand
-from planner.parts.stator import StatorGeometry, build_stator_mesh
+from planner.parts.stator import StatorGeometry
+from planner.parts.stator_mesh import build_stator_mesh
 from planner.sim.error_models import RobotErrorModel
 from planner.sim.probe import SimulatedProbe
 from planner.sim.proximity import ProximitySensor, sunflower_disk

@@ -9,12 +9,8 @@ import numpy as np
 import pytest
 
 from calib.errors import ShapeError
-from planner.parts.stator import (
-    EPSILON_M,
-    StatorGeometry,
-    build_stator_mesh,
-    register_stator_builtins,
-)
+from planner.parts.stator import EPSILON_M, StatorGeometry
+from planner.parts.stator_mesh import build_stator_mesh
 from planner.sim.raycast import MeshRayCaster
 
 
@@ -112,6 +108,5 @@ def test_flat_variant_without_holes_is_a_box() -> None:
 def test_builtins_registered() -> None:
     from planner.builtins import builtin_mesh
 
-    assert register_stator_builtins()
     m = builtin_mesh("builtin:stator_prototype")
     assert m.is_watertight and m.bounds[0, 1] == pytest.approx(-0.5)

@@ -11,9 +11,9 @@ import pytest
 import trimesh
 
 from calib.frames import make_transform
-from planner.builtins import register_builtin_mesh
+from planner import builtins
 from planner.cell.workobject import AUTO_MM_EXTENT, load_work_object
-from planner.errors import MeshError
+from planner.errors import MeshError, UnknownFrameError
 
 
 def test_plate_in_mm_is_detected_with_a_warning(reference_dir, caplog) -> None:
@@ -95,11 +95,20 @@ def test_bad_meshes_name_the_file(tmp_path) -> None:
         load_work_object(trimesh.Trimesh())
 
 
-def test_builtin_mesh_registry() -> None:
-    register_builtin_mesh("test_cube", lambda: trimesh.creation.box([0.1, 0.1, 0.1]))
+def cube_mesh() -> trimesh.Trimesh:
+    """A 0.1 m cube: a built-in part factory for the registry test."""
+    return trimesh.creation.box([0.1, 0.1, 0.1])
+
+
+def test_builtin_part_registry(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A part is one factory plus one table entry; unknown names list the valid ones."""
+    monkeypatch.setitem(builtins.BUILTIN_PARTS, "test_cube", f"{__name__}:cube_mesh")
+    assert "builtin:test_cube" in builtins.builtin_part_names()
     wobj = load_work_object("builtin:test_cube")
     assert wobj.name == "test_cube"
     assert wobj.mesh.volume == pytest.approx(1e-3)
+    with pytest.raises(UnknownFrameError, match=r"builtin:stator_section.*builtin:test_cube"):
+        load_work_object("builtin:no_such_part")
 
 
 def test_concave_body_does_not_fill_holes() -> None:

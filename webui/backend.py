@@ -22,7 +22,6 @@ from calib.plan.file import Plan, resolve_ref
 from calib.probing import ProbePoint, SearchCommand
 from planner.builtins import robot_urdf
 from planner.cell.workobject import load_work_object
-from planner.parts.stator import register_stator_builtins
 from planner.plan_cell import open_cell
 from webui.status import PointCheck
 
@@ -81,8 +80,6 @@ def load_mesh(ref: str, units: str, plan_dir: Path) -> trimesh.Trimesh:
         MeshError: the file is missing, unreadable or empty, or its units are unknown.
     """
     resolved = resolve_ref(ref, plan_dir)
-    if isinstance(resolved, str):  # built-in meshes are registered by the modules making them
-        register_stator_builtins()
     return load_work_object(resolved, units=units).mesh
 
 

@@ -1,394 +1,50 @@
-"""The kinematic cell: one PyBullet DIRECT client holding robot, tool, work object, fixtures.
+"""The kinematic cell: the scene (:class:`planner.cell.scene.CellScene`) with its queries.
 
     with Cell(robot="builtin:irb4400", tool="builtin:cable_feeder") as cell:
         cell.set_work_object("part.stl", units="auto", T_world_wobj=T)
         cell.add_fixture("table", size_m=(1, 1, 0.05), T_world_fixture=T_table)
         results = cell.check_probes(points_wobj, normals_wobj, tcp="sensor")
 
-A Cell owns its client (``physicsClientId`` on every call, no global client); ``close()`` or
-``with`` releases it. It is not thread-safe: serialize access (one lock or one worker). The
-robot stands with its chain base link at ``T_world_base``; the tool's root link sits on the
-chain's tip link (the flange, ``tool0``). Poses follow :mod:`calib.frames`.
+The queries are functions of a scene in their own modules (:mod:`planner.cell.feasibility`,
+:mod:`planner.cell.search_paths`, :mod:`planner.cell.reachability_map`); the methods here only
+forward to them, so the modules depend on the scene and never on this class.
 """
 
 from __future__ import annotations
 
-import contextlib
-import logging
-from collections.abc import Iterator
-from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
-import trimesh
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
-from calib.errors import ShapeError
-from calib.frames import check_transform, invert_transform
-from calib.validation import check_shape
-from planner.builtins import is_builtin, robot_urdf
-from planner.cell.acl import acl_key, compute_acl, sample_configurations
-from planner.cell.bodies import BodyLinks, set_link_pose, world_link_pose
-from planner.cell.collision import Clearance, CollisionChecker
-from planner.cell.fixtures import Fixture, fixture_from_spec
-from planner.cell.pybullet_client import connect_direct, pb
-from planner.cell.robot_body import load_robot_body
-from planner.cell.tool import Tool, load_tool
-from planner.cell.workobject import WorkObject, load_work_object
-from planner.errors import UnknownFrameError
-from planner.robot.kinematics.chain import KinematicChain
-from planner.robot.kinematics.solver import IKSolver, make_ik_solver
-from planner.robot.urdf import load_urdf
-
-if TYPE_CHECKING:
-    from calib.probing import SearchCommand
-    from planner.cell.feasibility import ProbeFeasibility
-    from planner.cell.reach import ReachModel
-    from planner.cell.reachability_map import ReachabilityMap
-    from planner.cell.search_paths import PathFeasibility
-
-FloatArray = NDArray[np.float64]
-log = logging.getLogger(__name__)
-
-#: Default clearance of robot and tool to the work object and fixtures, m.
-DEFAULT_MARGIN_M = 0.005
-#: Default clearance between robot/tool links that the ACL does not allow, m.
-DEFAULT_SELF_MARGIN_M = 0.002
+from calib.probing import SearchCommand
+from planner.cell.feasibility import ProbeFeasibility, check_probes
+from planner.cell.reachability_map import ReachabilityMap, reachability_map
+from planner.cell.scene import CellScene
+from planner.cell.search_paths import PathFeasibility, check_search
 
 
-class Cell:
-    """A robot cell in its own PyBullet DIRECT client.
+class Cell(CellScene):
+    """A robot cell in its own PyBullet DIRECT client, with its feasibility queries.
 
-    Args:
-        robot: ``"builtin:irb4400"`` or a URDF path (fixed base; limits from the URDF).
-        tool: ``"builtin:cable_feeder"``, a tool description JSON, a tool URDF, a
-            :class:`planner.cell.tool.Tool`, or ``None`` for a bare flange.
-        T_world_base: ``(4, 4)`` pose of the robot base link in the world; default identity.
-        base_link: chain base link (default the URDF root); tip_link: the flange (default
-            ``tool0`` or the end of the longest chain).
-        self_margin_m: clearance between robot/tool links not in the ACL, m.
-        acl_samples: random configurations sampled for the allowed-collision list.
-        acl_rng: generator of those samples (default seeded, so the ACL is reproducible).
-        use_acl_cache: read/write the ACL cache (see :mod:`planner.cell.collision`).
-
-    Raises:
-        URDFError: missing or malformed robot/tool URDF (the message names the file).
-        UnknownFrameError: unknown built-in name, base or tip link.
+    Takes the arguments of :class:`planner.cell.scene.CellScene`.
     """
-
-    def __init__(
-        self,
-        robot: str | Path = "builtin:irb4400",
-        tool: str | Path | Tool | None = "builtin:cable_feeder",
-        T_world_base: ArrayLike | None = None,
-        *,
-        base_link: str | None = None,
-        tip_link: str | None = None,
-        self_margin_m: float = DEFAULT_SELF_MARGIN_M,
-        acl_samples: int = 1000,
-        acl_rng: np.random.Generator | None = None,
-        use_acl_cache: bool = True,
-    ) -> None:
-        if int(acl_samples) < 1:
-            raise ShapeError(f"acl_samples must be >= 1, got {acl_samples}")
-        path = robot_urdf(str(robot)) if is_builtin(robot) else Path(robot)
-        model = load_urdf(path)
-        self.chain: KinematicChain = KinematicChain.from_model(model, base_link, tip_link)
-        self.solver: IKSolver = make_ik_solver(self.chain)
-        self.tool: Tool | None = None if tool is None else load_tool(tool)
-        self.self_margin_m = float(self_margin_m)
-        self._T_world_base = (
-            np.eye(4) if T_world_base is None else check_transform(T_world_base, "T_world_base")
-        )
-        self._T_world_wobj = np.eye(4)
-        self._reach: ReachModel | None = None
-        self.work_object: WorkObject | None = None
-        self._wobj_links: BodyLinks | None = None
-        self.fixtures: dict[str, Fixture] = {}
-        self._client: int | None = connect_direct()
-        try:
-            self._load_bodies(path)
-            self._build_checker(path, acl_samples, acl_rng, use_acl_cache)
-        except BaseException:
-            self.close()
-            raise
-
-    # ----------------------------------------------------------------- construction
-    def _load_bodies(self, path: Path) -> None:
-        c = self.client
-        self.robot_body = load_robot_body(c, path, self.chain, self._T_world_base)
-        self.robot: BodyLinks = self.robot_body.links
-        self._names: dict[tuple[int, int], str] = {
-            (self.robot.body_id, i): n for i, n in self.robot.names.items()
-        }
-        self.tool_body: BodyLinks | None = None
-        if self.tool is not None:
-            self.tool_body = self.tool.create_body(c)
-            robot_names = set(self.robot.names.values())
-            for i, n in self.tool_body.names.items():
-                self._names[(self.tool_body.body_id, i)] = f"tool:{n}" if n in robot_names else n
-        self.set_joint_positions(self.home_q)
-
-    def _build_checker(
-        self, path: Path, n: int, rng: np.random.Generator | None, use_cache: bool
-    ) -> None:
-        rng = rng if rng is not None else np.random.default_rng(0)
-        samples = sample_configurations(self.chain.lower, self.chain.upper, n, rng)
-        texts = [path.read_bytes()]
-        root, sensor_links = None, frozenset[int]()
-        if self.tool_body is not None and self.tool is not None:
-            root = self._names[(self.tool_body.body_id, -1)]
-            sensor_links = frozenset(
-                i for i, name in self.tool_body.names.items() if name in self.tool.sensor_links
-            )
-            texts.append(self.tool.fingerprint())
-        settings = f"{self.chain.base_link}>{self.chain.tip_link}:{n}:{self.self_margin_m:.6f}"
-        with self.saved_state():
-            acl = compute_acl(
-                self.client,
-                self.robot,
-                self.tool_body,
-                self._name,
-                self.set_joint_positions,
-                samples,
-                self.robot_body.adjacent_pairs(root),
-                self.self_margin_m,
-                acl_key(texts, settings),
-                use_cache,
-            )
-        self.checker = CollisionChecker(
-            self.client,
-            self.robot,
-            self.tool_body,
-            self._name,
-            self.robot_body.static_links,
-            acl,
-            sensor_links,
-        )
-
-    def _name(self, body: int, link: int) -> str:
-        return self._names[(body, link)]
-
-    # ----------------------------------------------------------------- life cycle
-    @property
-    def client(self) -> int:
-        """The PyBullet ``physicsClientId`` (raises when the cell is closed)."""
-        if self._client is None:
-            raise RuntimeError("the cell is closed")
-        return self._client
-
-    def close(self) -> None:
-        """Disconnect the PyBullet client (idempotent)."""
-        if self._client is not None:
-            with contextlib.suppress(pb.error):
-                pb.disconnect(self._client)
-            self._client = None
 
     def __enter__(self) -> Cell:
         return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
-
-    def __del__(self) -> None:
-        with contextlib.suppress(Exception):
-            self.close()
-
-    @contextlib.contextmanager
-    def saved_state(self) -> Iterator[None]:
-        """Restore the joint positions (and so the tool pose) on exit."""
-        q = self.joint_positions
-        try:
-            yield
-        finally:
-            self.set_joint_positions(q)
-
-    # ----------------------------------------------------------------- frames
-    @property
-    def T_world_base(self) -> FloatArray:
-        """``(4, 4)`` robot base link in the world, m."""
-        return self._T_world_base.copy()
-
-    @property
-    def T_world_wobj(self) -> FloatArray:
-        """``(4, 4)`` work-object frame in the world, m."""
-        return self._T_world_wobj.copy()
-
-    @property
-    def T_base_wobj(self) -> FloatArray:
-        """``(4, 4)`` work-object frame in the robot base frame, m."""
-        return invert_transform(self._T_world_base) @ self._T_world_wobj
-
-    @property
-    def reach_model(self) -> ReachModel:
-        """Shoulder and reach of the robot (computed once, seeded)."""
-        if self._reach is None:
-            from planner.cell.reach import reach_model
-
-            self._reach = reach_model(self.chain, np.random.default_rng(0))
-        return self._reach
-
-    @property
-    def joint_indices(self) -> list[int]:
-        """PyBullet joint indices of the chain's joints, in chain order."""
-        return list(self.robot_body.joint_index)
-
-    @property
-    def flange_index(self) -> int:
-        """PyBullet link index of the flange (the chain's tip link) in ``self.robot``."""
-        return self.robot_body.flange_index
-
-    @property
-    def home_q(self) -> FloatArray:
-        """``(n,)`` a reference configuration: 0 clipped into the limits, rad."""
-        return np.clip(np.zeros(self.chain.n_joints), self.chain.lower, self.chain.upper)
-
-    @property
-    def joint_positions(self) -> FloatArray:
-        """``(n,)`` current joint values, rad."""
-        return np.array(
-            [
-                pb.getJointState(self.robot.body_id, j, physicsClientId=self.client)[0]
-                for j in self.robot_body.joint_index
-            ]
-        )
-
-    def set_joint_positions(self, q: ArrayLike) -> None:
-        """Put the robot in configuration ``q (n,)`` (rad) and move the tool with the flange.
-
-        Raises:
-            ShapeError, NonFiniteError: ``q`` is not a finite ``(n,)`` vector.
-        """
-        qa = check_shape(q, (self.chain.n_joints,), "q")
-        c = self.client
-        self.robot_body.set_q(c, qa)
-        if self.tool_body is not None:
-            flange = world_link_pose(c, self.robot, self.robot_body.flange_index)
-            set_link_pose(c, self.tool_body, flange)
-
-    def link_poses(self) -> dict[str, FloatArray]:
-        """``T_world_link (4, 4)`` of every robot and tool link in the current state."""
-        out = {}
-        for (body, i), name in self._names.items():
-            links = self.robot if body == self.robot.body_id else self.tool_body
-            if links is not None:
-                out[name] = world_link_pose(self.client, links, i)
-        return out
-
-    def T_flange_tcp(self, tcp: str) -> FloatArray:
-        """``(4, 4)`` TCP ``tcp`` in the flange frame (``"flange"`` is always valid).
-
-        Raises:
-            UnknownFrameError: unknown TCP (the message lists the valid names).
-        """
-        if self.tool is None:
-            if tcp != "flange":
-                raise UnknownFrameError(f"tcp {tcp!r}: the cell has no tool; valid: ['flange']")
-            return np.eye(4)
-        return self.tool.T_flange_tcp(tcp)
-
-    # ----------------------------------------------------------------- scene
-    def set_work_object(
-        self,
-        mesh: str | Path | trimesh.Trimesh | WorkObject,
-        units: str = "auto",
-        T_world_wobj: ArrayLike | None = None,
-        name: str | None = None,
-    ) -> WorkObject:
-        """Load (or replace) the work object, as a concave static body at ``T_world_wobj``.
-
-        Raises:
-            MeshError: missing, unreadable or empty mesh (the message names the file).
-        """
-        wobj = mesh if isinstance(mesh, WorkObject) else load_work_object(mesh, units, name)
-        T = np.eye(4) if T_world_wobj is None else check_transform(T_world_wobj, "T_world_wobj")
-        if self.checker.wobj_body is not None:
-            pb.removeBody(self.checker.wobj_body, physicsClientId=self.client)
-            self.checker.environment.pop(self.checker.wobj_body, None)
-        body = wobj.create_body(self.client, T)
-        self.checker.wobj_body = body.body_id
-        self.checker.environment[body.body_id] = wobj.name
-        self.work_object, self._T_world_wobj, self._wobj_links = wobj, T, body
-        self.checker.log_static_contacts(body.body_id)
-        return wobj
-
-    def move_work_object(self, T_world_wobj: ArrayLike) -> None:
-        """Move the loaded work object to ``T_world_wobj`` without rebuilding its mesh body
-        (the Monte Carlo validation moves the part every trial).
-
-        Raises:
-            UnknownFrameError: no work object is loaded.
-        """
-        if self.work_object is None or self._wobj_links is None:
-            raise UnknownFrameError("move_work_object: the cell has no work object yet")
-        T = check_transform(T_world_wobj, "T_world_wobj")
-        set_link_pose(self.client, self._wobj_links, T)
-        self._T_world_wobj = T
-
-    def add_fixture(self, fixture: Fixture | str, **kwargs: Any) -> Fixture:
-        """Add a fixture: a :class:`Fixture`, or a name and ``size_m=`` (box), ``radius_m=`` +
-        ``height_m=`` (cylinder) or ``mesh=`` (+ ``units=``), with ``T_world_fixture=``.
-
-        Raises:
-            ShapeError: bad sizes or pose, or a name already used; MeshError: bad mesh.
-        """
-        if isinstance(fixture, str):
-            fixture = fixture_from_spec(fixture, **kwargs)
-        if fixture.name in self.fixtures:
-            raise ShapeError(f"a fixture named {fixture.name!r} already exists")
-        body = fixture.create_body(self.client)
-        self.checker.environment[body.body_id] = fixture.name
-        self.fixtures[fixture.name] = fixture
-        self.checker.log_static_contacts(body.body_id)
-        return fixture
-
-    def remove_fixture(self, name: str) -> None:
-        """Remove the fixture ``name``.
-
-        Raises:
-            UnknownFrameError: no such fixture (the message lists the fixtures).
-        """
-        if name not in self.fixtures:
-            raise UnknownFrameError(f"no fixture {name!r}; fixtures: {sorted(self.fixtures)}")
-        body = next(
-            b
-            for b, n in self.checker.environment.items()
-            if n == name and b != self.checker.wobj_body
-        )
-        pb.removeBody(body, physicsClientId=self.client)
-        del self.checker.environment[body]
-        del self.fixtures[name]
-
-    # ----------------------------------------------------------------- queries
-    def clearance(
-        self,
-        margin_m: float = DEFAULT_MARGIN_M,
-        sensor_wobj_allowed: bool = True,
-        skip_wobj: bool = False,
-    ) -> Clearance:
-        """Clearance of the current state (see :meth:`CollisionChecker.query`)."""
-        return self.checker.query(
-            margin_m, self.self_margin_m, None, sensor_wobj_allowed, skip_wobj
-        )
 
     def check_probes(
         self, points_wobj: ArrayLike, normals_wobj: ArrayLike, **kw: Any
     ) -> list[ProbeFeasibility]:
         """Feasibility of probe poses; see :func:`planner.cell.feasibility.check_probes`."""
-        from planner.cell.feasibility import check_probes
-
         return check_probes(self, points_wobj, normals_wobj, **kw)
 
     def check_search(self, command: SearchCommand, **kw: Any) -> PathFeasibility:
         """Feasibility of a search path; see :func:`planner.cell.search_paths.check_search`."""
-        from planner.cell.search_paths import check_search
-
         return check_search(self, command, **kw)
 
     def reachability_map(
         self, n_samples: int, rng: np.random.Generator, **kw: Any
     ) -> ReachabilityMap:
         """Surface reachability map; see :func:`planner.cell.reachability_map.reachability_map`."""
-        from planner.cell.reachability_map import reachability_map
-
         return reachability_map(self, n_samples, rng, **kw)

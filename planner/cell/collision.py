@@ -52,6 +52,12 @@ __all__ = [
 ]
 
 
+#: Default clearance of robot and tool to the work object and fixtures, m.
+DEFAULT_MARGIN_M = 0.005
+#: Default clearance between robot/tool links that the ACL does not allow, m.
+DEFAULT_SELF_MARGIN_M = 0.002
+
+
 def report_distance_m(margin_m: float) -> float:
     """How far clearance queries look, metres: ``2 * margin_m + 5 mm``.
 

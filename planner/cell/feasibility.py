@@ -27,12 +27,12 @@ from numpy.typing import ArrayLike, NDArray
 from calib.errors import DegenerateGeometryError, ShapeError
 from calib.frames import invert_transform
 from calib.validation import check_positive, check_shape
-from planner.cell.collision import Clearance
+from planner.cell.collision import DEFAULT_MARGIN_M, Clearance
 from planner.cell.probe_clearance import ProbeClearance
-from planner.cell.reach import no_ik_reason
+from planner.robot.reach import no_ik_reason
 
 if TYPE_CHECKING:
-    from planner.cell.cell import Cell
+    from planner.cell.scene import CellScene
     from planner.robot.kinematics.chain import KinematicChain
 
 FloatArray = NDArray[np.float64]
@@ -120,7 +120,7 @@ def _near_limit_reason(chain: KinematicChain, q: FloatArray) -> str:
     )
 
 
-def singular(cell: Cell, q: FloatArray) -> tuple[NDArray[np.bool_], str]:
+def singular(cell: CellScene, q: FloatArray) -> tuple[NDArray[np.bool_], str]:
     """Mask ``(M,)`` of configurations ``q (M, n)`` too near a singularity, and the reason."""
     if cell.solver.kind == "opw" and q.shape[1] == 6:
         return np.abs(np.sin(q[:, 4])) < math.sin(WRIST_SINGULAR_RAD), "singular wrist"
@@ -132,7 +132,7 @@ def singular(cell: Cell, q: FloatArray) -> tuple[NDArray[np.bool_], str]:
 
 
 def check_probes(
-    cell: Cell,
+    cell: CellScene,
     points_wobj: ArrayLike,
     normals_wobj: ArrayLike,
     tcp: str = "sensor",
@@ -167,7 +167,6 @@ def check_probes(
         DegenerateGeometryError: a zero normal.
         UnknownFrameError: unknown TCP (the message lists the valid names).
     """
-    from planner.cell.cell import DEFAULT_MARGIN_M
 
     pts = check_shape(points_wobj, (None, 3), "points_wobj")
     nrm = check_shape(normals_wobj, (None, 3), "normals_wobj")
@@ -204,7 +203,9 @@ def check_probes(
     with cell.saved_state():
         for i in range(N):
             if not valid[i].any():
-                reason = no_ik_reason(cell, T_bf[i * R : (i + 1) * R])
+                reason = no_ik_reason(
+                    cell.reach_model, cell.solver, cell.chain, T_bf[i * R : (i + 1) * R]
+                )
                 out.append(_none(reason))
                 continue
             if not usable[i].any():

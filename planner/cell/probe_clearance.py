@@ -36,7 +36,7 @@ from planner.cell.collision import Clearance, QueryPart
 from planner.cell.pybullet_client import pb
 
 if TYPE_CHECKING:
-    from planner.cell.cell import Cell
+    from planner.cell.scene import CellScene
 
 FloatArray = NDArray[np.float64]
 
@@ -62,7 +62,7 @@ class ProbeClearance:
         margin_m: required distance to the work object and fixtures, m.
     """
 
-    def __init__(self, cell: Cell, margin_m: float) -> None:
+    def __init__(self, cell: CellScene, margin_m: float) -> None:
         self._cell = cell
         self._plan = cell.checker.plan(margin_m, cell.self_margin_m, None, True, False)
         parts = self._plan.parts

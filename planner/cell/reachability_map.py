@@ -15,9 +15,10 @@ import trimesh
 from numpy.typing import NDArray
 
 from calib.errors import ShapeError
+from planner.cell.feasibility import check_probes
 
 if TYPE_CHECKING:
-    from planner.cell.cell import Cell
+    from planner.cell.scene import CellScene
 
 FloatArray = NDArray[np.float64]
 
@@ -78,7 +79,7 @@ def sample_surface(
 
 
 def reachability_map(
-    cell: Cell, n_samples: int, rng: np.random.Generator, **check_kw: Any
+    cell: CellScene, n_samples: int, rng: np.random.Generator, **check_kw: Any
 ) -> ReachabilityMap:
     """Sample the cell's work object and check every sample as a probe pose.
 
@@ -95,7 +96,7 @@ def reachability_map(
     if cell.work_object is None:
         raise ShapeError("reachability_map needs a work object: call cell.set_work_object first")
     pts, nrm, face = sample_surface(cell.work_object.mesh, n_samples, rng)
-    res = cell.check_probes(pts, nrm, **check_kw)
+    res = check_probes(cell, pts, nrm, **check_kw)
     return ReachabilityMap(
         points_wobj=pts,
         normals_wobj=nrm,

@@ -25,17 +25,18 @@ from numpy.typing import ArrayLike, NDArray
 from calib.errors import DegenerateGeometryError
 from calib.frames import invert_transform
 from calib.validation import check_positive, check_shape, check_vector3
+from planner.cell.collision import DEFAULT_MARGIN_M
 from planner.cell.feasibility import (
     MARGINAL_LIMIT_RAD,
     limit_margin,
     singular,
     tcp_frames,
 )
-from planner.cell.reach import no_ik_reason
+from planner.robot.reach import no_ik_reason
 
 if TYPE_CHECKING:
     from calib.probing import SearchCommand
-    from planner.cell.cell import Cell
+    from planner.cell.scene import CellScene
 
 FloatArray = NDArray[np.float64]
 
@@ -69,7 +70,7 @@ class PathFeasibility:
 
 
 def check_search(
-    cell: Cell,
+    cell: CellScene,
     command: SearchCommand,
     step_m: float = 0.001,
     max_joint_jump_rad: float = math.radians(5.0),
@@ -100,7 +101,6 @@ def check_search(
         ShapeError, NonFiniteError: bad vectors in the command; DegenerateGeometryError:
         zero direction or sensor axis; UnknownFrameError: unknown TCP.
     """
-    from planner.cell.cell import DEFAULT_MARGIN_M
 
     start = check_vector3(command.start_m, "command.start_m")
     direction = _unit(command.direction, "command.direction")
@@ -131,7 +131,7 @@ def check_search(
     empty = np.zeros((0, cell.chain.n_joints))
     if not ok0.any():
         reason = (
-            no_ik_reason(cell, T_start @ T_tcp_flange)
+            no_ik_reason(cell.reach_model, cell.solver, cell.chain, T_start @ T_tcp_flange)
             if not starts.valid.any()
             else ("singular at the start")
         )
@@ -167,7 +167,7 @@ def check_search(
 
 
 def _walk(
-    cell: Cell,
+    cell: CellScene,
     T_flange: FloatArray,
     q_start: FloatArray,
     branch: int,
@@ -188,7 +188,7 @@ def _walk(
         if not ok.any():
             fail_j = j
             why = (
-                no_ik_reason(cell, T_flange[j : j + 1])
+                no_ik_reason(cell.reach_model, cell.solver, cell.chain, T_flange[j : j + 1])
                 if not sol.valid[j].any()
                 else (f"leaves IK branch {branch}")
             )

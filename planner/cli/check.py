@@ -182,8 +182,7 @@ def export_job_for(plan: Plan, plan_dir: Path, run_check: bool = True) -> tuple[
 
 def _clearance_capped(clearance_m: float) -> bool:
     """True when the clearance is the query's look-ahead distance (nothing nearer found)."""
-    from planner.cell.cell import DEFAULT_MARGIN_M
-    from planner.cell.collision import report_distance_m
+    from planner.cell.collision import DEFAULT_MARGIN_M, report_distance_m
 
     return clearance_m >= report_distance_m(DEFAULT_MARGIN_M) - 1e-6
 

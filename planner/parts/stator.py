@@ -23,7 +23,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import trimesh
 from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import ShapeError
@@ -201,42 +200,3 @@ class StatorGeometry:
         dy = y_arr + self.first_slot_offset_m + j * self.slot_pitch_m
         dz = z_arr + self.first_layer_depth_m + k * self.layer_pitch_m
         return np.hypot(dy, dz) < self.hole_diameter_m / 2
-
-
-def build_stator_mesh(geom: StatorGeometry, deformed: bool = True) -> trimesh.Trimesh:
-    """Watertight triangle mesh of the section in the wobj frame, metres.
-
-    Args:
-        geom: the dimensions.
-        deformed: apply the tightening-bolt bulge to the side face.
-
-    Returns:
-        The mesh; its side face lies at ``x = side_face_offset_m(y, z)`` (``x = 0`` undeformed).
-    """
-    from planner.parts.stator_mesh import side_face_grid, triangulate_section
-
-    grid = side_face_grid(geom)
-    vertices, faces = triangulate_section(grid, geom.depth_m)
-    if deformed:
-        front = vertices[:, 0] == 0.0
-        vertices[front, 0] = geom.side_face_offset_m(vertices[front, 1], vertices[front, 2])
-    mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=True, validate=False)
-    return mesh
-
-
-def register_stator_builtins() -> bool:
-    """Register ``builtin:stator_section`` and ``builtin:stator_prototype`` with the cell.
-
-    Returns:
-        True when ``planner.builtins`` exists and took the registration.
-    """
-    try:
-        from planner import builtins
-    except ImportError:
-        return False
-    register = getattr(builtins, "register_builtin_mesh", None)
-    if register is None:
-        return False
-    register("stator_section", lambda: build_stator_mesh(StatorGeometry.full_section()))
-    register("stator_prototype", lambda: build_stator_mesh(StatorGeometry.prototype()))
-    return True

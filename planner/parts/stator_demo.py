@@ -23,7 +23,8 @@ from numpy.typing import NDArray
 from calib.errors import ShapeError
 from calib.frames import make_transform
 from calib.probing import ProbePoint, SearchSpec
-from planner.parts.stator import StatorGeometry, build_stator_mesh
+from planner.parts.stator import StatorGeometry
+from planner.parts.stator_mesh import build_stator_mesh
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell

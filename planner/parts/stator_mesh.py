@@ -1,4 +1,4 @@
-"""Construction of the stator-section mesh (used by :func:`planner.parts.stator.build_stator_mesh`).
+"""The stator-section mesh: :func:`build_stator_mesh` and the built-in parts' factories.
 
 The side face (wobj ``x = 0``) is tiled by a rectangular grid of cells: solid cells and cells with
 one round slot hole in the middle. Every cell edge is sampled with the same ``k + 1`` points, so
@@ -11,13 +11,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
+import trimesh
 from numpy.typing import NDArray
 
-if TYPE_CHECKING:
-    from planner.parts.stator import StatorGeometry
+from planner.parts.stator import StatorGeometry
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -178,3 +177,32 @@ def triangulate_section(grid: FaceGrid, depth_m: float) -> tuple[FloatArray, Int
     vertices[:nv, 1:], vertices[nv:, 1:] = uniq, uniq
     vertices[nv:, 0] = -depth_m
     return vertices, np.concatenate(faces).astype(np.int64)
+
+
+def build_stator_mesh(geom: StatorGeometry, deformed: bool = True) -> trimesh.Trimesh:
+    """Watertight triangle mesh of the section in the wobj frame, metres.
+
+    Args:
+        geom: the dimensions.
+        deformed: apply the tightening-bolt bulge to the side face.
+
+    Returns:
+        The mesh; its side face lies at ``x = side_face_offset_m(y, z)`` (``x = 0`` undeformed).
+    """
+    grid = side_face_grid(geom)
+    vertices, faces = triangulate_section(grid, geom.depth_m)
+    if deformed:
+        front = vertices[:, 0] == 0.0
+        vertices[front, 0] = geom.side_face_offset_m(vertices[front, 1], vertices[front, 2])
+    mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=True, validate=False)
+    return mesh
+
+
+def full_section_mesh() -> trimesh.Trimesh:
+    """``builtin:stator_section``: the full-size section (:meth:`StatorGeometry.full_section`)."""
+    return build_stator_mesh(StatorGeometry.full_section())
+
+
+def prototype_mesh() -> trimesh.Trimesh:
+    """``builtin:stator_prototype``: the 0.5 m prototype (:meth:`StatorGeometry.prototype`)."""
+    return build_stator_mesh(StatorGeometry.prototype())

@@ -32,7 +32,8 @@ from calib.errors import InputError, ShapeError
 from calib.frames import check_transform
 from calib.paper.stator_procedure import StatorSettings, check_stator_points
 from calib.probing import ProbePoint
-from planner.parts.stator import StatorGeometry, build_stator_mesh
+from planner.parts.stator import StatorGeometry
+from planner.parts.stator_mesh import build_stator_mesh
 from planner.sim.error_models import Misplacement, RobotErrorModel
 from planner.sim.probe import ReachabilityHook, cell_search_hook
 from planner.sim.proximity import ProximitySensor
@@ -103,7 +104,7 @@ def validate(
         misplacement: :class:`Misplacement` or ``(max_translation_m, max_angle_rad)``; default
             the paper's experiment, 20 mm and 3 deg.
         procedure: ``"hultman2013"`` (the paper's A-H procedure).
-        mesh: the true part mesh in wobj (default ``build_stator_mesh(geometry)``).
+        mesh: the true part mesh in wobj (default: the stator mesh of ``geometry``).
         pivot_wobj_m: ``(3,)`` misplacement pivot (default: centroid of the points).
         settings: A-H procedure settings; by default the paper's, with the sensor's analytic
             straight-edge offset (:meth:`ProximitySensor.edge_event_offset_m`) as the known

@@ -17,8 +17,8 @@ from numpy.typing import NDArray
 from calib.frames import invert_transform
 
 if TYPE_CHECKING:
-    from planner.cell.cell import Cell
     from planner.robot.kinematics.chain import KinematicChain
+    from planner.robot.kinematics.solver import IKSolver
 
 FloatArray = NDArray[np.float64]
 
@@ -67,21 +67,29 @@ def reach_model(chain: KinematicChain, rng: np.random.Generator) -> ReachModel:
     return ReachModel(zero[0, :3, 3].copy(), axis, zero[k, :3, 3].copy(), reach)
 
 
-def no_ik_reason(cell: Cell, T_flange: FloatArray) -> str:
-    """Why ``(R, 4, 4)`` flange poses of one point have no valid IK solution."""
-    model = cell.reach_model
+def no_ik_reason(
+    model: ReachModel, solver: IKSolver, chain: KinematicChain, T_flange: FloatArray
+) -> str:
+    """Why ``(R, 4, 4)`` flange poses (base frame, m) of one point have no valid IK solution.
+
+    Args:
+        model: the robot's reach (:func:`reach_model`).
+        solver: its IK solver (the OPW branches say which joint breaks its limit).
+        chain: its kinematic chain (joint names and limits).
+        T_flange: ``(R, 4, 4)`` the candidate flange poses, base frame, m.
+    """
     p = T_flange[:, :3, 3]
     dist = float(np.min(np.linalg.norm(p - model.shoulder_towards(p), axis=1)))
     where = f"{dist:.2f} m from the shoulder, reach {model.reach_m:.2f} m"
     if dist > model.reach_m:
         return f"out of reach ({where})"
-    opw = getattr(cell.solver, "opw", None)
+    opw = solver.opw
     if opw is not None:
         q8, ok8 = opw.ik_branches(T_flange)
         if not ok8.any():
             return opw_wrist_reason(opw, T_flange)
         q = q8[ok8]
-        lo, hi = cell.chain.lower, cell.chain.upper
+        lo, hi = chain.lower, chain.upper
         two_pi = 2 * np.pi
         with np.errstate(invalid="ignore"):
             best = np.full(q.shape, np.inf)  # violation of each joint over its 2*pi variants
@@ -90,7 +98,7 @@ def no_ik_reason(cell: Cell, T_flange: FloatArray) -> str:
                 best = np.minimum(best, np.maximum(lo - qk, 0) + np.maximum(qk - hi, 0))
         worst = np.argmax(best, axis=1)  # each candidate's worst joint
         j = int(np.bincount(worst, minlength=q.shape[1]).argmax())
-        return f"joint {j + 1} at limit ({cell.chain.joint_names[j]})"
+        return f"joint {j + 1} at limit ({chain.joint_names[j]})"
     return f"no IK solution within joint limits ({where})"
 
 
