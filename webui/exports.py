@@ -14,10 +14,12 @@ from pathlib import Path
 from calib.errors import InputError
 from calib.plan.file import Plan
 from planner.cli.check import export_job_for
+from planner.export import FORMATS as EXPORT_FORMATS
 from planner.export import export_files
 
 #: UI name -> ``planner.export`` format name.
-FORMATS: dict[str, str] = {"RAPID": "rapid", "KRL": "krl", "URScript": "urscript"}
+#: Download button label -> export format name, from the export registry.
+FORMATS: dict[str, str] = {f.label: f.name for f in EXPORT_FORMATS.values()}
 
 
 @dataclass(frozen=True)

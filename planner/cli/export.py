@@ -10,7 +10,7 @@ from typing import Any
 from calib.atomic_io import write_text_atomic
 from calib.plan.file import plan_to_json
 from planner.cli.common import read_plan, stderr
-from planner.export import FORMATS, export_files
+from planner.export import FORMAT_CHOICES, FORMATS, export_files
 
 
 def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
@@ -30,7 +30,14 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "wobjcal export plan.json --format krl -o wobjcal_stator.src",
     )
     p.add_argument("plan", metavar="PLAN", help="plan file (wobjcal.plan/1)")
-    p.add_argument("--format", required=True, choices=FORMATS, help="output format")
+    p.add_argument(
+        "--format",
+        required=True,
+        choices=FORMAT_CHOICES,
+        help="output format: "
+        + ", ".join(f"{f.name} ({f.vendor} {f.label})" for f in FORMATS.values())
+        + ", json (the canonical plan)",
+    )
     p.add_argument("-o", "--output", required=True, metavar="FILE", help="output file")
     p.add_argument(
         "--no-check",

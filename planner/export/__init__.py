@@ -1,34 +1,109 @@
-"""Export a plan to robot programs: ABB RAPID, KUKA KRL, URScript (and plan JSON).
+"""Robot programs from a plan: the export job and one writer per robot language.
 
-Each exporter formats an :class:`planner.export.job.ExportJob`; :func:`export_text` picks one
-by name and returns ``{file name suffix: text}`` (KRL writes a ``.src`` and a ``.dat``).
+Owns:
+    - :mod:`planner.export.job`: :class:`~planner.export.job.ExportJob` (what every writer
+      formats: the nominal work object, the sensor tool, one :class:`TargetPair` per point,
+      the safe starts and the adaptive A-H spec) and :func:`~planner.export.job.build_job`;
+    - :mod:`planner.export.safety`: safe search starts under the plan's misplacement;
+    - :mod:`planner.export.text`: identifiers, numbers and header comments shared by writers;
+    - one module per language: ``rapid`` (+ ``rapid_probe``, ``rapid_adaptive``,
+      ``rapid_write``), ``krl``, ``urscript``;
+    - the registry :data:`FORMATS` and :func:`export_files`.
+
+A writer is a function ``(ExportJob) -> {file suffix: text}`` (KRL writes a ``.src`` and a
+``.dat``). Adding a robot language is one module with a writer plus one entry in
+:data:`FORMATS`; the command line (``wobjcal export --format NAME``), the web UI's download
+buttons and the tests all look formats up here::
+
+    FORMATS["mylang"] = ExportFormat(
+        "mylang", "MyLang", "Maker", "planner.export.mylang:export_mylang", (".prg",)
+    )
+
+Writers are imported when first used, so listing the formats imports no writer.
 """
 
 from __future__ import annotations
 
+import importlib
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from calib.errors import InputError
 from planner.export.job import ExportJob, TargetPair, ToolData, build_job
 
-FORMATS = ("rapid", "krl", "urscript", "json")
+#: A writer: the program files of a job, ``{suffix: text}``.
+Writer = Callable[[ExportJob], dict[str, str]]
 
-__all__ = ["FORMATS", "ExportJob", "TargetPair", "ToolData", "build_job", "export_files"]
+
+@dataclass(frozen=True)
+class ExportFormat:
+    """One robot-program format.
+
+    Attributes:
+        name: the format's name on the command line, e.g. ``"rapid"``.
+        label: the language's name, as the UI's download button shows it, e.g. ``"RAPID"``.
+        vendor: the robot maker, e.g. ``"ABB"``.
+        writer: ``"module:function"`` of the writer ``(ExportJob) -> {suffix: text}``.
+        suffixes: the suffixes of the files the writer returns, first one first (the first
+            file is written to the output path, the others beside it with their suffix).
+    """
+
+    name: str
+    label: str
+    vendor: str
+    writer: str
+    suffixes: tuple[str, ...]
+
+    def load(self) -> Writer:
+        """The writer function (imports its module)."""
+        module, _, function = self.writer.partition(":")
+        writer: Writer = getattr(importlib.import_module(module), function)
+        return writer
+
+
+#: The robot-program formats by name.
+FORMATS: dict[str, ExportFormat] = {
+    f.name: f
+    for f in (
+        ExportFormat("rapid", "RAPID", "ABB", "planner.export.rapid:rapid_files", (".mod",)),
+        ExportFormat("krl", "KRL", "KUKA", "planner.export.krl:export_krl", (".src", ".dat")),
+        ExportFormat(
+            "urscript",
+            "URScript",
+            "Universal Robots",
+            "planner.export.urscript:urscript_files",
+            (".script",),
+        ),
+    )
+}
+#: What ``wobjcal export --format`` accepts: the robot formats and the plan's own JSON.
+FORMAT_CHOICES = (*FORMATS, "json")
+
+__all__ = [
+    "FORMATS",
+    "FORMAT_CHOICES",
+    "ExportFormat",
+    "ExportJob",
+    "TargetPair",
+    "ToolData",
+    "Writer",
+    "build_job",
+    "export_files",
+]
 
 
 def export_files(job: ExportJob, fmt: str) -> dict[str, str]:
-    """The program files of ``job`` in format ``fmt`` (``rapid``, ``krl`` or ``urscript``).
+    """The program files of ``job`` in the robot format ``fmt`` (a key of :data:`FORMATS`).
 
     Returns:
         ``{suffix: text}``, e.g. ``{".mod": ...}`` or ``{".src": ..., ".dat": ...}``.
+
+    Raises:
+        InputError: unknown format (the message lists the known ones).
     """
-    if fmt == "rapid":
-        from planner.export.rapid import export_rapid
-
-        return {".mod": export_rapid(job)}
-    if fmt == "krl":
-        from planner.export.krl import export_krl
-
-        return export_krl(job)
-    if fmt == "urscript":
-        from planner.export.urscript import export_urscript
-
-        return {".script": export_urscript(job)}
-    raise ValueError(f"format must be one of {FORMATS[:3]}, got {fmt!r}")
+    if fmt not in FORMATS:
+        raise InputError(f"format must be one of {sorted(FORMATS)}, got {fmt!r}")
+    files = FORMATS[fmt].load()(job)
+    if tuple(files) != FORMATS[fmt].suffixes:
+        raise RuntimeError(f"writer of {fmt!r} returned {list(files)}, not {FORMATS[fmt].suffixes}")
+    return files

@@ -208,3 +208,8 @@ def _unique_names(ids: list[str]) -> list[str]:
             name, k = f"{base}_{k}", k + 1
         names.append(name)
     return names
+
+
+def rapid_files(job: ExportJob) -> dict[str, str]:
+    """The RAPID module of ``job`` as ``{".mod": text}`` (the export registry's writer)."""
+    return {".mod": export_rapid(job)}

@@ -120,3 +120,8 @@ def export_urscript(job: ExportJob) -> str:
         ]
     lines += ["end", ""]
     return "\n".join(lines)
+
+
+def urscript_files(job: ExportJob) -> dict[str, str]:
+    """The URScript program of ``job`` as ``{".script": text}`` (the export registry's writer)."""
+    return {".script": export_urscript(job)}
