@@ -23,11 +23,11 @@ from pathlib import Path
 import numpy as np
 
 from calib.atomic_io import write_text_atomic
+from calib.models.proximity import ProximitySensor
 from planner.parts.stator import StatorGeometry
 from planner.parts.stator_demo import nominal_T_base_wobj, stator_ah_points
 from planner.parts.stator_mesh import build_stator_mesh
 from planner.sim.montecarlo import validate
-from planner.sim.proximity import ProximitySensor
 from planner.sim.raycast import MeshRayCaster
 
 RESULTS = Path(__file__).resolve().parent / "results"

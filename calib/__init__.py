@@ -35,7 +35,8 @@ from calib.estimators.observability import ObservabilityReport, analyze_layout, 
 from calib.estimators.runners import run_best_fit, run_three_two_one
 from calib.estimators.three_two_one import ThreeTwoOneLayout, ThreeTwoOneResult, three_two_one
 from calib.paper.hultman import adjust_origin, orientation_from_three_points, p3_estimate
-from calib.paper.stator_procedure import StatorSettings, run_stator_procedure
+from calib.paper.settings import Hultman2013
+from calib.paper.stator_procedure import run_stator_procedure
 from calib.paper.xoffset import SlotGrid, slot_target, xoffset_matrix
 from calib.probing import Probe, ProbePoint, ProbeResult, SearchCommand, SearchSpec
 from calib.stats import ConfidenceTable, confidence_intervals, to_markdown
@@ -44,6 +45,7 @@ __all__ = [
     "BestFitResult",
     "ConfidenceTable",
     "DegenerateGeometryError",
+    "Hultman2013",
     "InputError",
     "NonFiniteError",
     "ObservabilityReport",
@@ -55,7 +57,6 @@ __all__ = [
     "SearchSpec",
     "ShapeError",
     "SlotGrid",
-    "StatorSettings",
     "ThreeTwoOneLayout",
     "ThreeTwoOneResult",
     "UnobservableError",

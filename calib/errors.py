@@ -19,6 +19,13 @@ class InputError(WobjcalError, ValueError):
     """An argument, field or file has the wrong shape, type, unit or value."""
 
 
+class PlanError(InputError):
+    """A plan file, a model in it or a plan object is malformed.
+
+    The message names the file and the JSON path (``points[3].normal: must have length 3``).
+    """
+
+
 class ShapeError(InputError):
     """An array has the wrong shape, e.g. ``points must be (N, 3), got (4, 2)``."""
 

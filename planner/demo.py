@@ -16,7 +16,7 @@ from calib.plan.file import (
     WorkObjectSpec,
     plan_to_json,
 )
-from calib.plan.procedures import Hultman2013
+from calib.procedures import Hultman2013
 
 
 def stator_plan() -> Plan:

@@ -14,9 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.frames import invert_transform
-from calib.plan.file import Plan, PlanError, resolve_ref
-from calib.plan.procedures import Hultman2013, check_roles
-from calib.probing import ProbePoint
+from calib.plan.file import Plan, resolve_ref
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
@@ -32,18 +30,6 @@ def T_base_world(plan: Plan) -> FloatArray:
 def nominal_T_base_wobj(plan: Plan) -> FloatArray:
     """``(4, 4)`` the nominal work object in the robot base frame."""
     return T_base_world(plan) @ plan.work_object.T_world_wobj.matrix()
-
-
-def hultman_points(plan: Plan) -> dict[str, ProbePoint]:
-    """``{role: ProbePoint with id = role}`` for the A-H procedure."""
-    msg = check_roles(Hultman2013(), [p.role for p in plan.points])
-    if msg:
-        raise PlanError(f"hultman2013: {msg}")
-    out = {}
-    for p in plan.points:
-        q = p.to_probe_point()
-        out[p.role] = ProbePoint(p.role, q.position_m, q.normal, q.search, q.edge_normal)
-    return out
 
 
 def plan_dir_of(path: str | Path) -> Path:
@@ -173,7 +159,6 @@ def _urdf_mass(path: Path | None) -> tuple[float, tuple[float, float, float]]:
 
 __all__ = [
     "T_base_world",
-    "hultman_points",
     "nominal_T_base_wobj",
     "open_cell",
     "resolved_refs",

@@ -21,17 +21,17 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import msgspec
 import numpy as np
 
-from calib.paper.stator_procedure import StatorSettings
+from calib.models import Misplacement, RobotErrorModel
+from calib.models.proximity import ProximitySensor
+from calib.paper.settings import Hultman2013
 from calib.plan.file import Plan, PlanError
-from calib.plan.procedures import Hultman2013
+from calib.procedures.hultman2013 import points_by_role
 from planner.parts.stator import StatorGeometry
-from planner.plan_cell import hultman_points, nominal_T_base_wobj, open_cell
-from planner.sim.error_models import Misplacement, RobotErrorModel
+from planner.plan_cell import nominal_T_base_wobj, open_cell
 from planner.sim.montecarlo import DEFAULT_EDGE_INSET_M, ValidationReport, validate
-from planner.sim.proximity import ProximitySensor
+from planner.sim.trial import resolved_settings
 
 __all__ = [
     "SIMULATED_PARTS",
@@ -68,7 +68,7 @@ class ValidationModels:
     sensor: ProximitySensor
     robot_error: RobotErrorModel
     misplacement: Misplacement
-    settings: StatorSettings
+    settings: Hultman2013
     geometry: StatorGeometry
     edge_inset_m: float = DEFAULT_EDGE_INSET_M
 
@@ -96,32 +96,22 @@ def check_simulatable(plan: Plan) -> Hultman2013:
 def validation_models(plan: Plan) -> ValidationModels:
     """The sensor, robot-error, misplacement, procedure and geometry models of ``plan``.
 
+    The sensor, robot error and misplacement are the plan's own objects; the A-H settings are
+    the plan's with an unset edge-event offset resolved from the sensor
+    (:func:`planner.sim.trial.resolved_settings`).
+
     Raises:
         PlanError: the plan cannot be simulated (see :func:`check_simulatable`).
     """
     proc = check_simulatable(plan)
     v = plan.validation
-    s, r, m = v.sensor, v.robot_error, v.misplacement
-    # the plan's models mirror the simulation's field by field (tests/test_plan_models.py)
-    sensor = ProximitySensor(**msgspec.structs.asdict(s))
-    edge_inset_m = DEFAULT_EDGE_INSET_M
-    edge_offset = proc.edge_event_offset_m
-    if edge_offset is None:  # the sensor model's straight-edge offset, as montecarlo's default
-        edge_offset = sensor.edge_event_offset_m(edge_inset_m)
     return ValidationModels(
-        sensor=sensor,
-        robot_error=RobotErrorModel(**msgspec.structs.asdict(r)),
-        misplacement=Misplacement(**msgspec.structs.asdict(m)),
-        settings=StatorSettings(
-            beta1_rad=proc.beta1_rad,
-            p3_height_m=proc.p3_height_m,
-            retake_c_d=proc.retake_c_d,
-            edge_start_from_measured=proc.edge_start_from_measured,
-            edge_start_offset_m=proc.edge_start_offset_m,
-            edge_event_offset_m=edge_offset,
-        ),
+        sensor=v.sensor,
+        robot_error=v.robot_error,
+        misplacement=v.misplacement,
+        settings=resolved_settings(proc, v.sensor, DEFAULT_EDGE_INSET_M),
         geometry=getattr(StatorGeometry, SIMULATED_PARTS[plan.work_object.mesh])(),
-        edge_inset_m=edge_inset_m,
+        edge_inset_m=DEFAULT_EDGE_INSET_M,
     )
 
 
@@ -177,7 +167,7 @@ def _run(
     reach_trials: int,
 ) -> ValidationReport:
     return validate(
-        hultman_points(plan),
+        points_by_role(plan.role_points()),
         models.geometry,
         nominal_T_base_wobj(plan),
         plan.validation.trials if trials is None else int(trials),

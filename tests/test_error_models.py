@@ -7,13 +7,13 @@ import math
 import numpy as np
 import pytest
 
-from calib.errors import ShapeError
+from calib.errors import PlanError
 from calib.frames import rotvec_from_matrix
-from planner.sim.error_models import Misplacement, RobotErrorModel
+from calib.models import Misplacement, RobotErrorModel
 
 
 def test_misplacement_stays_within_tolerance_and_turns_about_the_pivot(rng) -> None:
-    m = Misplacement(0.020, math.radians(3.0))
+    m = Misplacement(max_translation_m=0.020, max_angle_rad=math.radians(3.0))
     pivot = np.array([0.0, -0.3, -0.1])
     shifts, angles = [], []
     for _ in range(2000):
@@ -29,7 +29,7 @@ def test_misplacement_stays_within_tolerance_and_turns_about_the_pivot(rng) -> N
 
 
 def test_zero_misplacement_is_identity(rng) -> None:
-    assert np.allclose(Misplacement(0.0, 0.0).sample(rng, [1.0, 2.0, 3.0]), np.eye(4))
+    assert np.allclose(Misplacement(max_translation_m=0.0, max_angle_rad=0.0).sample(rng, [1.0, 2.0, 3.0]), np.eye(4))
 
 
 def test_repeatability_has_the_given_sigma(rng) -> None:
@@ -54,7 +54,7 @@ def test_accuracy_field_is_smooth_with_the_given_rms(rng) -> None:
 
 
 def test_bad_values_name_the_field() -> None:
-    with pytest.raises(ShapeError, match=r"misplacement\.max_translation_m"):
+    with pytest.raises(PlanError, match=r"^max_translation_m: must be >= 0"):
         Misplacement(max_translation_m=-1.0)
-    with pytest.raises(ShapeError, match=r"robot_error\.repeatability_sigma_m"):
+    with pytest.raises(PlanError, match=r"^repeatability_sigma_m: must be >= 0"):
         RobotErrorModel(repeatability_sigma_m=-1e-5)

@@ -11,13 +11,14 @@ import numpy as np
 import pytest
 
 from calib.frames import invert_transform, make_transform, transform_points
-from calib.paper.stator_procedure import StatorSettings, run_stator_procedure
+from calib.paper.stator_procedure import run_stator_procedure
 from calib.plan.file import load_plan
 from calib.plan.measurements import measurements_from_json
 from calib.probing import SearchCommand
+from calib.procedures.hultman2013 import points_by_role
 from planner.export.job import ToolData, build_job
 from planner.export.rapid import export_rapid
-from planner.plan_cell import hultman_points, nominal_T_base_wobj
+from planner.plan_cell import nominal_T_base_wobj
 from tests.box_part import BoxProbe, distance_to_box
 from tests.rapid_interp import Machine
 
@@ -60,18 +61,6 @@ def full_misplacement(plan, rng: np.random.Generator) -> np.ndarray:  # type: ig
     return make_transform(R, c - R @ c + t)
 
 
-def settings_of(plan) -> StatorSettings:  # type: ignore[no-untyped-def]
-    p = plan.procedure
-    return StatorSettings(
-        beta1_rad=p.beta1_rad,
-        p3_height_m=p.p3_height_m,
-        retake_c_d=p.retake_c_d,
-        edge_start_from_measured=p.edge_start_from_measured,
-        edge_start_offset_m=p.edge_start_offset_m,
-        edge_event_offset_m=p.edge_event_offset_m or 0.0,
-    )
-
-
 VARIANTS = {
     "plan": {},
     "from_measured": {"edge_start_from_measured": True, "edge_start_offset_m": 0.004},
@@ -96,7 +85,8 @@ def test_program_frame_equals_the_procedure(seed: int, variant: str) -> None:
     m.main()
     assert m.tp[-2].startswith("wobjcal: A-H done"), m.tp
     T_prog = m.wobj_matrix_m("wobjCal")
-    ref = run_stator_procedure(hultman_points(plan), T_nom, BoxProbe(T_true), settings_of(plan))
+    points = points_by_role(plan.role_points())
+    ref = run_stator_procedure(points, T_nom, BoxProbe(T_true), plan.procedure)
     assert np.abs(T_prog[:3, 3] - ref.T_base_wobj[:3, 3]).max() < 1e-6
     dR = T_prog[:3, :3].T @ ref.T_base_wobj[:3, :3]
     assert np.arccos(np.clip((np.trace(dR) - 1) / 2, -1, 1)) < 1e-6

@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 
 from calib.errors import InputError, ShapeError
+from calib.models.proximity import ProximitySensor
+from calib.models.robot_error import RobotErrorModel
 from calib.probing import SearchSpec
 from planner.parts.stator import StatorGeometry
 from planner.parts.stator_demo import nominal_T_base_wobj, stator_ah_points
 from planner.parts.stator_mesh import build_stator_mesh
-from planner.sim.error_models import RobotErrorModel
 from planner.sim.montecarlo import validate
-from planner.sim.proximity import ProximitySensor
 
 GEOM = StatorGeometry.full_section()
 POINTS = stator_ah_points(GEOM)

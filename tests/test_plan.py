@@ -27,8 +27,8 @@ from calib.plan.file import (
     save_plan,
 )
 from calib.plan.json_io import json_schema
-from calib.plan.procedures import BestFit, Hultman2013, ThreeTwoOne
 from calib.probing import ProbePoint, SearchSpec
+from calib.procedures import BestFit, Hultman2013, ThreeTwoOne
 
 DATA = Path(__file__).resolve().parent / "data" / "plans"
 VALID = DATA / "valid_three_two_one.json"

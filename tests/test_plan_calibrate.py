@@ -11,7 +11,8 @@ from calib.errors import InputError
 from calib.frames import invert_transform, motion_between, random_transform, transform_points
 from calib.plan.file import PlanError, load_plan
 from calib.plan.measurements import Measurements, MeasurementsError
-from planner.calibrate import assign_three_two_one, calibrate_plan
+from calib.procedures.three_two_one import THREE_TWO_ONE, pick_roles
+from planner.calibrate import calibrate_plan
 from planner.plan_cell import nominal_T_base_wobj
 
 REPO = Path(__file__).resolve().parent.parent
@@ -101,13 +102,13 @@ def test_retakes_feed_c2_d2(rng: np.random.Generator) -> None:
 
 
 def test_three_two_one_roles_are_picked_from_faces() -> None:
-    roles = assign_three_two_one(load_plan(STATOR))
-    ids = {r: [p.id for p in pts] for r, pts in roles.items()}
+    roles = pick_roles(load_plan(STATOR).role_points())
+    ids = {r: [rp.point.id for rp in pts] for r, pts in roles.items()}
     assert len(ids["primary"]) == 3 and set(ids["primary"]) <= {"A", "B", "D", "E", "G"}
     assert set(ids["secondary"]) == {"F", "H"}  # the top face, found by the edge searches
     assert ids["tertiary"] == ["C"]
-    small = assign_three_two_one(load_plan(SMALL))
-    assert [p.id for p in small["secondary"]] == ["S1", "S2"]
+    small = THREE_TWO_ONE.assign(load_plan(SMALL).role_points())  # the plan's own roles
+    assert [rp.point.id for rp in small if rp.role == "secondary"] == ["S1", "S2"]
 
 
 def test_measured_point_not_in_plan_is_an_error() -> None:

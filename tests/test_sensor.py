@@ -2,18 +2,21 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
 import pytest
 
-from calib.errors import ShapeError
+from calib.errors import PlanError
+from calib.models.proximity import ProximitySensor, sunflower_disk
+from calib.models.robot_error import RobotErrorModel
+from calib.plan import plan_from_json, plan_to_json
 from calib.probing import ProbePoint, SearchCommand
+from planner.demo import stator_plan
 from planner.parts.stator import StatorGeometry
 from planner.parts.stator_mesh import build_stator_mesh
-from planner.sim.error_models import RobotErrorModel
 from planner.sim.probe import SimulatedProbe
-from planner.sim.proximity import ProximitySensor, sunflower_disk
 from planner.sim.raycast import MeshRayCaster
 
 
@@ -74,7 +77,7 @@ def test_edge_event_offset_solves_the_disk_segment() -> None:
     assert covered == pytest.approx(s.off_level() * math.exp(-0.003 / s.decay_length_m))
     assert 0 < t < s.radius_m
     assert ProximitySensor.ideal().edge_event_offset_m(0.003) == 0.0
-    with pytest.raises(ShapeError, match="inset"):
+    with pytest.raises(PlanError, match="inset"):
         s.edge_event_offset_m(-0.01)
 
 
@@ -112,7 +115,16 @@ def test_slot_hole_reads_farther_than_tooth_by_the_predicted_amount() -> None:
 
 
 def test_bad_parameters_name_the_field() -> None:
-    with pytest.raises(ShapeError, match=r"sensor\.sensing_distance_m"):
+    with pytest.raises(PlanError, match=r"^sensing_distance_m: must be > 0"):
         ProximitySensor(sensing_distance_m=0.0)
-    with pytest.raises(ShapeError, match=r"sensor\.n_rays"):
+    with pytest.raises(PlanError, match=r"^n_rays: must be an integer >= 1"):
         ProximitySensor(n_rays=0)
+
+
+def test_bad_sensor_in_a_plan_file_names_the_json_path() -> None:
+    """The plan holds the same sensor object; a bad field names its path in the file."""
+    raw = json.loads(plan_to_json(stator_plan()))
+    raw["validation"]["sensor"]["sensing_distance_m"] = -0.008
+    with pytest.raises(PlanError, match=r"validation\.sensor.*sensing_distance_m.*> 0"):
+        plan_from_json(json.dumps(raw))
+    assert isinstance(stator_plan().validation.sensor, ProximitySensor)

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from calib.errors import DegenerateGeometryError, ProbeFailedError, ShapeError
+from calib.errors import DegenerateGeometryError, PlanError, ProbeFailedError, ShapeError
 from calib.frames import (
     invert_transform,
     make_transform,
@@ -21,8 +21,8 @@ from calib.frames import (
     random_transform,
     transform_points,
 )
+from calib.paper.settings import Hultman2013
 from calib.paper.stator_procedure import (
-    StatorSettings,
     check_stator_points,
     example_stator_points,
     probe_from_measurements,
@@ -61,7 +61,7 @@ def test_noise_free_random_pose_is_exact(seed: int, retake: bool, facing: bool) 
     T_prelim = nominal_pose(rng.uniform(-0.15, 0.15), position, robot_at_plus_x=facing)
     T_true = T_prelim @ random_transform(rng, 0.020, math.radians(3.0))
     probe = BoxProbe(T_true)
-    res = run_stator_procedure(LAYOUT, T_prelim, probe, StatorSettings(retake_c_d=retake))
+    res = run_stator_procedure(LAYOUT, T_prelim, probe, Hultman2013(retake_c_d=retake))
     dt, dr = pose_error(res.T_base_wobj, T_true)
     assert dt < 1e-9 and dr < 1e-9
     assert res.n_probes == (10 if retake else 8) == len(probe.calls)
@@ -198,7 +198,7 @@ def test_bad_preliminary_frame_raises() -> None:
 def test_edge_searches_can_start_from_measured_e_and_g(rng: np.random.Generator) -> None:
     T_prelim = nominal_pose(0.1, (1.0, -0.2, 0.8))
     T_true = T_prelim @ random_transform(rng, 0.02, math.radians(3.0))
-    cfg = StatorSettings(edge_start_from_measured=True, edge_start_offset_m=0.003)
+    cfg = Hultman2013(edge_start_from_measured=True, edge_start_offset_m=0.003)
     res = run_stator_procedure(LAYOUT, T_prelim, BoxProbe(T_true), cfg)
     dt, dr = pose_error(res.T_base_wobj, T_true)
     assert dt < 1e-9 and dr < 1e-9
@@ -234,7 +234,7 @@ def test_known_edge_event_offset_is_removed(rng: np.random.Generator) -> None:
     late = run_stator_procedure(LAYOUT, T_prelim, LateEdgeProbe(T_true))
     dt, dr = pose_error(late.T_base_wobj, T_true)
     assert dt > 0.002  # uncorrected, the z origin is 3 mm off
-    cfg = StatorSettings(edge_event_offset_m=0.003)
+    cfg = Hultman2013(edge_event_offset_m=0.003)
     fixed = run_stator_procedure(LAYOUT, T_prelim, LateEdgeProbe(T_true), cfg)
     dt, dr = pose_error(fixed.T_base_wobj, T_true)
     assert dt < 1e-9 and dr < 1e-9
@@ -243,16 +243,16 @@ def test_known_edge_event_offset_is_removed(rng: np.random.Generator) -> None:
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
-        ({"beta1_rad": math.pi / 2}, "beta1_rad must lie in"),
-        ({"beta1_rad": float("nan")}, "beta1_rad must lie in"),
-        ({"p3_height_m": 0.0}, "p3_height_m must be > 0"),
-        ({"edge_start_offset_m": -0.001}, "edge_start_offset_m must be >= 0"),
-        ({"edge_event_offset_m": float("inf")}, "edge_event_offset_m must be finite"),
+        ({"beta1_rad": math.pi / 2}, "beta1_rad: must lie in"),
+        ({"beta1_rad": float("nan")}, "beta1_rad: must lie in"),
+        ({"p3_height_m": 0.0}, "p3_height_m: must be > 0"),
+        ({"edge_start_offset_m": -0.001}, "edge_start_offset_m: must be >= 0"),
+        ({"edge_event_offset_m": float("inf")}, "edge_event_offset_m: must be finite"),
     ],
 )
 def test_bad_settings_raise(kwargs, match) -> None:
-    with pytest.raises(ShapeError, match=match):
-        StatorSettings(**kwargs)
+    with pytest.raises(PlanError, match=match):
+        Hultman2013(**kwargs)
 
 
 def test_points_keyed_by_role_are_commanded_under_the_role() -> None:

@@ -17,23 +17,13 @@ import msgspec
 
 from calib.plan.file import Plan, PlanError, PlanPoint, load_plan, plan_from_json, plan_to_json
 from calib.plan.json_io import canonical_json
-from calib.plan.procedures import (
-    BEST_FIT_ROLE,
-    HULTMAN_ROLES,
-    THREE_TWO_ONE_ROLES,
-    method_of,
-)
+from calib.procedures import procedure_kind
 from webui.plan_doc import UiPlan, UiPoint
 
 
 def roles_of(plan: Plan) -> tuple[str, ...]:
     """The point roles the plan's procedure allows."""
-    method = method_of(plan.procedure)
-    if method == "hultman2013":
-        return HULTMAN_ROLES
-    if method == "three_two_one":
-        return tuple(THREE_TWO_ONE_ROLES)
-    return (BEST_FIT_ROLE,)
+    return procedure_kind(plan.procedure).roles
 
 
 def ui_plan_from_plan(plan: Plan, name: str | None = None) -> UiPlan:

@@ -30,7 +30,7 @@ class UiPoint:
     Attributes:
         probe: the nominal point, normal and search, wobj frame (metres).
         role: what the point is for in the procedure (e.g. ``"A"`` for the paper's A-H
-            procedure, ``"primary"`` for 3-2-1); see ``calib.plan.procedures``.
+            procedure, ``"primary"`` for 3-2-1); see :mod:`calib.procedures`.
         speed_m_s: search speed written into robot programs, m/s.
     """
 

@@ -25,8 +25,8 @@ from calib.plan.file import (
     file_sha256,
     save_plan,
 )
-from calib.plan.procedures import ThreeTwoOne
 from calib.probing import ProbePoint
+from calib.procedures import ThreeTwoOne
 
 #: Size of the test box, metres (x, y, z); its top face is z = 0 and it lies in z < 0.
 BOX_EXTENTS = (0.6, 0.4, 0.3)

@@ -24,13 +24,13 @@ key (``"A"``... ``"H"``, ``"C2"``, ``"D2"``) and the probe's reason; bad layouts
 the sensor-TCP position the robot records at the event. For the edge searches F and H that is
 on the side face: by then the WOCS yz-plane is the plane measured through A, B, D, E and the
 search runs in it. When an edge search is started ``edge_start_offset_m`` outside the face
-(:class:`StatorSettings`), F and H are moved back by that offset before use; a point left off
+(:class:`calib.paper.settings.Hultman2013`), F and H are moved back by that offset before use;
+a point left off
 the face by ``d`` would tilt the final WOCS by about ``d / |F - D|``.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
@@ -46,6 +46,7 @@ from calib.paper.hultman import (  # the unchecked kernels: inputs are checked h
     alpha1_from_points,
     p3_estimate,
 )
+from calib.paper.settings import Hultman2013
 from calib.paper.stator_layout import (
     STATOR_POINT_IDS,
     StatorLayout,
@@ -54,14 +55,13 @@ from calib.paper.stator_layout import (
     relabel_point,
 )
 from calib.probing import Probe, ProbePoint, ProbeResult, SearchCommand
-from calib.validation import check_positive, check_vector3
+from calib.validation import check_vector3
 
 __all__ = [
     "STATOR_POINT_IDS",
     "ProcedureResult",
     "ProcedureStep",
     "StatorLayout",
-    "StatorSettings",
     "check_stator_points",
     "example_stator_points",
     "probe_from_measurements",
@@ -69,47 +69,6 @@ __all__ = [
 ]
 
 FloatArray = NDArray[np.float64]
-
-
-@dataclass(frozen=True)
-class StatorSettings:
-    """Settings of the A-H procedure.
-
-    Attributes:
-        beta1_rad: assumed inclination of the stator side from vertical (eq. 12), radians
-            (paper: 15 deg; positive when the face's top leans towards base +x, see
-            :func:`calib.paper.hultman.p3_estimate`).
-        p3_height_m: height of the constructed point P3 above B (eq. 12), metres (paper: 50 mm).
-        retake_c_d: measure C and D again at the end, as the paper does (``"C2"``, ``"D2"``);
-            when False the first C and D are reused for the final origin.
-        edge_start_from_measured: start the edge search F at the measured E and H at the
-            measured G, shifted ``edge_start_offset_m`` along the estimated WOCS +x (the
-            paper's literal wording); when False (default) F and H start where the plan's
-            search says (e.g. at E's and G's nominal height). The search still runs up
-            to the height where the plan's search ends.
-        edge_start_offset_m: the paper's "few millimeters" offset in +x of that start, metres.
-        edge_event_offset_m: how far past the true edge, along the search direction, the
-            sensor reports it (a sensor characteristic measured once on a reference edge;
-            footprint and hysteresis make it a few mm), metres; subtracted from F and H.
-    """
-
-    beta1_rad: float = math.radians(15.0)
-    p3_height_m: float = 0.050
-    retake_c_d: bool = True
-    edge_start_from_measured: bool = False
-    edge_start_offset_m: float = 0.0
-    edge_event_offset_m: float = 0.0
-
-    def __post_init__(self) -> None:
-        beta1 = float(self.beta1_rad)
-        if not (math.isfinite(beta1) and abs(beta1) < math.pi / 2):
-            raise ShapeError(f"settings.beta1_rad must lie in (-pi/2, pi/2), got {beta1}")
-        check_positive(self.p3_height_m, "settings.p3_height_m")
-        check_positive(self.edge_start_offset_m, "settings.edge_start_offset_m", allow_zero=True)
-        if not math.isfinite(float(self.edge_event_offset_m)):
-            raise ShapeError(
-                f"settings.edge_event_offset_m must be finite, got {self.edge_event_offset_m}"
-            )
 
 
 @dataclass(frozen=True)
@@ -226,7 +185,7 @@ def run_stator_procedure(
     points: Mapping[str, ProbePoint] | Sequence[ProbePoint] | StatorLayout,
     T_base_wobj_prelim: ArrayLike,
     probe: Probe | Callable[[SearchCommand], ProbeResult],
-    settings: StatorSettings | None = None,
+    settings: Hultman2013 | None = None,
 ) -> ProcedureResult:
     """Run the paper's A-H procedure (section 3.2) with ``probe`` and return the calibrated WOCS.
 
@@ -236,7 +195,8 @@ def run_stator_procedure(
         T_base_wobj_prelim: ``(4, 4)`` the preliminary ``T_base_wobj`` the first searches are
             commanded in.
         probe: runs one search and returns its result.
-        settings: beta1, P3 height and whether C and D are retaken; paper values by default.
+        settings: the A-H settings (beta1, P3 height, retakes, edge starts and offset); the
+            paper's values by default.
 
     Returns:
         The final frame, the estimate after every step, all measured points and commands.
@@ -247,7 +207,7 @@ def run_stator_procedure(
             ``(3,)`` point; measured points that define no frame (DegenerateGeometryError).
     """
     layout = check_stator_points(points)
-    cfg = StatorSettings() if settings is None else settings
+    cfg = Hultman2013() if settings is None else settings
     T0 = check_transform(T_base_wobj_prelim, "T_base_wobj_prelim")
     if T0.shape != (4, 4):
         raise ShapeError(f"T_base_wobj_prelim must be (4, 4), got {T0.shape}")
@@ -276,9 +236,9 @@ def run_stator_procedure(
     h = run.measure("H", start_m=g + off * x_now if from_measured else None)
     if from_measured:  # the TCP ran `off` outside the face: back onto it
         f, h = f - off * x_now, h - off * x_now
-    if cfg.edge_event_offset_m:  # the sensor reports the edge this far past it
-        f = f - cfg.edge_event_offset_m * run.commands["F"].direction
-        h = h - cfg.edge_event_offset_m * run.commands["H"].direction
+    if cfg.edge_offset_m:  # the sensor reports the edge this far past it
+        f = f - cfg.edge_offset_m * run.commands["F"].direction
+        h = h - cfg.edge_offset_m * run.commands["H"].direction
     R3 = _rotation_from_points(h, f, d, True, ("H", "F", "D"))
     run.rotate(R3, "final rotation from H, F, D (V2 inverted)", ("H", "F", "D"), "eq. 1-9")
     run.origin(2, "H", "z origin from H (P6)", point=h)

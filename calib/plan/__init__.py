@@ -1,4 +1,19 @@
-"""TODO"""
+"""The versioned files of wobjcal: the plan (``wobjcal.plan/1``) and the measurements.
+
+Owns:
+    - :mod:`calib.plan.file`: :class:`Plan` and its parts (:class:`PlanPoint`,
+      :class:`Search`), strict loading (:func:`load_plan`, :func:`plan_from_json`), canonical
+      saving (:func:`save_plan`, :func:`plan_to_json`), file references and their digests;
+    - :mod:`calib.plan.cell`: the cell part (robot, tool, fixtures, work object, poses);
+    - :mod:`calib.plan.models`: the validation settings (the physical models themselves are in
+      :mod:`calib.models`, the procedure settings in :mod:`calib.procedures`);
+    - :mod:`calib.plan.json_io`: strict JSON decoding with errors naming the JSON path, and the
+      generated JSON Schemas (``assets/schema/``);
+    - :mod:`calib.plan.measurements`: the measured-points file (``wobjcal.measurements/1``);
+    - :mod:`calib.plan.base`: built-in references, mesh units, sha256 checks.
+
+Pure: msgspec and numpy, no simulator. Public names are importable from ``calib.plan``.
+"""
 
 from calib.plan.file import (
     BUILTIN_PREFIX,
@@ -6,15 +21,12 @@ from calib.plan.file import (
     SUPPORTED_PLAN_SCHEMAS,
     CellSpec,
     FixtureSpec,
-    Misplacement,
     Plan,
     PlanError,
     PlanPoint,
     Pose,
-    RobotErrorModel,
     RobotSpec,
     Search,
-    SensorModel,
     ToolSpec,
     ValidationSpec,
     WorkObjectSpec,
@@ -33,15 +45,12 @@ __all__ = [
     "SUPPORTED_PLAN_SCHEMAS",
     "CellSpec",
     "FixtureSpec",
-    "Misplacement",
     "Plan",
     "PlanError",
     "PlanPoint",
     "Pose",
-    "RobotErrorModel",
     "RobotSpec",
     "Search",
-    "SensorModel",
     "ToolSpec",
     "ValidationSpec",
     "WorkObjectSpec",

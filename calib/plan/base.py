@@ -1,55 +1,24 @@
-"""Shared pieces of the plan structs: the error, the strict base struct and field checks.
+"""Pieces of the plan structs that only plans use: built-in references, mesh units, digests.
 
-Checks raise :class:`PlanError` with ``"field: message"``; when msgspec decodes a file, it adds
-the JSON path of the struct (see :func:`calib.plan.json_io.reword_validation_error`).
+The strict base struct and the generic field checks are in :mod:`calib.structs`.
 """
 
 from __future__ import annotations
 
-import math
 import re
 from typing import Literal
 
-import msgspec
-
-from calib.errors import InputError
+from calib.errors import PlanError
 
 BUILTIN_PREFIX = "builtin:"
 #: The plan's mesh units: exactly ``calib.units.MESH_UNITS`` (a test keeps them equal).
 MeshUnits = Literal["m", "mm", "cm", "in", "auto"]
-Vec3 = tuple[float, float, float]
-UNIT_TOL = 1e-6
 _SHA256_RE = re.compile(r"^[0-9a-f]{64}$")
 
 
-class PlanError(InputError):
-    """A plan file or plan object is malformed; the message names the file and JSON path."""
-
-
-class Strict(msgspec.Struct, frozen=True, forbid_unknown_fields=True, kw_only=True):
-    """Base of the plan structs: immutable, unknown fields rejected."""
-
-
-def check_finite(values: tuple[float, ...] | None, field: str) -> None:
-    if values is not None and not all(math.isfinite(v) for v in values):
-        raise PlanError(f"{field}: must hold finite numbers, got {list(values)}")
-
-
-def check_unit(values: tuple[float, ...] | None, field: str) -> None:
-    if values is None:
-        return
-    check_finite(values, field)
-    norm = math.sqrt(sum(v * v for v in values))
-    if abs(norm - 1.0) > UNIT_TOL:
-        raise PlanError(f"{field}: must be a unit vector, got length {norm:.6g}")
-
-
-def check_positive(value: float, field: str, allow_zero: bool = False) -> None:
-    if not math.isfinite(value) or value < 0 or (value == 0 and not allow_zero):
-        raise PlanError(f"{field}: must be {'>= 0' if allow_zero else '> 0'}, got {value}")
-
-
 def check_sha256(value: str | None, ref: str, field: str) -> None:
+    """Raise :class:`PlanError` unless ``value`` is ``None`` or a sha256 hex digest of a file
+    (never of a built-in)."""
     if value is None:
         return
     if ref.startswith(BUILTIN_PREFIX):

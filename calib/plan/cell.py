@@ -11,21 +11,15 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.errors import PlanError
 from calib.frames import (
     check_transform,
     make_transform,
     matrix_from_quat_wxyz,
     quat_wxyz_from_matrix,
 )
-from calib.plan.base import (
-    MeshUnits,
-    PlanError,
-    Strict,
-    Vec3,
-    check_finite,
-    check_sha256,
-    check_unit,
-)
+from calib.plan.base import MeshUnits, check_sha256
+from calib.structs import Strict, Vec3, check_finite, check_unit
 
 
 class Pose(Strict, frozen=True, kw_only=True):

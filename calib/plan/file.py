@@ -22,17 +22,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from calib.atomic_io import write_text_atomic
-from calib.plan.base import (
-    BUILTIN_PREFIX,
-    UNIT_TOL,
-    MeshUnits,
-    PlanError,
-    Strict,
-    Vec3,
-    check_finite,
-    check_positive,
-    check_unit,
-)
+from calib.errors import PlanError
+from calib.plan.base import BUILTIN_PREFIX, MeshUnits
 from calib.plan.cell import (
     CellSpec,
     FixtureSpec,
@@ -48,9 +39,11 @@ from calib.plan.json_io import (
     parse_json_text,
     read_text_file,
 )
-from calib.plan.models import Misplacement, RobotErrorModel, SensorModel, ValidationSpec
-from calib.plan.procedures import METHODS, Procedure, check_roles, method_of
+from calib.plan.models import ValidationSpec
 from calib.probing import ProbePoint, SearchSpec
+from calib.procedures import METHODS, ProcedureSettings, method_of, procedure_kind
+from calib.procedures.base import RolePoint
+from calib.structs import UNIT_TOL, Strict, Vec3, check_finite, check_positive, check_unit
 
 __all__ = [
     "BUILTIN_PREFIX",
@@ -58,15 +51,12 @@ __all__ = [
     "SUPPORTED_PLAN_SCHEMAS",
     "CellSpec",
     "FixtureSpec",
-    "Misplacement",
     "Plan",
     "PlanError",
     "PlanPoint",
     "Pose",
-    "RobotErrorModel",
     "RobotSpec",
     "Search",
-    "SensorModel",
     "ToolSpec",
     "ValidationSpec",
     "WorkObjectSpec",
@@ -116,7 +106,7 @@ class PlanPoint(Strict, frozen=True, kw_only=True):
 
     Attributes:
         id: unique name, e.g. ``"A"``.
-        role: the point's role in the procedure (see ``calib.plan.procedures``).
+        role: the point's role in the procedure (see :mod:`calib.procedures`).
         position_m: ``(3,)`` nominal surface (or edge) point, wobj frame, metres.
         normal: ``(3,)`` unit outward normal of the face, wobj frame.
         search: how the point is searched for.
@@ -195,7 +185,7 @@ class Plan(Strict, frozen=True, kw_only=True):
     cell: CellSpec = CellSpec()
     work_object: WorkObjectSpec = WorkObjectSpec()
     points: list[PlanPoint] = []  # noqa: RUF012 (msgspec copies empty defaults)
-    procedure: Procedure
+    procedure: ProcedureSettings
     validation: ValidationSpec = ValidationSpec()
 
     def __post_init__(self) -> None:
@@ -209,7 +199,7 @@ class Plan(Strict, frozen=True, kw_only=True):
         names = [f.name for f in self.cell.fixtures]
         if len(set(names)) != len(names):
             raise PlanError(f"cell.fixtures: duplicate fixture names in {names}")
-        msg = check_roles(self.procedure, [p.role for p in self.points], complete=False)
+        msg = procedure_kind(self.procedure).role_problem([p.role for p in self.points], False)
         if msg:
             raise PlanError(msg)
 
@@ -220,7 +210,7 @@ class Plan(Strict, frozen=True, kw_only=True):
 
     def require_complete(self) -> None:
         """Raise :class:`PlanError` unless the points have all roles the procedure needs."""
-        msg = check_roles(self.procedure, [p.role for p in self.points], complete=True)
+        msg = procedure_kind(self.procedure).role_problem([p.role for p in self.points], True)
         if msg:
             raise PlanError(msg)
 
@@ -238,6 +228,10 @@ class Plan(Strict, frozen=True, kw_only=True):
     def roles(self) -> dict[str, str]:
         """Role of each point, by id."""
         return {p.id: p.role for p in self.points}
+
+    def role_points(self) -> list[RolePoint]:
+        """Every point with its role, in plan order (what the procedures take)."""
+        return [RolePoint(p.role, p.to_probe_point()) for p in self.points]
 
 
 def file_sha256(path: str | Path) -> str:

@@ -11,7 +11,7 @@ from rich.table import Table
 
 from calib.frames import motion_between, quat_wxyz_from_matrix, tait_bryan_zyx_from_matrix
 from calib.plan.measurements import load_measurements
-from calib.plan.procedures import METHODS
+from calib.procedures import METHODS
 from planner.calibrate import CalibrationOutput, calibrate_plan
 from planner.cli.common import print_json, read_plan, stdout
 from planner.export.krl import BASE_NO, frame_text

@@ -17,8 +17,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from calib.frames import check_transform, make_transform
+from calib.paper.settings import Hultman2013
 from calib.plan.file import Plan
 from calib.probing import SearchCommand
+from calib.procedures import procedure_kind
 from planner.export.safety import SafetySpec
 
 FloatArray = NDArray[np.float64]
@@ -97,28 +99,17 @@ class ToolData:
 
 @dataclass(frozen=True)
 class AdaptiveSpec:
-    """The paper's A-H procedure as the program runs it (``hultman2013`` plans).
+    """A procedure the program runs adaptively: the paper's A-H (``hultman2013`` plans).
 
     Attributes:
         index: ``{role: i}`` the target index (0-based, plan order) of each role ``A``..``H``.
-        beta1_rad: assumed inclination of the side face (eq. 12), rad.
-        p3_height_m: height of P3 above B (eq. 12), m.
-        retake_c_d: C and D are measured again at the end (``C2``, ``D2``).
-        edge_start_from_measured: F and H start at the measured E and G (else at an approach
-            search of the face at the plan's edge start).
-        edge_start_offset_m: offset of that start along the estimated +x, m.
-        edge_event_offset_m: how far past the edge the sensor reports it, m (0 when the plan
-            leaves it unset, as ``wobjcal calibrate`` does).
+        settings: the plan's A-H settings (an unset edge-event offset counts as 0, as
+            ``wobjcal calibrate`` does: :attr:`Hultman2013.edge_offset_m`).
         face_coords_wobj: x of the side face, y of the short side, z of the top, wobj, m.
     """
 
     index: dict[str, int]
-    beta1_rad: float
-    p3_height_m: float
-    retake_c_d: bool
-    edge_start_from_measured: bool
-    edge_start_offset_m: float
-    edge_event_offset_m: float
+    settings: Hultman2013
     face_coords_wobj: tuple[float, float, float]
 
 
@@ -268,27 +259,15 @@ def safety_spec(plan: Plan) -> SafetySpec:
 
 
 def adaptive_spec(plan: Plan) -> AdaptiveSpec | None:
-    """The A-H procedure of a complete ``hultman2013`` plan, else ``None``."""
-    if plan.method != "hultman2013":
+    """How the program runs the plan's procedure adaptively, or ``None``: every search in the
+    nominal frame (the procedure has no adaptive layout, or the plan lacks a role)."""
+    layout = procedure_kind(plan.procedure).adaptive_layout(plan.role_points())
+    if layout is None or not isinstance(plan.procedure, Hultman2013):
         return None
-    from calib.paper.stator_layout import check_stator_points
-    from calib.plan.procedures import Hultman2013
-    from planner.plan_cell import hultman_points
-
-    roles = [p.role for p in plan.points]
-    if sorted(roles) != sorted("ABCDEFGH"):
-        return None
-    layout = check_stator_points(hultman_points(plan))
-    proc = plan.procedure if isinstance(plan.procedure, Hultman2013) else Hultman2013()
     face = layout.face_coords_wobj
     return AdaptiveSpec(
-        index={r: i for i, r in enumerate(roles)},
-        beta1_rad=proc.beta1_rad,
-        p3_height_m=proc.p3_height_m,
-        retake_c_d=proc.retake_c_d,
-        edge_start_from_measured=proc.edge_start_from_measured,
-        edge_start_offset_m=proc.edge_start_offset_m,
-        edge_event_offset_m=proc.edge_event_offset_m or 0.0,
+        index={p.role: i for i, p in enumerate(plan.points)},
+        settings=plan.procedure,
         face_coords_wobj=(float(face[0]), float(face[1]), float(face[2])),
     )
 

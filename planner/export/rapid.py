@@ -112,7 +112,7 @@ def measured_slots(job: ExportJob) -> list[tuple[str, bool]]:
     """``(point id, is a retake)`` of each entry of the RAPID ``measured`` array, in order."""
     slots = [(t.point_id, False) for t in job.targets]
     a = job.adaptive
-    if a is not None and a.retake_c_d:
+    if a is not None and a.settings.retake_c_d:
         slots += [(job.targets[a.index[r]].point_id, True) for r in ("C", "D")]
     return slots
 
@@ -167,8 +167,8 @@ def export_rapid(job: ExportJob) -> str:
     ]
     for t, name in zip(job.targets, names, strict=True):
         start_at = None
-        if a is not None and a.edge_start_from_measured and t.role in ("F", "H"):
-            start_at = a.edge_start_offset_m
+        if a is not None and a.settings.edge_start_from_measured and t.role in ("F", "H"):
+            start_at = a.settings.edge_start_offset_m
         lines += probe_proc(t, name, start_at)
     lines += write_proc()
     lines.append("ENDMODULE")

@@ -46,14 +46,14 @@ def adaptive_procs(job: ExportJob) -> list[str]:
     """Constants and the routines of the frame update."""
     a = job.adaptive
     assert a is not None
-    back = a.edge_start_offset_m if a.edge_start_from_measured else 0.0
+    back = a.settings.edge_start_offset_m if a.settings.edge_start_from_measured else 0.0
     u = f"{WOBJ}.uframe"
     return [
         "    ! A-H procedure settings (mm, degrees)",
-        f"    CONST num nTanBeta1:={fmt(math.tan(a.beta1_rad), 12)};",
-        f"    CONST num nP3Height:={fmt(a.p3_height_m * 1000.0, 6)};",
+        f"    CONST num nTanBeta1:={fmt(math.tan(a.settings.beta1_rad), 12)};",
+        f"    CONST num nP3Height:={fmt(a.settings.p3_height_m * 1000.0, 6)};",
         f"    CONST num nEdgeBack:={fmt(back * 1000.0, 6)};",
-        f"    CONST num nEdgeEvent:={fmt(a.edge_event_offset_m * 1000.0, 6)};",
+        f"    CONST num nEdgeEvent:={fmt(a.settings.edge_offset_m * 1000.0, 6)};",
         f"    CONST num nFaceX:={fmt(a.face_coords_wobj[0] * 1000.0, 6)};",
         f"    CONST num nFaceY:={fmt(a.face_coords_wobj[1] * 1000.0, 6)};",
         f"    CONST num nFaceZ:={fmt(a.face_coords_wobj[2] * 1000.0, 6)};",
@@ -131,9 +131,9 @@ def adaptive_main(job: ExportJob, names: list[str]) -> list[str]:
         arg = f",{start_from}" if start_from else ""
         return [f"{ind}Probe_{name[role]} {i}{arg};", f"{ind}Require {i};"]
 
-    from_e = m["E"] if a.edge_start_from_measured else None
-    from_g = m["G"] if a.edge_start_from_measured else None
-    c2, d2 = (n + 1, n + 2) if a.retake_c_d else (idx["C"], idx["D"])
+    from_e = m["E"] if a.settings.edge_start_from_measured else None
+    from_g = m["G"] if a.settings.edge_start_from_measured else None
+    c2, d2 = (n + 1, n + 2) if a.settings.retake_c_d else (idx["C"], idx["D"])
     lines = [
         f"{ind}! 1: A, B in the preliminary frame; alpha1, P3 (eq. 11-12); rotation (eq. 1-9)",
         *probe("A", idx["A"]),
@@ -160,11 +160,11 @@ def adaptive_main(job: ExportJob, names: list[str]) -> list[str]:
         f"{ind}SetRotation pF-pH,pF-{m['D']};",
         f"{ind}! 7: z origin from H",
         f"{ind}ShiftOrigin [0,0,1],pH,nFaceZ;",
-        f"{ind}! 8: C{' retaken' if a.retake_c_d else ''}, y origin",
-        *(probe("C", c2) if a.retake_c_d else []),
+        f"{ind}! 8: C{' retaken' if a.settings.retake_c_d else ''}, y origin",
+        *(probe("C", c2) if a.settings.retake_c_d else []),
         f"{ind}ShiftOrigin [0,1,0],measured{{{c2}}},nFaceY;",
-        f"{ind}! 9: D{' retaken' if a.retake_c_d else ''}, x origin",
-        *(probe("D", d2) if a.retake_c_d else []),
+        f"{ind}! 9: D{' retaken' if a.settings.retake_c_d else ''}, x origin",
+        *(probe("D", d2) if a.settings.retake_c_d else []),
         f"{ind}ShiftOrigin [1,0,0],measured{{{d2}}},nFaceX;",
         f'{ind}TPWrite "wobjcal: A-H done, {WOBJ} is the calibrated work object";',
     ]

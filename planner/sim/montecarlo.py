@@ -30,22 +30,23 @@ from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import InputError, ShapeError
 from calib.frames import check_transform
-from calib.paper.stator_procedure import StatorSettings, check_stator_points
+from calib.models import Misplacement, RobotErrorModel
+from calib.models.proximity import ProximitySensor
+from calib.paper.settings import Hultman2013
+from calib.paper.stator_procedure import check_stator_points
 from calib.probing import ProbePoint
 from planner.parts.stator import StatorGeometry
 from planner.parts.stator_mesh import build_stator_mesh
-from planner.sim.error_models import Misplacement, RobotErrorModel
 from planner.sim.probe import ReachabilityHook, cell_search_hook
-from planner.sim.proximity import ProximitySensor
 from planner.sim.report import ValidationReport, build_report
 from planner.sim.trial import (
     DEFAULT_EDGE_INSET_M,
-    WORKER,
     SimulationSetup,
     TrialResult,
+    TrialRunner,
     default_settings,
     init_worker,
-    run_chunk,
+    run_chunk_in_worker,
 )
 
 __all__ = [
@@ -82,7 +83,7 @@ def validate(
     procedure: str = "hultman2013",
     mesh: trimesh.Trimesh | None = None,
     pivot_wobj_m: ArrayLike | None = None,
-    settings: StatorSettings | None = None,
+    settings: Hultman2013 | None = None,
     reachability: ReachabilityHook | None = None,
     cell: Any = None,
     reach_trials: int | None = None,
@@ -138,7 +139,9 @@ def validate(
     if misplacement is None:
         misplacement = Misplacement()
     elif isinstance(misplacement, tuple):
-        misplacement = Misplacement(*misplacement)
+        misplacement = Misplacement(
+            max_translation_m=misplacement[0], max_angle_rad=misplacement[1]
+        )
     robot_error = robot_error or RobotErrorModel()
     sensor = sensor or ProximitySensor()
     pivot = default_pivot(points) if pivot_wobj_m is None else np.asarray(pivot_wobj_m, float)
@@ -169,7 +172,6 @@ def validate(
         n_workers = 1
     t0 = time.perf_counter()
     T_cell = None if cell is None else cell.T_world_wobj
-    WORKER["cell"] = cell
 
     def vetted(done: int, total: int) -> None:  # progress over all trials, vetted ones first
         if progress is not None:
@@ -182,11 +184,11 @@ def validate(
     try:
         results = []
         if n_reach:
-            results = _run_all(setup, part, seeds[:n_reach], 1, reachability, vetted)
+            # vetted trials run here: they move the cell's part to where it really lies
+            results = _run_all(setup, part, seeds[:n_reach], 1, reachability, vetted, cell)
         if n_reach < n_trials:
             results += _run_all(setup, part, seeds[n_reach:], n_workers, None, later)
     finally:
-        WORKER.pop("cell", None)
         if cell is not None:
             cell.move_work_object(T_cell)
     elapsed = time.perf_counter() - t0
@@ -212,21 +214,24 @@ def _run_all(
     n_workers: int,
     reach: ReachabilityHook | None,
     progress: ProgressCallback | None,
+    cell: Any = None,
 ) -> list[TrialResult]:
+    """Run ``seeds`` in this process (1 worker; the only place a ``reach`` hook or a ``cell``
+    is used) or on a process pool, each process with its own :class:`TrialRunner`."""
     total = len(seeds)
     chunk = max(1, min(100, math.ceil(total / (8 * n_workers))))
     chunks = [seeds[i : i + chunk] for i in range(0, total, chunk)]
     out: list[TrialResult] = []
     if n_workers == 1:
-        init_worker(setup, mesh)
+        runner = TrialRunner(setup, mesh, cell)
         for c in chunks:
-            out.extend(run_chunk(c, reach))
+            out.extend(runner.run_chunk(c, reach))
             if progress is not None:
                 progress(len(out), total)
         return out
     ctx = mp.get_context("fork") if "fork" in mp.get_all_start_methods() else None
     with ProcessPoolExecutor(n_workers, ctx, init_worker, (setup, mesh)) as pool:
-        for res in pool.map(run_chunk, chunks):
+        for res in pool.map(run_chunk_in_worker, chunks):
             out.extend(res)
             if progress is not None:
                 progress(len(out), total)

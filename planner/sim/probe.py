@@ -2,7 +2,7 @@
 
 The robot moves the sensor TCP along the commanded straight path; where it really is differs by
 its repeatability (a fresh offset per search) and, optionally, a smooth absolute-accuracy field.
-The sensor model (:mod:`planner.sim.proximity`) decides where it switches, from a ray bundle cast
+The sensor model (:mod:`calib.models.proximity`) decides where it switches, from a ray bundle cast
 against the true part. The probe returns what the robot controller records: the *commanded*
 TCP position at the switching event, in the base frame.
 
@@ -27,10 +27,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from calib.frames import check_transform, invert_transform
+from calib.models.proximity import ProximitySensor
+from calib.models.robot_error import AccuracyField, RobotErrorModel
 from calib.probing import ProbeResult, SearchCommand
 from planner.parts.stator import StatorGeometry
-from planner.sim.error_models import AccuracyField, RobotErrorModel
-from planner.sim.proximity import ProximitySensor
 from planner.sim.raycast import MeshRayCaster
 from planner.sim.search_events import (
     ProbeEvent,

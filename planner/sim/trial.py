@@ -12,6 +12,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import msgspec
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
@@ -20,12 +21,14 @@ from calib.errors import InputError, ProbeFailedError
 from calib.estimators.best_fit import best_fit
 from calib.estimators.layout import constraint_set
 from calib.frames import motion_between
-from calib.paper.stator_procedure import StatorSettings, check_stator_points, run_stator_procedure
+from calib.models import AccuracyField, Misplacement, RobotErrorModel
+from calib.models.proximity import ProximitySensor
+from calib.paper.settings import Hultman2013
+from calib.paper.stator_procedure import check_stator_points, run_stator_procedure
 from calib.probing import ProbePoint
+from calib.procedures.hultman2013 import ROLES
 from planner.parts.stator import StatorGeometry
-from planner.sim.error_models import AccuracyField, Misplacement, RobotErrorModel
 from planner.sim.probe import ReachabilityHook, SimulatedProbe
-from planner.sim.proximity import ProximitySensor
 from planner.sim.raycast import MeshRayCaster
 
 FloatArray = NDArray[np.float64]
@@ -36,7 +39,7 @@ DEFAULT_EDGE_INSET_M = 0.003
 
 def default_settings(
     sensor: ProximitySensor, edge_inset_m: float = DEFAULT_EDGE_INSET_M, **kwargs: Any
-) -> StatorSettings:
+) -> Hultman2013:
     """A-H settings for a simulation: ``kwargs`` (e.g. ``beta1_rad``) plus, unless given, the
     sensor's analytic straight-edge offset for ``edge_inset_m`` as ``edge_event_offset_m``.
 
@@ -44,7 +47,19 @@ def default_settings(
     default sensor, and the WOCS z origin is off by as much.
     """
     kwargs.setdefault("edge_event_offset_m", sensor.edge_event_offset_m(edge_inset_m))
-    return StatorSettings(**kwargs)
+    return Hultman2013(**kwargs)
+
+
+def resolved_settings(
+    settings: Hultman2013, sensor: ProximitySensor, edge_inset_m: float = DEFAULT_EDGE_INSET_M
+) -> Hultman2013:
+    """``settings`` with an unset edge-event offset replaced by the sensor's analytic
+    straight-edge offset at ``edge_inset_m`` (what a robot cell measures once on a reference
+    edge; see :meth:`ProximitySensor.edge_event_offset_m`)."""
+    if settings.edge_event_offset_m is not None:
+        return settings
+    offset = sensor.edge_event_offset_m(edge_inset_m)
+    return msgspec.structs.replace(settings, edge_event_offset_m=offset)
 
 
 @dataclass(frozen=True)
@@ -73,7 +88,7 @@ class SimulationSetup:
     misplacement: Misplacement
     pivot_wobj_m: FloatArray
     accuracy_field: AccuracyField | None = None
-    settings: StatorSettings | None = None
+    settings: Hultman2013 | None = None
     edge_inset_m: float = DEFAULT_EDGE_INSET_M
     edge_tolerance_m: float = 2e-5
 
@@ -100,58 +115,83 @@ class TrialResult:
     delta_best_fit: FloatArray
 
 
-WORKER: dict[str, object] = {}
+class TrialRunner:
+    """Runs trials of one setup: holds the part's ray caster and the A-H layout (built once).
+
+    Args:
+        setup: what every trial shares.
+        mesh: the true part mesh in its own (wobj) frame, metres.
+        cell: optional cell whose work object each trial moves to the true part pose before
+            the searches are vetted by a reachability hook (in this process only; the cell is
+            not picklable). ``None``: no cell.
+    """
+
+    def __init__(self, setup: SimulationSetup, mesh: trimesh.Trimesh, cell: Any = None) -> None:
+        self.setup = setup
+        self.caster = MeshRayCaster(mesh)
+        self.layout = check_stator_points(setup.points)
+        self.constraints = constraint_set([setup.points[k] for k in ROLES])
+        self.cell = cell
+
+    def run_trial(
+        self, seed: np.random.SeedSequence, reach: ReachabilityHook | None
+    ) -> TrialResult:
+        """One simulated calibration with its own misplacement and noise from ``seed``."""
+        setup = self.setup
+        rng = np.random.default_rng(seed)
+        T_nom = setup.T_base_wobj_nominal
+        T_true = T_nom @ setup.misplacement.sample(rng, setup.pivot_wobj_m)
+        if self.cell is not None and reach is not None:  # the cell's part goes where it really is
+            self.cell.move_work_object(self.cell.T_world_base @ T_true)
+        probe = SimulatedProbe(
+            self.caster,
+            T_true,
+            rng,
+            sensor=setup.sensor,
+            robot_error=setup.robot_error,
+            accuracy_field=setup.accuracy_field,
+            geometry=setup.geometry,
+            reachability=reach,
+            edge_inset_m=setup.edge_inset_m,
+            edge_tolerance_m=setup.edge_tolerance_m,
+        )
+        nan6 = np.full(6, np.nan)
+        failure = ""
+        d_proc = d_fit = nan6
+        settings = setup.settings
+        assert settings is not None  # set in SimulationSetup.__post_init__
+        try:
+            res = run_stator_procedure(self.layout, T_nom, probe, settings)
+            d_proc = motion_between(T_true, res.T_base_wobj)
+            q = np.array([res.measured_m[k] for k in ROLES])
+            edge = settings.edge_offset_m  # the same known edge offset as the procedure
+            for k in ("F", "H"):
+                q[ROLES.index(k)] -= edge * res.commands[k].direction
+            fit = best_fit(self.constraints, q, T_nom, sigma_m=1e-4)
+            d_fit = motion_between(T_true, fit.T_base_wobj)
+        except ProbeFailedError as exc:
+            failure = f"{exc.point_id}: {exc.reason}"
+        except InputError as exc:  # degenerate measurements: a failed calibration, not a crash
+            failure = f"procedure: {exc}"
+        landings = tuple(f"{e.point_id}: {e.landing}" for e in probe.events if e.landing)
+        return TrialResult(failure, landings, d_proc, d_fit)
+
+    def run_chunk(
+        self, seeds: list[np.random.SeedSequence], reach: ReachabilityHook | None = None
+    ) -> list[TrialResult]:
+        """Trials of ``seeds`` in order."""
+        return [self.run_trial(s, reach) for s in seeds]
+
+
+#: The runner of a worker process (set by :func:`init_worker`, the pool's initializer).
+_PROCESS_RUNNER: list[TrialRunner] = []
 
 
 def init_worker(setup: SimulationSetup, mesh: trimesh.Trimesh) -> None:
-    WORKER["setup"] = setup
-    WORKER["caster"] = MeshRayCaster(mesh)
-    WORKER["layout"] = check_stator_points(setup.points)
-    pts = [setup.points[k] for k in "ABCDEFGH"]
-    WORKER["constraints"] = constraint_set(pts)
+    """Process-pool initializer: build this process's :class:`TrialRunner` (no cell)."""
+    _PROCESS_RUNNER[:] = [TrialRunner(setup, mesh)]
 
 
-def run_trial(seed: np.random.SeedSequence, reach: ReachabilityHook | None) -> TrialResult:
-    setup: SimulationSetup = WORKER["setup"]  # type: ignore[assignment]
-    rng = np.random.default_rng(seed)
-    T_nom = setup.T_base_wobj_nominal
-    T_true = T_nom @ setup.misplacement.sample(rng, setup.pivot_wobj_m)
-    cell = WORKER.get("cell")
-    if cell is not None and reach is not None:  # the cell's part goes where it really is
-        cell.move_work_object(cell.T_world_base @ T_true)  # type: ignore[attr-defined]
-    probe = SimulatedProbe(
-        WORKER["caster"],  # type: ignore[arg-type]
-        T_true,
-        rng,
-        sensor=setup.sensor,
-        robot_error=setup.robot_error,
-        accuracy_field=setup.accuracy_field,
-        geometry=setup.geometry,
-        reachability=reach,
-        edge_inset_m=setup.edge_inset_m,
-        edge_tolerance_m=setup.edge_tolerance_m,
-    )
-    nan6 = np.full(6, np.nan)
-    failure = ""
-    d_proc = d_fit = nan6
-    try:
-        res = run_stator_procedure(WORKER["layout"], T_nom, probe, setup.settings)  # type: ignore[arg-type]
-        d_proc = motion_between(T_true, res.T_base_wobj)
-        q = np.array([res.measured_m[k] for k in "ABCDEFGH"])
-        edge = setup.settings.edge_event_offset_m  # type: ignore[union-attr]  # the same known edge offset as the procedure
-        q[5] -= edge * res.commands["F"].direction
-        q[7] -= edge * res.commands["H"].direction
-        fit = best_fit(WORKER["constraints"], q, T_nom, sigma_m=1e-4)  # type: ignore[arg-type]
-        d_fit = motion_between(T_true, fit.T_base_wobj)
-    except ProbeFailedError as exc:
-        failure = f"{exc.point_id}: {exc.reason}"
-    except InputError as exc:  # degenerate measurements: a failed calibration, not a crash
-        failure = f"procedure: {exc}"
-    landings = tuple(f"{e.point_id}: {e.landing}" for e in probe.events if e.landing)
-    return TrialResult(failure, landings, d_proc, d_fit)
-
-
-def run_chunk(
-    seeds: list[np.random.SeedSequence], reach: ReachabilityHook | None = None
-) -> list[TrialResult]:
-    return [run_trial(s, reach) for s in seeds]
+def run_chunk_in_worker(seeds: list[np.random.SeedSequence]) -> list[TrialResult]:
+    """Run ``seeds`` on this worker process's runner (see :func:`init_worker`)."""
+    return _PROCESS_RUNNER[0].run_chunk(seeds)

@@ -66,7 +66,7 @@ CASES: dict[str, Callable[[Any], None]] = {
 def write_valid() -> None:
     """A small valid 3-2-1 plan on the stator section's three faces (WOCS of ARCHITECTURE.md)."""
     from calib.plan.file import Plan, PlanPoint, Pose, Search, WorkObjectSpec, save_plan
-    from calib.plan.procedures import ThreeTwoOne
+    from calib.procedures import ThreeTwoOne
 
     s = 1 / math.sqrt(2)
     x, y, z = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)

@@ -1,4 +1,9 @@
-"""Inductive proximity-sensor model: when does an M18 shielded sensor switch over a real part?
+"""The inductive proximity sensor: when does an M18 shielded sensor switch over a real part?
+
+This struct is the one definition of the sensor: the plan file holds it
+(``validation.sensor``), the simulation casts its ray bundle (:mod:`planner.sim.probe`), the
+planar-face check sizes its footprint with it, and the exporters take its sensing distance for
+the safe starts.
 
 The sensor face is a disk (diameter ``face_diameter_m``) sampled by a bundle of equal-area rays
 cast along the sensor axis. A ray that meets metal at distance ``d`` from the face contributes
@@ -15,38 +20,47 @@ that only partly covers the sensor (a slot hole, an edge) switches closer: over 
 holes change the reading in the same way, through the ray distances. The sensor TCP lies at
 ``Sn`` in front of the face, so on a full flat target the TCP is on the surface at the switch.
 
-Defaults and their sources are in ``docs/simulation.md``.
+Defaults and their sources are in ``docs/simulation.md``. Pure numpy: no ray casting here.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from functools import cached_property
+from functools import lru_cache
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
-from calib.errors import ShapeError
-from calib.validation import check_positive
+from calib.errors import PlanError
+from calib.structs import Strict, check_count, check_positive
 
 FloatArray = NDArray[np.float64]
 
 _GOLDEN_ANGLE = math.pi * (3.0 - math.sqrt(5.0))
 
 
+@lru_cache(maxsize=32)
+def _sunflower(n: int, radius_m: float) -> FloatArray:
+    pts = np.zeros((1, 2))
+    if n > 1:
+        i = np.arange(n)
+        r = radius_m * np.sqrt((i + 0.5) / n)
+        theta = i * _GOLDEN_ANGLE
+        pts = np.column_stack([r * np.cos(theta), r * np.sin(theta)])
+    pts.flags.writeable = False
+    return pts
+
+
 def sunflower_disk(n: int, radius_m: float) -> FloatArray:
-    """``(n, 2)`` equal-area sample points on a disk (Vogel's sunflower); one point: the centre."""
-    if n == 1:
-        return np.zeros((1, 2))
-    i = np.arange(n)
-    r = radius_m * np.sqrt((i + 0.5) / n)
-    theta = i * _GOLDEN_ANGLE
-    return np.column_stack([r * np.cos(theta), r * np.sin(theta)])
+    """``(n, 2)`` equal-area sample points on a disk (Vogel's sunflower); one point: the centre.
+
+    The array is shared and read-only.
+    """
+    return _sunflower(int(n), float(radius_m))
 
 
-@dataclass(frozen=True)
-class ProximitySensor:
+class ProximitySensor(Strict, frozen=True, kw_only=True):
     """A cylindrical shielded inductive proximity sensor (defaults: M18, Sn = 8 mm).
 
     Attributes:
@@ -59,6 +73,9 @@ class ProximitySensor:
         n_scan_rays: fewer rays used only to scan an edge search coarsely before refining.
     """
 
+    #: The sensor kind's name in the sensor registry (:mod:`planner.sim.sensors`).
+    KIND: ClassVar[str] = "proximity"
+
     face_diameter_m: float = 0.018
     sensing_distance_m: float = 0.008
     decay_length_m: float = 0.0016
@@ -68,15 +85,13 @@ class ProximitySensor:
     n_scan_rays: int = 19
 
     def __post_init__(self) -> None:
-        check_positive(self.face_diameter_m, "sensor.face_diameter_m", allow_zero=True)
-        check_positive(self.sensing_distance_m, "sensor.sensing_distance_m")
-        check_positive(self.decay_length_m, "sensor.decay_length_m")
-        check_positive(self.hysteresis_fraction, "sensor.hysteresis_fraction", allow_zero=True)
-        check_positive(self.repeatability_sigma_m, "sensor.repeatability_sigma_m", allow_zero=True)
-        for name in ("n_rays", "n_scan_rays"):
-            value = getattr(self, name)
-            if not isinstance(value, int) or value < 1:
-                raise ShapeError(f"sensor.{name} must be a positive integer, got {value!r}")
+        check_positive(self.face_diameter_m, "face_diameter_m", allow_zero=True)
+        check_positive(self.sensing_distance_m, "sensing_distance_m")
+        check_positive(self.decay_length_m, "decay_length_m")
+        check_positive(self.hysteresis_fraction, "hysteresis_fraction", allow_zero=True)
+        check_positive(self.repeatability_sigma_m, "repeatability_sigma_m", allow_zero=True)
+        check_count(self.n_rays, "n_rays")
+        check_count(self.n_scan_rays, "n_scan_rays")
 
     @classmethod
     def ideal(cls) -> ProximitySensor:
@@ -89,21 +104,56 @@ class ProximitySensor:
             n_scan_rays=1,
         )
 
+    # ------------------------------------------------------------------ geometry
     @property
     def radius_m(self) -> float:
         """Face radius, m."""
         return self.face_diameter_m / 2
 
-    @cached_property
+    @property
+    def footprint_radius_m(self) -> float:
+        """Radius of the area that must lie on one planar face under the sensor, m."""
+        return self.radius_m
+
+    @property
+    def standoff_m(self) -> float:
+        """Distance from the sensor face to the TCP (the surface point at the switch), m."""
+        return self.sensing_distance_m
+
+    @property
     def face_points_m(self) -> FloatArray:
-        """``(n_rays, 2)`` ray origins on the face, sensor-face coordinates, m."""
+        """``(n_rays, 2)`` ray origins on the face, sensor-face coordinates, m (read-only)."""
         return sunflower_disk(self.n_rays, self.radius_m)
 
-    @cached_property
+    @property
     def scan_points_m(self) -> FloatArray:
-        """``(n_scan_rays, 2)`` coarse ray origins on the face, m."""
+        """``(n_scan_rays, 2)`` coarse ray origins on the face, m (read-only)."""
         return sunflower_disk(self.n_scan_rays, self.radius_m)
 
+    def face_frame(self, axis: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Two unit vectors ``(u, v)`` spanning the face, perpendicular to ``axis`` ``(3,)``."""
+        ax, ay, az = (float(c) for c in axis)
+        # u = axis x helper, helper = e_x unless the axis is close to it (then e_y)
+        u = np.array([0.0, az, -ay]) if abs(ax) < 0.9 else np.array([-az, 0.0, ax])
+        u /= math.sqrt(float(u @ u))
+        v = np.array([ay * u[2] - az * u[1], az * u[0] - ax * u[2], ax * u[1] - ay * u[0]])
+        return u, v
+
+    def face_offsets_m(self, axis: FloatArray, coarse: bool = False) -> FloatArray:
+        """``(n, 3)`` ray-origin offsets from the face centre for a sensor axis ``(3,)``, m."""
+        pts = self.scan_points_m if coarse else self.face_points_m
+        u, v = self.face_frame(axis)
+        return pts[:, :1] * u + pts[:, 1:] * v
+
+    def ray_origins(self, tcp_m: FloatArray, axis: FloatArray, coarse: bool = False) -> FloatArray:
+        """Ray origins on the face for TCP position(s) ``(..., 3)``: ``(..., n, 3)``, same frame.
+
+        The face centre lies ``Sn`` behind the TCP along ``axis``.
+        """
+        centre = np.asarray(tcp_m, float) - self.sensing_distance_m * np.asarray(axis, float)
+        return centre[..., None, :] + self.face_offsets_m(axis, coarse)
+
+    # ------------------------------------------------------------------ response
     def signal(self, distances_m: FloatArray) -> FloatArray:
         """Damping signal ``(...)`` from face-to-metal distances ``(..., n)`` (m, ``inf``: none).
 
@@ -136,9 +186,13 @@ class ProximitySensor:
         return self.decay_length_m * math.log(self.on_level(jitter_m) / s0)
 
     def coverage_shift_m(self, covered_fraction: float) -> float:
-        """How much closer the switch happens over a flat face covering ``covered_fraction``, m."""
+        """How much closer the switch happens over a flat face covering ``covered_fraction``, m.
+
+        Raises:
+            PlanError: ``covered_fraction`` is not in ``(0, 1]``.
+        """
         if not 0.0 < covered_fraction <= 1.0:
-            raise ShapeError(f"covered_fraction must be in (0, 1], got {covered_fraction}")
+            raise PlanError(f"covered_fraction must be in (0, 1], got {covered_fraction}")
         return self.decay_length_m * math.log(1.0 / covered_fraction)
 
     def edge_event_offset_m(self, inset_m: float) -> float:
@@ -149,11 +203,14 @@ class ProximitySensor:
         the covered fraction ``c(t) = (acos(t/R) - (t/R) sqrt(1 - (t/R)^2)) / pi`` of the disk
         falls to ``off_level() exp(-inset / lambda)``. Solved for ``t`` on the exact disk, not
         the ray bundle: this is the analytic bias of an edge search, which a robot program
-        measures once on a reference edge (``StatorSettings.edge_event_offset_m``).
+        measures once on a reference edge (the A-H settings' ``edge_event_offset_m``).
+
+        Raises:
+            PlanError: the inset is too small for the sensor to detect the face at all.
         """
         c_off = self.off_level() * math.exp(-float(inset_m) / self.decay_length_m)
         if c_off >= 1.0:
-            raise ShapeError(
+            raise PlanError(
                 f"edge inset {inset_m} m is too small: the sensor would not detect the face"
             )
         r = self.radius_m
@@ -178,26 +235,3 @@ class ProximitySensor:
         if self.repeatability_sigma_m == 0.0:
             return 0.0
         return float(rng.normal(0.0, self.repeatability_sigma_m))
-
-    def face_frame(self, axis: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """Two unit vectors ``(u, v)`` spanning the face, perpendicular to ``axis`` ``(3,)``."""
-        ax, ay, az = (float(c) for c in axis)
-        # u = axis x helper, helper = e_x unless the axis is close to it (then e_y)
-        u = np.array([0.0, az, -ay]) if abs(ax) < 0.9 else np.array([-az, 0.0, ax])
-        u /= math.sqrt(float(u @ u))
-        v = np.array([ay * u[2] - az * u[1], az * u[0] - ax * u[2], ax * u[1] - ay * u[0]])
-        return u, v
-
-    def face_offsets_m(self, axis: FloatArray, coarse: bool = False) -> FloatArray:
-        """``(n, 3)`` ray-origin offsets from the face centre for a sensor axis ``(3,)``, m."""
-        pts = self.scan_points_m if coarse else self.face_points_m
-        u, v = self.face_frame(axis)
-        return pts[:, :1] * u + pts[:, 1:] * v
-
-    def ray_origins(self, tcp_m: FloatArray, axis: FloatArray, coarse: bool = False) -> FloatArray:
-        """Ray origins on the face for TCP position(s) ``(..., 3)``: ``(..., n, 3)``, same frame.
-
-        The face centre lies ``Sn`` behind the TCP along ``axis``.
-        """
-        centre = np.asarray(tcp_m, float) - self.sensing_distance_m * np.asarray(axis, float)
-        return centre[..., None, :] + self.face_offsets_m(axis, coarse)

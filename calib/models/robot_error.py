@@ -1,7 +1,8 @@
-"""Error models of the simulated cell: robot repeatability and accuracy, part misplacement.
+"""How far the robot's TCP is from where the controller believes it is.
 
-All defaults are justified in ``docs/simulation.md``. Every sampler takes an explicit
-``rng: numpy.random.Generator``.
+:class:`RobotErrorModel` is the one definition of the robot's error: the plan file holds it
+(``validation.robot_error``) and the simulation draws from it. Defaults and their sources are
+in ``docs/simulation.md``. Every sampler takes an explicit ``rng: numpy.random.Generator``.
 """
 
 from __future__ import annotations
@@ -12,8 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from calib.frames import make_transform, matrix_from_rotvec
-from calib.validation import check_positive, check_vector3
+from calib.structs import Strict, check_count, check_positive
 
 FloatArray = NDArray[np.float64]
 
@@ -42,8 +42,7 @@ class AccuracyField:
         return np.sin(arg) @ self.amplitudes_m
 
 
-@dataclass(frozen=True)
-class RobotErrorModel:
+class RobotErrorModel(Strict, frozen=True, kw_only=True):
     """Robot positioning errors added to every commanded search.
 
     Attributes:
@@ -62,10 +61,10 @@ class RobotErrorModel:
     accuracy_terms: int = 6
 
     def __post_init__(self) -> None:
-        check_positive(self.repeatability_sigma_m, "robot_error.repeatability_sigma_m", True)
-        check_positive(self.accuracy_amplitude_m, "robot_error.accuracy_amplitude_m", True)
-        check_positive(self.accuracy_wavelength_m, "robot_error.accuracy_wavelength_m")
-        check_positive(self.accuracy_terms, "robot_error.accuracy_terms")
+        check_positive(self.repeatability_sigma_m, "repeatability_sigma_m", allow_zero=True)
+        check_positive(self.accuracy_amplitude_m, "accuracy_amplitude_m", allow_zero=True)
+        check_positive(self.accuracy_wavelength_m, "accuracy_wavelength_m")
+        check_count(self.accuracy_terms, "accuracy_terms")
 
     @classmethod
     def none(cls) -> RobotErrorModel:
@@ -93,35 +92,3 @@ class RobotErrorModel:
             wavevectors=directions * (2 * math.pi / wavelengths)[:, None],
             phases=rng.uniform(0, 2 * math.pi, size=k),
         )
-
-
-@dataclass(frozen=True)
-class Misplacement:
-    """Tolerance of the part's placement: a random rigid motion about a pivot.
-
-    Attributes:
-        max_translation_m: largest translation, uniform in a ball, m (paper: 20 mm).
-        max_angle_rad: largest rotation, uniform in angle about a random axis, rad (paper: 3 deg).
-    """
-
-    max_translation_m: float = 0.020
-    max_angle_rad: float = math.radians(3.0)
-
-    def __post_init__(self) -> None:
-        check_positive(self.max_translation_m, "misplacement.max_translation_m", True)
-        check_positive(self.max_angle_rad, "misplacement.max_angle_rad", True)
-
-    def sample(self, rng: np.random.Generator, pivot_wobj_m: ArrayLike) -> FloatArray:
-        """``T_nominal_true`` ``(4, 4)``: the true part frame in the nominal one.
-
-        The rotation turns about ``pivot_wobj_m`` (``(3,)``, nominal wobj, m), e.g. the middle
-        of the probed region, so a 3 deg turn does not swing the far end of a 2 m part by 100 mm.
-        """
-        c = check_vector3(pivot_wobj_m, "pivot_wobj_m")
-        direction = rng.normal(size=3)
-        direction /= np.linalg.norm(direction)
-        t = direction * self.max_translation_m * rng.uniform() ** (1.0 / 3.0)
-        axis = rng.normal(size=3)
-        axis /= np.linalg.norm(axis)
-        R = matrix_from_rotvec(axis * rng.uniform(-self.max_angle_rad, self.max_angle_rad))
-        return make_transform(R, c - R @ c + t)

@@ -1,0 +1,68 @@
+"""Calibration procedures: the registry of what a plan's ``procedure.method`` can name.
+
+Owns:
+    - :mod:`calib.procedures.base`: the :class:`~calib.procedures.base.ProcedureKind` protocol
+      (roles, role checks, :meth:`run` with a probe, :meth:`estimate` from measurements, the
+      layout an adaptive robot program needs), :class:`RolePoint`, :class:`ProcedureRun`;
+    - one module per procedure, with its settings struct (the plan's ``procedure`` object) and
+      its implementation: ``hultman2013`` (the paper's A-H), ``three_two_one``, ``best_fit``;
+    - the registry :data:`PROCEDURES`, the settings union :data:`ProcedureSettings` and
+      :func:`procedure_kind`.
+
+Every caller (the plan file, ``wobjcal calibrate``, the validation, the exporters, the UI)
+looks a procedure up here; none tests the method's name. Adding a procedure is one module
+(a settings struct tagged ``method="<name>"`` and a class following the protocol) plus its entry
+in :data:`PROCEDURES` and in the :data:`ProcedureSettings` union::
+
+    # calib/procedures/iterative.py: class Iterative(msgspec.Struct, tag="iterative", ...)
+    #                                ITERATIVE = IterativeProcedure()
+    PROCEDURES["iterative"] = ITERATIVE
+    ProcedureSettings = Hultman2013 | ThreeTwoOne | BestFit | Iterative
+"""
+
+from __future__ import annotations
+
+from calib.errors import PlanError
+from calib.paper.settings import Hultman2013
+from calib.procedures.base import ProcedureKind, ProcedureRun, RolePoint
+from calib.procedures.best_fit import BEST_FIT, BestFit
+from calib.procedures.hultman2013 import HULTMAN2013
+from calib.procedures.three_two_one import THREE_TWO_ONE, ThreeTwoOne
+
+#: The procedures by method name, in the order the UI offers them.
+PROCEDURES: dict[str, ProcedureKind] = {k.method: k for k in (HULTMAN2013, THREE_TWO_ONE, BEST_FIT)}
+#: The plan's ``procedure`` object: one settings struct per procedure, tagged by ``method``.
+ProcedureSettings = Hultman2013 | ThreeTwoOne | BestFit
+#: The method names.
+METHODS = tuple(PROCEDURES)
+
+__all__ = [
+    "METHODS",
+    "PROCEDURES",
+    "BestFit",
+    "Hultman2013",
+    "ProcedureKind",
+    "ProcedureRun",
+    "ProcedureSettings",
+    "RolePoint",
+    "ThreeTwoOne",
+    "method_of",
+    "procedure_kind",
+]
+
+
+def method_of(settings: ProcedureSettings) -> str:
+    """The ``method`` tag of a procedure's settings struct."""
+    return str(type(settings).__struct_config__.tag)
+
+
+def procedure_kind(method: str | ProcedureSettings) -> ProcedureKind:
+    """The procedure named ``method`` (or of a settings struct).
+
+    Raises:
+        PlanError: no such procedure (the message lists the known ones).
+    """
+    name = method if isinstance(method, str) else method_of(method)
+    if name not in PROCEDURES:
+        raise PlanError(f"procedure.method: must be one of {list(PROCEDURES)}, got {name!r}")
+    return PROCEDURES[name]

@@ -1,0 +1,108 @@
+"""``best_fit``: least-squares point-to-plane fit of all ``fit`` points.
+
+At least 3 points; together they must constrain all 6 degrees of freedom (an edge point
+constrains two faces). The fit itself is :func:`calib.estimators.best_fit.best_fit`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import msgspec
+import numpy as np
+
+from calib.errors import PlanError
+from calib.estimators.best_fit import best_fit
+from calib.estimators.runners import run_best_fit
+from calib.paper.stator_layout import StatorLayout
+from calib.probing import Probe
+from calib.procedures.base import (
+    FloatArray,
+    Measured,
+    ProcedureRun,
+    RolePoint,
+    unknown_role_problem,
+)
+
+ROLE = "fit"
+MIN_POINTS = 3
+
+
+class BestFit(
+    msgspec.Struct,
+    tag="best_fit",
+    tag_field="method",
+    frozen=True,
+    forbid_unknown_fields=True,
+    kw_only=True,
+):
+    """Least-squares point-to-plane fit.
+
+    Attributes:
+        max_iterations: largest number of Gauss-Newton iterations.
+        tol: stop when the step is smaller than this (metres, and radians times the layout
+            size).
+    """
+
+    max_iterations: int = 30
+    tol: float = 1e-13
+
+
+class BestFitProcedure:
+    """The best fit as a :class:`~calib.procedures.base.ProcedureKind`."""
+
+    method = "best_fit"
+    settings_type: type = BestFit
+    roles: tuple[str, ...] = (ROLE,)
+    summary = "least-squares fit of every point to its face"
+
+    def role_problem(self, roles: Sequence[str], complete: bool) -> str:
+        """See :meth:`ProcedureKind.role_problem`."""
+        problem = unknown_role_problem(self.method, roles, self.roles)
+        if problem or not complete:
+            return problem
+        if sum(r == ROLE for r in roles) < MIN_POINTS:
+            return f"points: best_fit needs at least {MIN_POINTS} points, got {len(roles)}"
+        return ""
+
+    def assign(self, points: Sequence[RolePoint]) -> list[RolePoint]:
+        """Every point, with the role ``fit``."""
+        if len(points) < MIN_POINTS:
+            raise PlanError(f"best_fit needs at least {MIN_POINTS} points, got {len(points)}")
+        return [RolePoint(ROLE, rp.point) for rp in points]
+
+    def run(
+        self,
+        points: Sequence[RolePoint],
+        T_base_wobj_nominal: FloatArray,
+        probe: Probe,
+        settings: object,
+    ) -> ProcedureRun:
+        """Probe all points (updating the estimate after each), fit, and re-probe once."""
+        pts = [rp.point for rp in self.assign(points)]
+        res = run_best_fit(pts, probe, T_base_wobj_nominal)
+        last = {s.point_id: s.measured_m for s in res.steps}
+        return ProcedureRun(res.T_base_wobj, tuple(p.id for p in pts), last)
+
+    def estimate(
+        self,
+        points: Sequence[RolePoint],
+        measured: Measured,
+        T_base_wobj_nominal: FloatArray,
+        settings: object,
+    ) -> ProcedureRun:
+        """The fit of the first measurement of every measured point (unmeasured points are
+        left out; the fit refuses a set that no longer fixes all 6 degrees of freedom)."""
+        cfg = settings if isinstance(settings, BestFit) else BestFit()
+        pts = [rp.point for rp in self.assign(points) if rp.point.id in measured]
+        q = np.array([np.asarray(measured[p.id], dtype=float).reshape(-1, 3)[0] for p in pts])
+        res = best_fit(pts, q, T_base_wobj_nominal, max_iterations=cfg.max_iterations, tol=cfg.tol)
+        ids = tuple(p.id for p in pts)
+        return ProcedureRun(res.T_base_wobj, ids, dict(zip(ids, q, strict=True)))
+
+    def adaptive_layout(self, points: Sequence[RolePoint]) -> StatorLayout | None:
+        """``None``: programs run the searches in the nominal frame."""
+        return None
+
+
+BEST_FIT = BestFitProcedure()

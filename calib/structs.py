@@ -1,0 +1,53 @@
+"""The strict, immutable struct every file-backed model derives from, and its field checks.
+
+Plan files, measurement files and the physical models they hold (sensor, robot error,
+misplacement, procedure settings) are ``msgspec`` structs: typed, frozen, unknown fields
+rejected. A check in ``__post_init__`` raises :class:`calib.errors.PlanError` with
+``"field: message"``; when msgspec decodes a file it adds the JSON path of the struct (see
+:func:`calib.plan.json_io.reword_validation_error`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import msgspec
+
+from calib.errors import PlanError
+
+Vec3 = tuple[float, float, float]
+#: Tolerance on the length of a unit vector given in a file.
+UNIT_TOL = 1e-6
+
+
+class Strict(msgspec.Struct, frozen=True, forbid_unknown_fields=True, kw_only=True):
+    """Base of the file-backed structs: immutable, unknown fields rejected."""
+
+
+def check_finite(values: tuple[float, ...] | None, field: str) -> None:
+    """Raise :class:`PlanError` unless every value is finite (``None`` passes)."""
+    if values is not None and not all(math.isfinite(v) for v in values):
+        raise PlanError(f"{field}: must hold finite numbers, got {list(values)}")
+
+
+def check_unit(values: tuple[float, ...] | None, field: str) -> None:
+    """Raise :class:`PlanError` unless ``values`` is a unit vector (``None`` passes)."""
+    if values is None:
+        return
+    check_finite(values, field)
+    norm = math.sqrt(sum(v * v for v in values))
+    if abs(norm - 1.0) > UNIT_TOL:
+        raise PlanError(f"{field}: must be a unit vector, got length {norm:.6g}")
+
+
+def check_positive(value: float, field: str, allow_zero: bool = False) -> None:
+    """Raise :class:`PlanError` unless ``value`` is finite and ``> 0`` (``>= 0`` with
+    ``allow_zero``)."""
+    if not math.isfinite(value) or value < 0 or (value == 0 and not allow_zero):
+        raise PlanError(f"{field}: must be {'>= 0' if allow_zero else '> 0'}, got {value}")
+
+
+def check_count(value: int, field: str, minimum: int = 1) -> None:
+    """Raise :class:`PlanError` unless ``value`` is an integer ``>= minimum``."""
+    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+        raise PlanError(f"{field}: must be an integer >= {minimum}, got {value!r}")
