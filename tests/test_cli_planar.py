@@ -86,4 +86,9 @@ def test_plan_on_a_raw_scan_fails_with_no_planar_face(
     assert code == 1
     assert "noether_raw_mesh: no planar face: largest flat region" in err
     assert "mm^2" in err and "RMS" in err
-    assert "Traceback" not in err and out == ""
+    assert "Traceback" not in err
+    assert "0 of 8 points feasible" in out  # the table still shows every point, each refused
+    code, out, _ = run(capsys, "check", str(_copy(tmp_path, edit)), "--json")
+    data = json.loads(out)
+    assert code == 1 and not data["feasible"] and "no planar face" in data["error"]
+    assert all("no planar face" in p["face_reason"] for p in data["points"])

@@ -29,7 +29,10 @@ def test_misplacement_stays_within_tolerance_and_turns_about_the_pivot(rng) -> N
 
 
 def test_zero_misplacement_is_identity(rng) -> None:
-    assert np.allclose(Misplacement(max_translation_m=0.0, max_angle_rad=0.0).sample(rng, [1.0, 2.0, 3.0]), np.eye(4))
+    assert np.allclose(
+        Misplacement(max_translation_m=0.0, max_angle_rad=0.0).sample(rng, [1.0, 2.0, 3.0]),
+        np.eye(4),
+    )
 
 
 def test_repeatability_has_the_given_sigma(rng) -> None:

@@ -42,7 +42,9 @@ def test_same_seed_same_trial_and_errors_are_small() -> None:
 
 def test_failed_probe_is_recorded_with_point_and_reason() -> None:
     points = stator_ah_points(G, approach=SearchSpec("approach", 0.050, 0.060))
-    res = TrialRunner(_setup(points), MESH).run_trial(np.random.SeedSequence(1), lambda cmd: "unreachable: joint 5 at limit")
+    res = TrialRunner(_setup(points), MESH).run_trial(
+        np.random.SeedSequence(1), lambda cmd: "unreachable: joint 5 at limit"
+    )
     assert res.failure == "A: unreachable: joint 5 at limit"
     assert np.all(np.isnan(res.delta_procedure)) and np.all(np.isnan(res.delta_best_fit))
 

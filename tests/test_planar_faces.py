@@ -159,24 +159,6 @@ def test_bad_input_is_named() -> None:
         find_planar_faces(box, flatness_tol_m=-1.0)
 
 
-def test_ui_marks_points_off_planar_faces_infeasible() -> None:
-    from webui.backend import _with_planar_faces
-    from webui.status import PointCheck
-
-    box = trimesh.creation.box(extents=EXTENTS)
-    probes = [
-        ProbePoint("A", (0.05, 0.0, 0.0), (1.0, 0.0, 0.0)),
-        ProbePoint("B", (0.05, 0.095, 0.0), (1.0, 0.0, 0.0)),  # 5 mm from an edge
-    ]
-    checks = [PointCheck("A", "feasible"), PointCheck("B", "feasible")]
-    a, b = _with_planar_faces(box, probes, checks)
-    assert a == checks[0]
-    assert b.status == "infeasible" and b.reason.startswith("footprint over a hole/edge")
-    sphere = trimesh.creation.icosphere(subdivisions=3, radius=0.05)
-    for c in _with_planar_faces(sphere, probes, checks):
-        assert c.status == "infeasible" and "no planar face" in c.reason
-
-
 @pytest.mark.parametrize(
     ("extents", "why"),
     [

@@ -27,6 +27,10 @@ UPDATE = os.environ.get("WOBJCAL_UPDATE_GOLDEN") == "1"
 TOL = 1e-9
 #: Fields that differ from run to run (timing, process count) or name the caller's paths.
 VOLATILE = {"elapsed_s", "workers", "plan"}
+#: Fields added on purpose since the recording, allowed in new output only: the one plan check
+#: (``planner.check``) also reports the IK kind, the pose and face parts of the status, where a
+#: path fails and the pair that limits the clearance. Every recorded field must still match.
+ADDED = {"ik_kind", "pose_status", "pose_reason", "path_fail_at_m", "face_reason", "clearance_pair"}
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 
@@ -55,7 +59,8 @@ def assert_json_matches(got: Any, want: Any, path: str = "$") -> None:
     if isinstance(want, dict):
         assert isinstance(got, dict), f"{path}: {type(got).__name__}, want object"
         keys = set(want) - VOLATILE
-        assert set(got) - VOLATILE == keys, f"{path}: keys {sorted(set(got) - VOLATILE)}"
+        extra = set(got) - VOLATILE - keys
+        assert keys <= set(got) and extra <= ADDED, f"{path}: keys {sorted(set(got) - VOLATILE)}"
         for k in sorted(keys):
             assert_json_matches(got[k], want[k], f"{path}.{k}")
     elif isinstance(want, list):
@@ -122,3 +127,8 @@ def test_comparison_catches_a_changed_number() -> None:
     with pytest.raises(AssertionError):
         assert_json_matches({"a": [1.0, 2.0]}, {"a": [1.0, 2.1]})
     assert_json_matches({"a": 1.0, "elapsed_s": 3.0}, {"a": 1.0 + 1e-12, "elapsed_s": 9.0})
+    assert_json_matches({"a": 1.0, "ik_kind": "opw"}, {"a": 1.0})  # an added field
+    with pytest.raises(AssertionError):
+        assert_json_matches({"a": 1.0, "b": 2.0}, {"a": 1.0})  # an unknown new field
+    with pytest.raises(AssertionError):
+        assert_json_matches({"ik_kind": "opw"}, {"a": 1.0})  # a recorded field lost

@@ -18,15 +18,15 @@ from numpy.typing import ArrayLike
 
 from calib.errors import InputError
 from calib.plan.file import Plan
+from planner.check import PointCheck
 from webui import clients, demo, plan_doc
 from webui.backend import CellSession, CellView
 from webui.heatmap import HeatMap
-from webui.plan_adapter import autosave_bytes, ui_plan_from_file
+from webui.plan_adapter import autosave_bytes, plan_point, ui_plan_from_file
 from webui.plan_doc import UiPlan
 from webui.robot_view import RobotView
 from webui.scene import PlanScene
 from webui.state import DEFAULT_AUTOSAVE, Change, SessionState, default_autosave_path
-from webui.status import PointCheck
 from webui.surface import SurfacePicker
 from webui.worker import CellWorker
 
@@ -120,8 +120,8 @@ class WobjcalApp:
         points = [doc.get(pid) for pid in point_ids if pid in doc.ids]
         if not points:
             return []
-        probes = [p.probe for p in points]
-        results = self.worker.call(lambda s: [] if s is None else s.check_points(probes))
+        edited = [plan_point(p) for p in points]
+        results = self.worker.call(lambda s: [] if s is None else s.check_points(edited))
         current = self.state.doc
         with self._lock:
             for point, check in zip(points, results, strict=False):

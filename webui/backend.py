@@ -6,24 +6,22 @@ PyBullet cell (built by :func:`planner.plan_cell.open_cell`, as ``wobjcal check`
 
 from __future__ import annotations
 
-import dataclasses
 import logging
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
 from calib.frames import invert_transform
-from calib.plan.file import Plan, resolve_ref
-from calib.probing import ProbePoint, SearchCommand
+from calib.plan.file import Plan, PlanPoint, resolve_ref
 from planner.builtins import robot_urdf
+from planner.cell.cell import Cell
 from planner.cell.workobject import load_work_object
+from planner.check import PointCheck, check_points
 from planner.plan_cell import open_cell
-from webui.status import PointCheck
+from planner.robot.kinematics.chain import KinematicChain
 
 logger = logging.getLogger(__name__)
 
@@ -50,7 +48,7 @@ class CellView:
     fixtures: dict[str, tuple[trimesh.Trimesh, NDArray[np.float64]]] = field(default_factory=dict)
     tool_urdf: Path | None = None
     tool_mesh: trimesh.Trimesh | None = None
-    chain: Any = None
+    chain: KinematicChain | None = None
 
     def T_world_flange(self, q: ArrayLike) -> NDArray[np.float64] | None:
         """``(4, 4)`` flange pose in the world at joint values ``q`` (``None``: no chain)."""
@@ -94,20 +92,19 @@ class CellSession:
     def __init__(self, plan: Plan, plan_dir: Path) -> None:
         self.plan = plan
         self.plan_dir = Path(plan_dir)
+        cell = open_cell(plan, self.plan_dir)
+        self.cell: Cell | None = cell
+        if cell.work_object is None:  # open_cell always loads the plan's work object
+            raise RuntimeError("the plan's cell has no work object")
         self.view = CellView(
             robot_urdf=resolve_robot_urdf(plan.cell.robot.urdf, self.plan_dir),
             T_world_base=plan.cell.robot.T_world_base.matrix(),
-            wobj_mesh=load_mesh(plan.work_object.mesh, plan.work_object.units, self.plan_dir),
+            wobj_mesh=cell.work_object.mesh,
             T_world_wobj=plan.work_object.T_world_wobj.matrix(),
             fixtures=self._fixture_meshes(),
-        )
-        self.cell: Any = open_cell(plan, self.plan_dir)
-        tool = self.cell.tool
-        self.view = dataclasses.replace(
-            self.view,
-            tool_urdf=getattr(tool, "urdf_path", None),
-            tool_mesh=getattr(tool, "mesh", None),
-            chain=self.cell.chain,
+            tool_urdf=None if cell.tool is None else cell.tool.urdf_path,
+            tool_mesh=None if cell.tool is None else cell.tool.mesh,
+            chain=cell.chain,
         )
 
     def _fixture_meshes(self) -> dict[str, tuple[trimesh.Trimesh, NDArray[np.float64]]]:
@@ -120,37 +117,13 @@ class CellSession:
             out[f.name] = (mesh, f.T_world_fixture.matrix())
         return out
 
-    def check_points(self, points: list[ProbePoint]) -> list[PointCheck]:
-        """Check the probe poses and search paths of ``points`` (wobj frame) in the cell."""
-        if not points:
+    def check_points(self, points: list[PlanPoint]) -> list[PointCheck]:
+        """Check the probe poses, search paths and planar faces of ``points`` (the session
+        plan's, possibly edited) in the cell: :func:`planner.check.check_points`, the check
+        ``wobjcal check`` runs."""
+        if not points or self.cell is None:
             return []
-        t0 = time.perf_counter()
-        P = np.array([p.position_m for p in points], dtype=np.float64)
-        N = np.array([p.normal for p in points], dtype=np.float64)
-        results = self.cell.check_probes(P, N, tcp=self.plan.cell.tool.tcp)
-        checks = [self._combine(p, r, t0) for p, r in zip(points, results, strict=True)]
-        return _with_planar_faces(self.view.wobj_mesh, points, checks)
-
-    def _combine(self, point: ProbePoint, res: Any, t0: float) -> PointCheck:
-        status, reason = str(res.status), str(res.reason or "")
-        q = None if res.q is None else np.asarray(res.q, dtype=np.float64)
-        q_path = None
-        if status != "infeasible":
-            cmd = SearchCommand.from_point(point, self.view.T_base_wobj)
-            path = self.cell.check_search(cmd, q_ref=q)
-            q_path = None if path.q_path is None else np.asarray(path.q_path, dtype=np.float64)
-            if not path.feasible:
-                status = "infeasible"
-                reason = f"search path: {path.reason}"
-        return PointCheck(
-            point_id=point.id,
-            status=status,  # type: ignore[arg-type]
-            reason=reason,
-            q=q,
-            q_path=q_path,
-            clearance_m=float(getattr(res, "clearance_m", float("nan"))),
-            elapsed_s=time.perf_counter() - t0,
-        )
+        return list(check_points(self.cell, self.plan, points))
 
     def close(self) -> None:
         """Release the PyBullet client."""
@@ -158,15 +131,3 @@ class CellSession:
             self.cell.close()
         self.cell = None
 
-
-def _with_planar_faces(
-    mesh: trimesh.Trimesh, points: list[ProbePoint], checks: list[PointCheck]
-) -> list[PointCheck]:
-    """Mark points off a planar face (or with the footprint over a hole/edge) infeasible."""
-    from planner.faces.checks import plan_face_reasons
-
-    reasons = plan_face_reasons(mesh, points, raise_if_none=False)
-    return [
-        c if not why else dataclasses.replace(c, status="infeasible", reason=why)
-        for c, why in zip(checks, reasons, strict=True)
-    ]

@@ -1,23 +1,24 @@
-"""Between the files panel and ``planner.export``: robot programs of the session plan.
+"""Between the files panel and :mod:`planner.export_plan`: robot programs of the session plan.
 
-The job is built exactly as ``wobjcal export`` builds it (``planner.cli.check.export_job_for``:
-orientations and configurations from the cell check when it can run), then formatted by
-``planner.export.export_files``. Call :func:`export_program` on the cell worker: the check opens
-a PyBullet client.
+The program is made exactly as ``wobjcal export`` makes it
+(:func:`planner.export_plan.export_program`: orientations and configurations from the plan
+check in the session's cell). Call :func:`export_program` on the cell worker.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from calib.errors import InputError
 from calib.plan.file import Plan
-from planner.cli.check import export_job_for
 from planner.export import FORMATS as EXPORT_FORMATS
-from planner.export import export_files
+from planner.export.job import module_name
 
-#: UI name -> ``planner.export`` format name.
+if TYPE_CHECKING:
+    from planner.cell.cell import Cell
+
 #: Download button label -> export format name, from the export registry.
 FORMATS: dict[str, str] = {f.label: f.name for f in EXPORT_FORMATS.values()}
 
@@ -35,16 +36,25 @@ class ExportResult:
     note: str = ""
 
 
-def export_program(plan: Plan, fmt: str, plan_dir: Path) -> ExportResult:
+def export_program(
+    plan: Plan, fmt: str, plan_dir: Path, cell: Cell | None = None
+) -> ExportResult:
     """The robot program(s) of ``plan`` in ``fmt`` (a key of :data:`FORMATS`).
+
+    Args:
+        plan: the session plan.
+        fmt: a download label of :data:`FORMATS`.
+        plan_dir: folder the plan's relative file references resolve against.
+        cell: the session's open cell of the plan (``None``: a cell is opened for the check).
 
     Raises:
         InputError: unknown format, or the plan cannot be exported (the message says why).
     """
+    from planner.export_plan import export_program as make
+
     if fmt not in FORMATS:
         raise InputError(f"unknown export format {fmt!r}; known: {', '.join(FORMATS)}")
-    job, note = export_job_for(plan, plan_dir, run_check=True)
-    files = export_files(job, FORMATS[fmt])
-    stem = job.name or plan.name or "wobjcal_plan"
-    out = tuple((f"{stem}{suffix}", text.encode("utf-8")) for suffix, text in files.items())
-    return ExportResult(out, note)
+    result = make(plan, plan_dir, FORMATS[fmt], cell=cell)
+    stem = module_name(plan.name or "plan") or "wobjcal_plan"
+    out = tuple((f"{stem}{suffix}", text.encode("utf-8")) for suffix, text in result.files.items())
+    return ExportResult(out, "; ".join(result.notes))

@@ -157,7 +157,9 @@ class FilesPanel:
         """The session plan as robot program(s) in ``fmt``, made on the cell worker."""
         plan = plan_from_ui(self._app.state.doc)
         plan_dir = self._app.plan_dir
-        return self._app.worker.call(lambda _s: export_program(plan, fmt, plan_dir))
+        return self._app.worker.call(
+            lambda s: export_program(plan, fmt, plan_dir, None if s is None else s.cell)
+        )
 
     def download_export(self, client: Any, fmt: str) -> str:
         """Send the session plan as robot program(s) in ``fmt`` to ``client``."""

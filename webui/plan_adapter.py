@@ -37,8 +37,13 @@ def ui_plan_from_plan(plan: Plan, name: str | None = None) -> UiPlan:
     )
 
 
+def plan_point(point: UiPoint) -> PlanPoint:
+    """The plan-file form of one edited point (what :func:`planner.check.check_points` takes)."""
+    return PlanPoint.from_probe_point(point.probe, point.role, point.speed_m_s)
+
+
 def _plan_points(ui: UiPlan) -> list[PlanPoint]:
-    return [PlanPoint.from_probe_point(p.probe, p.role, p.speed_m_s) for p in ui.points]
+    return [plan_point(p) for p in ui.points]
 
 
 def plan_from_ui(ui: UiPlan) -> Plan:

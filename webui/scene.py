@@ -17,8 +17,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from calib.frames import quat_wxyz_from_matrix
 from calib.probing import SearchCommand
+from planner.check import PointCheck
 from webui.plan_doc import UiPlan, UiPoint
-from webui.status import PointCheck
 
 #: RGB colour of each feasibility status (``pending``: being computed); ``unknown`` is the
 #: fallback colour of any other status.

@@ -68,6 +68,8 @@ class ProbeFeasibility:
             (nothing nearer); NaN when no pose was checked.
         joint_margin_rad: smallest distance of ``q`` to a joint limit, rad (NaN when none).
         T_base_flange: ``(4, 4)`` flange pose of ``q``, base frame, m (``None`` when none).
+        clearance_pair: ``(robot or tool link, obstacle)`` that limits ``clearance_m``, or
+            ``None`` when nothing came within the query's look-ahead (or no pose was checked).
     """
 
     feasible: bool
@@ -79,6 +81,7 @@ class ProbeFeasibility:
     clearance_m: float
     joint_margin_rad: float
     T_base_flange: FloatArray | None
+    clearance_pair: tuple[str, str] | None = None
 
 
 def tcp_frames(points: FloatArray, normals: FloatArray, angles: FloatArray) -> FloatArray:
@@ -264,6 +267,7 @@ def check_probes(
                     clearance_m=float(cl.clearance_m),
                     joint_margin_rad=float(margin_all[i, c]),
                     T_base_flange=T_bf[i * R + r].copy(),
+                    clearance_pair=cl.pair,
                 )
             )
     return out

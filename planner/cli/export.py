@@ -10,7 +10,7 @@ from typing import Any
 from calib.atomic_io import write_text_atomic
 from calib.plan.file import plan_to_json
 from planner.cli.common import read_plan, stderr
-from planner.export import FORMAT_CHOICES, FORMATS, export_files
+from planner.export import FORMAT_CHOICES, FORMATS
 
 
 def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
@@ -60,20 +60,19 @@ def cmd_export(args: argparse.Namespace) -> int:
         write_text_atomic(out, plan_to_json(plan))
         stderr().print(f"wrote {out}")
         return 0
-    from planner.cli.check import check_plan, export_job_for
+    from planner.export_plan import export_program  # PyBullet: not for ``wobjcal --help``
 
-    if not args.no_check and not args.force:
-        bad = [r for r in check_plan(plan, plan_dir) if not r.feasible]
-        if bad:
-            for r in bad:
-                why = "; ".join(x for x in (r.reason, r.path_reason) if x) or r.status
-                stderr().print(f"error: point {r.point_id} is not feasible: {why}")
-            stderr().print("nothing written; fix the plan, or export anyway with --force")
-            return 1
-    job, note = export_job_for(plan, plan_dir, run_check=not args.no_check)
-    if note:
-        stderr().print(f"note: {note}")
-    files = export_files(job, args.format)
+    result = export_program(plan, plan_dir, args.format, run_check=not args.no_check)
+    if result.check is not None and not result.check.feasible and not args.force:
+        if result.check.error:
+            stderr().print(f"error: {result.check.error}")
+        for p in result.check.infeasible:
+            stderr().print(f"error: point {p.point_id} is not feasible: {p.reason or p.status}")
+        stderr().print("nothing written; fix the plan, or export anyway with --force")
+        return 1
+    if result.notes:
+        stderr().print("note: " + "; ".join(result.notes))
+    files = result.files
     written = []
     for i, (suffix, text) in enumerate(files.items()):
         target = out if i == 0 else out.with_suffix(suffix)

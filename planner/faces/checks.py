@@ -23,8 +23,8 @@ from calib.probing import ProbePoint
 from calib.validation import check_points
 from planner.faces.detection import NoPlanarFaceError, PlanarFaces, find_planar_faces
 from planner.faces.footprint import (
+    DEFAULT_FOOTPRINT_RADIUS_M,
     RAY_LIFT_M,
-    SENSOR_DIAMETER_M,
     footprint_hits,
     footprint_offsets,
 )
@@ -90,7 +90,7 @@ def check_probe_faces(
     points: ArrayLike,
     normals: ArrayLike,
     *,
-    footprint_radius_m: float = SENSOR_DIAMETER_M / 2,
+    footprint_radius_m: float = DEFAULT_FOOTPRINT_RADIUS_M,
     max_normal_angle_rad: float = MAX_NORMAL_ANGLE_RAD,
     max_distance_m: float = 1.0e-3,
     name: str | None = None,
@@ -98,8 +98,8 @@ def check_probe_faces(
     """Check that probe points lie on planar faces with the sensor footprint on the same face.
 
     Args:
-        mesh_or_faces: the work-object mesh (faces found with the defaults, cached) or its
-            :class:`PlanarFaces`.
+        mesh_or_faces: the work-object mesh (faces found with the default tolerances and this
+            footprint, cached) or its :class:`PlanarFaces`.
         points: ``(N, 3)`` probe points on the surface, mesh frame, metres.
         normals: ``(N, 3)`` the plan's outward normals at the points (need not be unit).
         footprint_radius_m: sensor face radius, metres (the paper's sensor: 9 mm).
@@ -117,7 +117,12 @@ def check_probe_faces(
     pf = (
         mesh_or_faces
         if isinstance(mesh_or_faces, PlanarFaces)
-        else find_planar_faces(mesh_or_faces, name=name)
+        else find_planar_faces(
+            mesh_or_faces,
+            min_area_m2=math.pi * footprint_radius_m**2,
+            footprint_radius_m=footprint_radius_m,
+            name=name,
+        )
     )
     pf.require_any()
     P = check_points(points, "points")
@@ -225,6 +230,7 @@ def plan_face_reasons(
     *,
     name: str | None = None,
     raise_if_none: bool = True,
+    footprint_radius_m: float = DEFAULT_FOOTPRINT_RADIUS_M,
 ) -> list[str]:
     """Why each plan point fails the planar-face check (``""`` when it passes), for reports.
 
@@ -234,6 +240,8 @@ def plan_face_reasons(
         name: the work object's name in messages.
         raise_if_none: raise when the mesh has no planar face; else every point gets that
             message as its reason (for the UI, which shows reasons per point).
+        footprint_radius_m: the plan's sensor footprint radius, metres
+            (``plan.validation.sensor.footprint_radius_m``).
 
     Raises:
         NoPlanarFaceError: the mesh has no planar face and ``raise_if_none`` is true.
@@ -241,7 +249,7 @@ def plan_face_reasons(
     if not probes:
         return []
     try:
-        checks = check_plan_faces(mesh, probes, name=name)
+        checks = check_plan_faces(mesh, probes, name=name, footprint_radius_m=footprint_radius_m)
     except NoPlanarFaceError as exc:
         if raise_if_none:
             raise

@@ -43,9 +43,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from calib.validation import check_points
 from planner.errors import MeshError
+from planner.faces.footprint import DEFAULT_FOOTPRINT_RADIUS_M, holds_footprint
 from planner.faces.footprint import N_RIM_SAMPLES as N_RIM_SAMPLES
 from planner.faces.footprint import RAY_LIFT_M as RAY_LIFT_M
-from planner.faces.footprint import SENSOR_DIAMETER_M, holds_footprint
 from planner.faces.regions import RegionStats as RegionStats
 from planner.faces.regions import fit_planes, flat_regions, region_stats
 
@@ -53,7 +53,7 @@ FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 #: Default smallest face area: the sensor footprint, m^2.
-MIN_AREA_M2 = math.pi * (SENSOR_DIAMETER_M / 2) ** 2
+MIN_AREA_M2 = math.pi * DEFAULT_FOOTPRINT_RADIUS_M**2
 #: Default largest angle between triangle normals (and to the fitted plane) in a face, rad.
 ANGLE_TOL_RAD = math.radians(3.0)
 #: Default largest RMS distance of a face from its fitted plane, m.
@@ -195,7 +195,7 @@ def find_planar_faces(
     angle_tol_rad: float = ANGLE_TOL_RAD,
     flatness_tol_m: float = FLATNESS_TOL_M,
     max_deviation_m: float = MAX_DEVIATION_M,
-    footprint_radius_m: float = SENSOR_DIAMETER_M / 2,
+    footprint_radius_m: float = DEFAULT_FOOTPRINT_RADIUS_M,
     name: str | None = None,
 ) -> PlanarFaces:
     """Find the planar faces of a mesh (cached by mesh content and tolerances).

@@ -1,9 +1,10 @@
 """The sensor's round footprint on a mesh: samples in a plane, and ray tests onto a planar face.
 
-A proximity sensor's face (18 mm diameter for the paper's sensor) must lie wholly over one planar
-face. The footprint is sampled at its centre, on its rim and on a ring at half the radius; a ray
-cast down the face normal from just above each sample tells whether the sample lies on the face
-(a hole lets the ray through, an edge or a step makes it miss or hit another face).
+A proximity sensor's face (18 mm diameter for the paper's sensor; the plan's sensor says) must
+lie wholly over one planar face. The footprint is sampled at its centre, on its rim and on a ring
+at half the radius; a ray cast down the face normal from just above each sample tells whether the
+sample lies on the face (a hole lets the ray through, an edge or a step makes it miss or hit
+another face).
 
 Used by detection (:mod:`planner.faces.detection`: does a region hold the footprint anywhere?) and
 by the per-point checks (:mod:`planner.faces.checks`).
@@ -17,11 +18,14 @@ import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
+from calib.models.proximity import ProximitySensor
+
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
-#: Sensor face diameter of the paper's proximity sensor, metres.
-SENSOR_DIAMETER_M = 0.018
+#: Default footprint radius: the default sensor's (:class:`calib.models.ProximitySensor`), m.
+#: Callers with a plan pass ``plan.validation.sensor.footprint_radius_m``.
+DEFAULT_FOOTPRINT_RADIUS_M = ProximitySensor().footprint_radius_m
 #: Footprint samples: this many on the rim, half as many at half the radius, and the centre.
 N_RIM_SAMPLES = 12
 #: Footprint rays start this far above the face's plane, m.

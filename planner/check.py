@@ -1,0 +1,288 @@
+"""Check a plan: can the robot reach every probe point and run every search, on a planar face?
+
+The one plan check. ``wobjcal check`` (table and ``--json``), the web UI's colours and reasons,
+``wobjcal export`` (orientations and confdata of the targets) and scripts all call
+:func:`check_plan` (a whole plan, in its own cell or a given one) or :func:`check_points` (some
+points, in an open cell, as the UI does after an edit); the rules below hold for all of them.
+
+Per point, three checks:
+
+1. the probe pose (:func:`planner.cell.feasibility.check_probes`): IK, joint limits, wrist
+   singularity, collisions with clearance; ``marginal`` when little clearance or near a limit;
+2. the search path (:func:`planner.cell.search_paths.check_search`) from start to end of
+   travel, started from the pose's IK solution, in the nominal work-object frame;
+3. the planar face (:func:`planner.faces.checks.plan_face_reasons`): the point lies on a planar
+   face with the plan's sensor footprint on it.
+
+A point is ``infeasible`` when any of the three fails, ``marginal`` when only the pose is
+marginal, else ``feasible``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from calib.plan.file import Plan, PlanPoint
+from calib.probing import SearchCommand
+from planner.plan_cell import nominal_T_base_wobj, open_cell
+
+if TYPE_CHECKING:
+    from planner.cell.cell import Cell
+    from planner.cell.feasibility import ProbeFeasibility
+
+FloatArray = NDArray[np.float64]
+Status = Literal["feasible", "marginal", "infeasible"]
+#: ABB ``confdata`` (cf1, cf4, cf6, cfx).
+ConfData = tuple[int, int, int, int]
+
+
+@dataclass(frozen=True)
+class PointCheck:
+    """The check of one probe point and its search.
+
+    Attributes:
+        point_id: the plan's point id.
+        role: its role in the procedure.
+        kind: ``"approach"`` or ``"edge"`` search.
+        status: ``feasible``, ``marginal`` or ``infeasible``: the pose, the path and the face
+            together (see the module docstring).
+        reason: why not feasible, all parts joined with ``"; "`` (``""`` when feasible).
+        pose_status: the probe pose alone.
+        pose_reason: why the pose is marginal or infeasible (``""`` when feasible).
+        path_feasible: the whole search path can be run.
+        path_reason: why not, with the distance along the path (``""`` when feasible).
+        path_fail_at_m: distance from the search start of the first failing sample, m (NaN
+            when the path is feasible).
+        face_reason: why the point is not on a planar face with the sensor footprint on it
+            (``""`` when it is).
+        clearance_m: clearance of the limiting pair at the chosen pose, m (NaN: no pose);
+            nothing nearer than the query's look-ahead when ``clearance_is_lower_bound``.
+        clearance_pair: ``(robot or tool link, obstacle)`` of that clearance, or ``None``.
+        clearance_is_lower_bound: the clearance is the look-ahead distance (nothing nearer).
+        confdata: ABB ``(cf1, cf4, cf6, cfx)`` of the chosen IK branch (OPW arms, feasible or
+            marginal pose), else ``None``.
+        ik_kind: the cell's IK: ``"opw"`` (analytic) or ``"numeric"``.
+        q: ``(n,)`` joint values of the chosen (or least-bad) pose, rad; ``None`` when no IK.
+        q_path: ``(M, n)`` joint values along the path samples that passed, rad, or ``None``.
+        T_base_flange: ``(4, 4)`` flange pose of ``q``, robot base frame, m, or ``None``.
+        elapsed_s: time this point's check took, s.
+    """
+
+    point_id: str
+    role: str
+    kind: str
+    status: Status
+    reason: str
+    pose_status: Status
+    pose_reason: str
+    path_feasible: bool
+    path_reason: str
+    path_fail_at_m: float
+    face_reason: str
+    clearance_m: float
+    clearance_pair: tuple[str, str] | None
+    clearance_is_lower_bound: bool
+    confdata: ConfData | None
+    ik_kind: str
+    q: FloatArray | None
+    q_path: FloatArray | None
+    T_base_flange: FloatArray | None
+    elapsed_s: float = 0.0
+
+    @property
+    def feasible(self) -> bool:
+        """The point can be measured as planned (marginal counts as feasible)."""
+        return self.status != "infeasible"
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict (distances in metres; NaN as ``null``)."""
+        return {
+            "id": self.point_id,
+            "role": self.role,
+            "kind": self.kind,
+            "status": self.status,
+            "reason": self.reason,
+            "pose_status": self.pose_status,
+            "pose_reason": self.pose_reason,
+            "path_feasible": self.path_feasible,
+            "path_reason": self.path_reason,
+            "path_fail_at_m": _finite_or_none(self.path_fail_at_m),
+            "face_reason": self.face_reason,
+            "clearance_m": _finite_or_none(self.clearance_m),
+            "clearance_pair": list(self.clearance_pair) if self.clearance_pair else None,
+            "clearance_is_lower_bound": self.clearance_is_lower_bound,
+            "confdata": list(self.confdata) if self.confdata else None,
+            "ik_kind": self.ik_kind,
+            "feasible": self.feasible,
+        }
+
+
+@dataclass(frozen=True)
+class PlanCheck:
+    """The check of a whole plan.
+
+    Attributes:
+        points: one :class:`PointCheck` per plan point, in plan order.
+        ik_kind: the cell's IK: ``"opw"`` (analytic) or ``"numeric"``.
+        ik_note: why the analytic IK does not apply (``""`` for ``opw``).
+        error: a problem of the whole plan on this part (e.g. the part has no planar face),
+            ``""`` when none.
+    """
+
+    points: tuple[PointCheck, ...]
+    ik_kind: str
+    ik_note: str = ""
+    error: str = ""
+
+    @property
+    def feasible(self) -> bool:
+        """Every point and path is feasible and the plan has no error."""
+        return not self.error and all(p.feasible for p in self.points)
+
+    @property
+    def infeasible(self) -> tuple[PointCheck, ...]:
+        """The points that fail."""
+        return tuple(p for p in self.points if not p.feasible)
+
+    def point(self, point_id: str) -> PointCheck:
+        """The check of ``point_id``.
+
+        Raises:
+            KeyError: no such point (the message lists the ids).
+        """
+        for p in self.points:
+            if p.point_id == point_id:
+                return p
+        raise KeyError(f"no point {point_id!r}; points: {[p.point_id for p in self.points]}")
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict; ``error`` appears only when there is one."""
+        out: dict[str, Any] = {
+            "feasible": self.feasible,
+            "ik_kind": self.ik_kind,
+            "points": [p.to_json() for p in self.points],
+        }
+        if self.error:
+            out["error"] = self.error
+        return out
+
+
+def check_plan(plan: Plan, plan_dir: Path | None = None, *, cell: Cell | None = None) -> PlanCheck:
+    """Check every point and search path of ``plan`` (see the module docstring).
+
+    Args:
+        plan: the plan.
+        plan_dir: folder the plan's relative file references resolve against (default: the
+            current folder); used only when ``cell`` is ``None``.
+        cell: an open cell of the plan (the UI's); ``None`` opens the plan's cell and closes
+            it afterwards.
+
+    Raises:
+        InputError: a file of the plan cannot be loaded (named in the message).
+    """
+    if cell is None:
+        with open_cell(plan, plan_dir or Path.cwd()) as own:
+            return check_plan(plan, cell=own)
+    checks, error = _check(plan, list(plan.points), cell)
+    return PlanCheck(checks, cell.solver.kind, cell.solver.why_not_opw or "", error)
+
+
+def check_points(cell: Cell, plan: Plan, points: Sequence[PlanPoint]) -> tuple[PointCheck, ...]:
+    """Check ``points`` (of ``plan``, or edited versions of them) in the plan's open ``cell``.
+
+    The same rules as :func:`check_plan`; a part without any planar face shows as every
+    point's ``face_reason``.
+    """
+    return _check(plan, list(points), cell)[0]
+
+
+def _check(plan: Plan, points: list[PlanPoint], cell: Cell) -> tuple[tuple[PointCheck, ...], str]:
+    from planner.faces.checks import plan_face_reasons
+    from planner.faces.detection import NoPlanarFaceError
+
+    if not points:
+        return (), ""
+    t0 = time.perf_counter()
+    wo = cell.work_object
+    if wo is None:
+        raise RuntimeError("the plan's cell has no work object")
+    probes = [p.to_probe_point() for p in points]
+    radius = plan.validation.sensor.footprint_radius_m
+    error = ""
+    try:
+        faces = plan_face_reasons(wo.mesh, probes, name=wo.name, footprint_radius_m=radius)
+    except NoPlanarFaceError as exc:  # the plan cannot work on this part
+        error = str(exc)
+        faces = [error] * len(points)
+    P = np.array([p.position_m for p in points], dtype=float).reshape(-1, 3)
+    N = np.array([p.normal for p in points], dtype=float).reshape(-1, 3)
+    poses = cell.check_probes(P, N, tcp=plan.cell.tool.tcp)
+    T_nom = nominal_T_base_wobj(plan)
+    ik_kind = cell.solver.kind
+    out = []
+    for p, probe, pose, face in zip(points, probes, poses, faces, strict=True):
+        path = cell.check_search(SearchCommand.from_point(probe, T_nom), q_ref=pose.q)
+        out.append(_point_check(cell, p, pose, path, face, ik_kind, t0))
+        t0 = time.perf_counter()
+    return tuple(out), error
+
+
+def _point_check(
+    cell: Cell, p: PlanPoint, pose: ProbeFeasibility, path: Any, face: str, ik_kind: str, t0: float
+) -> PointCheck:
+    from planner.cell.collision import DEFAULT_MARGIN_M, report_distance_m
+
+    path_reason = str(path.reason or "")
+    status: Status = pose.status
+    if face or not path.feasible:
+        status = "infeasible"
+    parts = [pose.reason, f"search path: {path_reason}" if path_reason else "", face]
+    clearance = float(pose.clearance_m)
+    capped = math.isfinite(clearance) and clearance >= report_distance_m(DEFAULT_MARGIN_M) - 1e-6
+    return PointCheck(
+        point_id=p.id,
+        role=p.role,
+        kind=p.search.kind,
+        status=status,
+        reason="; ".join(x for x in parts if x),
+        pose_status=pose.status,
+        pose_reason=pose.reason,
+        path_feasible=bool(path.feasible),
+        path_reason=path_reason,
+        path_fail_at_m=float(path.fail_at_m),
+        face_reason=face,
+        clearance_m=clearance,
+        clearance_pair=None if capped else pose.clearance_pair,
+        clearance_is_lower_bound=capped,
+        confdata=_confdata(cell, pose.q) if pose.feasible else None,
+        ik_kind=ik_kind,
+        q=None if pose.q is None else np.asarray(pose.q, dtype=float),
+        q_path=None if path.q_path is None else np.asarray(path.q_path, dtype=float),
+        T_base_flange=None if pose.T_base_flange is None else np.asarray(pose.T_base_flange),
+        elapsed_s=time.perf_counter() - t0,
+    )
+
+
+def _confdata(cell: Cell, q: FloatArray | None) -> ConfData | None:
+    """ABB confdata of joint values ``q``; ``None`` for robots that are not OPW arms."""
+    from planner.robot.kinematics.opw_from_urdf import NotOPWError
+
+    if q is None or cell.solver.opw is None:
+        return None
+    try:
+        cf1, cf4, cf6, cfx = cell.solver.abb_confdata(np.asarray(q, float))
+    except NotOPWError:
+        return None
+    return int(cf1), int(cf4), int(cf6), int(cfx)
+
+
+def _finite_or_none(x: float) -> float | None:
+    return x if math.isfinite(x) else None

@@ -1,0 +1,102 @@
+"""Export a plan as robot programs: the one export job the command line and the UI share.
+
+:func:`export_program` checks the plan (:func:`planner.check.check_plan`, unless told not to),
+builds the :class:`planner.export.job.ExportJob` with each target's sensor orientation and ABB
+configuration from the check, and formats it with the writer registered for the format
+(:data:`planner.export.FORMATS`). Whether infeasible points stop the export is the caller's
+decision (``wobjcal export`` exits 1 unless ``--force``); the result says which they are.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from calib.frames import invert_transform
+from calib.plan.file import Plan
+from planner.check import ConfData, PlanCheck, check_plan
+from planner.export import export_files
+from planner.export.job import ExportJob, build_job
+from planner.plan_cell import nominal_T_base_wobj, tool_data
+
+if TYPE_CHECKING:
+    from planner.cell.cell import Cell
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class ProgramExport:
+    """A robot program of a plan.
+
+    Attributes:
+        files: ``{suffix: text}`` of the program, e.g. ``{".src": ..., ".dat": ...}``.
+        notes: what the user should know (estimated tool load, points without a checked pose).
+        check: the plan check the orientations came from, or ``None`` when not run.
+    """
+
+    files: dict[str, str]
+    notes: tuple[str, ...]
+    check: PlanCheck | None
+
+    @property
+    def infeasible(self) -> tuple[str, ...]:
+        """Ids of the points the check found infeasible (``()`` without a check)."""
+        return () if self.check is None else tuple(p.point_id for p in self.check.infeasible)
+
+
+def export_job_for(
+    plan: Plan, plan_dir: Path, check: PlanCheck | None
+) -> tuple[ExportJob, tuple[str, ...]]:
+    """The export job of ``plan``, with orientations and confdata from ``check`` when given.
+
+    Returns:
+        The job and notes for the user.
+    """
+    T_nom = nominal_T_base_wobj(plan)
+    tool, note = tool_data(plan, plan_dir)
+    notes = [note] if note else []
+    rotations: dict[str, FloatArray] = {}
+    confs: dict[str, ConfData] = {}
+    if check is None:
+        notes.append("no check: default orientations, no confdata")
+    else:
+        T_wobj_base = invert_transform(T_nom)
+        for r in check.points:
+            if r.T_base_flange is not None and r.pose_status != "infeasible":  # chosen pose
+                T_wobj_tcp = T_wobj_base @ r.T_base_flange @ tool.T_flange_tcp
+                rotations[r.point_id] = T_wobj_tcp[:3, :3]
+            if r.confdata is not None:
+                confs[r.point_id] = r.confdata
+        no_pose = [r.point_id for r in check.points if r.point_id not in rotations]
+        blocked = [r.point_id for r in check.infeasible if r.point_id in rotations]
+        if no_pose:
+            notes.append(f"no feasible pose for {no_pose}: default orientation, no confdata")
+        if blocked:
+            notes.append(f"points {blocked} are not feasible (see 'wobjcal check')")
+    return build_job(plan, T_nom, tool, rotations, confs), tuple(notes)
+
+
+def export_program(
+    plan: Plan, plan_dir: Path, fmt: str, *, run_check: bool = True, cell: Cell | None = None
+) -> ProgramExport:
+    """The robot program of ``plan`` in format ``fmt`` (a key of :data:`planner.export.FORMATS`).
+
+    Args:
+        plan: the plan.
+        plan_dir: folder the plan's relative file references resolve against.
+        fmt: the robot-program format.
+        run_check: check the plan in its cell first (orientations and confdata of the chosen
+            poses); ``False``: default orientations, no confdata, no cell opened.
+        cell: an open cell of the plan to check in (the UI's); ``None`` opens one.
+
+    Raises:
+        InputError: unknown format, or a file of the plan cannot be loaded.
+    """
+    check = check_plan(plan, plan_dir, cell=cell) if run_check else None
+    job, notes = export_job_for(plan, plan_dir, check)
+    return ProgramExport(export_files(job, fmt), notes, check)
