@@ -7,7 +7,7 @@ Owns:
     - :mod:`planner.export.safety`: safe search starts under the plan's misplacement;
     - :mod:`planner.export.text`: identifiers, numbers and header comments shared by writers;
     - one module per language: ``rapid`` (+ ``rapid_probe``, ``rapid_adaptive``,
-      ``rapid_write``), ``krl``, ``urscript``;
+      ``rapid_write``), ``krl``, ``urscript``, ``fanuc`` (FANUC TP ``.ls``);
     - the registry :data:`FORMATS` and :func:`export_files`.
 
 A writer is a function ``(ExportJob) -> {file suffix: text}`` (KRL writes a ``.src`` and a
@@ -74,6 +74,7 @@ FORMATS: dict[str, ExportFormat] = {
             "planner.export.urscript:urscript_files",
             (".script",),
         ),
+        ExportFormat("fanuc", "TP", "FANUC", "planner.export.fanuc:export_fanuc", (".ls",)),
     )
 }
 #: What ``wobjcal export --format`` accepts: the robot formats and the plan's own JSON.

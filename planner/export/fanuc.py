@@ -1,0 +1,320 @@
+"""FANUC TP export: one ASCII ``.ls`` program that probes every point with skip searches and
+keeps the measured points in position registers.
+
+Conventions: millimetres and degrees; a pose is ``X, Y, Z, W, P, R`` with W, P, R the fixed-axis
+rotations about x, y, z of the user frame, ``R = Rz(R) @ Ry(P) @ Rx(W)``: the paper's Tait-Bryan
+z-y'-x'' angles with (alpha, beta, gamma) = (R, P, W)
+(:func:`calib.frames.tait_bryan_zyx_from_matrix`). The program writes the nominal work object
+into ``PR[PR_UFRAME]`` and sets ``UFRAME[UFRAME_NO]`` from it (relative to WORLD, taken to be the
+robot base of the plan, as KRL takes ``$WORLD``), and the sensor TCP into ``PR[PR_UTOOL]`` ->
+``UTOOL[UTOOL_NO]``; every ``P[]`` is a sensor-TCP pose in that user frame with that tool, with
+``CONFIG 'N U T, 0, 0, 0'`` (the check's ABB confdata does not carry over: verify in T1).
+
+Every search runs in the nominal user frame (not adaptive; the frame comes from ``wobjcal
+calibrate``) and starts at the safe start of :mod:`planner.export.safety`. A search is
+``SKIP CONDITION DI[SENSOR_DI]=ON`` (approach) or ``=OFF`` (edge) and a linear move to the end
+point ``... FINE Skip,LBL[i],PR[k]=LPOS``: when the input switches, the robot stops, ``PR[k]``
+holds the TCP where the skip fired (user frame) and the next line runs; when it never switches,
+the robot reaches the end point and the program jumps to ``LBL[i]``. An edge point first runs an
+approach search to its face (``face_end``), then the edge search from the measured face point
+(orientation of the plan's edge start) along the plan's direction up to the plan's end, as the
+KRL export does. Results, point ``i`` (1-based, plan order): ``PR[PR_MEAS_BASE + i]`` the measured
+TCP (user frame, mm) and ``R[R_CODE_BASE + i]`` 0 measured, 1 no detection on the path, 2 the
+input already at the searched level at the start, 3 not run (program stopped before).
+
+Limits relied on (conservative; larger on recent controllers): program names of at most 36
+characters (letters, digits, ``_``, starting with a letter), ``!`` comments of at most 32
+characters, position comments of at most 16, ``PR[1..100]``, ``R[1..200]`` (the default register
+counts), user frames 1-9 and tool frames 1-10.
+"""
+
+from __future__ import annotations
+
+import re
+import textwrap
+
+import numpy as np
+
+from calib._version import __version__
+from calib.errors import InputError
+from calib.frames import tait_bryan_zyx_from_matrix
+from planner.export.job import ExportJob, TargetPair, fmt, identifier, safety_header
+
+#: User frame of the nominal work object (``UFRAME[9]``).
+UFRAME_NO = 9
+#: Tool frame of the sensor TCP (``UTOOL[9]``).
+UTOOL_NO = 9
+#: Digital input of the proximity sensor (``DI[1]``).
+SENSOR_DI = 1
+#: Position register the nominal work object is written to before ``UFRAME[UFRAME_NO]=PR[1]``.
+PR_UFRAME = 1
+#: Position register the sensor TCP is written to before ``UTOOL[UTOOL_NO]=PR[2]``.
+PR_UTOOL = 2
+#: Scratch: start of an edge search (the measured face point).
+PR_EDGE_START = 3
+#: Scratch: end of an edge search.
+PR_EDGE_END = 4
+#: Scratch: the face point measured by the approach search of an edge point.
+PR_FACE = 5
+#: Point ``i`` (1-based) is measured into ``PR[PR_MEAS_BASE + i]``: PR[11], PR[12], ...
+PR_MEAS_BASE = 10
+#: Point ``i`` (1-based) reports its result code in ``R[R_CODE_BASE + i]``: R[11], R[12], ...
+R_CODE_BASE = 10
+#: Scratch numeric registers (the edge search's projection).
+R_TMP = (1, 2)
+#: Position and numeric registers the program may use (the controllers' default counts).
+PR_COUNT = 100
+R_COUNT = 200
+#: Most points one program can probe (PR[11..100]).
+MAX_POINTS = min(PR_COUNT - PR_MEAS_BASE, R_COUNT - R_CODE_BASE)
+#: Program name, comment and position-comment lengths relied on.
+NAME_MAX = 36
+COMMENT_MAX = 32
+POS_COMMENT_MAX = 16
+#: Joint speed to the safe starts (%), linear speed of the moves that are no search (mm/sec).
+JOINT_PCT = 20
+LINEAR_MM_S = 100
+#: Configuration written on every position (flip, up, top; turns of J4, J5, J6).
+CONFIG = "N U T, 0, 0, 0"
+
+_NOT_IN_COMMENT = re.compile(r"[^A-Za-z0-9 _+*/=.,:()<>\[\]#%&?@-]")
+
+
+def program_name(name: str) -> str:
+    """A TP program name made of ``name``: upper case, ``[A-Z][A-Z0-9_]*``, at most 36 chars."""
+    ident = re.sub(r"[^A-Z0-9_]", "_", name.upper())
+    if not ident[:1].isalpha():
+        ident = "W" + ident
+    return ident[:NAME_MAX]
+
+
+def comment_lines(text: str) -> list[str]:
+    """``text`` as TP comment texts: printable ASCII without ``;``, quotes or ``!``, wrapped to
+    :data:`COMMENT_MAX` characters (the ``!`` and `` ;`` around them not counted)."""
+    text = re.sub(r"\s+", " ", text.replace(";", ",").replace("'s ", " "))
+    clean = _NOT_IN_COMMENT.sub("", text)
+    return textwrap.wrap(clean, COMMENT_MAX, break_on_hyphens=False)
+
+
+def wpr_deg(R: np.ndarray) -> tuple[float, float, float]:
+    """FANUC ``(W, P, R)`` in degrees of a rotation matrix: ``R = Rz(R) @ Ry(P) @ Rx(W)``."""
+    alpha, beta, gamma = np.degrees(tait_bryan_zyx_from_matrix(R))
+    return float(gamma), float(beta), float(alpha)
+
+
+def xyzwpr(T: np.ndarray) -> list[float]:
+    """``[X, Y, Z, W, P, R]`` of a transform in metres: mm and degrees."""
+    return [*(float(v) * 1000.0 for v in T[:3, 3]), *wpr_deg(T[:3, :3])]
+
+
+def _const(x: float) -> str:
+    """A TP numeric constant (6 decimals; a negative one in parentheses, ``(-1.5)``)."""
+    s = fmt(x, 6)
+    return f"({s})" if s.startswith("-") else s
+
+
+def _pos_num(x: float) -> str:
+    return f"{0.0 if abs(x) < 5e-7 else x:.6f}"
+
+
+def _ascii_ident(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_]", "_", identifier(text))
+
+
+class _Program:
+    """The ``/MN`` instructions and the ``/POS`` positions of the program being written."""
+
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+        self.positions: list[str] = []
+
+    def add(self, instruction: str) -> None:
+        self.lines.append(instruction)
+
+    def comment(self, text: str) -> None:
+        self.lines += ["!" + c for c in comment_lines(text)]
+
+    def position(self, T: np.ndarray, label: str) -> int:
+        """Add the sensor-TCP pose ``T`` (user frame, m) as the next ``P[n]``; return ``n``."""
+        n = len(self.positions) + 1
+        x, y, z, w, p, r = (_pos_num(v) for v in xyzwpr(T))
+        self.positions.append(
+            f'P[{n}:"{label[:POS_COMMENT_MAX]}"]{{\n'
+            "   GP1:\n"
+            f"\tUF : {UFRAME_NO}, UT : {UTOOL_NO},\t\tCONFIG : '{CONFIG}',\n"
+            f"\tX = {x}  mm,\tY = {y}  mm,\tZ = {z}  mm,\n"
+            f"\tW = {w} deg,\tP = {p} deg,\tR = {r} deg\n"
+            "};"
+        )
+        return n
+
+    def set_register(self, pr: int, T: np.ndarray) -> None:
+        """``PR[pr]`` = the pose ``T`` (m), component by component (mm, degrees)."""
+        self.add(f"PR[{pr}]=LPOS")  # a Cartesian position register, then its six components
+        for k, v in enumerate(xyzwpr(T), start=1):
+            self.add(f"PR[{pr},{k}]={_const(v)}")
+
+    def mn(self) -> str:
+        out = []
+        for i, line in enumerate(self.lines, start=1):
+            pad = "" if line[:2] in ("J ", "L ") else "  "
+            out.append(f"{i:4d}:{pad}{line} ;")
+        return "\n".join(out)
+
+
+def export_fanuc(job: ExportJob) -> dict[str, str]:
+    """The FANUC TP program of ``job``: ``{".ls": text}``.
+
+    Raises:
+        InputError: more points than :data:`MAX_POINTS` (the register block holds).
+    """
+    n = len(job.targets)
+    if n > MAX_POINTS:
+        raise InputError(
+            f"a FANUC program holds at most {MAX_POINTS} points (PR[{PR_MEAS_BASE + 1}.."
+            f"{PR_COUNT}]), the plan has {n}; split the plan"
+        )
+    name = program_name(job.name)
+    prog = _Program()
+    _header(prog, job, name)
+    prog.set_register(PR_UFRAME, job.T_base_wobj)
+    prog.set_register(PR_UTOOL, job.tool.T_flange_tcp)
+    prog.add(f"UFRAME[{UFRAME_NO}]=PR[{PR_UFRAME}]")
+    prog.add(f"UTOOL[{UTOOL_NO}]=PR[{PR_UTOOL}]")
+    prog.add(f"UFRAME_NUM={UFRAME_NO}")
+    prog.add(f"UTOOL_NUM={UTOOL_NO}")
+    for i in range(1, n + 1):
+        prog.add(f"R[{R_CODE_BASE + i}]=3")
+    for i, t in enumerate(job.targets, start=1):
+        _point(prog, i, t)
+    text = "\n".join(
+        [
+            f"/PROG  {name}",
+            "/ATTR",
+            "OWNER\t\t= MNEDITOR;",
+            'COMMENT\t\t= "wobjcal probe";',
+            "PROG_SIZE\t= 0;",
+            "FILE_NAME\t= ;",
+            "VERSION\t\t= 0;",
+            f"LINE_COUNT\t= {len(prog.lines)};",
+            "MEMORY_SIZE\t= 0;",
+            "PROTECT\t\t= READ_WRITE;",
+            "TCD:  STACK_SIZE\t= 0,",
+            "      TASK_PRIORITY\t= 50,",
+            "      TIME_SLICE\t= 0,",
+            "      BUSY_LAMP_OFF\t= 0,",
+            "      ABORT_REQUEST\t= 0,",
+            "      PAUSE_REQUEST\t= 0;",
+            "DEFAULT_GROUP\t= 1,*,*,*,*;",
+            "CONTROL_CODE\t= 00000000 00000000;",
+            "/MN",
+            prog.mn(),
+            "/POS",
+            *prog.positions,
+            "/END",
+            "",
+        ]
+    )
+    return {".ls": text}
+
+
+def _header(prog: _Program, job: ExportJob, name: str) -> None:
+    """The comment lines at the top of ``/MN``: units, frames, safety, results."""
+    n = len(job.targets)
+    tool = job.tool
+    cog = ", ".join(fmt(c * 1000.0, 1) for c in tool.cog_m)
+    first, last = PR_MEAS_BASE + 1, PR_MEAS_BASE + n
+    for text in (
+        f"Generated by wobjcal {__version__} from plan {job.plan_name} (procedure {job.method}). "
+        f"Save as {name}.ls (file name = program name).",
+        "Units mm, deg. W,P,R: fixed angles about x,y,z of the user frame, R = Rz(R) Ry(P) "
+        "Rx(W) (the paper's Tait-Bryan z-y-x angles alpha,beta,gamma = R,P,W).",
+        f"UFRAME[{UFRAME_NO}] = PR[{PR_UFRAME}] = nominal work object in WORLD, taken to be the "
+        f"plan's robot base: check WORLD before the run. UTOOL[{UTOOL_NO}] = PR[{PR_UTOOL}] = "
+        f"sensor TCP in the flange. Sensor on DI[{SENSOR_DI}]. Tool {fmt(tool.mass_kg, 3)} kg, "
+        f"COG [{cog}] mm: set the payload schedule on the controller.",
+        " ".join(safety_header(job, "", 10_000)),
+        f"Results: PR[{first}]..PR[{last}] = point 1..{n}: TCP where the skip fired (LPOS), "
+        f"UFRAME[{UFRAME_NO}], mm. R[{R_CODE_BASE + 1}]..R[{R_CODE_BASE + n}] = 0 measured, "
+        "1 no detection, 2 input already at the searched level at the start, 3 not run. A PR "
+        "is valid only when its R is 0.",
+        "Points: "
+        + ", ".join(f"{i}={_ascii_ident(t.point_id)}" for i, t in enumerate(job.targets, start=1)),
+        "Read back: PR[] on the TP (DATA) or in MD:POSREG.VA, R[] in MD:NUMREG.VA. Convert each "
+        f"point to the base, p_base = Rot(W,P,R) p + (X,Y,Z) with the PR[{PR_UFRAME}] values set "
+        "below, and write a wobjcal.measurements/1 file (frame base, units mm) for wobjcal "
+        "calibrate.",
+        f"Overwrites PR[{PR_UFRAME}]..PR[{PR_FACE}], PR[{first}]..PR[{last}], "
+        f"R[{R_TMP[0]}]..R[{R_TMP[1]}], R[{R_CODE_BASE + 1}]..R[{R_CODE_BASE + n}]. CONFIG "
+        f"{CONFIG} on every position, not from the check: run the first time in T1. Limits "
+        f"assumed: name {NAME_MAX}, comment {COMMENT_MAX} chars, PR[1..{PR_COUNT}], "
+        f"R[1..{R_COUNT}].",
+    ):
+        prog.comment(text)
+
+
+def _point(prog: _Program, i: int, t: TargetPair) -> None:
+    """Probe point ``i``: approach search from the safe start; for an edge point, then the
+    edge search from the measured face point along the plan's direction to the plan's end."""
+    ident = _ascii_ident(t.point_id)
+    code, meas, label = R_CODE_BASE + i, PR_MEAS_BASE + i, i
+    speed = max(1, round(t.speed_m_s * 1000.0))
+    keep = POS_COMMENT_MAX - 6
+    safe = prog.position(t.safe_start, f"{ident[:keep]} safe")
+    prog.comment(f"--- point {i} {ident}: {t.kind} search")
+    prog.add(f"J P[{safe}] {JOINT_PCT}% FINE")
+    prog.add(f"R[{code}]=2")
+    prog.add(f"IF DI[{SENSOR_DI}]=ON,JMP LBL[{label}]")
+    prog.add(f"R[{code}]=1")
+    prog.add(f"SKIP CONDITION DI[{SENSOR_DI}]=ON")
+    if t.kind == "approach":
+        end = prog.position(t.T_wobj_end, f"{ident[:keep]} end")
+        prog.add(f"L P[{end}] {speed}mm/sec FINE Skip,LBL[{label}],PR[{meas}]=LPOS")
+    else:
+        face = prog.position(t.face_end, f"{ident[:keep]} face")
+        start = prog.position(t.T_wobj_start, f"{ident[:keep]} start")
+        end = prog.position(t.T_wobj_end, f"{ident[:keep]} end")
+        prog.add(f"L P[{face}] {speed}mm/sec FINE Skip,LBL[{label}],PR[{PR_FACE}]=LPOS")
+        prog.comment("edge start: the measured face point, plan orientation")
+        s, e = PR_EDGE_START, PR_EDGE_END
+        prog.add(f"PR[{s}]=P[{start}]")
+        for k in (1, 2, 3):
+            prog.add(f"PR[{s},{k}]=PR[{PR_FACE},{k}]")
+        prog.add(f"L PR[{s}] {LINEAR_MM_S}mm/sec FINE")
+        prog.add(f"PR[{e}]=P[{end}]")
+        _project_end(prog, t.edge_direction_wobj)
+        prog.add(f"R[{code}]=2")
+        prog.add(f"IF DI[{SENSOR_DI}]=OFF,JMP LBL[{label}]")
+        prog.add(f"R[{code}]=1")
+        prog.add(f"SKIP CONDITION DI[{SENSOR_DI}]=OFF")
+        prog.add(f"L PR[{e}] {speed}mm/sec FINE Skip,LBL[{label}],PR[{meas}]=LPOS")
+    prog.add(f"R[{code}]=0")
+    prog.add(f"LBL[{label}]")
+    prog.add(f"L P[{safe}] {LINEAR_MM_S}mm/sec FINE")
+
+
+def _project_end(prog: _Program, d: np.ndarray) -> None:
+    """``PR[end] = PR[start] + ((PR[end] - PR[start]) . d) d`` in x, y, z (``d`` a unit vector,
+    user frame): the plan's end projected on the line along ``d`` through the measured start.
+    One operation per line, no negative constant (a negative ``d`` swaps the operands)."""
+    s, e = PR_EDGE_START, PR_EDGE_END
+    acc, tmp = R_TMP
+    terms = [k for k in range(3) if abs(d[k]) > 1e-12]
+    prog.comment(f"end: along the plan's edge direction, R[{acc}] = travel mm")
+    for j, k in enumerate(terms):
+        a, b = (e, s) if d[k] > 0 else (s, e)
+        reg = acc if j == 0 else tmp
+        prog.add(f"R[{reg}]=PR[{a},{k + 1}]-PR[{b},{k + 1}]")
+        if abs(abs(d[k]) - 1.0) > 1e-12:
+            prog.add(f"R[{reg}]=R[{reg}]*{_const(abs(d[k]))}")
+        if j > 0:
+            prog.add(f"R[{acc}]=R[{acc}]+R[{tmp}]")
+    for k in range(3):
+        if k not in terms:
+            prog.add(f"PR[{e},{k + 1}]=PR[{s},{k + 1}]")
+            continue
+        step = acc
+        if abs(abs(d[k]) - 1.0) > 1e-12:
+            step = tmp
+            prog.add(f"R[{tmp}]=R[{acc}]*{_const(abs(d[k]))}")
+        prog.add(f"PR[{e},{k + 1}]=PR[{s},{k + 1}]{'+' if d[k] > 0 else '-'}R[{step}]")

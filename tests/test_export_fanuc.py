@@ -1,0 +1,583 @@
+"""Tests of planner.export.fanuc: the TP program parsed back (poses, frames, registers, labels)
+and run in a small interpreter of the TP subset it writes, against an ideal misplaced part."""
+
+from __future__ import annotations
+
+import itertools
+import re
+import warnings
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from calib.errors import InputError
+from calib.frames import (
+    invert_transform,
+    make_transform,
+    matrix_from_rotvec,
+    random_transform,
+    transform_points,
+)
+from calib.plan.file import Plan, load_plan
+from calib.probing import SearchCommand
+from planner.cli.check import export_job_for
+from planner.cli.main import main
+from planner.export import FORMATS, export_files
+from planner.export import fanuc as F
+from planner.export.job import ExportJob, ToolData, build_job, default_sensor_rotation
+from tests.box_part import BoxProbe, distance_to_box
+from tests.test_export_rapid_adaptive import full_misplacement
+
+REPO = Path(__file__).resolve().parent.parent
+VALID = REPO / "tests" / "data" / "plans" / "valid_three_two_one.json"
+STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
+
+NUM = r"-?\d+\.\d+"
+CONST = r"\d+(?:\.\d+)?|\(-\d+(?:\.\d+)?\)"
+OPERAND = rf"PR\[\d+,[1-6]\]|R\[\d+\]|{CONST}"
+COMMENT = r"![A-Za-z0-9 _+*/=.,:()<>\[\]#%&?@-]{1,32}"
+POS = re.compile(
+    r'P\[(\d+):"([A-Za-z0-9_ ]{0,16})"\]\{\n   GP1:\n'
+    r"\tUF : (\d+), UT : (\d+),\t\tCONFIG : '([^'\n]*)',\n"
+    rf"\tX = ({NUM})  mm,\tY = ({NUM})  mm,\tZ = ({NUM})  mm,\n"
+    rf"\tW = ({NUM}) deg,\tP = ({NUM}) deg,\tR = ({NUM}) deg\n}};"
+)
+
+
+# ------------------------------------------------------------------ parsing the .ls back
+
+
+def rot_wpr(w: float, p: float, r: float) -> np.ndarray:
+    """FANUC W, P, R (deg) to a matrix, built here by hand: ``Rz(r) @ Ry(p) @ Rx(w)``."""
+    w, p, r = np.radians([w, p, r])
+    Rx = np.array([[1, 0, 0], [0, np.cos(w), -np.sin(w)], [0, np.sin(w), np.cos(w)]])
+    Ry = np.array([[np.cos(p), 0, np.sin(p)], [0, 1, 0], [-np.sin(p), 0, np.cos(p)]])
+    Rz = np.array([[np.cos(r), -np.sin(r), 0], [np.sin(r), np.cos(r), 0], [0, 0, 1]])
+    return Rz @ Ry @ Rx
+
+
+def pose_matrix(v: np.ndarray) -> np.ndarray:
+    """``[X, Y, Z, W, P, R]`` (mm, deg) to a transform in metres."""
+    return make_transform(rot_wpr(*v[3:]), np.asarray(v[:3]) / 1000.0)
+
+
+def pose_values(T: np.ndarray) -> np.ndarray:
+    """A transform (m) to ``[X, Y, Z, W, P, R]`` (mm, deg) with scipy (extrinsic xyz)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # gimbal lock at P = +-90: any split of W, R is fine
+        wpr = Rotation.from_matrix(T[:3, :3]).as_euler("xyz", degrees=True)
+    return np.array([*(T[:3, 3] * 1000.0), *wpr])
+
+
+@dataclass
+class Position:
+    comment: str
+    uf: int
+    ut: int
+    config: str
+    values: np.ndarray  # X, Y, Z, W, P, R (mm, deg)
+
+
+@dataclass
+class Program:
+    name: str
+    attr: str
+    lines: list[str]  # /MN instructions without line number and " ;"
+    positions: dict[int, Position]
+
+
+def parse_ls(text: str) -> Program:
+    """The sections of a TP ASCII program; asserts its layout on the way."""
+    rows = text.split("\n")
+    assert text.endswith("/END\n")
+    heads = [i for i, row in enumerate(rows) if row.startswith("/")]
+    assert [rows[i].split()[0] for i in heads] == ["/PROG", "/ATTR", "/MN", "/POS", "/END"]
+    m = re.fullmatch(r"/PROG  (\w+)", rows[0])
+    assert m, rows[0]
+    _, attr, mn, pos = ("\n".join(rows[a + 1 : b]) for a, b in itertools.pairwise(heads))
+    lines = []
+    for k, row in enumerate(mn.split("\n"), start=1):
+        lm = re.fullmatch(r" *(\d+):(.*) ;", row)
+        assert lm and int(lm.group(1)) == k, (k, row)  # numbered 1, 2, 3, ... without gaps
+        lines.append(lm.group(2).strip())
+    positions = {}
+    for pm in POS.finditer(pos):
+        n = int(pm.group(1))
+        assert n not in positions
+        vals = np.array([float(pm.group(k)) for k in range(6, 12)])
+        positions[n] = Position(pm.group(2), int(pm.group(3)), int(pm.group(4)), pm.group(5), vals)
+    assert not POS.sub("", pos).strip(), "text in /POS that is no position"
+    lc = re.search(r"^LINE_COUNT\t= (\d+);$", attr, re.M)
+    assert lc and int(lc.group(1)) == len(lines)
+    return Program(m.group(1), attr, lines, positions)
+
+
+def frame_constants(lines: list[str], pr: int) -> np.ndarray:
+    """The six constants the program writes into ``PR[pr]``: X, Y, Z, W, P, R."""
+    vals = {}
+    for line in lines:
+        m = re.fullmatch(rf"PR\[{pr},([1-6])\]=({CONST})", line)
+        if m:
+            vals[int(m.group(1))] = float(m.group(2).strip("()"))
+    assert sorted(vals) == [1, 2, 3, 4, 5, 6]
+    return np.array([vals[k] for k in range(1, 7)])
+
+
+def point_blocks(lines: list[str]) -> list[dict]:
+    """Per point (a block starts at its joint move): its motions in order, the skip levels,
+    the P[] copied into the edge start and end registers."""
+    blocks: list[dict] = []
+    for line in lines:
+        if m := re.fullmatch(r"J P\[(\d+)\] \d+% FINE", line):
+            blocks.append({"safe": int(m.group(1)), "seq": [("J", "P", int(m.group(1)))]})
+            blocks[-1]["levels"] = []
+            continue
+        if not blocks:
+            continue
+        b = blocks[-1]
+        if m := re.fullmatch(r"SKIP CONDITION DI\[(\d+)\]=(ON|OFF)", line):
+            b["levels"].append(m.group(2))
+        elif m := re.fullmatch(
+            r"L (P|PR)\[(\d+)\] (\d+)mm/sec FINE Skip,LBL\[(\d+)\],PR\[(\d+)\]=LPOS", line
+        ):
+            b["seq"].append(("S", m.group(1), int(m.group(2)), int(m.group(4)), int(m.group(5))))
+            b["speed"] = int(m.group(3))
+        elif m := re.fullmatch(r"L (P|PR)\[(\d+)\] \d+mm/sec FINE", line):
+            b["seq"].append(("L", m.group(1), int(m.group(2))))
+        elif m := re.fullmatch(r"PR\[(\d+)\]=P\[(\d+)\]", line):
+            b[{F.PR_EDGE_START: "start", F.PR_EDGE_END: "end"}[int(m.group(1))]] = int(m.group(2))
+    return blocks
+
+
+def _angle_deg(R1: np.ndarray, R2: np.ndarray) -> float:
+    c = (np.trace(R1.T @ R2) - 1.0) / 2.0
+    return float(np.degrees(np.arccos(np.clip(c, -1.0, 1.0))))
+
+
+def assert_pose(got: np.ndarray, want: np.ndarray, what: object) -> None:
+    """Within 1e-8 m and 2e-6 deg (the program's 6 decimals of mm and deg)."""
+    assert np.abs(got[:3, 3] - want[:3, 3]).max() < 1e-8, what
+    assert _angle_deg(got[:3, :3], want[:3, :3]) < 2e-6, what
+
+
+# ------------------------------------------------------------------ a TP interpreter
+
+
+class TPRun:
+    """Runs the ``/MN`` of a program (only the instructions the exporter writes: anything else
+    fails) with the sensor TCP moving in the robot base and an ideal box part posed at
+    ``T_base_true`` (:class:`tests.box_part.BoxProbe`). ``DI[1]`` is on while the TCP is on or
+    inside the part (``stuck``: always that level)."""
+
+    def __init__(self, text: str, T_base_true: np.ndarray, stuck: bool | None = None) -> None:
+        self.prog = parse_ls(text)
+        self.labels: dict[int, int] = {}
+        for i, line in enumerate(self.prog.lines):
+            if m := re.fullmatch(r"LBL\[(\d+)\]", line):
+                assert int(m.group(1)) not in self.labels, line
+                self.labels[int(m.group(1))] = i
+        self.probe = BoxProbe(T_base_true)
+        self.T_true_base = invert_transform(T_base_true)
+        self.stuck = stuck
+        self.PR: dict[int, np.ndarray] = {}
+        self.R: dict[int, float] = {}
+        self.uframe: dict[int, np.ndarray] = {0: np.eye(4)}
+        self.utool: dict[int, np.ndarray] = {0: np.eye(4)}
+        self.uf = self.ut = 0
+        self.tcp = make_transform(np.eye(3), [0.9, 0.1, 1.3])  # TCP in the base, m
+        self.skip_on: bool | None = None
+        self.searches: list[dict] = []
+        self.joint_targets: list[np.ndarray] = []
+
+    def di(self) -> bool:
+        if self.stuck is not None:
+            return self.stuck
+        return distance_to_box(transform_points(self.T_true_base, self.tcp[:3, 3])) <= 1e-9
+
+    def value(self, tok: str) -> float:
+        if m := re.fullmatch(r"PR\[(\d+),([1-6])\]", tok):
+            return float(self.PR[int(m.group(1))][int(m.group(2)) - 1])
+        if m := re.fullmatch(r"R\[(\d+)\]", tok):
+            return self.R[int(m.group(1))]
+        return float(tok.strip("()"))
+
+    def target(self, kind: str, n: int) -> np.ndarray:
+        if kind == "P":
+            pos = self.prog.positions[n]
+            assert (pos.uf, pos.ut) == (self.uf, self.ut), "P[] frame numbers not active"
+            return self.uframe[self.uf] @ pose_matrix(pos.values)
+        return self.uframe[self.uf] @ pose_matrix(self.PR[n])
+
+    def lpos(self) -> np.ndarray:
+        return pose_values(invert_transform(self.uframe[self.uf]) @ self.tcp)
+
+    def search(self, target: np.ndarray) -> bool:
+        """One skip move from the TCP to ``target``: True when the skip fired."""
+        start, end = self.tcp[:3, 3].copy(), target[:3, 3]
+        record = {"on": self.skip_on, "start": start, "end": end.copy(), "found": True}
+        self.searches.append(record)
+        if self.di() == self.skip_on:  # condition already true: the skip fires at once
+            return True
+        length = float(np.linalg.norm(end - start))
+        cmd = SearchCommand(
+            point_id="",
+            kind="approach" if self.skip_on else "edge",
+            start_m=start,
+            direction=(end - start) / length,
+            length_m=length,
+            sensor_axis=target[:3, 2],
+            T_base_wobj_estimate=np.eye(4),
+            nominal_m=start,
+        )
+        res = None if self.stuck is not None else self.probe(cmd).point_m
+        record["found"] = res is not None
+        self.tcp = target if res is None else make_transform(target[:3, :3], res)
+        return res is not None
+
+    def run(self) -> TPRun:
+        lines, pc = self.prog.lines, 0
+        while pc < len(lines):
+            line = lines[pc]
+            pc += 1
+            if line.startswith("!"):
+                assert re.fullmatch(COMMENT, line), line
+            elif re.fullmatch(r"LBL\[\d+\]", line):
+                pass
+            elif m := re.fullmatch(r"PR\[(\d+)\]=LPOS", line):
+                self.PR[int(m.group(1))] = self.lpos()
+            elif m := re.fullmatch(r"PR\[(\d+)\]=P\[(\d+)\]", line):
+                self.PR[int(m.group(1))] = self.prog.positions[int(m.group(2))].values.copy()
+            elif m := re.fullmatch(rf"PR\[(\d+),([1-6])\]=({OPERAND})(?:([+-])({OPERAND}))?", line):
+                v = self.value(m.group(3))
+                if m.group(4):
+                    v += self.value(m.group(5)) * (1 if m.group(4) == "+" else -1)
+                self.PR[int(m.group(1))][int(m.group(2)) - 1] = v
+            elif m := re.fullmatch(rf"R\[(\d+)\]=({OPERAND})(?:([-+*])({OPERAND}))?", line):
+                v = self.value(m.group(2))
+                if m.group(3):
+                    w = self.value(m.group(4))
+                    v = {"+": v + w, "-": v - w, "*": v * w}[m.group(3)]
+                self.R[int(m.group(1))] = v
+            elif m := re.fullmatch(r"(UFRAME|UTOOL)\[(\d+)\]=PR\[(\d+)\]", line):
+                frames = self.uframe if m.group(1) == "UFRAME" else self.utool
+                frames[int(m.group(2))] = pose_matrix(self.PR[int(m.group(3))])
+            elif m := re.fullmatch(r"(UFRAME|UTOOL)_NUM=(\d+)", line):
+                if m.group(1) == "UFRAME":
+                    self.uf = int(m.group(2))
+                else:
+                    self.ut = int(m.group(2))
+            elif m := re.fullmatch(r"IF DI\[1\]=(ON|OFF),JMP LBL\[(\d+)\]", line):
+                if self.di() == (m.group(1) == "ON"):
+                    pc = self.labels[int(m.group(2))]
+            elif m := re.fullmatch(r"SKIP CONDITION DI\[1\]=(ON|OFF)", line):
+                self.skip_on = m.group(1) == "ON"
+            elif m := re.fullmatch(r"J P\[(\d+)\] \d+% FINE", line):
+                self.tcp = self.target("P", int(m.group(1)))
+                self.joint_targets.append(self.tcp)
+            elif m := re.fullmatch(
+                r"L (P|PR)\[(\d+)\] \d+mm/sec FINE(?: Skip,LBL\[(\d+)\],PR\[(\d+)\]=LPOS)?", line
+            ):
+                goal = self.target(m.group(1), int(m.group(2)))
+                if m.group(3) is None:
+                    self.tcp = goal
+                elif self.search(goal):
+                    self.PR[int(m.group(4))] = self.lpos()
+                else:
+                    pc = self.labels[int(m.group(3))]
+            else:
+                raise AssertionError(f"instruction the exporter should not write: {line!r}")
+        return self
+
+    def measured_wobj(self, job: ExportJob) -> dict[str, np.ndarray | int]:
+        """Per point: the measured position (nominal wobj frame, m) or the failure code."""
+        out: dict[str, np.ndarray | int] = {}
+        for i, t in enumerate(job.targets, start=1):
+            code = int(self.R[F.R_CODE_BASE + i])
+            out[t.point_id] = self.PR[F.PR_MEAS_BASE + i][:3] / 1000.0 if code == 0 else code
+        return out
+
+
+# ------------------------------------------------------------------ jobs
+
+
+def random_job(plan: Plan, rng: np.random.Generator) -> ExportJob:
+    T_base_wobj = random_transform(rng, 2.0, np.pi)
+    tool = ToolData(T_flange_tcp=random_transform(rng, 0.3, np.pi))
+    rotations = {
+        p.id: default_sensor_rotation(p.normal, p.search.edge_direction)
+        @ matrix_from_rotvec([0.0, 0.0, rng.uniform(-np.pi, np.pi)])
+        for p in plan.points
+    }
+    return build_job(plan, T_base_wobj, tool, rotations)
+
+
+def ls_of(job: ExportJob) -> str:
+    files = export_files(job, "fanuc")
+    assert list(files) == [".ls"]
+    return files[".ls"]
+
+
+def many_points(job: ExportJob, n: int) -> ExportJob:
+    """``job`` with ``n`` points: its own, repeated, renamed Q1, Q2, ..."""
+    ts = [replace(job.targets[k % len(job.targets)], point_id=f"Q{k + 1}") for k in range(n)]
+    return replace(job, targets=tuple(ts))
+
+
+# ------------------------------------------------------------------ tests
+
+
+def test_registered_with_the_cli_and_ui() -> None:
+    fmt = FORMATS["fanuc"]
+    assert (fmt.label, fmt.vendor, fmt.suffixes) == ("TP", "FANUC", (".ls",))
+    assert fmt.load() is F.export_fanuc
+
+
+def test_wpr_convention_round_trips_with_scipy(rng: np.random.Generator) -> None:
+    """W, P, R = scipy's extrinsic xyz angles; R = Rz(R) Ry(P) Rx(W), also at P = +-90."""
+    mats = list(Rotation.random(200, random_state=7).as_matrix())
+    mats += [rot_wpr(30.0, 90.0, -20.0), rot_wpr(-150.0, -90.0, 45.0), rot_wpr(180.0, 0.0, 0.0)]
+    for R in mats:
+        w, p, r = F.wpr_deg(R)
+        assert -90.0 <= p <= 90.0
+        scipy_R = Rotation.from_euler("xyz", [w, p, r], degrees=True).as_matrix()
+        assert np.abs(scipy_R - R).max() < 1e-12
+        assert np.abs(rot_wpr(w, p, r) - R).max() < 1e-12
+    # the textbook cases: tool z down is W = 180; a yaw of the frame is R
+    assert np.allclose(F.wpr_deg(rot_wpr(180.0, 0.0, 0.0)), (180.0, 0.0, 0.0)) or np.allclose(
+        F.wpr_deg(rot_wpr(180.0, 0.0, 0.0)), (-180.0, 0.0, 0.0)
+    )
+    assert np.allclose(F.wpr_deg(rot_wpr(0.0, 0.0, 35.0)), (0.0, 0.0, 35.0))
+    assert np.allclose(F.wpr_deg(rot_wpr(10.0, 20.0, 30.0)), (10.0, 20.0, 30.0))
+
+
+@pytest.mark.parametrize("path", [VALID, STATOR], ids=["three_two_one", "stator_ah"])
+def test_poses_and_frames_parse_back(path: Path, rng: np.random.Generator) -> None:
+    plan = load_plan(path)
+    job = random_job(plan, rng)
+    prog = parse_ls(ls_of(job))
+    # frames: UFRAME[9] = PR[1] = T_base_wobj, UTOOL[9] = PR[2] = the sensor TCP
+    assert f"UFRAME[{F.UFRAME_NO}]=PR[{F.PR_UFRAME}]" in prog.lines
+    assert f"UTOOL[{F.UTOOL_NO}]=PR[{F.PR_UTOOL}]" in prog.lines
+    assert_pose(pose_matrix(frame_constants(prog.lines, F.PR_UFRAME)), job.T_base_wobj, "uframe")
+    assert_pose(pose_matrix(frame_constants(prog.lines, F.PR_UTOOL)), job.tool.T_flange_tcp, "ut")
+    # every P[n]: in the user frame / tool frame of the program, the job's targets
+    assert sorted(prog.positions) == list(range(1, len(prog.positions) + 1))
+    for pos in prog.positions.values():
+        assert (pos.uf, pos.ut, pos.config) == (F.UFRAME_NO, F.UTOOL_NO, F.CONFIG)
+    blocks = point_blocks(prog.lines)
+    assert len(blocks) == len(job.targets)
+    P = {n: pose_matrix(pos.values) for n, pos in prog.positions.items()}
+    used: list[int] = []
+    for i, (b, t) in enumerate(zip(blocks, job.targets, strict=True), start=1):
+        safe = b["safe"]
+        assert_pose(P[safe], t.safe_start, (t.point_id, "safe"))
+        assert b["speed"] == round(t.speed_m_s * 1000.0)
+        face = b["seq"][1][2]
+        assert_pose(P[face], t.face_end, (t.point_id, "face"))
+        if t.kind == "approach":  # to the safe start, search to the end, back
+            assert_pose(P[face], t.T_wobj_end, (t.point_id, "end"))
+            assert b["levels"] == ["ON"]
+            assert b["seq"] == [
+                ("J", "P", safe),
+                ("S", "P", face, i, F.PR_MEAS_BASE + i),
+                ("L", "P", safe),
+            ]
+            used += [safe, face]
+        else:  # approach the face, to the measured face point, edge search to the end, back
+            assert_pose(P[b["start"]], t.T_wobj_start, (t.point_id, "start"))
+            assert_pose(P[b["end"]], t.T_wobj_end, (t.point_id, "end"))
+            assert b["levels"] == ["ON", "OFF"]
+            assert b["seq"] == [
+                ("J", "P", safe),
+                ("S", "P", face, i, F.PR_FACE),
+                ("L", "PR", F.PR_EDGE_START),
+                ("S", "PR", F.PR_EDGE_END, i, F.PR_MEAS_BASE + i),
+                ("L", "P", safe),
+            ]
+            used += [safe, face, b["start"], b["end"]]
+    assert sorted(used) == sorted(prog.positions)  # every P[] used once, no other
+
+
+def test_searches_start_outside_the_nominal_surface_by_the_clearance() -> None:
+    """In program order, each point's first search starts at its P[safe], at least the safe
+    clearance outside the nominal face; the edge search starts at the measured face point."""
+    plan = load_plan(VALID)
+    job = build_job(plan, np.eye(4), ToolData(T_flange_tcp=np.eye(4)))
+    prog = parse_ls(ls_of(job))
+    for b, t, p in zip(point_blocks(prog.lines), job.targets, plan.points, strict=True):
+        start = pose_matrix(prog.positions[b["safe"]].values)[:3, 3]
+        face = t.T_wobj_start[:3, 3] if t.kind == "edge" else np.asarray(p.position_m)
+        out = float(np.asarray(p.normal) @ (start - face))
+        assert out >= job.safety.start_clearance_m(face) - 1e-9
+        assert out > p.search.start_offset_m  # moved out: the test plan's start is too close
+    # no other motion between the joint move to P[safe] and the first search
+    for b in point_blocks(prog.lines):
+        assert b["seq"][0] == ("J", "P", b["safe"]) and b["seq"][1][0] == "S"
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("path", [VALID, STATOR], ids=["three_two_one", "stator_ah"])
+def test_program_run_against_a_misplaced_part(path: Path, seed: int) -> None:
+    """The interpreter runs the program on an ideal part misplaced at the tolerance: no search
+    starts within the sensing distance of it, the edge searches start on its face, every
+    approach point is found on the true part (the test plan's 20 mm edge search may end before
+    the moved edge, code 1)."""
+    plan = load_plan(path)
+    rng = np.random.default_rng(seed)
+    T_nom = make_transform(matrix_from_rotvec([0.0, 0.2, 0.1]), [1.4, -0.3, 0.8])
+    T_true = T_nom @ full_misplacement(plan, rng)
+    job = build_job(plan, T_nom, ToolData(T_flange_tcp=random_transform(rng, 0.3, np.pi)))
+    tp = TPRun(ls_of(job), T_true).run()
+    assert_pose(tp.uframe[F.UFRAME_NO], T_nom, "uframe")
+    assert_pose(tp.utool[F.UTOOL_NO], job.tool.T_flange_tcp, "utool")
+    sd = plan.validation.sensor.sensing_distance_m
+    T_true_base = invert_transform(T_true)
+    for s in tp.searches:
+        dist = distance_to_box(transform_points(T_true_base, s["start"]))
+        assert (dist > sd) if s["on"] else (abs(dist) < 1e-9), dist
+    for T in tp.joint_targets:
+        assert distance_to_box(transform_points(T_true_base, T[:3, 3])) > sd
+    n_edge = sum(t.kind == "edge" for t in job.targets)
+    assert [s["on"] for s in tp.searches].count(False) == n_edge
+    # as the header says: to the base with the PR[1] values, then into the true part frame
+    T_true_uf = T_true_base @ pose_matrix(frame_constants(tp.prog.lines, F.PR_UFRAME))
+    sin_a = np.sin(plan.validation.misplacement.max_angle_rad)
+    for t, got in zip(job.targets, tp.measured_wobj(job).values(), strict=True):
+        if isinstance(got, int):  # only the short edge search of the test plan may miss
+            assert (path, t.kind, got) == (VALID, "edge", 1), (t.point_id, got)
+            assert any(not s["on"] and not s["found"] for s in tp.searches)  # it ran, to its end
+            continue
+        dist = abs(distance_to_box(transform_points(T_true_uf, got)))
+        if t.kind == "approach":  # the TCP at the switching event is on the true face
+            assert dist < 1e-9, t.point_id
+        else:  # the track runs along the nominal direction: off a tilted face by the header's bound
+            assert dist <= t.length_m * sin_a + 1e-9, t.point_id
+
+
+@pytest.mark.parametrize("path", [VALID, STATOR], ids=["three_two_one", "stator_ah"])
+def test_nominal_part_gives_the_plan_points(path: Path, rng: np.random.Generator) -> None:
+    """On the part at its nominal pose every PR[10 + i] is the plan's point i (user frame)."""
+    plan = load_plan(path)
+    job = random_job(plan, rng)
+    tp = TPRun(ls_of(job), job.T_base_wobj).run()
+    for p in plan.points:
+        got = tp.measured_wobj(job)[p.id]
+        assert not isinstance(got, int)
+        assert np.abs(got - np.asarray(p.position_m)).max() < 1e-8, p.id
+
+
+def test_failure_codes() -> None:
+    """1: the part is not there (every search runs to its end); 2: the input is already on."""
+    plan = load_plan(VALID)
+    job = build_job(plan, np.eye(4), ToolData(T_flange_tcp=np.eye(4)))
+    away = make_transform(np.eye(3), [5.0, 0.0, 0.0])
+    tp = TPRun(ls_of(job), away).run()
+    assert set(tp.measured_wobj(job).values()) == {1}
+    assert all(not s["found"] and s["on"] for s in tp.searches)  # edge points stop after 1
+    tp = TPRun(ls_of(job), np.eye(4), stuck=True).run()
+    assert set(tp.measured_wobj(job).values()) == {2}
+    assert tp.searches == []  # no search started with the input on
+    # 3 until the point runs: set for every point before the first motion
+    lines = parse_ls(ls_of(job)).lines
+    first_motion = next(k for k, x in enumerate(lines) if x.startswith("J "))
+    init = [k for k, x in enumerate(lines) if re.fullmatch(r"R\[\d+\]=3", x)]
+    assert [lines[k] for k in init] == [f"R[{F.R_CODE_BASE + i}]=3" for i in range(1, 7)]
+    assert max(init) < first_motion
+
+
+def test_structure_labels_registers_and_name() -> None:
+    plan = load_plan(STATOR)
+    job = build_job(plan, np.eye(4), ToolData(T_flange_tcp=np.eye(4)))
+    prog = parse_ls(ls_of(job))
+    assert prog.name == "WOBJCALSTATORSECTIONAH" == F.program_name(job.name)
+    _check_structure(prog, len(job.targets))
+    text = "\n".join(x[1:] for x in prog.lines if x.startswith("!"))
+    assert "NOMINAL FRAME" in text and "not adaptive" in text
+    assert "SAFE FOR: part misplaced up to 20.0 mm" in " ".join(text.split())
+    assert f"PR[{F.PR_MEAS_BASE + 1}]..PR[{F.PR_MEAS_BASE + 8}]" in text
+    assert "Points: 1=A, 2=B, 3=C, 4=D, 5=E, 6=F, 7=G," in " ".join(text.split())
+
+
+def _check_structure(prog: Program, n: int) -> None:
+    """Name, labels, register and frame numbers of a program with ``n`` points."""
+    assert re.fullmatch(r"[A-Z][A-Z0-9_]{0,35}", prog.name)
+    defined = [int(x) for x in re.findall(r"^LBL\[(\d+)\]$", "\n".join(prog.lines), re.M)]
+    assert len(defined) == len(set(defined)) == n
+    jumped = re.findall(r"LBL\[(\d+)\]", "\n".join(x for x in prog.lines if "LBL" in x))
+    assert {int(x) for x in jumped} <= set(defined)
+    body = "\n".join(x for x in prog.lines if not x.startswith("!"))
+    prs = {int(x) for x in re.findall(r"PR\[(\d+)", body)}
+    rs = {int(x) for x in re.findall(r"(?<!P)R\[(\d+)", body)}
+    assert prs <= {1, 2, 3, 4, 5} | set(range(F.PR_MEAS_BASE + 1, F.PR_MEAS_BASE + n + 1))
+    assert max(prs) <= F.PR_COUNT and min(prs) >= 1
+    assert rs <= set(F.R_TMP) | set(range(F.R_CODE_BASE + 1, F.R_CODE_BASE + n + 1))
+    assert max(rs) <= F.R_COUNT
+    assert set(re.findall(r"UFRAME\[(\d+)\]", body)) == {str(F.UFRAME_NO)} and F.UFRAME_NO <= 9
+    assert set(re.findall(r"UTOOL\[(\d+)\]", body)) == {str(F.UTOOL_NO)} and F.UTOOL_NO <= 10
+    for x in prog.lines:
+        if x.startswith("!"):
+            assert re.fullmatch(COMMENT, x), x
+    assert re.search(r'^COMMENT\t\t= "[^"]{0,16}";$', prog.attr, re.M)
+
+
+def test_sixty_points_and_the_limit() -> None:
+    plan = load_plan(VALID)
+    job = many_points(build_job(plan, np.eye(4), ToolData(T_flange_tcp=np.eye(4))), 60)
+    text = ls_of(job)
+    prog = parse_ls(text)
+    _check_structure(prog, 60)
+    assert sorted(prog.positions) == list(range(1, len(prog.positions) + 1))
+    assert len(prog.positions) == 10 * (5 * 2 + 4)  # 5 approach and 1 edge point, 10 times
+    tp = TPRun(text, np.eye(4)).run()  # every point is measured, each in its own PR
+    got = tp.measured_wobj(job)
+    assert all(not isinstance(v, int) for v in got.values())
+    assert max(tp.PR) == F.PR_MEAS_BASE + 60
+    _check_structure(parse_ls(ls_of(many_points(job, F.MAX_POINTS))), F.MAX_POINTS)
+    with pytest.raises(InputError, match="at most 90 points"):
+        ls_of(many_points(job, F.MAX_POINTS + 1))
+
+
+def test_hostile_point_id_and_names_cannot_inject() -> None:
+    plan = load_plan(VALID)
+    job = build_job(plan, np.eye(4), ToolData(T_flange_tcp=np.eye(4)))
+    evil = "A;\n  1: CALL EVIL ;\r\"'!/END"
+    targets = (replace(job.targets[0], point_id=evil), *job.targets[1:])
+    job = replace(job, targets=targets, plan_name="x;\n/POS\nP[1]{", name='9 "bad";\nCALL')
+    text = ls_of(job)
+    prog = parse_ls(text)  # still exactly one of each section, numbered lines, LINE_COUNT
+    _check_structure(prog, len(job.targets))
+    assert prog.name == "W9__BAD___CALL"
+    for line in prog.lines:
+        assert "CALL" not in line or line.startswith("!"), line
+        assert ";" not in line and '"' not in line and "'" not in line
+    assert "\r" not in text and text.count("CALL EVIL") == 0
+    TPRun(text, np.eye(4)).run()  # runs: every line is one of the known instructions
+    assert prog.positions[1].comment.endswith(" safe")
+
+
+def test_program_name_limits() -> None:
+    assert F.program_name("WobjcalStatorSectionAh") == "WOBJCALSTATORSECTIONAH"
+    assert F.program_name("x" * 50) == "X" * 36
+    assert F.program_name("1st plan") == "W1ST_PLAN"
+    assert F.program_name("Ärger") == "W_RGER"
+    for line in F.comment_lines("a`b'c\"d;e!f\n" + "long " * 30 + "é"):
+        assert re.fullmatch(COMMENT, "!" + line) and len(line) <= 32
+
+
+def test_cli_export_and_help(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "X.ls"
+    assert main(["export", str(STATOR), "--format", "fanuc", "-o", str(out)]) == 0
+    assert main(["export", "--help"]) == 0
+    assert "fanuc" in capsys.readouterr().out
+    prog = parse_ls(out.read_text())
+    assert prog.name == "WOBJCALSTATORSECTIONAH"
+    plan = load_plan(STATOR)
+    job, _ = export_job_for(plan, STATOR.parent, run_check=False)  # frames, tool, positions
+    assert_pose(pose_matrix(frame_constants(prog.lines, F.PR_UFRAME)), job.T_base_wobj, "uf")
+    assert_pose(pose_matrix(frame_constants(prog.lines, F.PR_UTOOL)), job.tool.T_flange_tcp, "ut")
+    for b, t in zip(point_blocks(prog.lines), job.targets, strict=True):
+        got = prog.positions[b["safe"]].values[:3] / 1000.0
+        assert np.abs(got - t.safe_start[:3, 3]).max() < 1e-8  # orientations come from check
