@@ -23,11 +23,11 @@ from calib.frames import (
 )
 from calib.plan.file import Plan, load_plan
 from calib.probing import SearchCommand
-from planner.cli.check import export_job_for
 from planner.cli.main import main
 from planner.export import FORMATS, export_files
 from planner.export import fanuc as F
 from planner.export.job import ExportJob, ToolData, build_job, default_sensor_rotation
+from planner.export_plan import export_job_for
 from tests.box_part import BoxProbe, distance_to_box
 from tests.test_export_rapid_adaptive import full_misplacement
 
@@ -575,7 +575,7 @@ def test_cli_export_and_help(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     prog = parse_ls(out.read_text())
     assert prog.name == "WOBJCALSTATORSECTIONAH"
     plan = load_plan(STATOR)
-    job, _ = export_job_for(plan, STATOR.parent, run_check=False)  # frames, tool, positions
+    job, _ = export_job_for(plan, STATOR.parent, None)  # frames, tool, positions
     assert_pose(pose_matrix(frame_constants(prog.lines, F.PR_UFRAME)), job.T_base_wobj, "uf")
     assert_pose(pose_matrix(frame_constants(prog.lines, F.PR_UTOOL)), job.tool.T_flange_tcp, "ut")
     for b, t in zip(point_blocks(prog.lines), job.targets, strict=True):
