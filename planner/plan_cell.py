@@ -56,6 +56,7 @@ def open_cell(plan: Plan, plan_dir: Path) -> Cell:
         InputError: a file of the plan cannot be loaded (named in the message).
     """
     from planner.cell.cell import Cell  # PyBullet: imported when a cell is opened
+
     refs = resolved_refs(plan, plan_dir)
     robot = plan.cell.robot
     cell = Cell(
@@ -91,10 +92,15 @@ def tool_data(plan: Plan, plan_dir: Path) -> tuple[Any, str]:
     """
     from planner.cell.tool import load_tool
     from planner.export.job import ToolData
+    from planner.robot.urdf import load_urdf
 
     tool = load_tool(str(resolved_refs(plan, plan_dir)["tool"]))
     T_flange_tcp = tool.T_flange_tcp(plan.cell.tool.tcp)
-    mass, cog = _urdf_mass(getattr(tool, "urdf_path", None))
+    mass, cog = 0.0, (0.0, 0.0, 0.1)  # a mesh tool, or a URDF without masses: placeholders
+    if tool.urdf_path is not None:
+        kg, com = load_urdf(tool.urdf_path, check_meshes=False).mass_and_com()
+        if kg > 0.0:
+            mass, cog = kg, (float(com[0]), float(com[1]), float(com[2]))
     note = ""
     if mass < 1.0:
         note = (
@@ -103,58 +109,6 @@ def tool_data(plan: Plan, plan_dir: Path) -> tuple[Any, str]:
         )
         mass = 5.0
     return ToolData(T_flange_tcp=T_flange_tcp, mass_kg=mass, cog_m=cog), note
-
-
-def _urdf_origin(elem: Any) -> FloatArray:
-    """``T_parent_child`` of a URDF ``<origin xyz rpy>`` (rpy: fixed-axis roll, pitch, yaw)."""
-    from scipy.spatial.transform import Rotation
-
-    from calib.frames import make_transform
-
-    if elem is None:
-        return np.eye(4)
-    xyz = [float(v) for v in elem.get("xyz", "0 0 0").split()]
-    rpy = [float(v) for v in elem.get("rpy", "0 0 0").split()]
-    return make_transform(Rotation.from_euler("xyz", rpy).as_matrix(), xyz)
-
-
-def _urdf_mass(path: Path | None) -> tuple[float, tuple[float, float, float]]:
-    """Total mass (kg) and centre of gravity (root = flange frame, m) of a fixed-joint URDF."""
-    import xml.etree.ElementTree as ET
-
-    if path is None or not Path(path).is_file():
-        return 0.0, (0.0, 0.0, 0.1)
-    root = ET.parse(path).getroot()
-    parent_of: dict[str, tuple[str, FloatArray]] = {}
-    for j in root.findall("joint"):
-        parent, child = j.find("parent"), j.find("child")
-        if parent is not None and child is not None:
-            parent_of[child.get("link", "")] = (
-                parent.get("link", ""),
-                _urdf_origin(j.find("origin")),
-            )
-
-    def pose(link: str) -> FloatArray:
-        T = np.eye(4)
-        while link in parent_of:
-            link, T_parent_child = parent_of[link]
-            T = T_parent_child @ T
-        return T
-
-    total, moment = 0.0, np.zeros(3)
-    for link in root.findall("link"):
-        inertial = link.find("inertial")
-        m = None if inertial is None else inertial.find("mass")
-        if inertial is None or m is None:
-            continue
-        mass = float(m.get("value", "0"))
-        c = pose(link.get("name", "")) @ _urdf_origin(inertial.find("origin"))
-        total += mass
-        moment += mass * c[:3, 3]
-    if total <= 0:
-        return 0.0, (0.0, 0.0, 0.1)
-    cog = moment / total
-    return total, (float(cog[0]), float(cog[1]), float(cog[2]))
 
 
 __all__ = [

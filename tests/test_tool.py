@@ -129,3 +129,20 @@ def test_fingerprint_changes_with_geometry(feeder: Tool) -> None:
     a = Tool.from_mesh(trimesh.creation.box([0.1, 0.1, 0.1]), {})
     b = Tool.from_mesh(trimesh.creation.box([0.1, 0.1, 0.2]), {})
     assert a.fingerprint() != b.fingerprint()
+
+
+def test_tool_urdf_with_a_moving_joint_names_the_file_and_the_joint(tmp_path) -> None:
+    arm = tmp_path / "arm.urdf"
+    arm.write_text(
+        '<robot name="m"><link name="a"/><link name="b"/><link name="c"/>'
+        '<joint name="fix" type="fixed"><parent link="a"/><child link="b"/></joint>'
+        '<joint name="wrist" type="continuous"><parent link="b"/><child link="c"/></joint></robot>'
+    )
+    with pytest.raises(URDFError, match=r"arm\.urdf: <joint name='wrist'> is continuous, not fix"):
+        Tool.from_urdf(arm)
+
+
+def test_single_link_tool_has_only_the_flange(tmp_path) -> None:
+    one = tmp_path / "plate.urdf"
+    one.write_text('<robot name="p"><link name="mount"/></robot>')
+    assert Tool.from_urdf(one).tcp_names == ["flange"]

@@ -13,7 +13,6 @@ the sensor axis, pointing from the sensor into the surface (``calib.frames`` con
 from __future__ import annotations
 
 import json
-import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,10 +22,11 @@ import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
-from calib.frames import check_transform, make_transform, matrix_from_tait_bryan_zyx
+from calib.frames import check_transform
 from planner.builtins import is_builtin, tool_description
 from planner.cell.bodies import BodyLinks, load_urdf_body, mesh_collision_shape, static_body
 from planner.errors import MeshError, UnknownFrameError, URDFError
+from planner.robot.urdf import load_urdf
 
 FloatArray = NDArray[np.float64]
 
@@ -103,7 +103,7 @@ class Tool:
             URDFError: missing, malformed, not a tree of fixed joints, or a TCP name is not a link.
         """
         path = Path(path)
-        poses = _fixed_link_poses(path)
+        poses = load_urdf(path, check_meshes=False).fixed_link_poses()
         names = list(poses)[1:] if tcps is None else list(tcps)
         for n in [*names, *sensor_links, *([sensor_tcp] if sensor_tcp else [])]:
             if n not in poses:
@@ -201,44 +201,3 @@ def load_tool(spec: str | Path | Tool) -> Tool:
             raise
         raise URDFError(f"malformed tool description {path}: {exc!r}") from None
     return Tool(**{**tool.__dict__, "name": desc.get("name", tool.name)})
-
-
-def _origin(elem: ET.Element | None) -> FloatArray:
-    if elem is None:
-        return np.eye(4)
-    xyz = [float(v) for v in elem.get("xyz", "0 0 0").split()]
-    r, p, y = (float(v) for v in elem.get("rpy", "0 0 0").split())
-    return make_transform(matrix_from_tait_bryan_zyx(y, p, r), xyz)
-
-
-def _fixed_link_poses(path: Path) -> dict[str, FloatArray]:
-    """``T_root_link`` of every link of a fixed-joint tree, root first."""
-    if not path.is_file():
-        raise URDFError(f"tool URDF not found: {path}")
-    try:
-        root = ET.parse(path).getroot()
-        links = [lk.attrib["name"] for lk in root.iter("link")]
-        joints = []
-        for j in root.iter("joint"):
-            if j.get("type") != "fixed":
-                raise URDFError(f"tool URDF {path}: joint {j.get('name')!r} is not fixed")
-            parent = j.find("parent").attrib["link"]  # type: ignore[union-attr]
-            child = j.find("child").attrib["link"]  # type: ignore[union-attr]
-            joints.append((parent, child, _origin(j.find("origin"))))
-    except (ET.ParseError, KeyError, AttributeError, ValueError) as exc:
-        raise URDFError(f"malformed tool URDF {path}: {exc}") from None
-    children = {c for _, c, _ in joints}
-    roots = [lk for lk in links if lk not in children]
-    if len(roots) != 1:
-        raise URDFError(f"tool URDF {path} must have exactly one root link, found {roots}")
-    poses = {roots[0]: np.eye(4)}
-    pending = list(joints)
-    while pending:
-        ready = [jt for jt in pending if jt[0] in poses]
-        if not ready:
-            raise URDFError(f"tool URDF {path}: joints do not form a tree from {roots[0]!r}")
-        for parent, child, T in ready:
-            poses[child] = poses[parent] @ T
-        done = {id(jt) for jt in ready}
-        pending = [jt for jt in pending if id(jt) not in done]
-    return poses

@@ -1,26 +1,54 @@
-"""Parse and validate URDF robot descriptions into frozen dataclasses.
+"""Parse and validate URDF files into frozen dataclasses: wobjcal's one URDF parser.
 
-Only the standard library's ``xml.etree`` is used. Everything wobjcal needs is checked here, once,
-with errors (:class:`planner.errors.URDFError`) that name the file and the element: a missing
-file, malformed XML, no ``<robot>`` element, joints that refer to unknown links, revolute or
-prismatic joints without ``<limit>``, links with two parents, cycles and several roots.
+Robot and tool URDFs are both read here, into the product's own typed view
+(:mod:`planner.robot.urdf_model`: links with shapes and inertials, joints, the validated tree);
+callers never see yourdfpy or lxml objects. Errors are :class:`planner.errors.URDFError` naming
+the file and the element: a missing file, malformed XML or not XML at all, no ``<robot>``
+element, bad numbers, joints that refer to unknown links, revolute or prismatic joints without
+``<limit>``, links with two parents, cycles and several roots. A URDF of one link and no joints
+is valid (a tool or a fixed body); a robot chain needs moving joints, which
+:class:`planner.robot.kinematics.chain.KinematicChain` checks.
 
-Mesh file names are resolved relative to the URDF file: plain relative paths, ``file://`` URIs and
-``package://pkg/rest`` URIs (a folder named ``pkg`` is searched in the URDF's folder and upwards).
-:func:`load_urdf` raises when a referenced mesh is missing unless ``check_meshes=False``.
+How the work is split with yourdfpy:
 
-The data model lives in :mod:`planner.robot.urdf_model` and mesh URIs are resolved by
-:mod:`planner.robot.urdf_meshes`; their names are importable from here too.
+* yourdfpy converts each ``<link>``, ``<joint>`` and ``<material>`` element into its dataclasses
+  (``URDF._parse_link`` / ``_parse_joint`` / ``_parse_material``, the functions that
+  ``URDF.load`` itself calls): origins become 4x4 matrices (URDF's fixed-axis rpy), geometry,
+  limits, mimic, materials, inertials with their inertia tensor. We convert those to our model
+  (a visual's ``<material name>`` takes the colour of the top-level material of that name).
+  yourdfpy fills a missing ``ixx``/``iyy``/``izz`` with 1 (its default), not 0.
+* The XML is read here, with lxml (yourdfpy's own XML library) and a strict parser, because
+  ``URDF.load`` on malformed XML logs the error and re-parses in lxml's recover mode: a truncated
+  file loads silently as a smaller robot, and text that is not XML at all raises a bare
+  ``TypeError``. Comments are stripped as ``URDF.load`` does (yourdfpy reads ``<geometry>``'s
+  first child).
+* Checks on top, done here, because yourdfpy does not do them or fails without context: names,
+  ``<parent>``/``<child>`` and ``<geometry>`` present (yourdfpy raises a bare ``KeyError`` or
+  ``TypeError``); numeric attributes (yourdfpy silently drops a fourth ``xyz``/``rpy`` number,
+  turns ``nan`` into an all-NaN origin, and raises a bare ``ValueError`` on ``"x"``); joint type,
+  limits and non-zero axis; and the tree (yourdfpy accepts joints to unknown links, cycles, two
+  parents and several roots; its ``URDF.validate`` reports none of these, and its messages do not
+  say which element is wrong). ``yourdfpy.URDF`` itself is not built: without a scene graph it
+  only adds name maps.
+* Mesh URIs are resolved by :mod:`planner.robot.urdf_meshes`, not by yourdfpy's filename
+  handlers: those strip the package name from ``package://pkg/rest`` and then search ``rest``
+  upwards (so a mesh of a sibling package is not found, and a same-named file of another package
+  is taken instead), and they try paths relative to the process's working directory.
 
-Angles follow URDF: ``rpy`` is roll, pitch, yaw about fixed x, y, z, ``R = Rz(yaw) Ry(pitch)
-Rx(roll)``; lengths are metres.
+:func:`load_urdf` raises when a referenced mesh is missing unless ``check_meshes=False``. The
+data model's names are importable from here too. Angles follow URDF: ``rpy`` is roll, pitch, yaw
+about fixed x, y, z, ``R = Rz(yaw) Ry(pitch) Rx(roll)``; lengths are metres. An origin's ``rpy``
+is recovered from yourdfpy's matrix, so it is an equivalent triple (pitch in [-pi/2, pi/2]), not
+necessarily the one written in the file.
 """
 
 from __future__ import annotations
 
+import math
 import warnings
-import xml.etree.ElementTree as ET
+from collections.abc import Callable, Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -30,6 +58,7 @@ from planner.robot.urdf_model import (
     JOINT_TYPES,
     FloatArray,
     Geometry,
+    Inertial,
     Joint,
     JointLimit,
     Link,
@@ -43,6 +72,7 @@ __all__ = [
     "JOINT_TYPES",
     "FloatArray",
     "Geometry",
+    "Inertial",
     "Joint",
     "JointLimit",
     "Link",
@@ -56,6 +86,36 @@ __all__ = [
     "resolve_mesh",
     "transform_from_xyz_rpy",
 ]
+
+Vec3 = tuple[float, float, float]
+
+#: Numeric attributes checked before yourdfpy converts them: child path -> {attribute: count}.
+_ORIGIN = {"origin": {"xyz": 3, "rpy": 3}}
+_JOINT_NUMBERS = {
+    **_ORIGIN,
+    "axis": {"xyz": 3},
+    "limit": {"lower": 1, "upper": 1, "effort": 1, "velocity": 1},
+}
+_SHAPE_NUMBERS = {
+    **_ORIGIN,
+    "geometry/box": {"size": 3},
+    "geometry/cylinder": {"radius": 1, "length": 1},
+    "geometry/sphere": {"radius": 1},
+    "geometry/mesh": {"scale": 3},
+    "material/color": {"rgba": 4},
+}
+_INERTIAL_NUMBERS = {
+    **_ORIGIN,
+    "mass": {"value": 1},
+    "inertia": {k: 1 for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")},
+}
+#: Geometry elements and the attributes each needs (yourdfpy raises a bare KeyError without).
+_GEOMETRY_NEEDS = {
+    "box": ("size",),
+    "cylinder": ("radius", "length"),
+    "sphere": ("radius",),
+    "mesh": ("filename",),
+}
 
 
 class URDFWarning(UserWarning):
@@ -77,10 +137,10 @@ def load_urdf(path: str | Path, check_meshes: bool = True) -> URDFModel:
     if not p.is_file():
         raise URDFError(f"URDF file not found: {p}")
     try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
+        data = p.read_bytes()
+    except OSError as exc:
         raise URDFError(f"cannot read URDF file {p}: {exc}") from None
-    model = parse_urdf(text, source=p)
+    model = parse_urdf(data, source=p)
     missing = model.missing_meshes()
     if check_meshes and missing:
         listed = "; ".join(f"link {link!r}: {uri!r}" for link, uri in missing)
@@ -88,20 +148,44 @@ def load_urdf(path: str | Path, check_meshes: bool = True) -> URDFModel:
     return model
 
 
-def parse_urdf(text: str, source: Path | None = None) -> URDFModel:
-    """Parse URDF text; ``source`` (the file) names errors and anchors relative mesh paths."""
+def parse_urdf(text: str | bytes, source: Path | None = None) -> URDFModel:
+    """Parse URDF text; ``source`` (the file) names errors and anchors relative mesh paths.
+
+    ``bytes`` are decoded as their XML declaration says (default UTF-8); ``str`` is taken as is.
+    """
+    from yourdfpy import URDF  # pulls in trimesh: imported when a URDF is read
+
     where = str(source) if source is not None else "URDF text"
-    try:
-        root = ET.fromstring(text)
-    except ET.ParseError as exc:
-        raise URDFError(f"{where}: malformed XML: {exc}") from None
-    if root.tag != "robot":
-        raise URDFError(f"{where}: the top element must be <robot>, got <{root.tag}>")
+    root = _xml_root(text, where)
     name = root.get("name", "")
     base_dir = source.parent if source is not None else Path.cwd()
-    links = tuple(_parse_link(e, where, base_dir) for e in root.findall("link"))
-    joints = tuple(_parse_joint(e, where) for e in root.findall("joint"))
+    colors: dict[str, tuple[float, float, float, float]] = {}
+    for e in root.findall("material"):
+        what = f"{where}: <material name={e.get('name')!r}>"
+        _check_numbers(e, {"color": {"rgba": 4}}, what)
+        material = _parsed(URDF._parse_material, e, what)
+        if material.name and material.color is not None:
+            colors[material.name] = _tuple(material.color.rgba)
+    links = tuple(_link(e, URDF._parse_link, where, base_dir, colors) for e in root.findall("link"))
+    joints = tuple(_joint(e, URDF._parse_joint, where) for e in root.findall("joint"))
     return _validated(name, source, links, joints, where)
+
+
+def _xml_root(text: str | bytes, where: str) -> Any:
+    """The ``<robot>`` element, parsed strictly (no recovery), comments stripped."""
+    from lxml import etree
+
+    as_text = isinstance(text, str)
+    data = text.encode("utf-8") if isinstance(text, str) else text
+    parser = etree.XMLParser(remove_blank_text=True, encoding="utf-8" if as_text else None)
+    try:
+        root = etree.fromstring(data, parser)
+    except etree.XMLSyntaxError as exc:
+        raise URDFError(f"{where}: malformed XML: {exc}") from None
+    etree.strip_tags(root, etree.Comment, etree.ProcessingInstruction)
+    if root.tag != "robot":
+        raise URDFError(f"{where}: the top element must be <robot>, got <{root.tag}>")
+    return root
 
 
 def _validated(
@@ -143,115 +227,151 @@ def _validated(
     return URDFModel(name, source, links, joints, roots[0], by_child)
 
 
-Vec3 = tuple[float, float, float]
+def _check_numbers(e: Any, spec: Mapping[str, Mapping[str, int]], what: str) -> None:
+    """Every attribute of ``spec`` below ``e`` that is present holds that many finite numbers."""
+    for path, attrs in spec.items():
+        sub = e.find(path)
+        if sub is None:
+            continue
+        for attr, n in attrs.items():
+            text = sub.get(attr)
+            if text is None:
+                continue
+            label = f"{what} <{sub.tag} {attr}>"
+            try:
+                vals = [float(v) for v in text.split()]
+            except ValueError:
+                raise URDFError(f"{label} must be {n} numbers, got {text!r}") from None
+            if len(vals) != n or not all(math.isfinite(v) for v in vals):
+                raise URDFError(f"{label} must be {n} finite numbers, got {text!r}")
 
 
-def _floats(text: str | None, n: int, default: tuple[float, ...], what: str) -> tuple[float, ...]:
-    """``n`` finite floats parsed from an attribute, or ``default`` when it is absent."""
-    if text is None:
-        return default
+def _parsed(parse: Callable[[Any], Any], e: Any, what: str) -> Any:
+    """yourdfpy's dataclass of element ``e``; its bare exceptions become URDFErrors naming ``e``."""
     try:
-        vals = tuple(float(v) for v in text.split())
-    except ValueError:
-        raise URDFError(f"{what} must be {n} numbers, got {text!r}") from None
-    if len(vals) != n or not all(np.isfinite(vals)):
-        raise URDFError(f"{what} must be {n} finite numbers, got {text!r}")
-    return vals
+        return parse(e)
+    except (KeyError, ValueError, TypeError, IndexError, AttributeError) as exc:
+        raise URDFError(f"{what} cannot be read: {type(exc).__name__}: {exc}") from None
 
 
-def _float(text: str | None, default: float, what: str) -> float:
-    return _floats(text, 1, (default,), what)[0]
+def _tuple(values: Any) -> Any:
+    return tuple(float(v) for v in np.ravel(values))
 
 
-def _vec3(text: str | None, default: Vec3, what: str) -> Vec3:
-    x, y, z = _floats(text, 3, default, what)
-    return (x, y, z)
+def _xyz_rpy(T: FloatArray | None) -> tuple[Vec3, Vec3]:
+    """``xyz`` and an equivalent ``rpy`` of yourdfpy's origin matrix (``None``: identity)."""
+    from trimesh.transformations import euler_from_matrix
 
-
-def _origin(elem: ET.Element | None, what: str) -> tuple[Vec3, Vec3]:
-    if elem is None:
+    if T is None:
         return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
-    xyz = _vec3(elem.get("xyz"), (0.0, 0.0, 0.0), f"{what} <origin xyz>")
-    rpy = _vec3(elem.get("rpy"), (0.0, 0.0, 0.0), f"{what} <origin rpy>")
-    return xyz, rpy
+    return _tuple(T[:3, 3]), _tuple(euler_from_matrix(T, "sxyz"))
 
 
-def _parse_joint(e: ET.Element, where: str) -> Joint:
+def _joint(e: Any, parse: Callable[[Any], Any], where: str) -> Joint:
     name = e.get("name")
     if not name:
         raise URDFError(f"{where}: a <joint> element has no name")
     what = f"{where}: <joint name={name!r}>"
-    jtype = e.get("type", "")
-    if jtype not in JOINT_TYPES:
-        raise URDFError(f"{what} has type {jtype!r}; expected one of {list(JOINT_TYPES)}")
     parent, child = e.find("parent"), e.find("child")
     if parent is None or child is None or not parent.get("link") or not child.get("link"):
         raise URDFError(f"{what} needs <parent link=...> and <child link=...>")
-    xyz, rpy = _origin(e.find("origin"), what)
-    axis_e = e.find("axis")
-    axis_text = axis_e.get("xyz") if axis_e is not None else None
-    ax, ay, az = _vec3(axis_text, (1.0, 0.0, 0.0), f"{what} <axis>")
+    _check_numbers(e, _JOINT_NUMBERS, what)
+    yj = _parsed(parse, e, what)
+    jtype = yj.type or ""
+    if jtype not in JOINT_TYPES:
+        raise URDFError(f"{what} has type {jtype!r}; expected one of {list(JOINT_TYPES)}")
+    ax, ay, az = _tuple(yj.axis)
     norm = float(np.sqrt(ax * ax + ay * ay + az * az))
     if jtype not in ("fixed", "floating") and norm < 1e-12:
         raise URDFError(f"{what} has a zero <axis xyz>")
     axis = (ax / norm, ay / norm, az / norm) if norm > 0 else (1.0, 0.0, 0.0)
     limit = None
-    lim_e = e.find("limit")
     if jtype in ("revolute", "prismatic"):
-        if lim_e is None or lim_e.get("lower") is None or lim_e.get("upper") is None:
+        lim = yj.limit
+        if lim is None or lim.lower is None or lim.upper is None:
             raise URDFError(f"{what} is {jtype} but has no <limit lower=... upper=...>")
-        lo = _float(lim_e.get("lower"), 0.0, f"{what} <limit lower>")
-        hi = _float(lim_e.get("upper"), 0.0, f"{what} <limit upper>")
-        if lo > hi:
-            raise URDFError(f"{what} <limit> has lower {lo} > upper {hi}")
-        eff = _float(lim_e.get("effort"), 0.0, f"{what} <limit effort>")
-        vel = _float(lim_e.get("velocity"), 0.0, f"{what} <limit velocity>")
-        limit = JointLimit(lo, hi, eff, vel)
-    if e.find("mimic") is not None:
+        if lim.lower > lim.upper:
+            raise URDFError(f"{what} <limit> has lower {lim.lower} > upper {lim.upper}")
+        limit = JointLimit(lim.lower, lim.upper, lim.effort or 0.0, lim.velocity or 0.0)
+    if yj.mimic is not None:
         msg = f"{what}: <mimic> is ignored; the joint moves freely"
-        warnings.warn(msg, URDFWarning, stacklevel=3)
-    p_link, c_link = parent.get("link", ""), child.get("link", "")
-    return Joint(name, jtype, p_link, c_link, xyz, rpy, axis, limit)
+        warnings.warn(msg, URDFWarning, stacklevel=4)
+    xyz, rpy = _xyz_rpy(yj.origin)
+    return Joint(name, jtype, yj.parent, yj.child, xyz, rpy, axis, limit)
 
 
-def _parse_link(e: ET.Element, where: str, base_dir: Path) -> Link:
+def _link(
+    e: Any,
+    parse: Callable[[Any], Any],
+    where: str,
+    base_dir: Path,
+    colors: Mapping[str, tuple[float, float, float, float]],
+) -> Link:
     name = e.get("name")
     if not name:
         raise URDFError(f"{where}: a <link> element has no name")
     what = f"{where}: <link name={name!r}>"
-    visuals = tuple(_parse_shape(v, f"{what} <visual>", base_dir) for v in e.findall("visual"))
-    collisions = tuple(
-        _parse_shape(c, f"{what} <collision>", base_dir) for c in e.findall("collision")
-    )
-    return Link(name, visuals, collisions)
+    for kind in ("visual", "collision"):
+        for s in e.findall(kind):
+            _check_shape(s, f"{what} <{kind}>")
+    inertial_e = e.find("inertial")
+    if inertial_e is not None:
+        _check_numbers(inertial_e, _INERTIAL_NUMBERS, f"{what} <inertial>")
+    yl = _parsed(parse, e, what)
+    visuals = tuple(_shape(v, f"{what} <visual>", base_dir, colors) for v in yl.visuals)
+    collisions = tuple(_shape(c, f"{what} <collision>", base_dir, {}) for c in yl.collisions)
+    return Link(name, visuals, collisions, _inertial(yl.inertial, f"{what} <inertial>"))
 
 
-def _parse_shape(e: ET.Element, what: str, base_dir: Path) -> Shape:
-    xyz, rpy = _origin(e.find("origin"), what)
-    geom_e = e.find("geometry")
-    if geom_e is None or len(geom_e) == 0:
+def _check_shape(e: Any, what: str) -> None:
+    geom = e.find("geometry")
+    if geom is None or len(geom) == 0:
         raise URDFError(f"{what} has no <geometry>")
-    g = geom_e[0]
-    if g.tag == "box":
-        geom = Geometry("box", size=_vec3(g.get("size"), (0.0, 0.0, 0.0), f"{what} <box size>"))
-    elif g.tag == "cylinder":
-        r = _float(g.get("radius"), 0.0, f"{what} <cylinder radius>")
-        ln = _float(g.get("length"), 0.0, f"{what} <cylinder length>")
-        geom = Geometry("cylinder", radius=r, length=ln)
-    elif g.tag == "sphere":
-        geom = Geometry("sphere", radius=_float(g.get("radius"), 0.0, f"{what} <sphere radius>"))
-    elif g.tag == "mesh":
-        uri = g.get("filename", "")
-        if not uri:
-            raise URDFError(f"{what} <mesh> has no filename")
-        scale = _vec3(g.get("scale"), (1.0, 1.0, 1.0), f"{what} <mesh scale>")
-        path = resolve_mesh(uri, base_dir)
-        geom = Geometry("mesh", filename=uri, mesh_path=path, scale=scale)
-    else:
+    g = geom[0]
+    if g.tag not in _GEOMETRY_NEEDS:
         raise URDFError(f"{what} has unknown geometry <{g.tag}>")
+    for attr in _GEOMETRY_NEEDS[g.tag]:
+        if not g.get(attr):
+            raise URDFError(f"{what} <{g.tag}> has no {attr}")
+    _check_numbers(e, _SHAPE_NUMBERS, what)
+
+
+def _shape(
+    ys: Any, what: str, base_dir: Path, colors: Mapping[str, tuple[float, float, float, float]]
+) -> Shape:
+    """Our :class:`Shape` of a yourdfpy ``Visual`` or ``Collision`` (checked by _check_shape)."""
+    g = ys.geometry
+    if g.box is not None:
+        geom = Geometry("box", size=_tuple(g.box.size))
+    elif g.cylinder is not None:
+        c = g.cylinder
+        geom = Geometry("cylinder", radius=float(c.radius), length=float(c.length))
+    elif g.sphere is not None:
+        geom = Geometry("sphere", radius=float(g.sphere.radius))
+    else:
+        uri = g.mesh.filename
+        scale = (1.0, 1.0, 1.0) if g.mesh.scale is None else _tuple(g.mesh.scale)
+        geom = Geometry("mesh", filename=uri, mesh_path=resolve_mesh(uri, base_dir), scale=scale)
     rgba = None
-    color = e.find("material/color")
-    if color is not None and color.get("rgba"):
-        r_, g_, b_, a_ = _floats(color.get("rgba"), 4, (1.0, 1.0, 1.0, 1.0), f"{what} <rgba>")
-        rgba = (r_, g_, b_, a_)
+    material = getattr(ys, "material", None)
+    if material is not None:
+        if material.color is not None:
+            rgba = _tuple(material.color.rgba)
+        elif material.name:
+            rgba = colors.get(material.name)
+    xyz, rpy = _xyz_rpy(ys.origin)
     return Shape(xyz, rpy, geom, rgba)
+
+
+def _inertial(yi: Any, what: str) -> Inertial | None:
+    if yi is None:
+        return None
+    if yi.mass is None:
+        warnings.warn(f"{what} has no <mass>; taken as 0 kg", URDFWarning, stacklevel=5)
+    mass = float(yi.mass or 0.0)
+    if mass < 0.0:
+        raise URDFError(f"{what} <mass value> must be >= 0 kg, got {mass}")
+    xyz, rpy = _xyz_rpy(yi.origin)
+    I = np.zeros((3, 3)) if yi.inertia is None else yi.inertia
+    inertia = (I[0, 0], I[0, 1], I[0, 2], I[1, 1], I[1, 2], I[2, 2])
+    return Inertial(mass, xyz, rpy, _tuple(inertia))

@@ -1,8 +1,9 @@
-"""The data model of a parsed URDF: links, joints, shapes and the validated tree (frozen).
+"""The data model of a parsed URDF: links, joints, shapes, inertials, the validated tree (frozen).
 
 Built by :func:`planner.robot.urdf.parse_urdf` and :func:`planner.robot.urdf.load_urdf` (importable
-from :mod:`planner.robot.urdf` as well). Angles follow URDF: ``rpy`` is roll, pitch, yaw about
-fixed x, y, z, ``R = Rz(yaw) Ry(pitch) Rx(roll)``; lengths are metres.
+from :mod:`planner.robot.urdf` as well); callers never see the parser's own objects. Angles follow
+URDF: ``rpy`` is roll, pitch, yaw about fixed x, y, z, ``R = Rz(yaw) Ry(pitch) Rx(roll)``; lengths
+are metres, masses kilograms.
 """
 
 from __future__ import annotations
@@ -85,12 +86,42 @@ class Shape:
 
 
 @dataclass(frozen=True)
+class Inertial:
+    """The ``<inertial>`` of a link: mass, centre of mass and inertia about it.
+
+    Attributes:
+        mass: kg (``>= 0``).
+        xyz: centre of mass in the link frame, metres.
+        rpy: orientation of the inertia frame in the link frame, radians.
+        inertia: ``(ixx, ixy, ixz, iyy, iyz, izz)`` about the centre of mass in the inertia
+            frame, kg m^2.
+    """
+
+    mass: float
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    inertia: tuple[float, float, float, float, float, float] = (0.0,) * 6
+
+    @property
+    def T_link_com(self) -> FloatArray:
+        """The centre-of-mass (inertia) frame in the link frame, (4, 4)."""
+        return transform_from_xyz_rpy(self.xyz, self.rpy)
+
+    @property
+    def inertia_matrix(self) -> FloatArray:
+        """The symmetric inertia tensor (3, 3) in the inertia frame, kg m^2."""
+        ixx, ixy, ixz, iyy, iyz, izz = self.inertia
+        return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+
+
+@dataclass(frozen=True)
 class Link:
-    """A URDF link: a name and its shapes (link frame)."""
+    """A URDF link: a name, its shapes and its inertial (all in the link frame)."""
 
     name: str
     visuals: tuple[Shape, ...] = ()
     collisions: tuple[Shape, ...] = ()
+    inertial: Inertial | None = None
 
 
 @dataclass(frozen=True)
@@ -192,6 +223,65 @@ class URDFModel:
             chain.append(joint)
             link = joint.parent
         return tuple(reversed(chain))
+
+    def link_poses_at_zero(self, root: str | None = None) -> dict[str, FloatArray]:
+        """``T_root_link`` (4, 4) of ``root`` and every link below it, every joint at zero.
+
+        Args:
+            root: the frame of the poses; default the URDF's root link.
+
+        Returns:
+            ``{link name: T_root_link}``, ``root`` first, then breadth-first in joint file order.
+            Moving joints count at zero (their origin only); floating and planar joints too.
+
+        Raises:
+            URDFError: ``root`` is not a link.
+        """
+        return self._poses_below(root, fixed_only=False)
+
+    def fixed_link_poses(self, root: str | None = None) -> dict[str, FloatArray]:
+        """Like :meth:`link_poses_at_zero`, for a tree of fixed joints (a tool, a fixture).
+
+        Raises:
+            URDFError: a joint below ``root`` is not fixed (the message names it), or ``root``
+                is not a link.
+        """
+        return self._poses_below(root, fixed_only=True)
+
+    def mass_and_com(self, root: str | None = None) -> tuple[float, FloatArray]:
+        """Total mass (kg) and centre of mass (3,) in the ``root`` frame (m), joints at zero.
+
+        Sums the ``<inertial>`` of ``root`` (default the URDF's root link) and of every link
+        below it, posed by :meth:`link_poses_at_zero`. Links without an inertial weigh nothing.
+
+        Returns:
+            ``(mass, com)``; ``(0.0, zeros(3))`` when nothing below ``root`` has mass.
+        """
+        by_name = {link.name: link for link in self.links}
+        total, moment = 0.0, np.zeros(3)
+        for name, T_root_link in self.link_poses_at_zero(root).items():
+            inertial = by_name[name].inertial
+            if inertial is None or inertial.mass == 0.0:
+                continue
+            total += inertial.mass
+            moment += inertial.mass * (T_root_link @ inertial.T_link_com)[:3, 3]
+        return total, (moment / total if total > 0.0 else np.zeros(3))
+
+    def _poses_below(self, root: str | None, fixed_only: bool) -> dict[str, FloatArray]:
+        start = self.root if root is None else self.link(root).name
+        poses = {start: np.eye(4)}
+        frontier = [start]
+        while frontier:
+            parent = frontier.pop(0)
+            for j in self.children(parent):
+                if fixed_only and j.type != "fixed":
+                    raise URDFError(
+                        f"{self._where()}: <joint name={j.name!r}> is {j.type}, not fixed; "
+                        f"every joint below link {start!r} must be fixed"
+                    )
+                poses[j.child] = poses[parent] @ j.T_parent_joint
+                frontier.append(j.child)
+        return poses
 
     def missing_meshes(self) -> list[tuple[str, str]]:
         """``(link name, mesh URI)`` of every referenced mesh file that was not found."""

@@ -71,7 +71,8 @@ class KinematicChain:
                 last link of the longest serial chain below ``base_link``.
 
         Raises:
-            URDFError: the file is invalid, or the chain holds a floating or planar joint.
+            URDFError: the file is invalid, the chain holds a floating or planar joint, or it has
+                no moving joint (e.g. a URDF of one link).
             UnknownFrameError: ``base_link`` or ``tip_link`` is not a link of the URDF.
         """
         return cls.from_model(load_urdf(path, check_meshes=False), base_link, tip_link)
@@ -108,6 +109,11 @@ class KinematicChain:
             else:
                 pending = pending @ j.T_parent_joint
                 attach[j.child] = (len(moving) - 1, pending.copy())
+        if not moving:
+            raise URDFError(
+                f"{where}: no moving joint between base link {base!r} and tip link {tip!r}; "
+                "a robot chain needs at least one revolute, continuous or prismatic joint"
+            )
         _attach_fixed_subtrees(model, attach)
         lower = np.array([j.limit.lower if j.limit else -np.inf for j in moving])
         upper = np.array([j.limit.upper if j.limit else np.inf for j in moving])
