@@ -17,7 +17,8 @@ import viser
 from numpy.typing import ArrayLike
 
 from calib.errors import InputError
-from calib.plan.file import Plan
+from calib.plan.file import CellSpec, Plan, WorkObjectSpec
+from calib.probing import ProbePoint
 from planner.check import PointCheck
 from webui import clients, demo, plan_doc
 from webui.backend import CellSession, CellView
@@ -63,9 +64,9 @@ class WobjcalApp:
         self.picker: SurfacePicker | None = None
         self.robot: RobotView | None = None
         self.selected: str | None = None
-        self._checks: dict[str, tuple[Any, PointCheck]] = {}
+        self._checks: dict[str, tuple[ProbePoint, PointCheck]] = {}
         self._lock = threading.RLock()
-        self._cell_key: Any = None
+        self._cell_key: tuple[CellSpec, WorkObjectSpec] | None = None
         self.heatmap = HeatMap(self)
         self.points_panel = points_panel.PointsPanel(self)
         self.validate_panel = validate_panel.ValidatePanel(self)
@@ -247,7 +248,7 @@ class WobjcalApp:
         self.worker.close()
 
 
-def _cell_key(plan: Plan) -> tuple[Any, Any]:
+def _cell_key(plan: Plan) -> tuple[CellSpec, WorkObjectSpec]:
     """What decides the cell: when it changes, the cell is rebuilt."""
     return (plan.cell, plan.work_object)
 

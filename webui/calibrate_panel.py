@@ -14,12 +14,12 @@ import numpy as np
 from calib.errors import InputError
 from calib.frames import motion_between
 from calib.plan.measurements import measurements_from_json
-from planner.calibrate import calibrate_plan
+from planner.calibrate import CalibrationOutput, calibrate_plan
 from webui.files_panel import check_upload
 from webui.plan_adapter import plan_from_ui
 
 if TYPE_CHECKING:
-    from webui.app import WobjcalApp
+    from webui.context import AppContext
 
 logger = logging.getLogger(__name__)
 
@@ -31,9 +31,9 @@ class CalibratePanel:
         app: the app whose plan the measurements belong to.
     """
 
-    def __init__(self, app: WobjcalApp) -> None:
+    def __init__(self, app: AppContext) -> None:
         self._app = app
-        self.last_output: Any = None
+        self.last_output: CalibrationOutput | None = None
         gui = app.server.gui
         with gui.add_folder("Calibrate", expand_by_default=False):
             self.upload = gui.add_upload_button("Upload measurements (.json)", mime_type=".json")
@@ -52,7 +52,7 @@ class CalibratePanel:
             logger.exception("calibration failed")
             self._app.notify("Not calibrated", f"{type(exc).__name__}: {exc}", client=event.client)
 
-    def calibrate(self, name: str, content: bytes) -> Any:
+    def calibrate(self, name: str, content: bytes) -> CalibrationOutput:
         """Calibrate the session plan with uploaded measurements; draw and describe the result."""
         check_upload(name, content, (".json",), "measurements file")
         try:

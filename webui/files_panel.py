@@ -22,7 +22,7 @@ from webui.plan_adapter import plan_from_ui, plan_json_from_ui, ui_plan_from_byt
 from webui.state import atomic_write_bytes
 
 if TYPE_CHECKING:
-    from webui.app import WobjcalApp
+    from webui.context import AppContext
 
 logger = logging.getLogger(__name__)
 
@@ -57,7 +57,7 @@ class FilesPanel:
         upload_dir: where uploaded meshes and URDFs are kept (they must outlive the request).
     """
 
-    def __init__(self, app: WobjcalApp, upload_dir: Path = UPLOAD_DIR) -> None:
+    def __init__(self, app: AppContext, upload_dir: Path = UPLOAD_DIR) -> None:
         self._app = app
         self.upload_dir = upload_dir
         gui = app.server.gui
@@ -101,6 +101,8 @@ class FilesPanel:
         """Replace the session plan with an uploaded plan file (one undoable step)."""
         check_upload(name, content, (".json",), "plan file")
         ui = ui_plan_from_bytes(content, source=name)
+        if ui.source is None:  # ui_plan_from_bytes always keeps the loaded plan
+            raise InputError(f"{name}: no plan in the file")
         self._app.load_cell(ui.source, self._app.plan_dir)
         self._app.state.apply(ui, f"load plan {name}")
         return f"Plan {name} loaded"

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import threading
+from concurrent.futures import Future
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -23,7 +24,8 @@ from planner.cell.reachability_map import sample_surface
 from webui.scene import heat_rgb
 
 if TYPE_CHECKING:
-    from webui.app import WobjcalApp
+    from webui.backend import CellSession
+    from webui.context import AppContext
 
 logger = logging.getLogger(__name__)
 
@@ -49,7 +51,7 @@ class HeatMap:
         app: the app whose cell and work object are used.
     """
 
-    def __init__(self, app: WobjcalApp) -> None:
+    def __init__(self, app: AppContext) -> None:
         self._app = app
         self._stop = threading.Event()
         self.points: NDArray[np.float64] = np.zeros((0, 3))
@@ -85,13 +87,19 @@ class HeatMap:
         fut.add_done_callback(lambda f: self._chunk_done(f, stop))
 
     @staticmethod
-    def _job(session: Any, pts: Any, nrm: Any, tcp: str, stop: threading.Event) -> list[float]:
+    def _job(
+        session: CellSession | None,
+        pts: NDArray[np.float64],
+        nrm: NDArray[np.float64],
+        tcp: str,
+        stop: threading.Event,
+    ) -> list[float]:
         if stop.is_set() or session is None or session.cell is None:
             return []
         res = session.cell.check_probes(pts, nrm, tcp=tcp)
         return [SCORE.get(str(r.status), 0.0) for r in res]
 
-    def _chunk_done(self, fut: Any, stop: threading.Event) -> None:
+    def _chunk_done(self, fut: Future[list[float]], stop: threading.Event) -> None:
         if stop is not self._stop:  # a chunk of an earlier, stopped map
             return
         if stop.is_set():

@@ -11,13 +11,16 @@ from __future__ import annotations
 import dataclasses
 import string
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from calib.errors import InputError
 from calib.probing import ProbePoint, SearchSpec
+
+if TYPE_CHECKING:
+    from calib.plan.file import Plan
 
 #: The paper's point names (also the roles of its A-H procedure).
 PAPER_IDS: tuple[str, ...] = tuple("ABCDEFGH")
@@ -58,7 +61,7 @@ class UiPlan:
     points: tuple[UiPoint, ...] = ()
     name: str = "plan"
     roles: tuple[str, ...] = PAPER_IDS
-    source: Any = field(default=None, compare=False)
+    source: Plan | None = field(default=None, compare=False)
 
     @property
     def ids(self) -> tuple[str, ...]:

@@ -15,7 +15,7 @@ from webui import plan_doc
 from webui.plan_doc import PAPER_IDS
 
 if TYPE_CHECKING:
-    from webui.app import WobjcalApp
+    from webui.context import AppContext
 
 logger = logging.getLogger(__name__)
 
@@ -36,7 +36,7 @@ class PointsPanel:
         app: the app whose plan the panel edits.
     """
 
-    def __init__(self, app: WobjcalApp) -> None:
+    def __init__(self, app: AppContext) -> None:
         self._app = app
         self._syncing = threading.local()
         gui = app.server.gui

@@ -10,18 +10,20 @@ from __future__ import annotations
 import logging
 import threading
 import time
+from concurrent.futures import Future
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from calib.errors import InputError
+from planner.sim.report import ValidationReport
 from planner.validate import check_simulatable
 from webui import validation
 from webui.plan_adapter import plan_from_ui
 from webui.worker import CellWorker
 
 if TYPE_CHECKING:
-    from webui.app import WobjcalApp
+    from webui.context import AppContext
 
 logger = logging.getLogger(__name__)
 
@@ -33,12 +35,12 @@ class ValidatePanel:
         app: the app whose plan is validated.
     """
 
-    def __init__(self, app: WobjcalApp) -> None:
+    def __init__(self, app: AppContext) -> None:
         self._app = app
         self._worker: CellWorker[None] = CellWorker(None, name="wobjcal-validate")
         self._running = threading.Event()
         self._start_lock = threading.Lock()
-        self.last_report: Any = None
+        self.last_report: ValidationReport | None = None
         self.last_markdown = ""
         gui = app.server.gui
         self._folder = gui.add_folder("Validate", expand_by_default=True)
@@ -57,7 +59,7 @@ class ValidatePanel:
         except InputError as exc:
             self._app.notify("Validation not started", str(exc), client=client)
 
-    def start(self, trials: int) -> Any:
+    def start(self, trials: int) -> Future[validation.ValidationSummary]:
         """Start a validation of the session plan; return a future of the report.
 
         Raises:
@@ -82,14 +84,14 @@ class ValidatePanel:
                 last[0] = now
                 self.progress.value = 100.0 * done / max(total, 1)
 
-        def job(_res: None) -> Any:
+        def job(_res: None) -> validation.ValidationSummary:
             return validation.run_validation(plan, trials, progress)
 
         fut = self._worker.submit(job)
         fut.add_done_callback(self._done)
         return fut
 
-    def _done(self, fut: Any) -> None:
+    def _done(self, fut: Future[validation.ValidationSummary]) -> None:
         try:
             self._show(fut)
         finally:  # only now is the validation over for whoever watches `running`
@@ -97,7 +99,7 @@ class ValidatePanel:
             self.button.disabled = False
             self._running.clear()
 
-    def _show(self, fut: Any) -> None:
+    def _show(self, fut: Future[validation.ValidationSummary]) -> None:
         try:
             summary = fut.result()
         except Exception as exc:

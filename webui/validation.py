@@ -4,12 +4,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from calib.plan.file import Plan
+from planner.sim.report import ValidationReport
 from planner.validate import validate_plan
 
 Progress = Callable[[int, int], None]
@@ -20,14 +20,14 @@ class ValidationSummary:
     """What the validate panel shows.
 
     Attributes:
-        report: the ``planner.sim.montecarlo`` report object, as returned.
+        report: the report :func:`planner.validate.validate_plan` returned.
         markdown: Table-1-style markdown (confidence intervals) and the per-point failures.
         histograms: ``(title, bin_edges (B+1,), counts (B,))`` for each error histogram.
         headline: one line for the notification.
         T_world_wobj_example: ``(4, 4)`` one calibrated frame to draw, or ``None``.
     """
 
-    report: Any
+    report: ValidationReport
     markdown: str
     histograms: tuple[tuple[str, NDArray[np.float64], NDArray[np.float64]], ...]
     headline: str
@@ -46,14 +46,16 @@ def run_validation(plan: Plan, trials: int, progress: Progress) -> ValidationSum
     return summarize(validate_plan(plan, trials=int(trials), workers=1, progress=progress))
 
 
-def _histogram(samples: Any, scale: float, bins: int = 30) -> tuple[Any, Any]:
+def _histogram(
+    samples: ArrayLike, scale: float, bins: int = 30
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     x = np.asarray(samples, dtype=np.float64).ravel() * scale
     x = x[np.isfinite(x)]
     counts, edges = np.histogram(x, bins=bins)
     return edges, counts
 
 
-def summarize(report: Any) -> ValidationSummary:
+def summarize(report: ValidationReport) -> ValidationSummary:
     """Shape a ``planner.sim.report.ValidationReport`` for the panel."""
     markdown = report.to_markdown()
     units = {r.key: r.unit for r in report.rows}

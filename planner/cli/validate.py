@@ -7,12 +7,15 @@ import json
 import math
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from calib.atomic_io import write_text_atomic
 from planner.cli.common import count_arg, read_plan, stderr, stdout
+
+if TYPE_CHECKING:
+    from planner.sim.report import ValidationReport
 
 
 def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
@@ -47,7 +50,7 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
     p.set_defaults(handler=cmd_validate)
 
 
-def report_json(report: Any) -> dict[str, Any]:
+def report_json(report: ValidationReport) -> dict[str, Any]:
     """The JSON of a ``ValidationReport``: rows (display units), failures, landings."""
 
     def num(x: float) -> float | None:
