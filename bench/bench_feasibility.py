@@ -179,7 +179,7 @@ def run_worst_case(n_samples: int, seed: int, with_loop: bool) -> dict[str, obje
     tries all 24 rotations before it gives up); then all samples as one heat-map batch.
     """
     from planner.cell.reachability_map import reachability_map
-    from planner.parts.stator_demo import make_demo_cell
+    from planner.demo import make_demo_cell
 
     with make_demo_cell() as cell:
         pts, nrm, _ = sample_surface(cell.work_object.mesh, n_samples, np.random.default_rng(seed))

@@ -3,21 +3,17 @@
 Frames and conventions are documented once, in :mod:`calib.frames`. Importing ``calib`` never
 imports PyBullet, viser, trimesh or ``planner``.
 
-The public API, by module:
-
-* :mod:`calib.frames` - transforms, Tait-Bryan z-y'-x'' angles (paper eq. 7-9), quaternions.
-* :mod:`calib.probing` - :class:`ProbePoint`, :class:`SearchCommand`, :class:`ProbeResult`,
-  the :data:`Probe` callback contract.
-* :mod:`calib.paper.hultman` - the paper's equations 1-12.
-* :mod:`calib.paper.xoffset` - the x-offset matrix (eq. 13-14) and the slot-hole target function.
-* :mod:`calib.paper.stator_procedure` - the paper's A-H procedure driven by a probe callback.
-* :mod:`calib.estimators.three_two_one` - general 3-2-1 alignment (any non-parallel faces).
-* :mod:`calib.estimators.best_fit` - least-squares point-to-plane fit with the 6x6 covariance.
-* :mod:`calib.estimators.observability` - does a point layout constrain all 6 DOF, and if not, what
-moves.
-* :mod:`calib.estimators.runners` - step-by-step 3-2-1 and best-fit runners driven by a probe.
-* :mod:`calib.stats` - Table-1 confidence intervals.
-* :mod:`calib.plan.file`, :mod:`calib.plan.measurements` - the versioned JSON files.
+Owns:
+    - foundations: :mod:`calib.frames` (transforms, Tait-Bryan z-y'-x'' angles of eq. 7-9,
+      quaternions), :mod:`calib.errors`, :mod:`calib.validation` and :mod:`calib.structs`
+      (argument and field checks), :mod:`calib.probing` (probe points, search commands, the
+      :data:`Probe` callback contract), :mod:`calib.units`, :mod:`calib.atomic_io`;
+    - :mod:`calib.paper`: the paper's equations and its A-H procedure;
+    - :mod:`calib.estimators`: 3-2-1, best fit with covariance, observability, step runners;
+    - :mod:`calib.procedures`: the registry of procedures a plan can name;
+    - :mod:`calib.models`: the physical models (sensor, robot error, misplacement);
+    - :mod:`calib.plan`: the versioned plan and measurement files;
+    - :mod:`calib.stats`: Table-1 confidence intervals.
 """
 
 from calib._version import __version__

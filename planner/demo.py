@@ -1,11 +1,14 @@
-"""The built-in plan ``assets/plans/stator_section_ah.json``, made from
-:mod:`planner.parts.stator_demo`.
+"""The built-in demo: the stator-section cell and its A-H plan.
 
-``wobjcal demo --write-plan FILE`` writes it; ``tests/test_cli.py`` checks that the shipped file
-equals :func:`stator_plan_text` byte for byte, so the demo cell stays the single source.
+Both are made from the placement in :mod:`planner.parts.stator_demo`. The plan is shipped as
+``assets/plans/stator_section_ah.json`` (:data:`DEMO_PLAN`); ``wobjcal demo --write-plan FILE``
+writes it, and ``tests/test_cli.py`` checks that the shipped file equals
+:func:`stator_plan_text` byte for byte, so this module stays the single source.
 """
 
 from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
 
 from calib.plan.file import (
     CellSpec,
@@ -17,12 +20,20 @@ from calib.plan.file import (
     plan_to_json,
 )
 from calib.procedures import Hultman2013
+from planner.builtins import ASSETS
+from planner.parts import stator_demo as demo_cell
+from planner.parts.stator import StatorGeometry
+from planner.parts.stator_mesh import build_stator_mesh
+
+if TYPE_CHECKING:
+    from planner.cell.cell import Cell
+
+#: The built-in demo plan (the paper's A-H plan on the built-in stator cell).
+DEMO_PLAN = ASSETS / "plans" / "stator_section_ah.json"
 
 
 def stator_plan() -> Plan:
     """The paper's A-H plan on the built-in stator-section cell (robot base = world)."""
-    from planner.parts import stator_demo as demo_cell
-    from planner.parts.stator import StatorGeometry
 
     g = StatorGeometry.full_section()
     T = demo_cell.nominal_T_base_wobj()
@@ -53,3 +64,21 @@ def stator_plan() -> Plan:
 def stator_plan_text() -> str:
     """The canonical JSON of :func:`stator_plan`."""
     return plan_to_json(stator_plan())
+
+
+def make_demo_cell(geom: StatorGeometry | None = None, **cell_kwargs: Any) -> Cell:
+    """The demo cell: built-in IRB 4400 with the cable-feeder tool, the stator on a table.
+
+    The work object is the (bulged) stator mesh at :func:`nominal_T_base_wobj`; the robot base
+    is the world frame. Extra keyword arguments go to :class:`planner.cell.cell.Cell`.
+    """
+    from planner.cell.cell import Cell  # PyBullet: only when a cell is built
+    g = geom or StatorGeometry.full_section()
+    kwargs: dict[str, Any] = {"robot": "builtin:irb4400", "tool": "builtin:cable_feeder"}
+    kwargs.update(cell_kwargs)
+    cell = Cell(**kwargs)
+    T = demo_cell.nominal_T_base_wobj()
+    cell.set_work_object(build_stator_mesh(g), units="m", T_world_wobj=T)
+    size, T_table = demo_cell.demo_table(g, T)
+    cell.add_fixture("table", size_m=size, T_world_fixture=T_table)
+    return cell

@@ -9,13 +9,9 @@ import pytest
 
 from calib.frames import check_transform
 from calib.paper.stator_procedure import check_stator_points
+from planner.demo import make_demo_cell
 from planner.parts.stator import StatorGeometry
-from planner.parts.stator_demo import (
-    BETA1_RAD,
-    make_demo_cell,
-    nominal_T_base_wobj,
-    stator_ah_points,
-)
+from planner.parts.stator_demo import BETA1_RAD, nominal_T_base_wobj, stator_ah_points
 
 GEOM = StatorGeometry.full_section()
 

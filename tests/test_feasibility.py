@@ -250,7 +250,7 @@ def test_tool_blocked_by_a_plate_in_every_rotation(cell: Cell, monkeypatch, heig
 
 @pytest.fixture(scope="module")
 def demo() -> Iterator[Cell]:
-    from planner.parts.stator_demo import make_demo_cell
+    from planner.demo import make_demo_cell
 
     with make_demo_cell(use_acl_cache=False) as c:
         yield c

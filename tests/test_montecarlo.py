@@ -86,7 +86,7 @@ def test_bad_arguments_are_named() -> None:
 
 
 def test_cell_vets_every_search_and_counts_unreachable_ones() -> None:
-    from planner.parts.stator_demo import make_demo_cell
+    from planner.demo import make_demo_cell
 
     cell = make_demo_cell(GEOM)
     try:

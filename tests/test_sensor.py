@@ -128,3 +128,19 @@ def test_bad_sensor_in_a_plan_file_names_the_json_path() -> None:
     with pytest.raises(PlanError, match=r"validation\.sensor.*sensing_distance_m.*> 0"):
         plan_from_json(json.dumps(raw))
     assert isinstance(stator_plan().validation.sensor, ProximitySensor)
+
+
+def test_sensor_registry_gives_the_simulator_of_the_plans_sensor() -> None:
+    from planner.sim.sensors import SENSORS, sensor_kind
+
+    kind = sensor_kind(stator_plan().validation.sensor)
+    assert kind is SENSORS["proximity"] and kind.load() is SimulatedProbe
+    assert kind.name == ProximitySensor.KIND
+
+    class Unknown:
+        KIND = "capacitive"
+        footprint_radius_m = 0.01
+        standoff_m = 0.002
+
+    with pytest.raises(PlanError, match=r"no simulator for Unknown; known sensors: \['proximity'\]"):
+        sensor_kind(Unknown())

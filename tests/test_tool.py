@@ -9,8 +9,12 @@ import trimesh
 
 from calib.errors import ShapeError
 from calib.frames import make_transform
+from calib.models import ProximitySensor
 from planner.cell.tool import Tool, load_tool
 from planner.errors import MeshError, UnknownFrameError, URDFError
+
+#: The plan's default sensor: the built-in tool's geometry must match it.
+SENSOR = ProximitySensor()
 
 
 @pytest.fixture(scope="module")
@@ -21,8 +25,6 @@ def feeder() -> Tool:
 def test_builtin_tool_has_the_papers_tcps(feeder: Tool) -> None:
     assert feeder.tcp_names == ["flange", "sensor", "tube_1", "tube_2"]
     assert feeder.sensor_tcp == "sensor"
-    assert feeder.sensing_distance_m == pytest.approx(0.008)
-    assert feeder.sensor_diameter_m == pytest.approx(0.018)
     np.testing.assert_array_equal(feeder.T_flange_tcp("flange"), np.eye(4))
 
 
@@ -37,11 +39,11 @@ def test_sensor_tcp_lies_at_the_sensing_distance_in_front_of_the_sensor_face(fee
     T = feeder.T_flange_tcp("sensor")
     # sensor +z is the flange z (pointing away from the tool, into the surface)
     np.testing.assert_allclose(T[:3, 2], [0, 0, 1], atol=1e-12)
-    assert T[2, 3] - hi[2] == pytest.approx(feeder.sensing_distance_m, abs=1e-6)
-    assert hi[0] - lo[0] == pytest.approx(feeder.sensor_diameter_m, abs=1e-6)
+    assert T[2, 3] - hi[2] == pytest.approx(SENSOR.sensing_distance_m, abs=1e-6)
+    assert hi[0] - lo[0] == pytest.approx(SENSOR.face_diameter_m, abs=1e-6)
     assert (lo[0] + hi[0]) / 2 == pytest.approx(T[0, 3], abs=1e-9)  # on the sensor axis
     # the sensor protrudes beyond the cable tubes, so it can probe a flat face
-    assert T[2, 3] - feeder.sensing_distance_m > feeder.T_flange_tcp("tube_1")[2, 3]
+    assert T[2, 3] - SENSOR.sensing_distance_m > feeder.T_flange_tcp("tube_1")[2, 3]
 
 
 def test_tube_tcps_are_symmetric(feeder: Tool) -> None:

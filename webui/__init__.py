@@ -1,1 +1,10 @@
-"""wobjcal web UI (viser): a thin layer that turns browser events into planner/calib calls."""
+"""The wobjcal web UI (viser): a thin layer that turns browser events into planner/calib calls.
+
+Owns the app (:mod:`webui.app`, ``run()``), the interface its panels see
+(:mod:`webui.context`), the panels (points, files, validation, calibration, heat map), the
+scene and robot drawing, click-to-place (:mod:`webui.surface`), the edited plan with undo/redo
+and autosave (:mod:`webui.plan_doc`, :mod:`webui.state`, :mod:`webui.plan_adapter`), and the
+one worker thread that owns the cell (:mod:`webui.worker`, :mod:`webui.backend`). Checks,
+validation, exports and calibration are the planner's own jobs (:mod:`planner.check`, ...).
+``docs/webui.md`` has the details.
+"""

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from calib.plan.file import Plan, load_plan
-from planner.cli.common import DEMO_PLAN
+from planner.demo import DEMO_PLAN
 from webui.plan_adapter import ui_plan_from_plan
 from webui.plan_doc import UiPlan
 

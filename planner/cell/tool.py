@@ -47,8 +47,6 @@ class Tool:
         sensor_links: links of the sensor body; they may come closer to the work object than
             the clearance margin (down to contact), as the sensor face must be within its
             sensing distance of the surface.
-        sensing_distance_m: distance from the sensor face to the ``sensor`` TCP, m.
-        sensor_diameter_m: sensor diameter, m.
     """
 
     name: str
@@ -57,8 +55,6 @@ class Tool:
     mesh: trimesh.Trimesh | None = field(default=None, repr=False)
     sensor_tcp: str | None = None
     sensor_links: tuple[str, ...] = ()
-    sensing_distance_m: float = 0.008
-    sensor_diameter_m: float = 0.018
 
     @property
     def tcp_names(self) -> list[str]:
@@ -86,8 +82,6 @@ class Tool:
         tcps: list[str] | None = None,
         sensor_tcp: str | None = None,
         sensor_links: tuple[str, ...] = (),
-        sensing_distance_m: float = 0.008,
-        sensor_diameter_m: float = 0.018,
     ) -> Tool:
         """A tool from a URDF whose links are joined by fixed joints; TCPs are named links.
 
@@ -96,8 +90,6 @@ class Tool:
             tcps: link names to offer as TCPs; default every link but the root.
             sensor_tcp: the proximity-sensor TCP, if any.
             sensor_links: links of the sensor body (may approach the work object to contact).
-            sensing_distance_m: sensing distance, m.
-            sensor_diameter_m: sensor diameter, m.
 
         Raises:
             URDFError: missing, malformed, not a tree of fixed joints, or a TCP name is not a link.
@@ -114,8 +106,6 @@ class Tool:
             urdf_path=path,
             sensor_tcp=sensor_tcp,
             sensor_links=tuple(sensor_links),
-            sensing_distance_m=float(sensing_distance_m),
-            sensor_diameter_m=float(sensor_diameter_m),
         )
 
     @classmethod
@@ -125,7 +115,6 @@ class Tool:
         tcps: Mapping[str, ArrayLike],
         name: str = "tool",
         sensor_tcp: str | None = None,
-        sensing_distance_m: float = 0.008,
     ) -> Tool:
         """A tool from a mesh in the flange frame (metres) and TCP frames ``T_flange_tcp``.
 
@@ -148,7 +137,6 @@ class Tool:
             tcps=MappingProxyType(frames),
             mesh=mesh,
             sensor_tcp=sensor_tcp,
-            sensing_distance_m=float(sensing_distance_m),
         )
 
     def fingerprint(self) -> bytes:
@@ -173,7 +161,8 @@ def load_tool(spec: str | Path | Tool) -> Tool:
     """A tool from ``"builtin:<name>"``, a tool description ``.json``, a ``.urdf`` or a Tool.
 
     A description JSON holds ``urdf`` (relative to the JSON), ``tcps``, ``sensor_tcp``,
-    ``sensor_links``, ``sensing_distance_m`` and ``sensor_diameter_m``.
+    and ``sensor_links``. The sensor itself (sensing distance, face) is the plan's
+    :class:`calib.models.ProximitySensor`, not part of the tool.
 
     Raises:
         UnknownFrameError: unknown built-in name.
@@ -193,8 +182,6 @@ def load_tool(spec: str | Path | Tool) -> Tool:
             tcps=list(desc["tcps"]),
             sensor_tcp=desc.get("sensor_tcp"),
             sensor_links=tuple(desc.get("sensor_links", ())),
-            sensing_distance_m=float(desc.get("sensing_distance_m", 0.008)),
-            sensor_diameter_m=float(desc.get("sensor_diameter_m", 0.018)),
         )
     except (json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
         if isinstance(exc, URDFError):

@@ -14,12 +14,6 @@ from typing import Any
 from rich.console import Console
 
 from calib.plan.file import Plan, load_plan
-from planner.builtins import ASSETS
-
-#: Where the shipped plans live.
-PLANS_DIR = ASSETS / "plans"
-#: The built-in demo plan (the paper's A-H plan on the built-in stator cell).
-DEMO_PLAN = PLANS_DIR / "stator_section_ah.json"
 
 
 def count_arg(minimum: int) -> Callable[[str], int]:

@@ -10,7 +10,8 @@ from typing import Any
 from calib.atomic_io import write_text_atomic
 from calib.plan.file import load_plan
 from calib.plan.json_io import json_schema
-from planner.cli.common import DEMO_PLAN, stderr
+from planner.cli.common import stderr
+from planner.demo import DEMO_PLAN
 
 
 def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:

@@ -254,7 +254,7 @@ def safety_spec(plan: Plan) -> SafetySpec:
         max_translation_m=v.misplacement.max_translation_m,
         max_angle_rad=v.misplacement.max_angle_rad,
         pivot_wobj_m=(float(pivot[0]), float(pivot[1]), float(pivot[2])),
-        sensing_distance_m=v.sensor.sensing_distance_m,
+        sensing_distance_m=v.sensor.standoff_m,
     )
 
 

@@ -15,7 +15,6 @@ the built-in IRB 4400 at its limit for the yoke points (checked with ``Cell.chec
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -24,10 +23,6 @@ from calib.errors import ShapeError
 from calib.frames import make_transform
 from calib.probing import ProbePoint, SearchSpec
 from planner.parts.stator import StatorGeometry
-from planner.parts.stator_mesh import build_stator_mesh
-
-if TYPE_CHECKING:
-    from planner.cell.cell import Cell
 
 FloatArray = NDArray[np.float64]
 
@@ -126,22 +121,3 @@ def demo_table(
     size = (0.6, g.length_m + 0.2, 0.05)
     centre = (float(world[:, 0].min()) + 0.3, float(world[:, 1].mean()), top_z - 0.025)
     return size, make_transform(None, centre)
-
-
-def make_demo_cell(geom: StatorGeometry | None = None, **cell_kwargs: Any) -> Cell:
-    """The demo cell: built-in IRB 4400 with the cable-feeder tool, the stator on a table.
-
-    The work object is the (bulged) stator mesh at :func:`nominal_T_base_wobj`; the robot base
-    is the world frame. Extra keyword arguments go to :class:`planner.cell.cell.Cell`.
-    """
-    from planner.cell.cell import Cell
-
-    g = geom or StatorGeometry.full_section()
-    kwargs: dict[str, Any] = {"robot": "builtin:irb4400", "tool": "builtin:cable_feeder"}
-    kwargs.update(cell_kwargs)
-    cell = Cell(**kwargs)
-    T = nominal_T_base_wobj()
-    cell.set_work_object(build_stator_mesh(g), units="m", T_world_wobj=T)
-    size, T_table = demo_table(g, T)
-    cell.add_fixture("table", size_m=size, T_world_fixture=T_table)
-    return cell

@@ -28,8 +28,9 @@ from calib.paper.stator_procedure import check_stator_points, run_stator_procedu
 from calib.probing import ProbePoint
 from calib.procedures.hultman2013 import ROLES
 from planner.parts.stator import StatorGeometry
-from planner.sim.probe import ReachabilityHook, SimulatedProbe
+from planner.sim.probe import ReachabilityHook
 from planner.sim.raycast import MeshRayCaster
+from planner.sim.sensors import sensor_kind
 
 FloatArray = NDArray[np.float64]
 
@@ -132,6 +133,7 @@ class TrialRunner:
         self.layout = check_stator_points(setup.points)
         self.constraints = constraint_set([setup.points[k] for k in ROLES])
         self.cell = cell
+        self.simulator = sensor_kind(setup.sensor).load()
 
     def run_trial(
         self, seed: np.random.SeedSequence, reach: ReachabilityHook | None
@@ -143,7 +145,7 @@ class TrialRunner:
         T_true = T_nom @ setup.misplacement.sample(rng, setup.pivot_wobj_m)
         if self.cell is not None and reach is not None:  # the cell's part goes where it really is
             self.cell.move_work_object(self.cell.T_world_base @ T_true)
-        probe = SimulatedProbe(
+        probe = self.simulator(
             self.caster,
             T_true,
             rng,

@@ -1,0 +1,92 @@
+"""The sensor registry: which simulated search runs for each sensor model.
+
+A sensor kind is one model struct in :mod:`calib.models` (the plan holds it; it satisfies
+:class:`calib.models.sensor.SensorModel`) plus one simulator here: a class built as
+``Simulator(caster, T_base_wobj_true, rng, sensor=..., robot_error=..., accuracy_field=...,
+geometry=..., reachability=..., edge_inset_m=..., edge_tolerance_m=...)`` that is a
+:data:`calib.probing.Probe` (one commanded search in, a :class:`calib.probing.ProbeResult`
+out) and lists what happened in ``events``. Adding a sensor is a model, a simulator module and
+one entry in :data:`SENSORS`::
+
+    SENSORS["touch"] = SensorKind(
+        "touch", TouchProbe, "planner.sim.touch:SimulatedTouchProbe", "ball-tip touch probe"
+    )
+
+Simulators are imported when first used.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Protocol
+
+from calib.errors import PlanError
+from calib.models.proximity import ProximitySensor
+from calib.models.sensor import SensorModel
+from calib.probing import ProbeResult, SearchCommand
+from planner.sim.search_events import ProbeEvent
+
+
+class SimulatedSensorProbe(Protocol):
+    """A simulated search against the true part: a probe that records what happened."""
+
+    events: list[ProbeEvent]
+
+    def __call__(self, command: SearchCommand) -> ProbeResult:
+        """Run one commanded search (base frame) and return what the controller records."""
+        ...
+
+
+#: Builds a simulated probe (see the module docstring for its arguments).
+SimulatorFactory = Callable[..., SimulatedSensorProbe]
+
+
+@dataclass(frozen=True)
+class SensorKind:
+    """One sensor kind.
+
+    Attributes:
+        name: its name, equal to the model's ``KIND``.
+        model: the model struct (in :mod:`calib.models`).
+        simulator: ``"module:attr"`` of its simulator class.
+        summary: one line for humans.
+    """
+
+    name: str
+    model: type
+    simulator: str
+    summary: str
+
+    def load(self) -> SimulatorFactory:
+        """The simulator class (imports its module)."""
+        module, _, attr = self.simulator.partition(":")
+        factory: SimulatorFactory = getattr(importlib.import_module(module), attr)
+        return factory
+
+
+#: The sensor kinds by name.
+SENSORS: dict[str, SensorKind] = {
+    "proximity": SensorKind(
+        "proximity",
+        ProximitySensor,
+        "planner.sim.probe:SimulatedProbe",
+        "inductive proximity sensor: ray bundle over the face, exponential damping, hysteresis",
+    ),
+}
+
+
+def sensor_kind(model: SensorModel) -> SensorKind:
+    """The registry entry of a sensor model.
+
+    Raises:
+        PlanError: no simulator for this kind of sensor (the message lists the known ones).
+    """
+    kind = SENSORS.get(getattr(type(model), "KIND", ""))
+    if kind is None or not isinstance(model, kind.model):
+        raise PlanError(
+            f"validation.sensor: no simulator for {type(model).__name__}; known sensors: "
+            f"{sorted(SENSORS)}"
+        )
+    return kind

@@ -1,0 +1,131 @@
+"""The import graph: no circles anywhere, and every package imports only the layers below it.
+
+Read from the source (``tests/import_graph.py``): imports at module level, inside functions and
+under ``TYPE_CHECKING`` all count. ``docs/ARCHITECTURE.md`` draws the same layers.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.import_graph import Edge, cycles, edges, modules
+
+#: Plan-level jobs: the modules directly in ``planner/`` that the CLI, the UI and scripts call.
+JOBS = "planner.<jobs>"
+#: What each part may import (besides itself). A part is a subpackage, a top-level module of
+#: ``planner``, or one of the groups below.
+ALLOWED: dict[str, set[str]] = {
+    "calib": set(),
+    "planner": {"calib"},  # the version
+    "planner.errors": {"calib"},
+    "planner.builtins": {"calib", "planner.errors"},
+    "planner.robot": {"calib", "planner.errors", "planner.builtins"},
+    "planner.parts": {"calib", "planner.errors"},
+    "planner.faces": {"calib", "planner.errors"},
+    "planner.cell": {"calib", "planner.errors", "planner.builtins", "planner.robot"},
+    "planner.sim": {"calib", "planner.errors", "planner.parts", "planner.faces"},
+    "planner.export": {"calib", "planner.errors"},
+    JOBS: {
+        "calib",
+        "planner.errors",
+        "planner.builtins",
+        "planner.robot",
+        "planner.parts",
+        "planner.faces",
+        "planner.cell",
+        "planner.sim",
+        "planner.export",
+    },
+    "planner.cli": {
+        "calib",
+        "planner.errors",
+        "planner.builtins",
+        "planner.robot",
+        "planner.parts",
+        "planner.faces",
+        "planner.cell",
+        "planner.sim",
+        "planner.export",
+        JOBS,
+    },
+    "planner.__main__": {"planner.cli"},
+    "webui": {
+        "calib",
+        "planner.errors",
+        "planner.builtins",
+        "planner.robot",
+        "planner.parts",
+        "planner.faces",
+        "planner.cell",
+        "planner.sim",
+        "planner.export",
+        JOBS,
+    },
+}
+SUBPACKAGES = ("robot", "cell", "faces", "sim", "parts", "export", "cli")
+#: The one allowed upward import: ``wobjcal ui`` starts the web app, lazily, in one function.
+LAZY_UI = ("planner.cli.misc", "webui", "cmd_ui")
+
+
+def part_of(module: str) -> str:
+    """The layer a module belongs to (a key of :data:`ALLOWED`)."""
+    top, _, rest = module.partition(".")
+    if top in ("calib", "webui"):
+        return top
+    if not rest:
+        return "planner"
+    first = rest.split(".")[0]
+    if first in SUBPACKAGES:
+        return f"planner.{first}"
+    if first in ("errors", "builtins", "__main__"):
+        return f"planner.{first}"
+    return JOBS
+
+
+@pytest.fixture(scope="module")
+def graph() -> list[Edge]:
+    return edges()
+
+
+def test_no_import_circles(graph: list[Edge]) -> None:
+    assert cycles(graph) == []
+
+
+def test_every_package_imports_only_the_layers_below(graph: list[Edge]) -> None:
+    bad = []
+    for e in graph:
+        src, dst = part_of(e.source), part_of(e.target)
+        if src == dst:
+            continue
+        if (e.source.startswith(LAZY_UI[0]) and dst == LAZY_UI[1]) and e.function == LAZY_UI[2]:
+            continue
+        if dst not in ALLOWED[src]:
+            bad.append(f"{e.source}:{e.line} imports {e.target} ({src} -> {dst})")
+    assert bad == []
+
+
+def test_calib_imports_no_simulator_and_no_ui(graph: list[Edge]) -> None:
+    assert [e for e in graph if e.source.startswith("calib") and part_of(e.target) != "calib"] == []
+
+
+def test_every_subpackage_says_what_it_owns() -> None:
+    """Each package's ``__init__`` has a docstring that names its modules."""
+    import ast
+
+    for name, path in modules().items():
+        if path.name != "__init__.py":
+            continue
+        doc = ast.get_docstring(ast.parse(path.read_text())) or ""
+        assert len(doc) > 80 and "TODO" not in doc, f"{name}: no docstring saying what it owns"
+
+
+def test_the_checker_finds_a_circle_and_an_upward_import() -> None:
+    """The checks above can fail: a made-up circle and a made-up upward import are caught."""
+    fake = [
+        Edge("planner.cell.a", "planner.cell.b", "", 1),
+        Edge("planner.cell.b", "planner.cell.a", "f", 2),
+    ]
+    assert cycles(fake) == [["planner.cell.a", "planner.cell.b"]]
+    assert part_of("planner.cell.cell") == "planner.cell"
+    assert part_of("planner.check") == JOBS
+    assert JOBS not in ALLOWED[part_of("planner.cell.cell")]  # the cell may not import a job
