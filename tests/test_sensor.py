@@ -142,5 +142,7 @@ def test_sensor_registry_gives_the_simulator_of_the_plans_sensor() -> None:
         footprint_radius_m = 0.01
         standoff_m = 0.002
 
-    with pytest.raises(PlanError, match=r"no simulator for Unknown; known sensors: \['proximity'\]"):
+    with pytest.raises(
+        PlanError, match=r"no simulator for Unknown; known sensors: \['proximity'\]"
+    ):
         sensor_kind(Unknown())
