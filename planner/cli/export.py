@@ -18,14 +18,16 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
     p = add(
         sub,
         "export",
-        "write the plan as a robot program (rapid, krl, urscript) or canonical JSON",
+        "write the plan as a robot program (" + ", ".join(FORMATS) + ") or canonical JSON",
         "Write the plan as a robot program that probes every point with the proximity sensor\n"
         "and records the measured points, or as canonical plan JSON. The sensor orientation\n"
         "and the ABB confdata of each target come from the same reachability check as\n"
         "'wobjcal check' (when the cell is available; else a default orientation and no\n"
-        "confdata, noted in the program). rapid: one .mod; krl: FILE (.src) and a .dat next\n"
-        "to it; urscript: one .script. Exit 1 (nothing written) when the check finds an\n"
-        "infeasible point, naming it; --force writes the program anyway.",
+        "confdata, noted in the program). FILE gets the format's first file; further files\n"
+        "(KRL's .dat) go beside it: "
+        + "; ".join(f"{f.name}: {' + '.join(f.suffixes)}" for f in FORMATS.values())
+        + ".\nExit 1 (nothing written) when the check finds an infeasible point, naming it;\n"
+        "--force writes the program anyway.",
         "wobjcal export plan.json --format rapid -o WobjcalStator.mod\n"
         "wobjcal export plan.json --format krl -o wobjcal_stator.src",
     )
