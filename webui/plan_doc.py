@@ -17,13 +17,14 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from calib.errors import InputError
+from calib.paper.stator_layout import STATOR_POINT_IDS
 from calib.probing import ProbePoint, SearchSpec
 
 if TYPE_CHECKING:
     from calib.plan.file import Plan
 
 #: The paper's point names (also the roles of its A-H procedure).
-PAPER_IDS: tuple[str, ...] = tuple("ABCDEFGH")
+PAPER_IDS: tuple[str, ...] = STATOR_POINT_IDS
 
 
 @dataclass(frozen=True)

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 
+from calib.paper.stator_layout import STATOR_POINT_IDS as ROLES
 from planner.export.job import AdaptiveSpec, ExportJob, fmt
 from planner.export.rapid_probe import WOBJ
 
@@ -121,10 +122,10 @@ def adaptive_main(job: ExportJob, names: list[str]) -> list[str]:
     """The body of ``main``: the nine steps of the procedure."""
     a = job.adaptive
     assert a is not None
-    idx = {r: a.index[r] + 1 for r in "ABCDEFGH"}
-    name = {r: names[a.index[r]] for r in "ABCDEFGH"}
+    idx = {r: a.index[r] + 1 for r in ROLES}
+    name = {r: names[a.index[r]] for r in ROLES}
     n = len(job.targets)
-    m = {r: f"measured{{{idx[r]}}}" for r in "ABCDEFGH"}
+    m = {r: f"measured{{{idx[r]}}}" for r in ROLES}
     ind = "        "
 
     def probe(role: str, i: int, start_from: str | None = None) -> list[str]:
