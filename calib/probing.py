@@ -118,6 +118,9 @@ class SearchCommand:
         T_base_wobj_estimate: ``(4, 4)`` the estimate of the work-object frame the command was
             built from.
         nominal_m: ``(3,)`` where the event is expected on the estimated part, base frame.
+        stop_normal: ``(3,)`` unit outward normal of the face that ends the search (an
+            approach: the face it looks at; an edge search: the face whose end it finds), on
+            the estimated part, base frame; ``None`` when not known.
     """
 
     point_id: str
@@ -128,6 +131,7 @@ class SearchCommand:
     sensor_axis: FloatArray
     T_base_wobj_estimate: FloatArray
     nominal_m: FloatArray
+    stop_normal: FloatArray | None = None
 
     @classmethod
     def from_point(cls, point: ProbePoint, T_base_wobj: ArrayLike) -> SearchCommand:
@@ -137,10 +141,11 @@ class SearchCommand:
         n = np.asarray(point.normal, float)
         s = point.search
         if s.kind == "approach":
-            start_w, dir_w = p + s.start_offset_m * n, -n
+            start_w, dir_w, stop_w = p + s.start_offset_m * n, -n, n
         else:
             d = np.asarray(s.edge_direction, float)
             start_w, dir_w = p - s.start_offset_m * d, d
+            stop_w = d if point.edge_normal is None else np.asarray(point.edge_normal, float)
         return cls(
             point_id=point.id,
             kind=s.kind,
@@ -150,6 +155,7 @@ class SearchCommand:
             sensor_axis=transform_directions(T, -n),
             T_base_wobj_estimate=T.copy(),
             nominal_m=transform_points(T, p),
+            stop_normal=transform_directions(T, stop_w),
         )
 
 

@@ -16,6 +16,7 @@ from calib.plan.file import (
     Plan,
     PlanPoint,
     Pose,
+    ValidationSpec,
     WorkObjectSpec,
     plan_to_json,
 )
@@ -33,7 +34,8 @@ DEMO_PLAN = ASSETS / "plans" / "stator_section_ah.json"
 
 
 def stator_plan() -> Plan:
-    """The paper's A-H plan on the built-in stator-section cell (robot base = world)."""
+    """The paper's A-H plan on the built-in stator-section cell (robot base = world), with the
+    x-offset run and the paper's Table 1 rows in the report."""
 
     g = StatorGeometry.full_section()
     T = demo_cell.nominal_T_base_wobj()
@@ -57,7 +59,8 @@ def stator_plan() -> Plan:
             mesh="builtin:stator_section", units="m", T_world_wobj=Pose.from_matrix(T)
         ),
         points=points,
-        procedure=Hultman2013(beta1_rad=demo_cell.BETA1_RAD),
+        procedure=Hultman2013(beta1_rad=demo_cell.BETA1_RAD, xoffset=demo_cell.stator_xoffset(g)),
+        validation=ValidationSpec(report=demo_cell.STATOR_REPORT),
     )
 
 
@@ -73,6 +76,7 @@ def make_demo_cell(geom: StatorGeometry | None = None, **cell_kwargs: Any) -> Ce
     is the world frame. Extra keyword arguments go to :class:`planner.cell.cell.Cell`.
     """
     from planner.cell.cell import Cell  # PyBullet: only when a cell is built
+
     g = geom or StatorGeometry.full_section()
     kwargs: dict[str, Any] = {"robot": "builtin:irb4400", "tool": "builtin:cable_feeder"}
     kwargs.update(cell_kwargs)

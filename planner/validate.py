@@ -1,9 +1,19 @@
 """Monte Carlo validation of a plan: the one entry point the CLI, the UI and scripts share.
 
-:func:`validate_plan` turns a :class:`calib.plan.file.Plan` into the simulation's models (sensor,
-robot error, misplacement, A-H procedure settings, stator geometry) and runs
-:func:`planner.sim.montecarlo.validate`. ``wobjcal validate`` and the web UI's "Validate" panel both
-call it, so a plan validates the same way everywhere.
+:func:`validate_plan` validates any plan: every procedure of the registry
+(:data:`calib.procedures.PROCEDURES`), every sensor kind (:data:`planner.sim.sensors.SENSORS`),
+any work-object mesh (a file in any unit, or a built-in part) and any robot. The plan's own
+model objects (sensor, robot error, misplacement), its procedure settings (edge-event offset
+filled in from the sensor model when unset) and its report settings go into
+:func:`planner.sim.montecarlo.simulate`; ``wobjcal validate`` and the web UI's "Validate" panel
+both call it, so a plan validates the same way everywhere.
+
+A plan that cannot work is refused *before* the run, with a message naming the point and why
+(:func:`check_simulatable` and :func:`preflight`): roles that do not fit the procedure, a layout
+that leaves a degree of freedom free, an edge search with a touch probe, a point off its planar
+face or with the sensor's footprint over a hole or an edge, a search too short to reach its
+face (or starting too close to it) under the plan's misplacement. A run never crashes half-way:
+a search that fails in a trial is counted with its reason.
 
 Example::
 
@@ -22,26 +32,43 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import trimesh
 
+from calib.errors import InputError
+from calib.estimators.layout import search_constraint_set
+from calib.estimators.observability import analyze_layout
 from calib.models import Misplacement, RobotErrorModel
-from calib.models.proximity import ProximitySensor
-from calib.paper.settings import Hultman2013
-from calib.plan.file import Plan, PlanError
-from calib.procedures.hultman2013 import points_by_role
+from calib.plan.file import Plan, PlanError, resolve_ref
+from calib.procedures import RolePoint, procedure_kind
+from planner.export.safety import SafetySpec
 from planner.parts.stator import StatorGeometry
 from planner.plan_cell import nominal_T_base_wobj, open_cell
-from planner.sim.montecarlo import DEFAULT_EDGE_INSET_M, ValidationReport, validate
-from planner.sim.trial import resolved_settings
+from planner.sim.montecarlo import simulate
+from planner.sim.report import PAPER_TABLE1, ValidationReport
+from planner.sim.report_points import report_rows
+from planner.sim.sensitivity import SensitivityTable, sensitivity
+from planner.sim.sensors import sensor_kind
+from planner.sim.setup import (
+    DEFAULT_EDGE_INSET_M,
+    SimulationSetup,
+    default_pivot,
+    face_lookup,
+    resolved_settings,
+)
+from planner.sim.xoffset import xoffset_setup
 
 __all__ = [
     "SIMULATED_PARTS",
     "ValidationModels",
     "check_simulatable",
+    "preflight",
+    "sensitivity_plan",
     "validate_plan",
     "validation_models",
+    "work_object_mesh",
 ]
 
-#: Built-in work objects the validation can simulate -> the ``StatorGeometry`` constructor.
+#: Built-in stators -> the ``StatorGeometry`` constructor (their slot holes, bulge, epsilon).
 SIMULATED_PARTS: dict[str, str] = {
     "builtin:stator_section": "full_section",
     "builtin:stator_prototype": "prototype",
@@ -56,63 +83,173 @@ class ValidationModels:
     """What the simulation of a plan uses, built from the plan by :func:`validation_models`.
 
     Attributes:
-        sensor: the proximity-sensor model (``plan.validation.sensor``).
+        sensor: the sensor model (``plan.validation.sensor``, any kind).
         robot_error: the robot error model (``plan.validation.robot_error``).
         misplacement: the part placement tolerance (``plan.validation.misplacement``).
-        settings: the A-H procedure settings; ``edge_event_offset_m`` is the plan's, or when
-            unset the sensor's analytic straight-edge offset at ``edge_inset_m``.
-        geometry: the simulated stator geometry (``plan.work_object.mesh``).
+        method: the procedure's registry name.
+        settings: the procedure's settings; an unset ``edge_event_offset_m`` is the sensor's
+            analytic straight-edge offset at ``edge_inset_m``.
+        points: the plan's points with the procedure's roles.
+        geometry: the stator geometry of a built-in stator work object, else ``None``.
         edge_inset_m: how far inside the face edge searches run, metres.
     """
 
-    sensor: ProximitySensor
+    sensor: Any
     robot_error: RobotErrorModel
     misplacement: Misplacement
-    settings: Hultman2013
-    geometry: StatorGeometry
+    method: str
+    settings: Any
+    points: tuple[RolePoint, ...]
+    geometry: StatorGeometry | None
     edge_inset_m: float = DEFAULT_EDGE_INSET_M
 
 
-def check_simulatable(plan: Plan) -> Hultman2013:
-    """Raise unless the validation can simulate ``plan``; return its A-H settings.
-
-    Raises:
-        PlanError: the procedure is not ``hultman2013`` (names ``procedure.method``), or the
-            work object is not a built-in stator (names ``work_object.mesh``).
-    """
-    if not isinstance(plan.procedure, Hultman2013):
-        raise PlanError(
-            f"procedure.method: validation simulates only hultman2013 (the paper's A-H "
-            f"procedure), got {plan.method!r}"
-        )
-    if plan.work_object.mesh not in SIMULATED_PARTS:
-        raise PlanError(
-            f"work_object.mesh: validation simulates only the built-in stators "
-            f"{sorted(SIMULATED_PARTS)}, got {plan.work_object.mesh!r}"
-        )
-    return plan.procedure
+def _name(plan: Plan, point_id: str) -> str:
+    ids = [p.id for p in plan.points]
+    return f"points[{ids.index(point_id)}] ({point_id})" if point_id in ids else point_id
 
 
 def validation_models(plan: Plan) -> ValidationModels:
-    """The sensor, robot-error, misplacement, procedure and geometry models of ``plan``.
+    """The models, procedure and roles of ``plan`` (see :func:`check_simulatable`)."""
+    return check_simulatable(plan)
 
-    The sensor, robot error and misplacement are the plan's own objects; the A-H settings are
-    the plan's with an unset edge-event offset resolved from the sensor
-    (:func:`planner.sim.trial.resolved_settings`).
+
+def check_simulatable(plan: Plan) -> ValidationModels:
+    """Raise unless the validation can simulate ``plan`` (checks that need no mesh).
+
+    Returns:
+        The plan's :class:`ValidationModels`.
 
     Raises:
-        PlanError: the plan cannot be simulated (see :func:`check_simulatable`).
+        PlanError: the points lack a role the procedure needs, the procedure cannot use them
+            (e.g. an A-H layout against the paper's conditions, 3-2-1 faces parallel), the
+            layout leaves a degree of freedom free, the sensor has no simulator, a touch probe
+            is asked for an edge search, or an x-offset run is asked for on a part without
+            slot holes; the message names the point or field.
     """
-    proc = check_simulatable(plan)
+    plan.require_complete()
+    kind = procedure_kind(plan.procedure)
     v = plan.validation
+    sensor_kind(v.sensor)  # a simulator for this sensor
+    try:
+        points = tuple(kind.assign(plan.role_points()))
+    except PlanError:
+        raise
+    except InputError as exc:
+        raise PlanError(f"points: {plan.method} cannot use this layout: {exc}") from None
+    if not v.sensor.runs_edge_searches:
+        for p in plan.points:
+            if p.search.kind == "edge":
+                raise PlanError(
+                    f"{_name(plan, p.id)}.search.kind: a {v.sensor.KIND} sensor cannot run an "
+                    "edge search (it cannot find where a face ends while sliding over it)"
+                )
+    report = analyze_layout(search_constraint_set([rp.point for rp in points]))
+    if report.rating == "unobservable":
+        free = "; ".join(m.message for m in report.unconstrained)
+        raise PlanError(
+            f"points: the layout does not fix all 6 degrees of freedom (an edge search counts "
+            f"by its edge coordinate only): {free}"
+        )
+    geometry = None
+    if plan.work_object.mesh in SIMULATED_PARTS:
+        geometry = getattr(StatorGeometry, SIMULATED_PARTS[plan.work_object.mesh])()
+    if getattr(plan.procedure, "xoffset", None) is not None and geometry is None:
+        raise PlanError(
+            "procedure.xoffset: the x-offset run is simulated only on a built-in stator "
+            f"(its true slot holes), not on {plan.work_object.mesh!r}"
+        )
     return ValidationModels(
         sensor=v.sensor,
         robot_error=v.robot_error,
         misplacement=v.misplacement,
-        settings=resolved_settings(proc, v.sensor, DEFAULT_EDGE_INSET_M),
-        geometry=getattr(StatorGeometry, SIMULATED_PARTS[plan.work_object.mesh])(),
+        method=plan.method,
+        settings=resolved_settings(plan.procedure, v.sensor, DEFAULT_EDGE_INSET_M),
+        points=points,
+        geometry=geometry,
         edge_inset_m=DEFAULT_EDGE_INSET_M,
     )
+
+
+def work_object_mesh(plan: Plan, plan_dir: Path, models: ValidationModels) -> trimesh.Trimesh:
+    """The true part's mesh in wobj, metres: a built-in stator's from its geometry, else the
+    plan's file (or built-in) loaded in its units and lightly repaired, as the cell does.
+
+    Raises:
+        InputError: the mesh cannot be loaded (the message names the file).
+    """
+    if models.geometry is not None:
+        from planner.parts.stator_mesh import build_stator_mesh
+
+        return build_stator_mesh(models.geometry)
+    from planner.cell.workobject import load_work_object
+
+    wo = plan.work_object
+    return load_work_object(resolve_ref(wo.mesh, plan_dir), units=wo.units).mesh
+
+
+def preflight(plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh) -> None:
+    """Refuse a plan whose points or searches cannot work on ``mesh``, before any trial.
+
+    Every point must lie on a planar face with the sensor's footprint on it
+    (:func:`planner.faces.checks.plan_face_reasons`); every search must reach its face under
+    the plan's misplacement (the bound of :class:`planner.export.safety.SafetySpec`, the same
+    the exported programs use): an approach must start at least the face's largest shift plus
+    the sensor's standoff out, and run at least the shift past it; an edge search must start
+    at least the shift before the edge and run at least the shift plus the sensor's edge-event
+    offset past it.
+
+    Raises:
+        PlanError: naming every point that fails, and why.
+    """
+    from planner.faces.checks import plan_face_reasons
+
+    probes = [p.to_probe_point() for p in plan.points]
+    r = models.sensor.footprint_radius_m
+    why = {
+        p.id: f"not on a planar face: {reason}"
+        for p, reason in zip(
+            plan.points, plan_face_reasons(mesh, probes, footprint_radius_m=r), strict=True
+        )
+        if reason
+    }
+    m = models.misplacement
+    pivot = default_pivot(list(models.points))
+    safety = SafetySpec(
+        max_translation_m=m.max_translation_m,
+        max_angle_rad=m.max_angle_rad,
+        pivot_wobj_m=(float(pivot[0]), float(pivot[1]), float(pivot[2])),
+        sensing_distance_m=models.sensor.standoff_m,
+        margin_m=0.0,
+    )
+    edge_offset = float(getattr(models.settings, "edge_event_offset_m", 0.0) or 0.0)
+    for p in probes:
+        if p.id in why:
+            continue
+        shift = safety.surface_shift_bound_m(p.position_m)
+        s = p.search
+        if s.kind == "approach":
+            start_needed = safety.start_clearance_m(p.position_m)
+            run_needed = shift
+        else:
+            start_needed = shift
+            run_needed = shift + edge_offset
+        if s.start_offset_m < start_needed:
+            why[p.id] = (
+                f"the search starts {s.start_offset_m * 1e3:.1f} mm "
+                f"{'out' if s.kind == 'approach' else 'before the edge'}, but the part may lie "
+                f"up to {shift * 1e3:.1f} mm closer; it needs at least "
+                f"{start_needed * 1e3:.1f} mm"
+            )
+        elif s.overtravel_m < run_needed:
+            why[p.id] = (
+                f"the search runs {s.overtravel_m * 1e3:.1f} mm past the nominal "
+                f"{'face' if s.kind == 'approach' else 'edge'}, but the part may lie up to "
+                f"{shift * 1e3:.1f} mm farther; it needs at least {run_needed * 1e3:.1f} mm"
+            )
+    if why:
+        lines = "; ".join(f"{_name(plan, pid)}: {w}" for pid, w in why.items())
+        raise PlanError(f"cannot validate this plan: {lines}")
 
 
 def validate_plan(
@@ -124,11 +261,13 @@ def validate_plan(
     progress: ProgressCallback | None = None,
     reach_trials: int = 0,
     plan_dir: Path | None = None,
+    protocol: tuple[int, int] | None = None,
+    mesh: trimesh.Trimesh | None = None,
 ) -> ValidationReport:
-    """Simulate the calibration of ``plan`` many times and summarise it like Table 1.
+    """Simulate the calibration of ``plan`` many times and report it, simulated beside predicted.
 
     Args:
-        plan: the plan (``hultman2013`` procedure on a built-in stator work object).
+        plan: the plan (any procedure, sensor, part and robot).
         trials: number of simulated calibrations (>= 2); default ``plan.validation.trials``.
         seed: seed of the ``numpy.random.Generator``; default ``plan.validation.seed``. The
             same plan, trials and seed give the same report, whatever ``workers``.
@@ -139,46 +278,98 @@ def validate_plan(
             in the plan's cell (reachability, joint limits, collisions with the part where it
             really lies), so searches that fail because the part moved are counted with their
             reason; about 0.2 s a trial in the demo cell. 0: no cell check.
-        plan_dir: folder the plan's relative file references resolve against (for the cell).
+        plan_dir: folder the plan's relative file references resolve against.
+        protocol: ``(positions, repeats)``: also run the paper's protocol beside the default.
+        mesh: the work object's mesh (wobj, metres) when the caller has it loaded already
+            (the UI); default: loaded from the plan.
 
     Returns:
         The :class:`planner.sim.report.ValidationReport`.
 
     Raises:
-        PlanError: the plan cannot be simulated (the message names the field), or its points
-            lack an A-H role.
-        InputError: ``trials`` < 2 or another argument is out of range.
+        PlanError: the plan cannot be simulated (the message names the point or field).
+        InputError: ``trials`` < 2, another argument out of range, or a mesh that cannot load.
     """
-    models = validation_models(plan)
+    models = check_simulatable(plan)
+    folder = plan_dir or Path.cwd()
+    part = work_object_mesh(plan, folder, models) if mesh is None else mesh
+    preflight(plan, models, part)
+    setup = _setup(plan, models, part)
+    rows = report_rows(plan.validation.report, part, models.geometry, setup.xoffset)
+    paper = PAPER_TABLE1 if models.geometry is not None and models.method == "hultman2013" else None
+    n = plan.validation.trials if trials is None else int(trials)
+    rng = np.random.default_rng(plan.validation.seed if seed is None else seed)
+    kwargs: dict[str, Any] = {
+        "protocol": protocol,
+        "paper": paper,
+        "workers": workers,
+        "progress": progress,
+    }
     if reach_trials:
-        with open_cell(plan, plan_dir or Path.cwd()) as cell:
-            return _run(plan, models, trials, seed, workers, progress, cell, reach_trials)
-    return _run(plan, models, trials, seed, workers, progress, None, 0)
+        with open_cell(plan, folder) as cell:
+            return simulate(
+                setup, part, rows, n, rng, cell=cell, reach_trials=reach_trials, **kwargs
+            )
+    return simulate(setup, part, rows, n, rng, **kwargs)
 
 
-def _run(
+def sensitivity_plan(
     plan: Plan,
-    models: ValidationModels,
-    trials: int | None,
-    seed: int | None,
-    workers: int | None,
-    progress: ProgressCallback | None,
-    cell: Any,
-    reach_trials: int,
-) -> ValidationReport:
-    return validate(
-        points_by_role(plan.role_points()),
-        models.geometry,
-        nominal_T_base_wobj(plan),
-        plan.validation.trials if trials is None else int(trials),
-        np.random.default_rng(plan.validation.seed if seed is None else seed),
+    *,
+    trials: int | None = None,
+    seed: int | None = None,
+    workers: int | None = None,
+    progress: ProgressCallback | None = None,
+    plan_dir: Path | None = None,
+    mesh: trimesh.Trimesh | None = None,
+) -> SensitivityTable:
+    """The sensitivity table of ``plan``: its rows with each noise term off in turn
+    (:mod:`planner.sim.sensitivity`), ``trials`` trials per column (default the plan's).
+
+    Raises:
+        PlanError, InputError: as :func:`validate_plan`.
+    """
+    models = check_simulatable(plan)
+    part = work_object_mesh(plan, plan_dir or Path.cwd(), models) if mesh is None else mesh
+    preflight(plan, models, part)
+    setup = _setup(plan, models, part)
+    rows = report_rows(plan.validation.report, part, models.geometry, setup.xoffset)
+    n = plan.validation.trials if trials is None else int(trials)
+    return sensitivity(
+        setup,
+        part,
+        rows,
+        n,
+        plan.validation.seed if seed is None else int(seed),
+        workers=workers,
+        progress=progress,
+    )
+
+
+def _setup(plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh) -> SimulationSetup:
+    xo = getattr(models.settings, "xoffset", None)
+    xs = None
+    if xo is not None and models.geometry is not None:
+        g = models.geometry
+        grid = xo.grid()
+        y, z = np.meshgrid(grid.slot_y_m, grid.layer_z_m, indexing="xy")  # (layers, slots)
+        if not np.all(g.hole_near(y, z)):
+            raise PlanError(
+                "procedure.xoffset: the slot grid does not lie on the stator's slot holes"
+            )
+        # the true hole of each target: at its y and z, pushed out by the bolts' bulge
+        xs = xoffset_setup(xo, np.stack([g.side_face_offset_m(y, z), y, z], axis=-1))
+    px = tuple(RolePoint("xoffset", p) for row in (xs.points if xs else ()) for p in row)
+    return SimulationSetup(
+        points=models.points,
+        method=models.method,
+        settings=models.settings,
+        T_base_wobj_nominal=nominal_T_base_wobj(plan),
         sensor=models.sensor,
         robot_error=models.robot_error,
         misplacement=models.misplacement,
-        settings=models.settings,
+        pivot_wobj_m=default_pivot(list(models.points)),
+        faces=face_lookup(mesh, models.points + px, models.sensor.footprint_radius_m),
+        xoffset=xs,
         edge_inset_m=models.edge_inset_m,
-        workers=workers,
-        progress=progress,
-        cell=cell,
-        reach_trials=reach_trials if cell is not None else None,
     )

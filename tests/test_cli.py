@@ -112,8 +112,9 @@ def test_export_writes_files(fmt: str, tmp_path: Path, capsys: pytest.CaptureFix
         assert text == plan_to_json(load_plan(STATOR))
     elif fmt == "rapid":
         assert (
-            text.startswith("MODULE WobjcalStatorSectionAh") and text.count("SearchL\\SStop") == 10
-        )
+            text.startswith("MODULE WobjcalStatorSectionAh") and text.count("SearchL\\SStop") == 11
+        )  # 10 A-H searches and the x-offset run's one (in a loop)
+        assert "PROC XOffsetRun()" in text and "FUNC robtarget SlotTarget(" in text
     elif fmt == "krl":
         dat = (tmp_path / "prog.dat").read_text()
         assert len(re.findall(r"DECL E6POS x\w+_(?:start|end)=", dat)) == 16
@@ -225,11 +226,15 @@ def test_validate_small_run_writes_json(tmp_path: Path, capsys: pytest.CaptureFi
     assert again["rows"] == data["rows"]
 
 
-def test_validate_rejects_parts_it_cannot_simulate(capsys: pytest.CaptureFixture[str]) -> None:
+def test_validate_refuses_a_plan_that_cannot_work_naming_its_points(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """The 3-2-1 test plan's searches start 30 mm out, closer than the 20 mm, 3 deg
+    misplacement allows: refused before any trial, point by point."""
     code, _, err = run(capsys, "validate", str(DATA / "valid_three_two_one.json"), "--trials", "2")
     assert code == 2
-    assert "procedure.method: validation simulates only hultman2013" in err
-    assert "got 'three_two_one'" in err
+    assert "points[0] (P1): the search starts 30.0 mm out" in err
+    assert "points[2] (P3): not on a planar face" in err
 
 
 def _moved_copy(tmp_path: Path, point_id: str, offset_m: tuple[float, float, float]) -> Path:

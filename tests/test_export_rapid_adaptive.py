@@ -136,7 +136,8 @@ def test_no_search_starts_near_the_misplaced_part(seed: int) -> None:
     sd = plan.validation.sensor.sensing_distance_m
     T_true_base = invert_transform(T_true)
     searches = [mo for mo in m.motions if mo.kind == "SearchL"]
-    assert len(searches) == 12  # 10 measurements + the approaches before F and H
+    n_px = 2 * 21  # the x-offset run: every second tooth of 42 slots at two levels
+    assert len(searches) == 12 + n_px  # 10 measurements + the approaches before F and H
     # approach searches start at least the sensing distance outside the true part; edge
     # searches start at the measured face point: on the surface (tracking), never inside
     for mo in searches:

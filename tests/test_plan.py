@@ -51,7 +51,7 @@ MALFORMED = {
     "sha256_mismatch": "work_object.sha256: ",
     "missing_mesh": "work_object.mesh: file not found: ",
     "unknown_method": "procedure.method: invalid value 'guesswork' (valid: 'hultman2013', "
-    "'three_two_one', 'best_fit')",
+    "'three_two_one', 'best_fit', 'iterative')",
     "edge_without_direction": "points[5].search.edge_direction: required for an edge search",
     "not_json": "not valid JSON (line 1, column 46)",
 }

@@ -1,4 +1,5 @@
-"""Tests of ``planner.validate``: the one validation entry point of the CLI and the UI."""
+"""Tests of ``planner.validate``: the one validation entry point of the CLI and the UI, for any
+plan (procedure, sensor, part), and the plans it refuses before the run."""
 
 from __future__ import annotations
 
@@ -9,30 +10,38 @@ import msgspec
 import numpy as np
 import pytest
 
-from calib.plan.file import PlanError, load_plan
+from calib.plan.file import PlanError, PlanPoint, Search, load_plan
+from calib.procedures import BestFit, Iterative
 from planner.cli.main import main
 from planner.cli.validate import report_json
-from planner.sim.montecarlo import DEFAULT_EDGE_INSET_M
-from planner.validate import validate_plan, validation_models
+from planner.sim.setup import DEFAULT_EDGE_INSET_M
+from planner.validate import check_simulatable, sensitivity_plan, validate_plan, validation_models
 
 REPO = Path(__file__).resolve().parent.parent
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
+PLATE_321 = REPO / "assets" / "plans" / "plate_holes_321.json"
+PLATE_FIT = REPO / "assets" / "plans" / "plate_holes_best_fit.json"
 THREE_TWO_ONE = REPO / "tests" / "data" / "plans" / "valid_three_two_one.json"
 TRIALS = 3
+
+
+@pytest.fixture(scope="module")
+def plate_fit(reference_dir: Path):  # type: ignore[no-untyped-def]
+    return load_plan(PLATE_FIT)
 
 
 def test_models_follow_the_plan() -> None:
     plan = load_plan(STATOR)
     models = validation_models(plan)
     s = plan.validation.sensor
-    assert models.sensor.sensing_distance_m == s.sensing_distance_m
-    assert models.sensor.n_rays == s.n_rays
+    assert models.sensor == s and models.method == "hultman2013"
     assert models.robot_error.accuracy_terms == plan.validation.robot_error.accuracy_terms
     assert models.misplacement.max_translation_m == plan.validation.misplacement.max_translation_m
     assert models.settings.beta1_rad == plan.procedure.beta1_rad  # type: ignore[union-attr]
     # the plan leaves the edge-event offset unset: the sensor model's straight-edge value
     expected = models.sensor.edge_event_offset_m(DEFAULT_EDGE_INSET_M)
     assert expected > 0 and models.settings.edge_event_offset_m == expected
+    assert models.geometry is not None  # a built-in stator: slot holes, bulge
 
 
 def test_plan_edge_offset_overrides_the_sensor_model() -> None:
@@ -64,23 +73,129 @@ def test_progress_reaches_the_trial_count() -> None:
 def test_cli_and_function_agree(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "report.json"
     argv = ["validate", str(STATOR), "--trials", str(TRIALS), "--seed", "5", "--workers", "1"]
-    assert main([*argv, "--json", str(out)]) == 0, capsys.readouterr().err
+    assert main([*argv, "--json", str(out), "--reach-trials", "0"]) == 0, capsys.readouterr().err
     from_cli = json.loads(out.read_text())
     report = validate_plan(load_plan(STATOR), trials=TRIALS, seed=5, workers=1)
     assert from_cli["rows"] == report_json(report)["rows"]
     assert from_cli["failures"] == report.failures and from_cli["seed"] == 5
 
 
-def test_three_two_one_plan_names_the_procedure() -> None:
-    with pytest.raises(PlanError, match=r"^procedure\.method: .*hultman2013.*'three_two_one'"):
+def test_stator_report_has_the_papers_rows_and_the_x_offset() -> None:
+    r = validate_plan(load_plan(STATOR), trials=40, seed=2)
+    assert r.row("yz_epsilon", 99.9).paper == 0.66 and r.row("yz_slots", 99.9999).paper == 0.69
+    without, with_mx = r.row("x_slots", 95.5), r.row("x_slots_xoffset", 95.5)
+    assert with_mx.procedure < 0.75 * without.procedure  # the x-offset matrix narrows x
+    assert np.isnan(with_mx.best_fit)  # the x-offset run follows the procedure's frame
+    assert with_mx.procedure_predicted == pytest.approx(with_mx.procedure, rel=0.3)
+    px = [o for o in r.outcomes if o.point_id.startswith("PX")]
+    assert len(px) == 1 and px[0].searches == 40 * 42  # 21 teeth x 2 levels a trial
+
+
+def test_plate_plans_validate_from_the_cli(
+    reference_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The machined plate (mm mesh) with a touch probe: 3-2-1 and a 10-point best fit, each
+    validated end to end, simulated beside predicted."""
+    for plan in (PLATE_321, PLATE_FIT):
+        out = tmp_path / f"{plan.stem}.json"
+        argv = ["validate", str(plan), "--trials", "120", "--seed", "1", "--reach-trials", "2"]
+        assert main([*argv, "--json", str(out), "--plots", str(tmp_path / plan.stem)]) == 0
+        data = json.loads(out.read_text())
+        assert data["sensor"] == "touch" and data["n_ok"] == 120
+        rows = {(r["key"], r["level_percent"]): r for r in data["rows"]}
+        for key in ("origin_x", "origin_y", "origin_z", "rot_x", "rot_y", "rot_z"):
+            r = rows[(key, 95.5)]
+            assert r["procedure_predicted"] == pytest.approx(r["procedure"], rel=0.25), key
+        assert any(k.startswith("xyz_farthest") for k, _ in rows)
+        assert (tmp_path / plan.stem / "error_map.png").is_file()
+    assert "Reachability and collisions" in capsys.readouterr().out
+
+
+def test_iterative_validates_the_best_fit_plan(plate_fit) -> None:  # type: ignore[no-untyped-def]
+    plan = msgspec.structs.replace(plate_fit, procedure=Iterative())
+    r = validate_plan(plan, trials=40, seed=3, plan_dir=PLATE_FIT.parent)
+    assert r.method == "iterative" and r.n_ok == 40
+    # every point measured in at least two rounds: the first in the nominal frame
+    assert all(o.searches >= 80 for o in r.outcomes)
+
+
+def test_paper_protocol_stands_beside_the_default(plate_fit) -> None:  # type: ignore[no-untyped-def]
+    r = validate_plan(plate_fit, trials=30, seed=4, protocol=(5, 4), plan_dir=PLATE_FIT.parent)
+    assert r.protocol == "5 positions x 4 repeats" and r.n_trials == 30
+    row = r.row("origin_x", 95.5)
+    assert np.isfinite(row.procedure_protocol) and row.procedure_protocol > 0
+    assert "paper protocol" in r.to_markdown()
+
+
+def test_sensitivity_names_a_dominant_term(plate_fit) -> None:  # type: ignore[no-untyped-def]
+    table = sensitivity_plan(plate_fit, trials=60, seed=1, plan_dir=PLATE_FIT.parent)
+    assert table.terms[0] == "all on" and "robot repeatability off" in table.terms
+    # the touch probe's own scatter is 40x smaller than the robot's: the robot dominates
+    assert table.dominant["origin_x"] == "robot repeatability"
+    off = table.terms.index("robot repeatability off")
+    row = next(r for r in table.rows if r[0] == "origin_x")
+    assert row[4][off] < 0.2 * row[4][0]
+    assert "dominant" in table.to_markdown()
+
+
+def _with_points(plan, points):  # type: ignore[no-untyped-def]
+    return msgspec.structs.replace(plan, points=points)
+
+
+def test_a_layout_that_leaves_a_motion_free_is_refused(plate_fit) -> None:  # type: ignore[no-untyped-def]
+    top = [p for p in plate_fit.points if p.normal == (0.0, 0.0, 1.0)]
+    with pytest.raises(PlanError, match=r"does not fix all 6 degrees of freedom.*translation"):
+        check_simulatable(_with_points(plate_fit, top))
+
+
+def test_points_off_their_face_or_with_short_searches_are_named(plate_fit) -> None:  # type: ignore[no-untyped-def]
+    pts = list(plate_fit.points)
+    # T1 onto the centre of a hole; X2's search starting 2 mm out
+    pts[0] = msgspec.structs.replace(pts[0], position_m=(0.1016, 0.1545, 0.0127))
+    pts[5] = msgspec.structs.replace(
+        pts[5], search=msgspec.structs.replace(pts[5].search, start_offset_m=0.002)
+    )
+    with pytest.raises(PlanError) as info:
+        validate_plan(_with_points(plate_fit, pts), trials=2, plan_dir=PLATE_FIT.parent)
+    msg = str(info.value)
+    assert "points[0] (T1): not on a planar face" in msg
+    assert "points[5] (X2): the search starts 2.0 mm out, but the part may lie up to" in msg
+
+
+def test_a_touch_probe_cannot_run_an_edge_search(plate_fit) -> None:  # type: ignore[no-untyped-def]
+    pts = list(plate_fit.points)
+    edge = Search(kind="edge", start_offset_m=0.02, overtravel_m=0.02, edge_direction=(0, 1, 0))
+    pts[4] = PlanPoint(
+        id="X1",
+        role="fit",
+        position_m=(0.0, 0.2794, 0.0095),
+        normal=(-1, 0, 0),
+        search=edge,
+        edge_normal=(0, 1, 0),
+    )
+    with pytest.raises(PlanError, match=r"points\[4\] \(X1\)\.search\.kind: a touch sensor"):
+        check_simulatable(_with_points(plate_fit, pts))
+
+
+def test_the_stator_3_2_1_test_plan_is_refused_naming_its_points() -> None:
+    with pytest.raises(PlanError) as info:
         validate_plan(load_plan(THREE_TWO_ONE), trials=2, seed=0)
+    msg = str(info.value)
+    assert "points[0] (P1): the search starts 30.0 mm out" in msg
+    assert "points[5] (T1): the search starts 10.0 mm before the edge" in msg
 
 
-def test_mesh_work_object_names_the_mesh() -> None:
+def test_a_missing_mesh_file_is_named() -> None:
     plan = load_plan(STATOR)
     wo = msgspec.structs.replace(plan.work_object, mesh="part.stl")
-    with pytest.raises(PlanError, match=r"^work_object\.mesh: .*builtin:stator_section.*part\.stl"):
-        validate_plan(msgspec.structs.replace(plan, work_object=wo), trials=2, seed=0)
+    plan = msgspec.structs.replace(
+        plan,
+        work_object=wo,
+        procedure=BestFit(),
+        points=[msgspec.structs.replace(p, role="fit") for p in plan.points],
+    )
+    with pytest.raises(Exception, match=r"part\.stl"):
+        validate_plan(plan, trials=2, seed=0, plan_dir=Path("/nonexistent"))
 
 
 def test_reach_checked_trials_draw_the_same_numbers() -> None:

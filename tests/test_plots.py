@@ -8,6 +8,7 @@ from PIL import Image
 
 from planner.parts.stator import EPSILON_M, StatorGeometry
 from planner.parts.stator_demo import nominal_T_base_wobj, stator_ah_points
+from planner.sim.error_map import error_quantiles
 from planner.sim.montecarlo import validate
 from planner.sim.plots import histogram_figure, save_validation_plots, scatter_figure
 
@@ -22,7 +23,7 @@ def report():
 
 def test_plots_are_written_as_png(report, tmp_path) -> None:
     paths = save_validation_plots(report, tmp_path / "plots")
-    assert [p.name for p in paths] == ["histograms.png", "scatter.png"]
+    assert [p.name for p in paths] == ["histograms.png", "scatter.png", "error_map.png"]
     for p in paths:
         with Image.open(p) as im:
             assert im.format == "PNG" and im.size[0] > 800 and im.size[1] > 400
@@ -43,3 +44,21 @@ def test_histograms_have_one_panel_per_table_row(report) -> None:
     fig = histogram_figure(report)
     titles = [ax.get_title() for ax in fig.axes]
     assert "WOCS yz-plane at epsilon" in titles and len(titles) == 9
+
+
+def test_error_map_grows_away_from_the_probed_region(report) -> None:
+    """The map is the 95.5 % quantile of each surface point's error length: at the far end of
+    the 2 m section (rotation errors times 2 m) it is larger than beside the probe points, and
+    it equals the quantile computed point by point."""
+    emap = report.error_map
+    assert emap is not None and emap.level_percent == 95.5
+    y = emap.points_wobj[:, 1]
+    near, far = emap.error_m[y > -0.6].mean(), emap.error_m[y < -1.6].mean()
+    assert far > 1.5 * near > 0
+    p = emap.points_wobj[:3]
+    again = error_quantiles(report.delta_procedure, p, 95.5)
+    np.testing.assert_allclose(again, emap.error_m[:3], rtol=1e-12)
+    from planner.sim.rows import point_errors
+
+    one = np.linalg.norm(point_errors(report.delta_procedure, p[:1]), axis=2)[:, 0]
+    assert again[0] == pytest.approx(np.quantile(one, 0.955))

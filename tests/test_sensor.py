@@ -92,7 +92,6 @@ def test_slot_hole_reads_farther_than_tooth_by_the_predicted_amount() -> None:
         np.random.default_rng(0),
         sensor=sensor,
         robot_error=RobotErrorModel.none(),
-        geometry=g,
     )
 
     def reading(y: float, z: float) -> float:  # how far behind the face the point reads
@@ -111,7 +110,7 @@ def test_slot_hole_reads_farther_than_tooth_by_the_predicted_amount() -> None:
     measured = reading(*hole) - reading(*tooth)
     assert predicted > 0.3e-3  # the effect is real: a few tenths of a millimetre
     assert measured == pytest.approx(predicted, abs=0.03e-3)
-    assert probe.events[0].landing == "over slot hole" and probe.events[1].landing == ""
+    assert [e.landing for e in probe.events] == ["", ""]  # no face lookup given: unjudged
 
 
 def test_bad_parameters_name_the_field() -> None:
@@ -131,11 +130,21 @@ def test_bad_sensor_in_a_plan_file_names_the_json_path() -> None:
 
 
 def test_sensor_registry_gives_the_simulator_of_the_plans_sensor() -> None:
+    from calib.models import TouchProbe
     from planner.sim.sensors import SENSORS, sensor_kind
+    from planner.sim.touch import SimulatedTouchProbe
 
     kind = sensor_kind(stator_plan().validation.sensor)
     assert kind is SENSORS["proximity"] and kind.load() is SimulatedProbe
     assert kind.name == ProximitySensor.KIND
+    touch = sensor_kind(TouchProbe())
+    assert touch is SENSORS["touch"] and touch.load() is SimulatedTouchProbe
+    # every sensor kind of the plan's union has a simulator, and back
+    import typing
+
+    from calib.models import SensorSettings
+
+    assert {t.KIND for t in typing.get_args(SensorSettings)} == set(SENSORS)
 
     class Unknown:
         KIND = "capacitive"
@@ -143,6 +152,6 @@ def test_sensor_registry_gives_the_simulator_of_the_plans_sensor() -> None:
         standoff_m = 0.002
 
     with pytest.raises(
-        PlanError, match=r"no simulator for Unknown; known sensors: \['proximity'\]"
+        PlanError, match=r"no simulator for Unknown; known sensors: \['proximity', 'touch'\]"
     ):
         sensor_kind(Unknown())

@@ -1,8 +1,10 @@
-"""The "Validate" panel: Monte Carlo validation with a progress bar, Table-1 and histograms.
+"""The "Validate" panel: Monte Carlo validation of any plan with a progress bar, the report's
+rows (simulated beside predicted), histograms, and the simulated error painted on the part.
 
 Validation runs on its own thread (:class:`webui.worker.CellWorker` without a shared resource),
 not on the cell worker: point checks from any tab stay fast while it runs. Whatever simulator
-state ``planner.sim.montecarlo`` needs it builds itself, inside that thread.
+state ``planner.sim.montecarlo`` needs it builds itself, inside that thread. A plan that cannot
+be validated is refused before anything runs, with the point and the reason in a notification.
 """
 
 from __future__ import annotations
@@ -49,8 +51,11 @@ class ValidatePanel:
             self.button = gui.add_button("Validate plan", color="blue")
             self.progress = gui.add_progress_bar(0.0, visible=False, animated=True)
             self.result_md = gui.add_markdown("")
+            self.show_error = gui.add_checkbox("Show error on part", False, disabled=True)
+            self.error_md = gui.add_markdown("")
             self.plots: list[Any] = []
         self.button.on_click(self._on_click)
+        self.show_error.on_update(self._on_show_error)
 
     def _on_click(self, event: Any) -> None:
         client = getattr(event, "client", None)
@@ -84,8 +89,10 @@ class ValidatePanel:
                 last[0] = now
                 self.progress.value = 100.0 * done / max(total, 1)
 
+        plan_dir = self._app.plan_dir
+
         def job(_res: None) -> validation.ValidationSummary:
-            return validation.run_validation(plan, trials, progress)
+            return validation.run_validation(plan, trials, progress, plan_dir)
 
         fut = self._worker.submit(job)
         fut.add_done_callback(self._done)
@@ -110,6 +117,8 @@ class ValidatePanel:
         self.last_report = summary.report
         self.last_markdown = summary.markdown
         self.result_md.content = summary.markdown
+        self.show_error.disabled = summary.report.error_map is None
+        self.paint_error()
         for plot in self.plots:
             plot.remove()
         self.plots = []
@@ -131,6 +140,34 @@ class ValidatePanel:
                 aspect=2.0,
             )
         )
+
+    def _on_show_error(self, _event: Any) -> None:
+        self.paint_error()
+
+    def paint_error(self) -> bool:
+        """Paint the last report's simulated error on the work object while the box is ticked
+        (green: the part's smallest error, red: its largest); clear it otherwise.
+
+        Returns:
+            True when a map is shown.
+        """
+        view = self._app.view
+        report = self.last_report
+        if not self.show_error.value or view is None or report is None:
+            self._app.scene.color_work_object(None)
+            self.error_md.content = ""
+            return False
+        colours = validation.error_colours(report, view.wobj_mesh)
+        if colours is None:
+            return False
+        rgb, lo, hi = colours
+        self._app.scene.color_work_object(rgb)
+        level = report.error_map.level_percent if report.error_map else 95.5
+        self.error_md.content = (
+            f"{level:g} % of calibrations place each point within: green {lo * 1e3:.2f} mm "
+            f"to red {hi * 1e3:.2f} mm"
+        )
+        return True
 
     @property
     def running(self) -> bool:

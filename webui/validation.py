@@ -1,16 +1,26 @@
-"""Between the validate panel and ``planner.validate``: run it, shape its report for the UI."""
+"""Between the validate panel and ``planner.validate``: run it, shape its report for the UI.
+
+Besides the report's Markdown and histograms, :func:`error_colours` paints the simulated error
+over the part onto the work object's vertices (each vertex takes the error of the nearest
+surface sample of :attr:`planner.sim.report.ValidationReport.error_map`), so the UI can show
+where on the part the calibration is least accurate.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
+import trimesh
 from numpy.typing import ArrayLike, NDArray
+from scipy.spatial import cKDTree
 
 from calib.plan.file import Plan
 from planner.sim.report import ValidationReport
 from planner.validate import validate_plan
+from webui.scene import heat_rgb
 
 Progress = Callable[[int, int], None]
 
@@ -21,7 +31,7 @@ class ValidationSummary:
 
     Attributes:
         report: the report :func:`planner.validate.validate_plan` returned.
-        markdown: Table-1-style markdown (confidence intervals) and the per-point failures.
+        markdown: the report's rows (simulated, predicted, bias), per-point outcomes, failures.
         histograms: ``(title, bin_edges (B+1,), counts (B,))`` for each error histogram.
         headline: one line for the notification.
         T_world_wobj_example: ``(4, 4)`` one calibrated frame to draw, or ``None``.
@@ -34,16 +44,21 @@ class ValidationSummary:
     T_world_wobj_example: NDArray[np.float64] | None = None
 
 
-def run_validation(plan: Plan, trials: int, progress: Progress) -> ValidationSummary:
+def run_validation(
+    plan: Plan, trials: int, progress: Progress, plan_dir: Path | None = None
+) -> ValidationSummary:
     """Simulate the plan's calibration ``trials`` times with its error models and seed.
 
-    The same :func:`planner.validate.validate_plan` as ``wobjcal validate``, with one
-    in-process worker (no ``fork()`` of a threaded server).
+    The same :func:`planner.validate.validate_plan` as ``wobjcal validate`` (the same mesh,
+    loaded from the plan), with one in-process worker (no ``fork()`` of a threaded server).
 
     Raises:
-        PlanError: the plan cannot be simulated (the message names the field).
+        PlanError: the plan cannot be simulated (the message names the point or field).
     """
-    return summarize(validate_plan(plan, trials=int(trials), workers=1, progress=progress))
+    report = validate_plan(
+        plan, trials=int(trials), workers=1, progress=progress, plan_dir=plan_dir
+    )
+    return summarize(report)
 
 
 def _histogram(
@@ -69,3 +84,20 @@ def summarize(report: ValidationReport) -> ValidationSummary:
     failed = sum(report.failures.values())
     headline = f"{report.n_ok}/{report.n_trials} trials calibrated, {failed} failed"
     return ValidationSummary(report, markdown, tuple(hists), headline)
+
+
+def error_colours(
+    report: ValidationReport, mesh: trimesh.Trimesh
+) -> tuple[NDArray[np.uint8], float, float] | None:
+    """Vertex colours of ``mesh`` (wobj) from the report's error map, and its range (m).
+
+    Green is the smallest error on the part, red the largest; ``None`` without a map.
+    """
+    emap = report.error_map
+    if emap is None or len(emap.points_wobj) == 0 or not np.all(np.isfinite(emap.error_m)):
+        return None
+    _, idx = cKDTree(emap.points_wobj).query(np.asarray(mesh.vertices, dtype=np.float64))
+    err = emap.error_m[idx]
+    lo, hi = float(emap.error_m.min()), float(emap.error_m.max())
+    score = 1.0 - (err - lo) / max(hi - lo, 1e-12)
+    return heat_rgb(score), lo, hi

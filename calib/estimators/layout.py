@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -74,7 +75,9 @@ class ConstraintSet:
 
 
 def constraint_set(
-    points: Sequence[ProbePoint] | ConstraintSet, name: str = "points"
+    points: Sequence[ProbePoint] | ConstraintSet,
+    name: str = "points",
+    edge_rows: Literal["both", "edge"] = "both",
 ) -> ConstraintSet:
     """Validate a point layout and flatten it into a :class:`ConstraintSet`.
 
@@ -82,6 +85,11 @@ def constraint_set(
         points: the probe points (each already validated by :class:`ProbePoint`); a
             :class:`ConstraintSet` is returned as it is.
         name: argument name used in error messages.
+        edge_rows: ``"both"``: an edge point constrains its face and the face whose end it
+            finds; ``"edge"``: an edge *search* constrains only the face whose end it finds
+            (its ``edge_normal``), as when the point was measured by a search run along a
+            commanded track: its coordinate across the face it slides over is the command's,
+            not a measurement (see :func:`search_constraint_set`).
 
     Raises:
         ShapeError: no points, an entry that is not a ``ProbePoint``, or duplicate ids.
@@ -105,6 +113,8 @@ def constraint_set(
     index: list[int] = []
     for i, p in enumerate(pts):
         n = p.constraint_normals
+        if edge_rows == "edge" and p.search.kind == "edge" and p.edge_normal is not None:
+            n = n[1:]
         n = n / np.linalg.norm(n, axis=1, keepdims=True)
         normals_list.append(n)
         index.extend([i] * n.shape[0])
@@ -121,6 +131,19 @@ def constraint_set(
         centroid_m=centroid,
         scale_m=max(rms, MIN_SCALE_M),
     )
+
+
+def search_constraint_set(
+    points: Sequence[ProbePoint] | ConstraintSet, name: str = "points"
+) -> ConstraintSet:
+    """The constraints of points measured by searches: :func:`constraint_set` with an edge
+    search contributing only its edge coordinate (``edge_rows="edge"``).
+
+    An edge search slides the sensor along a commanded track over one face until that face
+    ends; the recorded point lies on the track, so its coordinate along the face's normal is
+    the command's (the estimate the search was commanded in), not a measurement of the part.
+    """
+    return constraint_set(points, name, edge_rows="edge")
 
 
 def check_coincident(positions: FloatArray, ids: Sequence[str], name: str) -> None:

@@ -17,16 +17,24 @@ from __future__ import annotations
 import logging
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import ProbeFailedError, ShapeError
 from calib.estimators.best_fit import BestFitResult, best_fit
-from calib.estimators.layout import ConstraintSet, constraint_jacobian, constraint_set
+from calib.estimators.layout import (
+    MIN_SCALE_M,
+    ConstraintSet,
+    constraint_jacobian,
+    constraint_set,
+    cross_rows,
+    small_motion_matrix,
+)
 from calib.estimators.observability import require_observable
 from calib.estimators.three_two_one import ThreeTwoOneLayout, ThreeTwoOneResult, three_two_one
-from calib.frames import check_transform, small_motion
+from calib.frames import check_transform, motion_between
 from calib.probing import Probe, ProbePoint, SearchCommand
 from calib.validation import check_vector3
 
@@ -100,6 +108,15 @@ def probe_point(
     return ProbeStep(point.id, round_index, command, q)
 
 
+def corrected_point(step: ProbeStep, edge_offset_m: float = 0.0) -> FloatArray:
+    """``(3,)`` a step's measurement as a fit uses it: an edge search's point moved back along
+    its direction by the sensor's known edge-event offset (how far past the edge the sensor
+    reports it; 0 for a sensor that reports the edge itself), base frame, metres."""
+    if edge_offset_m and step.command.kind == "edge":
+        return step.measured_m - edge_offset_m * np.asarray(step.command.direction, float)
+    return step.measured_m
+
+
 def min_norm_update(
     cs: ConstraintSet,
     measured_base: ArrayLike,
@@ -133,10 +150,27 @@ def min_norm_update(
         J[:, 3:] /= L
         step = -np.linalg.pinv(J, rcond=1e-9) @ r
         w = step[3:] / L
-        T = T @ small_motion(np.concatenate([step[:3] - np.cross(w, c), w]))
+        T = T @ small_motion_matrix(np.concatenate([step[:3] - cross_rows(w, c), w]))
         if float(np.max(np.abs(step))) < 1e-14:
             break
     return T
+
+
+def leading_points(cs: ConstraintSet, n: int) -> ConstraintSet:
+    """The constraints of the first ``n`` points of ``cs`` (already validated: no checks)."""
+    rows = cs.point_index < n
+    positions = cs.positions_m[:n]
+    centroid = positions.mean(axis=0)
+    rms = float(np.sqrt(np.mean(np.sum((positions - centroid) ** 2, axis=1))))
+    return ConstraintSet(
+        point_ids=cs.point_ids[:n],
+        positions_m=positions,
+        normals=cs.normals[rows],
+        nominal_m=cs.nominal_m[rows],
+        point_index=cs.point_index[rows],
+        centroid_m=centroid,
+        scale_m=max(rms, MIN_SCALE_M),
+    )
 
 
 def run_three_two_one(
@@ -145,6 +179,7 @@ def run_three_two_one(
     T_base_wobj_start: ArrayLike,
     *,
     rounds: int = 1,
+    edge_offset_m: float = 0.0,
 ) -> ProcedureResult:
     """Run a 3-2-1 alignment step by step.
 
@@ -158,6 +193,8 @@ def run_three_two_one(
         probe: runs one search (see :data:`calib.probing.Probe`).
         T_base_wobj_start: ``(4, 4)`` start estimate (e.g. the nominal part placement).
         rounds: number of passes over the six points (>= 1).
+        edge_offset_m: the sensor's edge-event offset removed from edge searches, metres
+            (:func:`corrected_point`).
 
     Raises:
         ProbeFailedError: a probe failed.
@@ -175,11 +212,12 @@ def run_three_two_one(
         for group, new in zip(groups, (layout.primary, layout.secondary)):
             done += [probe_point(probe, p, T, rnd) for p in new]
             cs = constraint_set(group)
-            q = np.array([s.measured_m for s in done])
+            q = np.array([corrected_point(s, edge_offset_m) for s in done])
             T = min_norm_update(cs, q, T, all_cs.centroid_m, all_cs.scale_m)
             estimates.append(T)
         done.append(probe_point(probe, layout.tertiary[0], T, rnd))
-        fit = three_two_one(layout, np.array([s.measured_m for s in done]), T_base_wobj_guess=T)
+        q = np.array([corrected_point(s, edge_offset_m) for s in done])
+        fit = three_two_one(layout, q, T_base_wobj_guess=T)
         T = fit.T_base_wobj
         estimates.append(T)
         steps += done
@@ -196,6 +234,8 @@ def run_best_fit(
     rounds: int = 2,
     progressive: bool = True,
     sigma_m: float | None = None,
+    edge_offset_m: float = 0.0,
+    edge_rows: Literal["both", "edge"] = "both",
 ) -> ProcedureResult:
     """Probe all points, fit, and re-probe in the new estimate, for ``rounds`` passes.
 
@@ -208,6 +248,10 @@ def run_best_fit(
             measurement, so later points are commanded where the part really is.
         sigma_m: measurement standard deviation for the covariance, metres (``None``: estimated
             from the residuals).
+        edge_offset_m: the sensor's edge-event offset removed from edge searches, metres.
+        edge_rows: ``"edge"``: an edge search constrains only the face whose end it finds
+            (:func:`calib.estimators.layout.search_constraint_set`); ``"both"``: also the face
+            it slides over.
 
     Raises:
         UnobservableError: the layout leaves a motion unconstrained (checked before probing).
@@ -215,7 +259,7 @@ def run_best_fit(
     """
     T = check_transform(T_base_wobj_start, "T_base_wobj_start").copy()
     _check_rounds(rounds)
-    cs = constraint_set(points)
+    cs = constraint_set(points, edge_rows=edge_rows)
     require_observable(cs)
     pts = tuple(points)
     steps: list[ProbeStep] = []
@@ -226,11 +270,12 @@ def run_best_fit(
         for k, p in enumerate(pts):
             done.append(probe_point(probe, p, T, rnd))
             if progressive and rnd == 0 and k + 1 < len(pts):
-                sub = constraint_set(pts[: k + 1])
-                q = np.array([s.measured_m for s in done])
+                sub = leading_points(cs, k + 1)
+                q = np.array([corrected_point(s, edge_offset_m) for s in done])
                 T = min_norm_update(sub, q, T, cs.centroid_m, cs.scale_m)
                 estimates.append(T)
-        fit = best_fit(cs, np.array([s.measured_m for s in done]), T, sigma_m=sigma_m)
+        q = np.array([corrected_point(s, edge_offset_m) for s in done])
+        fit = best_fit(cs, q, T, sigma_m=sigma_m)
         T = fit.T_base_wobj
         estimates.append(T)
         steps += done
@@ -242,3 +287,67 @@ def run_best_fit(
 def _check_rounds(rounds: int) -> None:
     if not isinstance(rounds, int | np.integer) or isinstance(rounds, bool) or rounds < 1:
         raise ShapeError(f"rounds must be an integer >= 1, got {rounds!r}")
+
+
+def run_iterative_fit(
+    points: Sequence[ProbePoint],
+    probe: Probe,
+    T_base_wobj_start: ArrayLike,
+    *,
+    tolerance_m: float = 1e-4,
+    max_rounds: int = 5,
+    edge_offset_m: float = 0.0,
+    sigma_m: float | None = None,
+) -> ProcedureResult:
+    """The iterative best fit: measure every point, fit, re-command every search in the new
+    estimate, and repeat until a round's fit moves the frame less than ``tolerance_m``.
+
+    The general form of the paper's step-by-step idea and of the iterative alignment of CMM
+    software: each round commands all searches where the previous fit says the part is, so
+    the searches land where the plan put them. The final frame is the fit of the last round's
+    measurements; an edge search contributes only its edge coordinate
+    (:func:`calib.estimators.layout.search_constraint_set`).
+
+    Args:
+        points: the probe points (must constrain all 6 DOF with edge searches counted by
+            their edge coordinate only).
+        probe: runs one search.
+        T_base_wobj_start: ``(4, 4)`` start estimate (the first round is commanded in it).
+        tolerance_m: stop when a round's fit moves the frame it was commanded in by less than
+            this: translation in metres, rotation in radians times the layout size. A round's
+            fit moves by about the frame's noise even at the fixed point, so the tolerance must
+            exceed that (0.1 mm by default).
+        max_rounds: at most this many rounds (>= 1); the last round's fit is returned even
+            when it moved more than the tolerance.
+        edge_offset_m: the sensor's edge-event offset removed from edge searches, metres.
+        sigma_m: measurement standard deviation for the covariance, metres.
+
+    Raises:
+        UnobservableError: the layout leaves a motion unconstrained (checked before probing).
+        ProbeFailedError: a probe failed.
+        ShapeError: a bad tolerance or round count.
+    """
+    T = check_transform(T_base_wobj_start, "T_base_wobj_start").copy()
+    _check_rounds(max_rounds)
+    if not (np.isfinite(tolerance_m) and tolerance_m > 0):
+        raise ShapeError(f"tolerance_m must be > 0, got {tolerance_m!r}")
+    cs = constraint_set(points, edge_rows="edge")
+    require_observable(cs)
+    pts = tuple(points)
+    steps: list[ProbeStep] = []
+    estimates: list[FloatArray] = []
+    fit: BestFitResult | None = None
+    for rnd in range(max_rounds):
+        done = [probe_point(probe, p, T, rnd) for p in pts]
+        q = np.array([corrected_point(s, edge_offset_m) for s in done])
+        fit = best_fit(cs, q, T, sigma_m=sigma_m)
+        moved = motion_between(T, fit.T_base_wobj)
+        T = fit.T_base_wobj
+        estimates.append(T)
+        steps += done
+        size = max(float(np.linalg.norm(moved[:3])), float(np.linalg.norm(moved[3:])) * cs.scale_m)
+        logger.info("iterative fit round %d: moved %.3g mm", rnd, size * 1e3)
+        if size < tolerance_m:
+            break
+    assert fit is not None  # max_rounds >= 1 is checked above
+    return ProcedureResult(T, tuple(steps), np.array(estimates), fit, cs.point_ids)

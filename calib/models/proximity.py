@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.errors import PlanError
+from calib.models.sensor import SearchNoise, face_frame
 from calib.structs import Strict, check_count, check_positive
 
 FloatArray = NDArray[np.float64]
@@ -60,8 +61,11 @@ def sunflower_disk(n: int, radius_m: float) -> FloatArray:
     return _sunflower(int(n), float(radius_m))
 
 
-class ProximitySensor(Strict, frozen=True, kw_only=True):
+class ProximitySensor(Strict, frozen=True, kw_only=True, tag="proximity", tag_field="kind"):
     """A cylindrical shielded inductive proximity sensor (defaults: M18, Sn = 8 mm).
+
+    In a plan: ``"sensor": {"kind": "proximity", ...}``; a plan written before the touch probe
+    existed has no ``kind`` and loads as this sensor (:func:`calib.plan.file.plan_from_json`).
 
     Attributes:
         face_diameter_m: diameter of the active face, m (paper: 18 mm).
@@ -130,14 +134,15 @@ class ProximitySensor(Strict, frozen=True, kw_only=True):
         """``(n_scan_rays, 2)`` coarse ray origins on the face, m (read-only)."""
         return sunflower_disk(self.n_scan_rays, self.radius_m)
 
+    @property
+    def runs_edge_searches(self) -> bool:
+        """True: the sensor stops detecting where the face under it ends."""
+        return True
+
     def face_frame(self, axis: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """Two unit vectors ``(u, v)`` spanning the face, perpendicular to ``axis`` ``(3,)``."""
-        ax, ay, az = (float(c) for c in axis)
-        # u = axis x helper, helper = e_x unless the axis is close to it (then e_y)
-        u = np.array([0.0, az, -ay]) if abs(ax) < 0.9 else np.array([-az, 0.0, ax])
-        u /= math.sqrt(float(u @ u))
-        v = np.array([ay * u[2] - az * u[1], az * u[0] - ax * u[2], ax * u[1] - ay * u[0]])
-        return u, v
+        """Two unit vectors ``(u, v)`` spanning the face, perpendicular to ``axis`` ``(3,)``
+        (:func:`calib.models.sensor.face_frame`)."""
+        return face_frame(axis)
 
     def face_offsets_m(self, axis: FloatArray, coarse: bool = False) -> FloatArray:
         """``(n, 3)`` ray-origin offsets from the face centre for a sensor axis ``(3,)``, m."""
@@ -229,6 +234,22 @@ class ProximitySensor(Strict, frozen=True, kw_only=True):
             else:
                 hi = mid
         return 0.5 * (lo + hi)
+
+    def search_noise(self, kind: str, edge_inset_m: float) -> SearchNoise:
+        """First-order noise of a search (see :class:`calib.models.sensor.SearchNoise`).
+
+        An approach switches when the signal reaches the on level, so the jitter ``nu`` moves
+        the event by ``nu`` itself. An edge search switches off where the covered fraction of
+        the face falls to ``off_level(nu) exp(-inset / lambda)``: the jitter and a TCP running
+        closer to the face (a larger inset) both move the event by ``k = d offset / d inset``
+        per metre (:meth:`edge_event_offset_m`, on the exact disk; about 1.2 for the defaults).
+        """
+        if kind == "approach":
+            return SearchNoise(self.repeatability_sigma_m, 0.0)
+        h = 1e-5
+        k = self.edge_event_offset_m(edge_inset_m + h) - self.edge_event_offset_m(edge_inset_m - h)
+        k /= 2 * h
+        return SearchNoise(abs(k) * self.repeatability_sigma_m, k)
 
     def sample_jitter_m(self, rng: np.random.Generator) -> float:
         """One switching-distance jitter ``nu ~ N(0, repeatability_sigma_m)``, m."""

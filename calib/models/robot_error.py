@@ -53,29 +53,41 @@ class RobotErrorModel(Strict, frozen=True, kw_only=True):
             not to the trial).
         accuracy_wavelength_m: typical wavelength of the accuracy field, m.
         accuracy_terms: number of sine terms in the field.
+        tcp_sigma_m: 1-sigma per axis of the sensor TCP's calibration error, in the sensor's
+            tool frame (:func:`calib.models.sensor.tool_rotation`), m; drawn once per simulated
+            calibration (each calibration stands for a cell with its own TCP calibration); 0
+            turns it off.
     """
 
     repeatability_sigma_m: float = 0.00002
     accuracy_amplitude_m: float = 0.0
     accuracy_wavelength_m: float = 1.0
     accuracy_terms: int = 6
+    tcp_sigma_m: float = 0.0
 
     def __post_init__(self) -> None:
         check_positive(self.repeatability_sigma_m, "repeatability_sigma_m", allow_zero=True)
         check_positive(self.accuracy_amplitude_m, "accuracy_amplitude_m", allow_zero=True)
         check_positive(self.accuracy_wavelength_m, "accuracy_wavelength_m")
         check_count(self.accuracy_terms, "accuracy_terms")
+        check_positive(self.tcp_sigma_m, "tcp_sigma_m", allow_zero=True)
 
     @classmethod
     def none(cls) -> RobotErrorModel:
         """A perfect robot."""
-        return cls(repeatability_sigma_m=0.0, accuracy_amplitude_m=0.0)
+        return cls(repeatability_sigma_m=0.0, accuracy_amplitude_m=0.0, tcp_sigma_m=0.0)
 
     def sample_repeatability_m(self, rng: np.random.Generator) -> FloatArray:
         """``(3,)`` TCP offset of one search, base frame, m."""
         if self.repeatability_sigma_m == 0.0:
             return np.zeros(3)
         return rng.normal(0.0, self.repeatability_sigma_m, size=3)
+
+    def sample_tcp_error_m(self, rng: np.random.Generator) -> FloatArray:
+        """``(3,)`` one TCP calibration error, sensor tool frame, m (no draw when it is off)."""
+        if self.tcp_sigma_m == 0.0:
+            return np.zeros(3)
+        return rng.normal(0.0, self.tcp_sigma_m, size=3)
 
     def sample_field(self, rng: np.random.Generator) -> AccuracyField | None:
         """One robot's absolute-accuracy field, or ``None`` when the amplitude is 0."""

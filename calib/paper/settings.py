@@ -12,7 +12,74 @@ import math
 import msgspec
 
 from calib.errors import PlanError
-from calib.structs import check_positive
+from calib.paper.xoffset import SlotGrid
+from calib.structs import Strict, check_count, check_positive
+
+
+class XOffsetRun(Strict, frozen=True, kw_only=True):
+    """The paper's x-offset run (section 3.2, eq. 13-14) after the frame is fixed.
+
+    Over every second tooth at two slot-hole levels the side face is measured along the WOCS
+    x axis in the calibrated frame; eq. 14 interpolates these into the x-offset of every slot
+    hole (:func:`calib.paper.xoffset.xoffset_matrix`), which the slot targets then use.
+
+    Attributes:
+        n_slots: slots (columns) of the side face the robot works on.
+        n_layers: slot-hole layers (rows).
+        first_slot_y_m: y of slot 1, wobj frame, metres.
+        first_layer_z_m: z of layer 1, wobj frame, metres.
+        slot_step_y_m: signed y step from one slot to the next, metres.
+        layer_step_z_m: signed z step from one layer to the next, metres.
+        layers: 1-based layers whose level the measurements are taken at (default: the first
+            and the last, the paper's "two different slot hole levels").
+        teeth: teeth measured over (tooth t lies between slots t and t + 1; default every
+            second tooth 1, 3, 5, ...).
+        start_offset_m: start of each approach outside the calibrated face, metres.
+        overtravel_m: allowed travel past the calibrated face, metres.
+    """
+
+    n_slots: int
+    n_layers: int
+    first_slot_y_m: float
+    first_layer_z_m: float
+    slot_step_y_m: float
+    layer_step_z_m: float
+    layers: tuple[int, ...] | None = None
+    teeth: tuple[int, ...] | None = None
+    start_offset_m: float = 0.020
+    overtravel_m: float = 0.020
+
+    def __post_init__(self) -> None:
+        check_count(self.n_slots, "n_slots", minimum=2)
+        check_count(self.n_layers, "n_layers", minimum=2)
+        check_positive(self.start_offset_m, "start_offset_m")
+        check_positive(self.overtravel_m, "overtravel_m")
+        try:
+            grid = self.grid()
+        except ValueError as exc:
+            raise PlanError(f"{str(exc).removeprefix('grid.')}") from None
+        for field, values, check in (
+            ("layers", self.layers, lambda v: grid.check_slot(1, v)),
+            ("teeth", self.teeth, grid.tooth_y_m),
+        ):
+            if values is not None and len(set(values)) < 2:
+                raise PlanError(f"{field}: needs at least 2 distinct values, got {list(values)}")
+            for v in values or ():
+                try:
+                    check(v)
+                except ValueError as exc:
+                    raise PlanError(f"{field}: {exc}") from None
+
+    def grid(self) -> SlotGrid:
+        """The slot grid of :mod:`calib.paper.xoffset`."""
+        return SlotGrid(
+            n_slots=self.n_slots,
+            n_layers=self.n_layers,
+            first_slot_y_m=self.first_slot_y_m,
+            first_layer_z_m=self.first_layer_z_m,
+            slot_step_y_m=self.slot_step_y_m,
+            layer_step_z_m=self.layer_step_z_m,
+        )
 
 
 class Hultman2013(
@@ -43,6 +110,7 @@ class Hultman2013(
             footprint and hysteresis make it a few mm), metres; subtracted from F and H.
             ``None``: not measured; ``wobjcal validate`` then uses the sensor model's analytic
             value and ``wobjcal calibrate`` and the programs use 0 (:attr:`edge_offset_m`).
+        xoffset: the x-offset run after the frame is fixed (eq. 13-14), or ``None``.
     """
 
     p3_height_m: float = 0.050
@@ -51,6 +119,7 @@ class Hultman2013(
     edge_start_from_measured: bool = False
     edge_start_offset_m: float = 0.0
     edge_event_offset_m: float | None = None
+    xoffset: XOffsetRun | None = None
 
     def __post_init__(self) -> None:
         beta1 = float(self.beta1_rad)

@@ -16,13 +16,14 @@ from __future__ import annotations
 
 import hashlib
 from pathlib import Path
-from typing import Final, Literal, get_args
+from typing import Any, Final, Literal, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from calib.atomic_io import write_text_atomic
 from calib.errors import PlanError
+from calib.models import SENSOR_KINDS, ProximitySensor
 from calib.plan.base import BUILTIN_PREFIX, MeshUnits
 from calib.plan.cell import (
     CellSpec,
@@ -40,6 +41,7 @@ from calib.plan.json_io import (
     read_text_file,
 )
 from calib.plan.models import ValidationSpec
+from calib.plan.report_spec import COMPONENTS
 from calib.probing import ProbePoint, SearchSpec
 from calib.procedures import METHODS, ProcedureSettings, method_of, procedure_kind
 from calib.procedures.base import RolePoint
@@ -254,15 +256,36 @@ def resolve_ref(ref: str, plan_dir: str | Path) -> str | Path:
 _CHOICES = {
     "units": get_args(MeshUnits),
     "method": METHODS,
-    "kind": ("approach", "edge"),
+    "search.kind": ("approach", "edge"),
+    "sensor.kind": SENSOR_KINDS,
+    "components": COMPONENTS,
 }
 
 
+def _with_legacy_defaults(raw: Any) -> Any:
+    """``raw`` with what older plan files leave out filled in.
+
+    A plan written before the touch probe existed has a ``validation.sensor`` without
+    ``kind``: it is the proximity sensor (the only sensor there was).
+    """
+    validation = raw.get("validation") if isinstance(raw, dict) else None
+    if not isinstance(validation, dict):
+        return raw
+    sensor = validation.get("sensor")
+    if isinstance(sensor, dict) and "kind" not in sensor:
+        validation["sensor"] = {"kind": ProximitySensor.KIND, **sensor}
+    return raw
+
+
 def plan_from_json(text: str, source: str = "plan") -> Plan:
-    """Parse and validate plan JSON text (no file checks); errors name ``source`` and the path."""
+    """Parse and validate plan JSON text (no file checks); errors name ``source`` and the path.
+
+    A ``validation.sensor`` without ``kind`` (a plan from before the touch probe) loads as the
+    proximity sensor.
+    """
     raw = parse_json_text(text, PlanError, source)
     check_schema_tag(raw, SUPPORTED_PLAN_SCHEMAS, PlanError, source)
-    return convert_strict(raw, Plan, PlanError, source, _CHOICES)
+    return convert_strict(_with_legacy_defaults(raw), Plan, PlanError, source, _CHOICES)
 
 
 def plan_to_json(plan: Plan) -> str:

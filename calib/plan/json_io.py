@@ -147,8 +147,9 @@ def reword_validation_error(
     """``"Expected `array` of length 3, got 2 - at `$.points[3].normal`"`` becomes
     ``"points[3].normal: must have length 3, got 2"``.
 
-    ``choices`` maps a field name (the last path component, e.g. ``units``) to its valid values,
-    listed in the message of an invalid value.
+    ``choices`` maps a field name (the last path component, e.g. ``units``, or the last two,
+    e.g. ``sensor.kind``, which win) to its valid values, listed in the message of an invalid
+    value.
     """
     match = _PATH_RE.match(str(exc))
     msg = match.group("msg") if match else str(exc)
@@ -164,7 +165,9 @@ def reword_validation_error(
         path, msg = join_path(path, missing.group(1)), "required field missing"
     elif enum:
         msg = f"invalid value {enum.group(1)}"
-        allowed = (choices or {}).get(re.split(r"[.\[]", path)[-1])
+        parts = re.split(r"[.\[]", path)  # "sensor.kind" before "kind": names are reused
+        table = choices or {}
+        allowed = table.get(".".join(parts[-2:])) or table.get(parts[-1])
         if allowed:
             msg += f" (valid: {', '.join(repr(a) for a in allowed)})"
     elif field_msg:  # raised by a __post_init__ as "field: message"

@@ -5,7 +5,9 @@ Owns:
       (roles, role checks, :meth:`run` with a probe, :meth:`estimate` from measurements, the
       layout an adaptive robot program needs), :class:`RolePoint`, :class:`ProcedureRun`;
     - one module per procedure, with its settings struct (the plan's ``procedure`` object) and
-      its implementation: ``hultman2013`` (the paper's A-H), ``three_two_one``, ``best_fit``;
+      its implementation: ``hultman2013`` (the paper's A-H), ``three_two_one``, ``best_fit``,
+      ``iterative`` (the iterative best fit: measure all, fit, re-command all, until it
+      settles);
     - the registry :data:`PROCEDURES`, the settings union :data:`ProcedureSettings` and
       :func:`procedure_kind`.
 
@@ -27,12 +29,15 @@ from calib.paper.settings import Hultman2013
 from calib.procedures.base import ProcedureKind, ProcedureRun, RolePoint
 from calib.procedures.best_fit import BEST_FIT, BestFit
 from calib.procedures.hultman2013 import HULTMAN2013
+from calib.procedures.iterative import ITERATIVE, Iterative
 from calib.procedures.three_two_one import THREE_TWO_ONE, ThreeTwoOne
 
 #: The procedures by method name, in the order the UI offers them.
-PROCEDURES: dict[str, ProcedureKind] = {k.method: k for k in (HULTMAN2013, THREE_TWO_ONE, BEST_FIT)}
+PROCEDURES: dict[str, ProcedureKind] = {
+    k.method: k for k in (HULTMAN2013, THREE_TWO_ONE, BEST_FIT, ITERATIVE)
+}
 #: The plan's ``procedure`` object: one settings struct per procedure, tagged by ``method``.
-ProcedureSettings = Hultman2013 | ThreeTwoOne | BestFit
+ProcedureSettings = Hultman2013 | ThreeTwoOne | BestFit | Iterative
 #: The method names.
 METHODS = tuple(PROCEDURES)
 
@@ -41,6 +46,7 @@ __all__ = [
     "PROCEDURES",
     "BestFit",
     "Hultman2013",
+    "Iterative",
     "ProcedureKind",
     "ProcedureRun",
     "ProcedureSettings",

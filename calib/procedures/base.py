@@ -9,6 +9,7 @@ measures as the procedure commands) or from measurements already taken
 
 from __future__ import annotations
 
+import math
 from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -17,6 +18,7 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from calib.errors import PlanError
 from calib.probing import Probe, ProbePoint
 
 if TYPE_CHECKING:
@@ -121,6 +123,38 @@ class ProcedureKind(Protocol):
         """The layout a robot program needs to run this procedure adaptively (frame updated
         after every step), or ``None`` when programs run every search in the nominal frame."""
         ...
+
+
+def check_edge_offset(value: float | None) -> None:
+    """Raise :class:`calib.errors.PlanError` unless an edge-event offset is finite or None."""
+    if value is not None and not math.isfinite(value):
+        raise PlanError(f"edge_event_offset_m: must be finite, got {value}")
+
+
+def edge_offset_of(settings: object) -> float:
+    """The edge-event offset a procedure's settings remove from edge searches, metres.
+
+    Every settings struct has ``edge_event_offset_m`` (how far past a face's end the sensor
+    reports it; ``None``: not measured, which counts as 0 here; the validation fills it from
+    the sensor model, see :func:`planner.sim.setup.resolved_settings`).
+    """
+    value = getattr(settings, "edge_event_offset_m", None)
+    return 0.0 if value is None else float(value)
+
+
+def edge_corrected(
+    points: Sequence[ProbePoint], q_base: FloatArray, T_base_wobj: FloatArray, offset_m: float
+) -> FloatArray:
+    """``(N, 3)`` recorded points with the edge-event offset removed from the edge searches'
+    (moved back along their search direction, taken in ``T_base_wobj``), base frame, m."""
+    if not offset_m:
+        return q_base
+    out = np.array(q_base, dtype=np.float64, copy=True)
+    R = np.asarray(T_base_wobj, dtype=np.float64)[:3, :3]
+    for i, p in enumerate(points):
+        if p.search.kind == "edge" and p.search.edge_direction is not None:
+            out[i] -= offset_m * (R @ np.asarray(p.search.edge_direction, dtype=np.float64))
+    return out
 
 
 def count_problem(method: str, roles: Sequence[str], need: Mapping[str, int]) -> str:

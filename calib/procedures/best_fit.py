@@ -21,6 +21,9 @@ from calib.procedures.base import (
     Measured,
     ProcedureRun,
     RolePoint,
+    check_edge_offset,
+    edge_corrected,
+    edge_offset_of,
     unknown_role_problem,
 )
 
@@ -42,10 +45,17 @@ class BestFit(
         max_iterations: largest number of Gauss-Newton iterations.
         tol: stop when the step is smaller than this (metres, and radians times the layout
             size).
+        edge_event_offset_m: how far past a face's end the sensor reports it, removed from
+            edge searches, metres (``None``: not measured; the validation uses the sensor
+            model's value, ``wobjcal calibrate`` 0).
     """
 
     max_iterations: int = 30
     tol: float = 1e-13
+    edge_event_offset_m: float | None = None
+
+    def __post_init__(self) -> None:
+        check_edge_offset(self.edge_event_offset_m)
 
 
 class BestFitProcedure:
@@ -78,9 +88,19 @@ class BestFitProcedure:
         probe: Probe,
         settings: object,
     ) -> ProcedureRun:
-        """Probe all points (updating the estimate after each), fit, and re-probe once."""
+        """Probe all points (updating the estimate after each), fit, and re-probe once.
+
+        An edge search counts only by its edge coordinate (its track's coordinate across the
+        face is the command's), with the sensor's edge-event offset removed.
+        """
         pts = [rp.point for rp in self.assign(points)]
-        res = run_best_fit(pts, probe, T_base_wobj_nominal)
+        res = run_best_fit(
+            pts,
+            probe,
+            T_base_wobj_nominal,
+            edge_offset_m=edge_offset_of(settings),
+            edge_rows="edge",
+        )
         last = {s.point_id: s.measured_m for s in res.steps}
         return ProcedureRun(res.T_base_wobj, tuple(p.id for p in pts), last)
 
@@ -96,6 +116,7 @@ class BestFitProcedure:
         cfg = settings if isinstance(settings, BestFit) else BestFit()
         pts = [rp.point for rp in self.assign(points) if rp.point.id in measured]
         q = np.array([np.asarray(measured[p.id], dtype=float).reshape(-1, 3)[0] for p in pts])
+        q = edge_corrected(pts, q, T_base_wobj_nominal, edge_offset_of(cfg))
         res = best_fit(pts, q, T_base_wobj_nominal, max_iterations=cfg.max_iterations, tol=cfg.tol)
         ids = tuple(p.id for p in pts)
         return ProcedureRun(res.T_base_wobj, ids, dict(zip(ids, q, strict=True)))

@@ -24,7 +24,10 @@ from calib.procedures.base import (
     Measured,
     ProcedureRun,
     RolePoint,
+    check_edge_offset,
     count_problem,
+    edge_corrected,
+    edge_offset_of,
     unknown_role_problem,
 )
 
@@ -40,7 +43,18 @@ class ThreeTwoOne(
     forbid_unknown_fields=True,
     kw_only=True,
 ):
-    """3-2-1 alignment: primary, secondary and tertiary faces (no settings)."""
+    """3-2-1 alignment: primary, secondary and tertiary faces.
+
+    Attributes:
+        edge_event_offset_m: how far past a face's end the sensor reports it, removed from
+            edge searches, metres (``None``: not measured; the validation uses the sensor
+            model's value, ``wobjcal calibrate`` 0).
+    """
+
+    edge_event_offset_m: float | None = None
+
+    def __post_init__(self) -> None:
+        check_edge_offset(self.edge_event_offset_m)
 
 
 def _faces(p: ProbePoint) -> list[tuple[float, ...]]:
@@ -163,7 +177,9 @@ class ThreeTwoOneProcedure:
     ) -> ProcedureRun:
         """Primary, then secondary, then tertiary, each commanded in the estimate so far."""
         layout = self.layout(points)
-        res = run_three_two_one(layout, probe, T_base_wobj_nominal)
+        res = run_three_two_one(
+            layout, probe, T_base_wobj_nominal, edge_offset_m=edge_offset_of(settings)
+        )
         measured = {s.point_id: s.measured_m for s in res.steps}
         return ProcedureRun(res.T_base_wobj, tuple(measured), measured)
 
@@ -179,6 +195,7 @@ class ThreeTwoOneProcedure:
         layout = self.layout(ordered)
         ids = tuple(rp.point.id for rp in ordered)
         q = np.array([np.asarray(measured[i], dtype=float).reshape(-1, 3)[0] for i in ids])
+        q = edge_corrected(layout.points, q, T_base_wobj_nominal, edge_offset_of(settings))
         T = three_two_one(layout, q, T_base_wobj_nominal).T_base_wobj
         return ProcedureRun(T, ids, dict(zip(ids, q, strict=True)))
 

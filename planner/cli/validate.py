@@ -1,10 +1,11 @@
-"""``wobjcal validate``: Monte Carlo validation of a plan, reported like Table 1 of the paper."""
+"""``wobjcal validate``: Monte Carlo validation of any plan, simulated beside predicted."""
 
 from __future__ import annotations
 
 import argparse
 import json
 import math
+import re
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -18,19 +19,35 @@ if TYPE_CHECKING:
     from planner.sim.report import ValidationReport
 
 
+def protocol_arg(text: str) -> tuple[int, int]:
+    """``"20x20"`` -> ``(20, 20)``: positions x repeats, each >= 2."""
+    m = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", text)
+    if not m or min(int(m.group(1)), int(m.group(2))) < 2:
+        raise argparse.ArgumentTypeError(
+            f"must be POSITIONSxREPEATS with both >= 2, e.g. 20x20, got {text!r}"
+        )
+    return int(m.group(1)), int(m.group(2))
+
+
 def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
     """Add ``validate`` to the subparsers ``sub``."""
     p = add(
         sub,
         "validate",
-        "simulate the calibration many times and report confidence intervals (Table 1)",
-        "Simulate the whole calibration TRIALS times with the plan's sensor model, robot\n"
-        "error model and part misplacement, and print the confidence intervals of the frame\n"
-        "and slot-position errors beside the paper's Table 1, plus which points failed how\n"
-        "often. Runs the A-H procedure (hultman2013) on a built-in stator work object.\n\n"
+        "simulate the calibration many times: confidence intervals, simulated and predicted",
+        "Simulate the whole calibration TRIALS times with the plan's procedure, sensor model\n"
+        "(proximity or touch probe, against the real mesh where the part really lies), robot\n"
+        "error model and part misplacement. Prints every row (origin x/y/z, rotations, the\n"
+        "error at the points of interest and over the regions) at the plan's confidence\n"
+        "levels: the simulated interval, the interval predicted from the procedure's\n"
+        "linearisation with the same noise, and the bias, for the procedure and for the best\n"
+        "fit of the same measurements; then how each point's searches went. A plan that\n"
+        "cannot work (roles, free degrees of freedom, points off planar faces, searches too\n"
+        "short for the misplacement) is refused before the run, naming the point.\n\n"
         "exit codes: 0 every trial calibrated, 1 some trials failed (listed), 2 bad input",
         "wobjcal validate assets/plans/stator_section_ah.json --trials 400 --seed 1\n"
-        "wobjcal validate plan.json --json report.json --plots plots/",
+        "wobjcal validate plan.json --json report.json --plots plots/\n"
+        "wobjcal validate plan.json --protocol 20x20 --sensitivity",
     )
     p.add_argument("plan", metavar="PLAN", help="plan file (wobjcal.plan/1)")
     p.add_argument("--trials", type=count_arg(1), help="number of trials (default: the plan's)")
@@ -45,56 +62,98 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "reachable and collision-free where the part really lies (about 0.2 s a trial; "
         "default 20; 0 turns it off)",
     )
+    p.add_argument(
+        "--protocol",
+        type=protocol_arg,
+        metavar="PxR",
+        help="also run the paper's protocol beside the default: P part positions x R repeats, "
+        "each position's errors centred on its mean (the paper: 20x20)",
+    )
+    p.add_argument(
+        "--sensitivity",
+        action="store_true",
+        help="also print the sensitivity table: the rows with each noise term off in turn "
+        "(runs the trials once more per term)",
+    )
     p.add_argument("--json", metavar="FILE", help="also write the report as JSON to FILE")
-    p.add_argument("--plots", metavar="DIR", help="also write PNG plots to DIR")
+    p.add_argument(
+        "--plots",
+        metavar="DIR",
+        help="also write PNG plots to DIR: histograms, scatter, and error_map.png, a colour "
+        "map of the simulated error over the part",
+    )
     p.set_defaults(handler=cmd_validate)
 
 
+def _num(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
+
+
 def report_json(report: ValidationReport) -> dict[str, Any]:
-    """The JSON of a ``ValidationReport``: rows (display units), failures, landings."""
-
-    def num(x: float) -> float | None:
-        return float(x) if math.isfinite(x) else None
-
+    """The JSON of a ``ValidationReport``: rows (display units), outcomes, failures, landings."""
     return {
+        "method": report.method,
+        "sensor": report.sensor,
         "n_trials": report.n_trials,
         "n_ok": report.n_ok,
         "elapsed_s": report.elapsed_s,
+        "protocol": report.protocol,
+        "noise_m": {k: _num(v) for k, v in report.noise.items()},
         "rows": [
             {
                 "key": r.key,
                 "label": r.label,
                 "unit": r.unit,
                 "level_percent": r.level_percent,
-                "procedure": num(r.procedure),
-                "procedure_bias": num(r.procedure_bias),
-                "best_fit": num(r.best_fit),
-                "best_fit_bias": num(r.best_fit_bias),
-                "paper": num(r.paper),
+                "procedure": _num(r.procedure),
+                "procedure_predicted": _num(r.procedure_predicted),
+                "procedure_bias": _num(r.procedure_bias),
+                "procedure_protocol": _num(r.procedure_protocol),
+                "best_fit": _num(r.best_fit),
+                "best_fit_predicted": _num(r.best_fit_predicted),
+                "best_fit_bias": _num(r.best_fit_bias),
+                "best_fit_protocol": _num(r.best_fit_protocol),
+                "paper": _num(r.paper),
             }
             for r in report.rows
+        ],
+        "outcomes": [
+            {
+                "search": o.point_id,
+                "runs": o.searches,
+                "failed": o.failed,
+                "landed_off": o.landed_off,
+                "partly_off": o.partly_off,
+                "off_fraction_mean": o.off_fraction_mean,
+                "off_fraction_max": o.off_fraction_max,
+            }
+            for o in report.outcomes
         ],
         "failures": report.failures,
         "landings": report.landings,
     }
 
 
-def cmd_validate(args: argparse.Namespace) -> int:
-    """Run the validation with a progress bar and print the report."""
-    from planner.validate import check_simulatable, validate_plan
-
-    plan, plan_dir = read_plan(args.plan)
-    check_simulatable(plan)  # a clear error before the simulation's heavy imports
-    trials = plan.validation.trials if args.trials is None else args.trials
-    seed = plan.validation.seed if args.seed is None else args.seed
-    with Progress(
+def _bar() -> Progress:
+    return Progress(
         TextColumn("validating"),
         BarColumn(),
         MofNCompleteColumn(),
         TimeRemainingColumn(),
         console=stderr(),
         transient=True,
-    ) as bar:
+    )
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    """Run the validation with a progress bar and print the report."""
+    from planner.validate import check_simulatable, sensitivity_plan, validate_plan
+
+    plan, plan_dir = read_plan(args.plan)
+    check_simulatable(plan)  # a clear error before the simulation's heavy imports
+    trials = plan.validation.trials if args.trials is None else args.trials
+    seed = plan.validation.seed if args.seed is None else args.seed
+    with _bar() as bar:
         task = bar.add_task("trials", total=trials)
         report = validate_plan(
             plan,
@@ -104,16 +163,35 @@ def cmd_validate(args: argparse.Namespace) -> int:
             progress=lambda done, total: bar.update(task, completed=done, total=total),
             reach_trials=min(args.reach_trials, trials),
             plan_dir=plan_dir,
+            protocol=args.protocol,
         )
     stdout().print(report.to_markdown(), markup=False)
+    data = report_json(report) | {"plan": args.plan, "seed": seed}
+    if args.sensitivity:
+        with _bar() as bar:
+            task = bar.add_task("sensitivity", total=trials)
+            table = sensitivity_plan(
+                plan,
+                trials=trials,
+                seed=seed,
+                workers=args.workers,
+                progress=lambda done, total: bar.update(task, completed=done, total=total),
+                plan_dir=plan_dir,
+            )
+        stdout().print(table.to_markdown(), markup=False)
+        data["sensitivity"] = {
+            "terms": list(table.terms),
+            "rows": [
+                {"key": k, "level_percent": lv, "half_widths": [_num(v) for v in vals]}
+                for k, _label, _unit, lv, vals in table.rows
+            ],
+            "dominant": table.dominant,
+        }
     if args.json:
-        data = report_json(report) | {"plan": args.plan, "seed": seed}
         write_text_atomic(args.json, json.dumps(data, indent=2, sort_keys=True) + "\n")
     if args.plots:
         from planner.sim.plots import save_validation_plots
 
-        out_dir = Path(args.plots)
-        out_dir.mkdir(parents=True, exist_ok=True)
-        written = save_validation_plots(report, out_dir)
+        written = save_validation_plots(report, Path(args.plots))
         stderr().print(f"plots: {', '.join(str(p) for p in written)}")
     return 0 if report.n_ok == report.n_trials else 1

@@ -119,7 +119,12 @@ def measured_slots(job: ExportJob) -> list[tuple[str, bool]]:
 
 def export_rapid(job: ExportJob) -> str:
     """The RAPID module text of ``job``."""
-    from planner.export.rapid_adaptive import adaptive_header, adaptive_main, adaptive_procs
+    from planner.export.rapid_adaptive import (
+        adaptive_header,
+        adaptive_main,
+        adaptive_procs,
+        xoffset_procs,
+    )
 
     names = _unique_names([t.point_id for t in job.targets])
     a = job.adaptive
@@ -147,6 +152,7 @@ def export_rapid(job: ExportJob) -> str:
         f"    ! HOME:/{MEASURED_FILE} for `wobjcal calibrate PLAN MEASURED`.",
         *_declarations(job, names),
         *(adaptive_procs(job) if a is not None else []),
+        *xoffset_procs(job, names),
         "",
         "    PROC main()",
         *_conf_lines(job),

@@ -8,7 +8,12 @@ estimate, so every later ``SearchL`` is commanded in the work-object frame estim
    ``V1 = B - A``, ``V2 = P3 - B`` (eq. 1-9); 2. ``ShiftOrigin`` x from B (eq. 10);
 3. C, y from C; 4. D, E, rotation from ``V1 = B - A``, ``V2 = D - E``; 5. x from E;
 6. F (edge), G, H (edge); final rotation from H, F, D with V2 inverted (``V1 = F - H``,
-``V2 = F - D``); 7. z from H; 8. C retaken, y; 9. D retaken, x.
+``V2 = F - D``); 7. z from H; 8. C retaken, y; 9. D retaken, x; 10. with the plan's x-offset
+run (:class:`calib.paper.settings.XOffsetRun`), the side face measured over every second tooth at
+two slot-hole levels in the calibrated frame (``pxMeas``), the x-offset matrix of eq. 13-14
+(``mxW``, the same plane interpolation as :func:`calib.paper.xoffset.xoffset_matrix`) and
+``SlotTarget(slot, layer, standoff)``, the paper's function returning the robot target at a slot
+hole (its y and z, the matrix's x plus the standoff, in ``wobjCal``).
 
 Measured points are kept in the base frame (``measured{i}``, mm): ``SearchL`` gives ``pMeas``
 in ``wobjCal`` and the probe routine converts it with ``PoseVect`` at once, before any update.
@@ -23,7 +28,9 @@ from __future__ import annotations
 
 import math
 
+from calib.paper.settings import XOffsetRun
 from calib.paper.stator_layout import STATOR_POINT_IDS as ROLES
+from calib.paper.xoffset import xoffset_probe_points
 from planner.export.job import AdaptiveSpec, ExportJob, fmt
 from planner.export.rapid_probe import WOBJ
 
@@ -169,4 +176,118 @@ def adaptive_main(job: ExportJob, names: list[str]) -> list[str]:
         f"{ind}ShiftOrigin [1,0,0],measured{{{d2}}},nFaceX;",
         f'{ind}TPWrite "wobjcal: A-H done, {WOBJ} is the calibrated work object";',
     ]
+    if a.settings.xoffset is not None:
+        lines += [
+            f"{ind}! 10: the x-offset run over every second tooth at two slot-hole levels, in the",
+            f"{ind}!     calibrated frame, and the x-offset matrix (eq. 13-14)",
+            f"{ind}XOffsetRun;",
+        ]
     return lines
+
+
+def xoffset_procs(job: ExportJob, names: list[str]) -> list[str]:
+    """Data and routines of the x-offset run (eq. 13-14) and ``SlotTarget``; ``[]`` without."""
+    a = job.adaptive
+    if a is None or a.settings.xoffset is None:
+        return []
+    run: XOffsetRun = a.settings.xoffset
+    grid = run.grid()
+    rows = xoffset_probe_points(grid, run.layers, run.teeth)
+    k_n, l_n = len(rows), len(rows[0])
+    ys = [p.position_m[1] for p in rows[0]]
+    zs = [row[0].position_m[2] for row in rows]
+    d = names[a.index["D"]]
+    nx = len(grid.slot_y_m) * len(grid.layer_z_m)
+
+    def nums(values: list[float]) -> str:
+        return ",".join(fmt(v * 1000.0, 4) for v in values)
+
+    u = f"tSensor\\WObj:={WOBJ}"
+    return [
+        "",
+        "    ! x-offset run (section 3.2, eq. 13-14): PX over the teeth (pxY) at the levels (pxZ),",
+        f"    ! searched along -x of {WOBJ} with {d}'s orientation; mxW{{(layer-1)*nSlots+slot}}",
+        "    ! is the x-offset of each slot hole (mm, wobjCal)",
+        f"    CONST num nPxLevels:={k_n};",
+        f"    CONST num nPxTeeth:={l_n};",
+        f"    CONST num pxY{{{l_n}}}:=[{nums(ys)}];",
+        f"    CONST num pxZ{{{k_n}}}:=[{nums(zs)}];",
+        f"    CONST num nPxStart:={fmt(run.start_offset_m * 1000.0, 4)};",
+        f"    CONST num nPxOver:={fmt(run.overtravel_m * 1000.0, 4)};",
+        f"    CONST num nSlots:={grid.n_slots};",
+        f"    CONST num nLayers:={grid.n_layers};",
+        f"    CONST num slotY{{{grid.n_slots}}}:=[{nums(list(grid.slot_y_m))}];",
+        f"    CONST num layerZ{{{grid.n_layers}}}:=[{nums(list(grid.layer_z_m))}];",
+        f"    PERS pos pxMeas{{{k_n * l_n}}}:=[{','.join(['[0,0,0]'] * (k_n * l_n))}];",
+        f"    PERS num mxW{{{nx}}}:=[{','.join(['0'] * nx)}];",
+        "",
+        "    ! One x-offset search: level k, tooth l; the point is kept in wobjCal (mm)",
+        "    PROC ProbePX(num k,num l)",
+        "        VAR robtarget pS;",
+        "        VAR robtarget pE;",
+        f"        pS:={d}_start;",
+        "        pS.trans:=[nFaceX+nPxStart,pxY{l},pxZ{k}];",
+        "        pE:=pS;",
+        "        pE.trans.x:=nFaceX-nPxOver;",
+        f"        MoveJ pS,vApproach,fine,{u};",
+        f"        SearchL\\SStop,diSensor,pMeas,pE,vSearch_{d},{u};",
+        "        pxMeas{(k-1)*nPxTeeth+l}:=pMeas.trans;",
+        f"        MoveL pS,vApproach,fine,{u};",
+        "    ERROR",
+        "        IF ERRNO=ERR_WHLSEARCH OR ERRNO=ERR_SIGSUPSEARCH THEN",
+        '            Fail "x-offset point PX"+NumToStr(k,0)+"_"+NumToStr(l,0)+" not found";',
+        "        ENDIF",
+        "        RAISE;",
+        "    ENDPROC",
+        "",
+        "    ! Eq. 14: x at (y, z) on the plane through PX[k,l], PX[k,l+1], PX[k+1,l], the levels",
+        "    ! and teeth bracketing (y, z) (the end pair outside them: extrapolation)",
+        "    FUNC num XOffsetAt(num y,num z)",
+        "        VAR num k:=1;",
+        "        VAR num l:=1;",
+        "        VAR num sk:=1;",
+        "        VAR num sl:=1;",
+        "        VAR num det;",
+        "        VAR pos p0;",
+        "        VAR pos d1;",
+        "        VAR pos d2;",
+        "        IF pxMeas{nPxTeeth+1}.z<pxMeas{1}.z sk:=-1;",
+        "        FOR m FROM 1 TO nPxLevels DO",
+        "            IF m>1 AND m<nPxLevels AND sk*pxMeas{(m-1)*nPxTeeth+1}.z<=sk*z k:=m;",
+        "        ENDFOR",
+        "        IF pxMeas{(k-1)*nPxTeeth+2}.y<pxMeas{(k-1)*nPxTeeth+1}.y sl:=-1;",
+        "        FOR m FROM 1 TO nPxTeeth DO",
+        "            IF m>1 AND m<nPxTeeth AND sl*pxMeas{(k-1)*nPxTeeth+m}.y<=sl*y l:=m;",
+        "        ENDFOR",
+        "        p0:=pxMeas{(k-1)*nPxTeeth+l};",
+        "        d1:=pxMeas{(k-1)*nPxTeeth+l+1}-p0;",
+        "        d2:=pxMeas{k*nPxTeeth+l}-p0;",
+        "        det:=d1.y*d2.z-d1.z*d2.y;",
+        '        IF Abs(det)<1E-6 Fail "x-offset points span no plane";',
+        "        RETURN p0.x+(y-p0.y)*(d1.x*d2.z-d1.z*d2.x)/det"
+        "+(z-p0.z)*(d1.y*d2.x-d1.x*d2.y)/det;",
+        "    ENDFUNC",
+        "",
+        "    ! Measure the PX points and fill the x-offset matrix",
+        "    PROC XOffsetRun()",
+        "        FOR k FROM 1 TO nPxLevels DO",
+        "            FOR l FROM 1 TO nPxTeeth DO",
+        "                ProbePX k,l;",
+        "            ENDFOR",
+        "        ENDFOR",
+        "        FOR i FROM 1 TO nLayers DO",
+        "            FOR j FROM 1 TO nSlots DO",
+        "                mxW{(i-1)*nSlots+j}:=XOffsetAt(slotY{j},layerZ{i});",
+        "            ENDFOR",
+        "        ENDFOR",
+        "    ENDPROC",
+        "",
+        "    ! The robot target at a slot hole (section 3.2): its y and z, the x-offset matrix's x",
+        f"    ! plus standoff (mm, along wobjCal +x), with {d}'s orientation, in {WOBJ}",
+        "    FUNC robtarget SlotTarget(num slot,num layer,num standoff)",
+        "        VAR robtarget t;",
+        f"        t:={d}_start;",
+        "        t.trans:=[mxW{(layer-1)*nSlots+slot}+standoff,slotY{slot},layerZ{layer}];",
+        "        RETURN t;",
+        "    ENDFUNC",
+    ]

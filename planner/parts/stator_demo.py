@@ -21,6 +21,8 @@ from numpy.typing import NDArray
 
 from calib.errors import ShapeError
 from calib.frames import make_transform
+from calib.paper.settings import XOffsetRun
+from calib.plan.report_spec import PointOfInterest, RegionSpec, ReportSpec
 from calib.probing import ProbePoint, SearchSpec
 from planner.parts.stator import StatorGeometry
 
@@ -121,3 +123,50 @@ def demo_table(
     size = (0.6, g.length_m + 0.2, 0.05)
     centre = (float(world[:, 0].min()) + 0.3, float(world[:, 1].mean()), top_z - 0.025)
     return size, make_transform(None, centre)
+
+
+#: The paper's Table 1 rows: origin and epsilon in the yz-plane, the stator side (slot holes
+#: within the robot's metre), at the paper's confidence levels.
+STATOR_REPORT = ReportSpec(
+    levels_percent=(95.5, 99.99),
+    points_of_interest=[
+        PointOfInterest(
+            name="origin",
+            position_m=(0.0, 0.0, 0.0),
+            components="yz",
+            label="WOCS yz-plane origin",
+            levels_percent=(95.5, 99.0, 99.9),
+        ),
+        PointOfInterest(
+            name="epsilon",
+            position_m=(0.0, -1.0, -0.1),
+            components="yz",
+            label="WOCS yz-plane at epsilon",
+            levels_percent=(95.5, 99.0, 99.9),
+        ),
+    ],
+    regions=[
+        RegionSpec(
+            name="slots",
+            points="slot_holes",
+            components="yz",
+            label="WOCS yz-plane stator side",
+            levels_percent=(95.5, 99.99, 99.999, 99.9999),
+        )
+    ],
+)
+
+
+def stator_xoffset(geom: StatorGeometry) -> XOffsetRun:
+    """The paper's x-offset run over the slot holes within the robot's reach of ``geom``:
+    every second tooth at the first and the last slot-hole layer (section 3.2)."""
+    slots = geom.slot_y_m
+    n_slots = int(sum(slots >= -geom.reach_length_m - 1e-9))
+    return XOffsetRun(
+        n_slots=n_slots,
+        n_layers=geom.n_layers,
+        first_slot_y_m=float(slots[0]),
+        first_layer_z_m=float(geom.layer_z_m[0]),
+        slot_step_y_m=-geom.slot_pitch_m,
+        layer_step_z_m=-geom.layer_pitch_m,
+    )

@@ -1,11 +1,14 @@
 """Monte Carlo validation of a calibration plan against the simulated sensor, robot and part.
 
-Each trial misplaces the true part by a random rigid motion within the tolerance, runs the
-paper's step-by-step A-H procedure (:func:`calib.paper.stator_procedure.run_stator_procedure`) with
-a :class:`~planner.sim.probe.SimulatedProbe` (each later search commanded in the WOCS estimated so
-far, as on the robot), and fits the same measurements by least squares
-(:func:`calib.estimators.best_fit.best_fit`) for comparison. The errors of both frames against the
-truth are summarised like Table 1 of the paper by :mod:`planner.sim.report`.
+:func:`simulate` runs any plan's setup (:class:`~planner.sim.setup.SimulationSetup`: any
+procedure of the registry, any sensor kind, any work-object mesh): each trial misplaces the true
+part by a random rigid motion within the tolerance, runs the procedure with the simulated
+sensor (each search commanded in the estimate so far, as on the robot), fits the same
+measurements by least squares fed as the procedure is fed, and runs the x-offset run if the plan
+has one (:mod:`planner.sim.trial`). The errors against the truth become the report's rows, each
+beside the interval predicted from the procedure's linearisation (:mod:`planner.sim.predict`).
+:func:`validate` is the same for the paper's A-H points on a stator geometry, as a script
+would call it.
 
 Trials are seeded one by one from ``rng`` (``SeedSequence.spawn``), so a run is repeatable and
 does not depend on how trials are split over worker processes. The ray-casting scene is built
@@ -14,12 +17,12 @@ once per worker; rays are moved into the part frame instead of moving the mesh.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import multiprocessing as mp
 import os
 import time
-from collections import Counter
 from collections.abc import Callable, Mapping
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any
@@ -35,39 +38,191 @@ from calib.models.proximity import ProximitySensor
 from calib.paper.settings import Hultman2013
 from calib.paper.stator_procedure import check_stator_points
 from calib.probing import ProbePoint
+from calib.procedures import RolePoint
 from planner.parts.stator import StatorGeometry
+from planner.parts.stator_demo import STATOR_REPORT
 from planner.parts.stator_mesh import build_stator_mesh
+from planner.sim.error_map import error_map
+from planner.sim.predict import predict
 from planner.sim.probe import ReachabilityHook, cell_search_hook
-from planner.sim.report import ValidationReport, build_report
-from planner.sim.trial import (
+from planner.sim.report import PAPER_TABLE1, ValidationReport
+from planner.sim.report_points import report_rows
+from planner.sim.rows import RowSpec
+from planner.sim.setup import (
     DEFAULT_EDGE_INSET_M,
     SimulationSetup,
-    TrialResult,
-    TrialRunner,
+    default_pivot,
     default_settings,
-    init_worker,
-    run_chunk_in_worker,
+    face_lookup,
+    resolved_settings,
 )
+from planner.sim.summary import build_report
+from planner.sim.trial import TrialResult, TrialRunner, TrialSeed, init_worker, run_chunk_in_worker
 
 __all__ = [
     "DEFAULT_EDGE_INSET_M",
     "ValidationReport",
     "default_pivot",
     "default_settings",
+    "simulate",
     "validate",
 ]
 
 FloatArray = NDArray[np.float64]
 log = logging.getLogger(__name__)
 
-PROCEDURES = ("hultman2013",)
 #: progress(done_trials, total_trials)
 ProgressCallback = Callable[[int, int], None]
 
 
-def default_pivot(points: Mapping[str, ProbePoint]) -> FloatArray:
-    """Centroid of the nominal probe points (wobj, m): the default misplacement pivot."""
-    return np.mean([p.position_m for p in points.values()], axis=0)
+def simulate(
+    setup: SimulationSetup,
+    mesh: trimesh.Trimesh,
+    rows: list[RowSpec],
+    n_trials: int,
+    rng: np.random.Generator,
+    *,
+    reachability: ReachabilityHook | None = None,
+    cell: Any = None,
+    reach_trials: int | None = None,
+    protocol: tuple[int, int] | None = None,
+    paper: Mapping[tuple[str, float], float] | None = None,
+    workers: int | None = None,
+    progress: ProgressCallback | None = None,
+) -> ValidationReport:
+    """Simulate the calibration of ``setup`` ``n_trials`` times and report every row.
+
+    Args:
+        setup: what every trial shares (see :mod:`planner.sim.setup`); its accuracy field is
+            drawn here, once per run, from ``rng``.
+        mesh: the true part mesh in wobj, metres.
+        rows: the report's rows (:func:`planner.sim.report_points.report_rows`).
+        n_trials: number of trials (>= 2).
+        rng: source of all randomness; the same seed gives the same report.
+        reachability: optional hook vetting each commanded search (runs in one process).
+        cell: optional :class:`planner.cell.cell.Cell` with the part as its work object; each
+            trial moves the work object to the true pose and vets every search with
+            ``cell.check_search`` (:func:`planner.sim.probe.cell_search_hook`). Runs in one
+            process; the work object is put back at the end.
+        reach_trials: with ``reachability`` or ``cell``, vet only the first ``reach_trials``
+            trials that way and run the rest without it, in parallel; ``None`` vets every
+            trial. Each trial draws the same numbers either way.
+        protocol: ``(positions, repeats)``: also run the paper's protocol (every position's
+            errors centred on that position's mean) beside the default.
+        paper: the paper's half-widths by (row key, level), shown beside the rows.
+        workers: worker processes (default: ``min(2, os.cpu_count())``; 1 runs in-process).
+        progress: called as ``progress(done, total)`` while trials complete.
+
+    Raises:
+        InputError: bad arguments (named in the message), or a plan that cannot calibrate even
+            on the ideal part (from the prediction, before any trial runs).
+    """
+    if not isinstance(n_trials, int) or n_trials < 2:
+        raise ShapeError(f"n_trials must be an integer >= 2, got {n_trials!r}")
+    if protocol is not None and (min(protocol) < 2 or len(protocol) != 2):
+        raise ShapeError(f"protocol must be (positions, repeats), each >= 2, got {protocol!r}")
+    prediction = predict(setup)  # before the run: a plan that cannot work fails here
+    setup = dataclasses.replace(setup, accuracy_field=setup.robot_error.sample_field(rng))
+    seeds: list[TrialSeed] = list(np.random.SeedSequence(int(rng.integers(2**63))).spawn(n_trials))
+    extra: list[TrialSeed] = []
+    if protocol is not None:
+        base = np.random.SeedSequence(int(rng.integers(2**63)))
+        for pos in base.spawn(protocol[0]):
+            extra += [(noise, pos) for noise in pos.spawn(protocol[1])]
+    n_workers = min(2, os.cpu_count() or 1) if workers is None else max(1, int(workers))
+    if cell is not None and reachability is None:
+        reachability = cell_search_hook(cell)
+    n_reach = 0 if reachability is None else n_trials
+    if reach_trials is not None and reachability is not None:
+        if int(reach_trials) < 0:
+            raise ShapeError(f"reach_trials must be >= 0, got {reach_trials!r}")
+        n_reach = min(int(reach_trials), n_trials)
+    total = n_trials + len(extra)
+    if total - n_reach < 50:
+        n_workers = 1
+    t0 = time.perf_counter()
+    T_cell = None if cell is None else cell.T_world_wobj
+
+    def vetted(done: int, _total: int) -> None:  # progress over all trials, vetted ones first
+        if progress is not None:
+            progress(done, total)
+
+    def later(done: int, _total: int) -> None:
+        if progress is not None:
+            progress(n_reach + done, total)
+
+    try:
+        results: list[TrialResult] = []
+        if n_reach:
+            # vetted trials run here: they move the cell's part to where it really lies
+            results = _run_all(setup, mesh, seeds[:n_reach], 1, reachability, vetted, cell)
+        if n_reach < total:
+            results += _run_all(setup, mesh, seeds[n_reach:] + extra, n_workers, None, later)
+    finally:
+        if cell is not None:
+            cell.move_work_object(T_cell)
+    elapsed = time.perf_counter() - t0
+    log.info("validated %d trials in %.2f s on %d workers", total, elapsed, n_workers)
+    main, proto = results[:n_trials], results[n_trials:]
+    report = build_report(
+        setup, main, proto, protocol, rows, prediction, paper, elapsed, n_workers, n_reach
+    )
+    pois = {
+        r.key: r.points_wobj[0].copy()
+        for r in rows
+        if r.points_wobj is not None and len(r.points_wobj) == 1
+    }
+    return dataclasses.replace(
+        report,
+        points_of_interest=pois,
+        probe_points_wobj=np.array([rp.point.position_m for rp in setup.points], dtype=float),
+        error_map=error_map(report.delta_procedure, mesh),
+    )
+
+
+def stator_setup(
+    points: Mapping[str, ProbePoint],
+    geometry: StatorGeometry,
+    T_base_wobj_nominal: ArrayLike,
+    *,
+    mesh: trimesh.Trimesh | None = None,
+    sensor: ProximitySensor | None = None,
+    robot_error: RobotErrorModel | None = None,
+    misplacement: Misplacement | tuple[float, float] | None = None,
+    settings: Hultman2013 | None = None,
+    pivot_wobj_m: ArrayLike | None = None,
+    edge_inset_m: float = DEFAULT_EDGE_INSET_M,
+    edge_tolerance_m: float = 2e-5,
+) -> tuple[SimulationSetup, trimesh.Trimesh]:
+    """The setup and mesh of the paper's A-H procedure on a stator (see :func:`validate`)."""
+    T_nom = check_transform(T_base_wobj_nominal, "T_base_wobj_nominal")
+    check_stator_points(points)
+    if misplacement is None:
+        misplacement = Misplacement()
+    elif isinstance(misplacement, tuple):
+        misplacement = Misplacement(
+            max_translation_m=misplacement[0], max_angle_rad=misplacement[1]
+        )
+    sensor = sensor or ProximitySensor()
+    cfg = default_settings(sensor, edge_inset_m) if settings is None else settings
+    part = build_stator_mesh(geometry) if mesh is None else mesh
+    role_points = tuple(RolePoint(role, p) for role, p in points.items())
+    setup = SimulationSetup(
+        points=role_points,
+        method="hultman2013",
+        settings=resolved_settings(cfg, sensor, edge_inset_m),
+        T_base_wobj_nominal=T_nom,
+        sensor=sensor,
+        robot_error=robot_error or RobotErrorModel(),
+        misplacement=misplacement,
+        pivot_wobj_m=(
+            default_pivot(points) if pivot_wobj_m is None else np.asarray(pivot_wobj_m, float)
+        ),
+        faces=face_lookup(part, role_points, sensor.footprint_radius_m),
+        edge_inset_m=edge_inset_m,
+        edge_tolerance_m=edge_tolerance_m,
+    )
+    return setup, part
 
 
 def validate(
@@ -77,140 +232,59 @@ def validate(
     n_trials: int,
     rng: np.random.Generator,
     *,
-    sensor: ProximitySensor | None = None,
-    robot_error: RobotErrorModel | None = None,
-    misplacement: Misplacement | tuple[float, float] | None = None,
     procedure: str = "hultman2013",
-    mesh: trimesh.Trimesh | None = None,
-    pivot_wobj_m: ArrayLike | None = None,
-    settings: Hultman2013 | None = None,
     reachability: ReachabilityHook | None = None,
     cell: Any = None,
     reach_trials: int | None = None,
-    edge_inset_m: float = DEFAULT_EDGE_INSET_M,
-    edge_tolerance_m: float = 2e-5,
     workers: int | None = None,
     progress: ProgressCallback | None = None,
+    **kwargs: Any,
 ) -> ValidationReport:
-    """Simulate the calibration ``n_trials`` times and summarise the errors like Table 1.
+    """Simulate the paper's A-H procedure on a stator ``n_trials`` times (Table 1 rows).
+
+    The script-level form of :func:`simulate` for ``points`` A-H (wobj frame, e.g.
+    :func:`planner.parts.stator_demo.stator_ah_points`) on ``geometry``'s mesh; a plan of any
+    procedure on any part validates with :func:`planner.validate.validate_plan`.
 
     Args:
-        points: nominal probe points A-H (wobj frame), e.g. ``demo_cell.stator_ah_points``.
+        points: nominal probe points A-H, keyed by role.
         geometry: the stator geometry; the true part is its (bulged) mesh.
-        T_base_wobj_nominal: ``(4, 4)`` nominal part pose, base frame; the procedure starts here.
+        T_base_wobj_nominal: ``(4, 4)`` nominal part pose, base frame.
         n_trials: number of trials (>= 2).
-        rng: source of all randomness; the same seed gives the same report.
-        sensor: proximity-sensor model (default :class:`ProximitySensor`).
-        robot_error: robot error model (default :class:`RobotErrorModel`).
-        misplacement: :class:`Misplacement` or ``(max_translation_m, max_angle_rad)``; default
-            the paper's experiment, 20 mm and 3 deg.
-        procedure: ``"hultman2013"`` (the paper's A-H procedure).
-        mesh: the true part mesh in wobj (default: the stator mesh of ``geometry``).
-        pivot_wobj_m: ``(3,)`` misplacement pivot (default: centroid of the points).
-        settings: A-H procedure settings; by default the paper's, with the sensor's analytic
-            straight-edge offset (:meth:`ProximitySensor.edge_event_offset_m`) as the known
-            edge-event offset removed from F and H. Build your own with
-            :func:`default_settings` (``default_settings(sensor, beta1_rad=...)``) to keep that
-            offset: settings with ``edge_event_offset_m = 0`` leave F and H ~6 mm high.
-        reachability: optional hook vetting each commanded search (runs in one process).
-        cell: optional :class:`planner.cell.cell.Cell` with the part as its work object; each trial
-            moves the work object to the true pose and vets every search with
-            ``cell.check_search`` (see :func:`planner.sim.probe.cell_search_hook`), so searches
-            that become unreachable or collide because the part moved are counted as failures.
-            Runs in one process; the work object is put back at the end.
-        reach_trials: with ``reachability`` or ``cell``, vet only the first ``reach_trials``
-            trials that way (about 0.2 s a trial in the demo cell) and run the rest without it,
-            in parallel; ``None`` vets every trial. Each trial draws the same numbers either
-            way, so the statistics do not depend on it.
-        edge_inset_m: edge-search track inset towards the face, m.
-        edge_tolerance_m: edge bisection tolerance, m.
-        workers: worker processes (default: ``min(2, os.cpu_count())``; 1 runs in-process).
-        progress: called as ``progress(done, total)`` while trials complete.
+        rng: source of all randomness.
+        procedure: ``"hultman2013"`` (the only procedure of this form).
+        reachability, cell, reach_trials, workers, progress: as :func:`simulate`.
+        **kwargs: ``mesh``, ``sensor``, ``robot_error``, ``misplacement``, ``settings``,
+            ``pivot_wobj_m``, ``edge_inset_m``, ``edge_tolerance_m`` of :func:`stator_setup`
+            (settings default to the paper's with the sensor's analytic edge offset).
 
     Raises:
         InputError: bad arguments (named in the message).
     """
-    if procedure not in PROCEDURES:
-        raise InputError(f"procedure must be one of {PROCEDURES}, got {procedure!r}")
+    if procedure != "hultman2013":
+        raise InputError(f"procedure must be 'hultman2013' here, got {procedure!r}")
     if not isinstance(n_trials, int) or n_trials < 2:
         raise ShapeError(f"n_trials must be an integer >= 2, got {n_trials!r}")
-    T_nom = check_transform(T_base_wobj_nominal, "T_base_wobj_nominal")
-    check_stator_points(points)
-    if misplacement is None:
-        misplacement = Misplacement()
-    elif isinstance(misplacement, tuple):
-        misplacement = Misplacement(
-            max_translation_m=misplacement[0], max_angle_rad=misplacement[1]
-        )
-    robot_error = robot_error or RobotErrorModel()
-    sensor = sensor or ProximitySensor()
-    pivot = default_pivot(points) if pivot_wobj_m is None else np.asarray(pivot_wobj_m, float)
-    setup = SimulationSetup(
-        points=dict(points),
-        geometry=geometry,
-        T_base_wobj_nominal=T_nom,
-        sensor=sensor,
-        robot_error=robot_error,
-        misplacement=misplacement,
-        pivot_wobj_m=pivot,
-        accuracy_field=robot_error.sample_field(rng),
-        settings=settings,
-        edge_inset_m=edge_inset_m,
-        edge_tolerance_m=edge_tolerance_m,
-    )
-    part = build_stator_mesh(geometry) if mesh is None else mesh
-    seeds = np.random.SeedSequence(int(rng.integers(2**63))).spawn(n_trials)
-    n_workers = min(2, os.cpu_count() or 1) if workers is None else max(1, int(workers))
-    if cell is not None and reachability is None:
-        reachability = cell_search_hook(cell)
-    n_reach = 0 if reachability is None else n_trials
-    if reach_trials is not None and reachability is not None:
-        if int(reach_trials) < 0:
-            raise ShapeError(f"reach_trials must be >= 0, got {reach_trials!r}")
-        n_reach = min(int(reach_trials), n_trials)
-    if n_trials - n_reach < 50:
-        n_workers = 1
-    t0 = time.perf_counter()
-    T_cell = None if cell is None else cell.T_world_wobj
-
-    def vetted(done: int, total: int) -> None:  # progress over all trials, vetted ones first
-        if progress is not None:
-            progress(done, n_trials)
-
-    def later(done: int, total: int) -> None:
-        if progress is not None:
-            progress(n_reach + done, n_trials)
-
-    try:
-        results = []
-        if n_reach:
-            # vetted trials run here: they move the cell's part to where it really lies
-            results = _run_all(setup, part, seeds[:n_reach], 1, reachability, vetted, cell)
-        if n_reach < n_trials:
-            results += _run_all(setup, part, seeds[n_reach:], n_workers, None, later)
-    finally:
-        if cell is not None:
-            cell.move_work_object(T_cell)
-    elapsed = time.perf_counter() - t0
-    log.info("validated %d trials in %.2f s on %d workers", n_trials, elapsed, n_workers)
-    failures = Counter(r.failure for r in results if r.failure)
-    landings = Counter(item for r in results for item in r.landings)
-    return build_report(
-        geometry=geometry,
-        delta_procedure=np.array([r.delta_procedure for r in results]),
-        delta_best_fit=np.array([r.delta_best_fit for r in results]),
-        failures=dict(failures),
-        landings=dict(landings),
-        elapsed_s=elapsed,
-        workers=n_workers,
-        reach_checked=n_reach,
+    setup, part = stator_setup(points, geometry, T_base_wobj_nominal, **kwargs)
+    return simulate(
+        setup,
+        part,
+        report_rows(STATOR_REPORT, part, geometry),
+        n_trials,
+        rng,
+        reachability=reachability,
+        cell=cell,
+        reach_trials=reach_trials,
+        paper=PAPER_TABLE1,
+        workers=workers,
+        progress=progress,
     )
 
 
 def _run_all(
     setup: SimulationSetup,
     mesh: trimesh.Trimesh,
-    seeds: list[np.random.SeedSequence],
+    seeds: list[TrialSeed],
     n_workers: int,
     reach: ReachabilityHook | None,
     progress: ProgressCallback | None,

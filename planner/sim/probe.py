@@ -15,7 +15,10 @@ TCP position at the switching event, in the base frame.
 Failures are returned as :class:`~calib.probing.ProbeResult` with a reason, never as a number:
 no detection within the search length, already detecting at the start, not detecting at the
 start of an edge search, the face touching the part, or an unreachable commanded path (when a
-reachability hook is given).
+reachability hook is given). Every approach's landing is judged over the whole sensor face: the
+triangles the ray bundle hits are looked up in the part's planar faces
+(:class:`~planner.sim.search_events.FaceLookup`), and a face partly over a hole or an edge is
+recorded with the fraction of its area that is off.
 """
 
 from __future__ import annotations
@@ -29,17 +32,39 @@ from numpy.typing import ArrayLike, NDArray
 from calib.frames import check_transform, invert_transform
 from calib.models.proximity import ProximitySensor
 from calib.models.robot_error import AccuracyField, RobotErrorModel
+from calib.models.sensor import tool_rotation
 from calib.probing import ProbeResult, SearchCommand
-from planner.parts.stator import StatorGeometry
 from planner.sim.raycast import MeshRayCaster
 from planner.sim.search_events import (
+    FaceLookup,
     ProbeEvent,
     ReachabilityHook,
     cell_search_hook,
-    footprint_landing,
 )
 
-__all__ = ["ProbeEvent", "ReachabilityHook", "SimulatedProbe", "cell_search_hook"]
+__all__ = ["ProbeEvent", "ReachabilityHook", "SimulatedProbe", "cell_search_hook", "robot_offset"]
+
+
+def robot_offset(
+    start_m: FloatArray,
+    axis: FloatArray,
+    rng: np.random.Generator,
+    robot_error: RobotErrorModel,
+    accuracy_field: AccuracyField | None,
+    tcp_error_m: FloatArray | None,
+) -> FloatArray:
+    """``(3,)`` where the robot's TCP really runs minus where it is commanded, base frame, m.
+
+    A fresh repeatability offset per search, the robot's accuracy field at the start, and the
+    TCP calibration error (sensor tool frame, :func:`calib.models.sensor.tool_rotation`).
+    """
+    offset = robot_error.sample_repeatability_m(rng)
+    if accuracy_field is not None:
+        offset = offset + accuracy_field(start_m)
+    if tcp_error_m is not None:
+        offset = offset + tool_rotation(axis) @ tcp_error_m
+    return offset
+
 
 FloatArray = NDArray[np.float64]
 
@@ -55,7 +80,9 @@ class SimulatedProbe:
         sensor: the sensor model.
         robot_error: robot repeatability (per search) and accuracy model.
         accuracy_field: this robot's accuracy field (``robot_error.sample_field``), or None.
-        geometry: the stator geometry, to classify landings over slot holes or off the face.
+        faces: the true part's planar faces and the face each search should land on, to
+            classify landings over the whole footprint; ``None``: not classified.
+        tcp_error_m: ``(3,)`` this calibration's TCP error, sensor tool frame, m, or None.
         reachability: optional hook that vets the path each successful search really ran (the
             command cut at the switching event); its reason fails the probe.
         edge_inset_m: an edge search runs its track this far inside the commanded path along
@@ -71,7 +98,8 @@ class SimulatedProbe:
     sensor: ProximitySensor = field(default_factory=ProximitySensor)
     robot_error: RobotErrorModel = field(default_factory=RobotErrorModel)
     accuracy_field: AccuracyField | None = None
-    geometry: StatorGeometry | None = None
+    faces: FaceLookup | None = None
+    tcp_error_m: FloatArray | None = None
     reachability: ReachabilityHook | None = None
     edge_inset_m: float = 0.003
     scan_step_m: float = 0.0025
@@ -102,17 +130,22 @@ class SimulatedProbe:
         self.events.append(ProbeEvent(cmd.point_id, cmd.kind, reason=reason))
         return ProbeResult(point_m=None, reason=reason)
 
-    def _succeed(self, cmd: SearchCommand, tcp0: FloatArray, travel: float) -> ProbeResult:
+    def _succeed(
+        self,
+        cmd: SearchCommand,
+        travel: float,
+        triangles: NDArray[np.int64] | None = None,
+    ) -> ProbeResult:
         if self.reachability is not None:  # the path the robot really ran: start to the event
             why = self.reachability(replace(cmd, length_m=max(travel, 1e-6)))
             if why:
                 return self._fail(cmd, why)
-        landing = ""
-        if self.geometry is not None and cmd.kind == "approach":
-            tcp_w = self._to_part((tcp0 + travel * cmd.direction)[None])[0]
-            axis_w = self._T_wobj_base[:3, :3] @ cmd.sensor_axis
-            landing = footprint_landing(self.geometry, tcp_w, axis_w, self.sensor.radius_m)
-        self.events.append(ProbeEvent(cmd.point_id, cmd.kind, landing=landing, travel_m=travel))
+        landing, frac = "", 0.0
+        if self.faces is not None and triangles is not None:
+            landing, frac = self.faces.landing(cmd.point_id, triangles)
+        self.events.append(
+            ProbeEvent(cmd.point_id, cmd.kind, landing=landing, off_fraction=frac, travel_m=travel)
+        )
         point = np.asarray(cmd.start_m, float) + travel * np.asarray(cmd.direction, float)
         return ProbeResult(point_m=point, travel_m=travel)
 
@@ -120,10 +153,10 @@ class SimulatedProbe:
     def __call__(self, cmd: SearchCommand) -> ProbeResult:
         """Run one commanded search against the true part."""
         start = np.asarray(cmd.start_m, float)
-        offset = self.robot_error.sample_repeatability_m(self.rng)
-        if self.accuracy_field is not None:
-            offset = offset + self.accuracy_field(start)
         axis = np.asarray(cmd.sensor_axis, float)
+        offset = robot_offset(
+            start, axis, self.rng, self.robot_error, self.accuracy_field, self.tcp_error_m
+        )
         tcp0 = start + offset + (self.edge_inset_m * axis if cmd.kind == "edge" else 0.0)
         direction = np.asarray(cmd.direction, float)
         length = float(cmd.length_m)
@@ -136,7 +169,7 @@ class SimulatedProbe:
     ) -> ProbeResult:
         origins = self._to_part(self.sensor.ray_origins(tcp0, axis))
         axis_part = np.broadcast_to(self._T_wobj_base[:3, :3] @ axis, origins.shape)
-        dist = self.caster.first_hits(origins, axis_part)
+        dist, tri = self.caster.first_hits_ids(origins, axis_part)
         if np.any(dist <= 0.0):
             return self._fail(cmd, "sensor face inside the part at start")
         travel = self.sensor.switch_travel_m(dist, self.sensor.sample_jitter_m(self.rng))
@@ -146,7 +179,7 @@ class SimulatedProbe:
             return self._fail(cmd, f"no detection within {length * 1e3:.0f} mm")
         if travel >= float(dist.min()):
             return self._fail(cmd, "sensor face touched the part before switching")
-        return self._succeed(cmd, tcp0, travel)
+        return self._succeed(cmd, travel, tri)  # along the axis the rays are the footprint's
 
     def _scan(
         self,
@@ -257,4 +290,12 @@ class SimulatedProbe:
                 lo, g_lo = s, margin(sig)
         if s_hi < 0:
             return self._fail(cmd, "sensor face collided with the part during the search")
-        return self._succeed(cmd, tcp0, hi)
+        triangles = None
+        if want_on and self.faces is not None:  # an approach across the axis: its footprint
+            at = (tcp0 + hi * direction)[None]
+            origins = self._to_part(
+                (at - self.sensor.sensing_distance_m * axis)[:, None, :] + fine_off
+            )
+            d_part = np.broadcast_to(self._T_wobj_base[:3, :3] @ axis, origins[0].shape)
+            triangles = self.caster.first_hits_ids(origins[0], d_part)[1]
+        return self._succeed(cmd, hi, triangles)

@@ -82,7 +82,7 @@ class MeshRayCaster:
         # faces_unique_edges columns are the edges (a, b), (b, c), (c, a)
         return ~smooth[np.asarray(mesh.faces_unique_edges)[:, [1, 2, 0]]]
 
-    def first_hits(self, origins: FloatArray, directions: FloatArray, depth: int = 0) -> FloatArray:
+    def first_hits(self, origins: FloatArray, directions: FloatArray) -> FloatArray:
         """Distance along each ray to the first surface it meets, metres.
 
         Args:
@@ -92,13 +92,22 @@ class MeshRayCaster:
         Returns:
             ``(N,)`` distances; ``inf`` where the ray misses; ``0`` where the ray starts inside
             the part (its first hit is a face seen from behind).
-            ``depth`` is internal (continuations past real edges).
+        """
+        return self.first_hits_ids(origins, directions)[0]
+
+    def first_hits_ids(
+        self, origins: FloatArray, directions: FloatArray, depth: int = 0
+    ) -> tuple[FloatArray, NDArray[np.int64]]:
+        """:meth:`first_hits` and the index of the triangle each ray hits (``-1``: none).
+
+        ``depth`` is internal (continuations past real edges).
         """
         o = np.ascontiguousarray(origins, dtype=np.float64)
         d = np.ascontiguousarray(directions, dtype=np.float64)
         out = np.full(len(o), np.inf)
+        tri_out = np.full(len(o), -1, dtype=np.int64)
         if len(o) == 0:
-            return out
+            return out, tri_out
         if self._scene is not None:
             ids = self._scene.run(o.astype(np.float32), d.astype(np.float32))
         else:  # pragma: no cover
@@ -106,7 +115,7 @@ class MeshRayCaster:
         tri = np.asarray(ids, dtype=np.int64)
         idx = np.flatnonzero(tri >= 0)
         if len(idx) == 0:
-            return out
+            return out, tri_out
         n = self._normals[tri[idx]]
         denom = np.einsum("ij,ij->i", n, d[idx])
         num = self._offsets[tri[idx]] - np.einsum("ij,ij->i", n, o[idx])
@@ -115,12 +124,24 @@ class MeshRayCaster:
         beyond = self._beyond_real_edge(o[idx] + t[:, None] * d[idx], tri[idx])
         keep = ~beyond
         out[idx[keep]] = np.where(denom[keep] > 0, 0.0, t[keep])  # back face: origin inside
+        tri_out[idx[keep]] = tri[idx[keep]]
         if np.any(beyond) and depth < 4:  # continue just past the face that was not hit
             r = idx[beyond]
             step = 1e-9 * self._scale
-            more = self.first_hits(o[r] + (t[beyond] + step)[:, None] * d[r], d[r], depth + 1)
+            more, more_tri = self.first_hits_ids(
+                o[r] + (t[beyond] + step)[:, None] * d[r], d[r], depth + 1
+            )
             out[r] = t[beyond] + step + more
-        return out
+            tri_out[r] = more_tri
+        return out, tri_out
+
+    def triangle_normal(self, triangle: int) -> FloatArray:
+        """``(3,)`` unit normal of a triangle, mesh frame (float64)."""
+        return self._normals[triangle].copy()
+
+    def triangle_offset(self, triangle: int) -> float:
+        """Plane offset ``d`` of a triangle: its plane is ``normal . x = d``, metres."""
+        return float(self._offsets[triangle])
 
     def _beyond_real_edge(self, p: FloatArray, tri: NDArray[np.int64]) -> NDArray[np.bool_]:
         """True where hit points ``(K, 3)`` lie outside their triangle across a real edge."""

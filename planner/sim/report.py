@@ -1,46 +1,31 @@
-"""The Monte Carlo validation report: Table-1 rows of the paper, failures and landings.
+"""The Monte Carlo validation report: every row simulated beside predicted, per-point outcomes.
 
-Errors follow section 4 of Hultman & Leijon (2013):
+Rows (:mod:`planner.sim.rows`): origin x/y/z, rotations about x/y/z, the error at each point of
+interest and pooled over each region, at the plan's confidence levels, for the procedure and
+for the least-squares fit of the same measurements fed as the procedure is fed
+(:mod:`calib.procedures.comparison`). Each has the simulated half-width (``+- z sigma`` about
+the mean, as the paper, which took the mean of its calibrations as the truth), the half-width
+*predicted* from the procedure's linearisation with the same noise figures
+(:mod:`calib.procedures.linearize`), and the bias (the simulation knows the truth). Optionally
+the paper's protocol (positions x repeats, centred on each position's mean) stands beside it,
+and for the built-in stator the paper's Table 1.
 
-- origin x, y, z: translation of the calibrated WOCS origin, in the true WOCS axes;
-- rotation x, y, z: rotation-vector components of ``T_true^-1 T_calibrated``;
-- yz-plane at a point ``p`` (the origin, epsilon, every slot hole in reach): the error vector
-  ``e = T_true^-1 T_calibrated p - p`` in the true WOCS axes; its yz-length, signed by ``e_x``
-  ("the displacement is defined as positive if the displacement is positive in the x-axis").
-
-The paper took the mean of repeated calibrations as the truth, so its intervals measure the
-scatter about the mean; the simulation knows the truth, so the table gives the same
-scatter-based intervals (``+- z * sigma`` about the mean, ``z`` from the confidence level) and
-the bias (mean error) in its own column. Intervals and the signed yz-plane error come from
-:mod:`calib.stats`.
+Per-point outcomes (:class:`PointOutcome`) count every search by the id the procedure gives it
+(``"D"``, its retake ``"D2"``): failures with their reason, and landings off the face or with
+part of the footprint over a hole or an edge (with the fraction of the footprint).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Literal
+import math
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
-from calib.frames import small_motion
-from calib.stats import confidence_intervals, signed_radial_error
-from planner.parts.stator import StatorGeometry
+from planner.sim.error_map import ErrorMap
 
 FloatArray = NDArray[np.float64]
-
-#: (key, label, unit, confidence levels in percent) of the paper's Table 1, in its order.
-TABLE1_ROWS: tuple[tuple[str, str, str, tuple[float, ...]], ...] = (
-    ("origin_x", "WOCS origin x-axis", "mm", (95.5,)),
-    ("origin_y", "WOCS origin y-axis", "mm", (95.5,)),
-    ("origin_z", "WOCS origin z-axis", "mm", (95.5,)),
-    ("rot_x", "WOCS rotation x-axis", "deg", (95.5, 99.99)),
-    ("rot_y", "WOCS rotation y-axis", "deg", (95.5, 99.99)),
-    ("rot_z", "WOCS rotation z-axis", "deg", (95.5, 99.99)),
-    ("yz_origin", "WOCS yz-plane origin", "mm", (95.5, 99.0, 99.9)),
-    ("yz_epsilon", "WOCS yz-plane at epsilon", "mm", (95.5, 99.0, 99.9)),
-    ("yz_slots", "WOCS yz-plane stator side", "mm", (95.5, 99.99, 99.999, 99.9999)),
-)
 
 #: The paper's Table 1 half-widths, display units, keyed by (row key, level in percent).
 PAPER_TABLE1: dict[tuple[str, float], float] = {
@@ -65,23 +50,26 @@ PAPER_TABLE1: dict[tuple[str, float], float] = {
     ("yz_slots", 99.9999): 0.69,
 }
 
-_SCALE = {"mm": 1e3, "deg": float(np.degrees(1.0))}
-
 
 @dataclass(frozen=True)
 class IntervalRow:
-    """One line of the simulated Table 1.
+    """One line of the report.
 
     Attributes:
         key: row key, e.g. ``"yz_epsilon"``.
-        label: the paper's row name.
+        label: the row's name.
         unit: display unit, ``"mm"`` or ``"deg"``.
         level_percent: confidence level, percent.
-        procedure: half-width of the interval of the A-H procedure, display unit.
-        best_fit: half-width for the least-squares fit on the same measurements, display unit.
+        procedure: simulated half-width of the procedure's interval, display unit.
+        procedure_predicted: half-width predicted from the procedure's linearisation.
         procedure_bias: mean error of the procedure (bias), display unit.
-        best_fit_bias: mean error of the best fit, display unit.
-        paper: the paper's half-width, display unit, or NaN where the paper has none.
+        best_fit: simulated half-width of the best fit fed as the procedure is fed.
+        best_fit_predicted: predicted half-width of that best fit.
+        best_fit_bias: mean error of that best fit.
+        paper: the paper's half-width (built-in stator, A-H), or NaN.
+        procedure_protocol: half-width under the paper's protocol (positions x repeats,
+            centred on each position's mean), or NaN when not run.
+        best_fit_protocol: the same for the best fit.
     """
 
     key: str
@@ -89,31 +77,70 @@ class IntervalRow:
     unit: str
     level_percent: float
     procedure: float
-    best_fit: float
+    procedure_predicted: float
     procedure_bias: float
+    best_fit: float
+    best_fit_predicted: float
     best_fit_bias: float
-    paper: float
+    paper: float = float("nan")
+    procedure_protocol: float = float("nan")
+    best_fit_protocol: float = float("nan")
+
+
+@dataclass(frozen=True)
+class PointOutcome:
+    """How the searches of one point went over all trials.
+
+    Attributes:
+        point_id: the search's id as the procedure names it (``"D"``, a retake ``"D2"``).
+        searches: searches run.
+        failed: failures by reason.
+        landed_off: approaches whose footprint centre was not on the face meant.
+        partly_off: approaches with part of the footprint over a hole or an edge.
+        off_fraction_mean: mean fraction of the footprint off the face over ``partly_off``.
+        off_fraction_max: largest such fraction.
+    """
+
+    point_id: str
+    searches: int
+    failed: dict[str, int]
+    landed_off: int
+    partly_off: int
+    off_fraction_mean: float
+    off_fraction_max: float
 
 
 @dataclass(frozen=True)
 class ValidationReport:
-    """Result of :func:`planner.sim.montecarlo.validate`.
+    """Result of a Monte Carlo validation (:func:`planner.sim.montecarlo.simulate`).
 
     Attributes:
         n_trials: trials run.
         n_ok: trials whose calibration finished.
-        rows: the simulated Table 1.
-        samples_procedure: per row key, the error samples of the procedure, SI (m, rad),
-            centred values as used for the intervals (``yz_slots`` pools all holes).
+        rows: the report's rows.
+        samples_procedure: per row key, the procedure's centred error samples, SI (m, rad);
+            point rows pool all their points.
         samples_best_fit: the same for the best fit.
         delta_procedure: ``(n_ok, 6)`` raw frame errors of the procedure (m, rad).
         delta_best_fit: ``(n_ok, 6)`` raw frame errors of the best fit (m, rad).
-        failures: ``"<point>: <reason>"`` -> number of failed trials.
-        landings: ``"<point>: over slot hole|off face"`` -> number of such approaches.
+        failures: ``"<search>: <reason>"`` -> number of failed trials.
+        landings: ``"<search>: <landing>"`` -> number of such approaches.
         elapsed_s: wall time, seconds.
         workers: worker processes used.
         reach_checked: how many trials (the first ones) also vetted every commanded search for
             reachability and collisions in the cell; 0 when no cell was given.
+        method: the procedure's method.
+        sensor: the sensor kind.
+        outcomes: per-search outcomes, in the order the searches were first run.
+        predicted_cov_procedure: ``(6, 6)`` predicted covariance of the procedure's frame error.
+        predicted_cov_best_fit: ``(6, 6)`` that of the best fit.
+        noise: the noise figures the run used, SI, by name.
+        protocol: ``""`` or ``"<positions> positions x <repeats> repeats"`` when the paper's
+            protocol ran beside the default.
+        notes: lines the markdown adds at the end (e.g. what the prediction leaves out).
+        points_of_interest: per point row key, ``(3,)`` its point, wobj frame, metres.
+        probe_points_wobj: ``(N, 3)`` the plan's probe points, wobj frame, metres.
+        error_map: the procedure's error over the part (:mod:`planner.sim.error_map`), or None.
     """
 
     n_trials: int
@@ -128,6 +155,17 @@ class ValidationReport:
     elapsed_s: float
     workers: int
     reach_checked: int = 0
+    method: str = "hultman2013"
+    sensor: str = "proximity"
+    outcomes: tuple[PointOutcome, ...] = ()
+    predicted_cov_procedure: FloatArray = field(default_factory=lambda: np.zeros((6, 6)))
+    predicted_cov_best_fit: FloatArray = field(default_factory=lambda: np.zeros((6, 6)))
+    noise: dict[str, float] = field(default_factory=dict)
+    protocol: str = ""
+    notes: tuple[str, ...] = ()
+    points_of_interest: dict[str, FloatArray] = field(default_factory=dict)
+    probe_points_wobj: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
+    error_map: ErrorMap | None = None
 
     def row(self, key: str, level_percent: float) -> IntervalRow:
         """The row ``key`` at ``level_percent``; raises KeyError when absent."""
@@ -137,128 +175,98 @@ class ValidationReport:
         raise KeyError(f"no row {key!r} at {level_percent} %")
 
     def to_markdown(self) -> str:
-        """The simulated Table 1 beside the paper's, failures and landings, as Markdown."""
-        lines = [
-            f"Trials: {self.n_trials}, calibrated: {self.n_ok}, "
-            f"time: {self.elapsed_s:.2f} s on {self.workers} worker(s)",
+        """The rows, per-point outcomes, failures and notes, as Markdown."""
+        return report_markdown(self)
+
+
+#: Why the paper's rotation rows look 100x too small (``docs/simulation.md``).
+ROTATION_NOTE = (
+    "The paper's rotation rows (+-0.0002 deg about x, ...) are about 100x smaller than its own"
+    " origin and epsilon rows imply (0.02 deg about x); they look like quaternion components"
+    " rather than degrees: compare the origin and epsilon rows (docs/simulation.md)."
+)
+
+
+def _hw(x: float, digits: int, unit: str) -> str:
+    return "—" if not math.isfinite(x) else f"± {x:.{digits}f} {unit}"
+
+
+def _bias(x: float, digits: int) -> str:
+    return "—" if not math.isfinite(x) else f"{x:+.{digits}f}"
+
+
+def _row_cells(r: IntervalRow, protocol: bool, paper: bool) -> list[str]:
+    d = 4 if r.unit == "deg" else 2
+    cells = [
+        r.label,
+        f"{r.level_percent:g}",
+        _hw(r.procedure, d, r.unit),
+        _hw(r.procedure_predicted, d, r.unit),
+        _bias(r.procedure_bias, d),
+    ]
+    if protocol:
+        cells.append(_hw(r.procedure_protocol, d, r.unit))
+    cells += [
+        _hw(r.best_fit, d, r.unit),
+        _hw(r.best_fit_predicted, d, r.unit),
+        _bias(r.best_fit_bias, d),
+    ]
+    if protocol:
+        cells.append(_hw(r.best_fit_protocol, d, r.unit))
+    if paper:
+        cells.append("" if math.isnan(r.paper) else _hw(r.paper, d, r.unit))
+    return cells
+
+
+def report_markdown(report: ValidationReport) -> str:
+    """The report's rows, per-point outcomes, failures and notes."""
+    protocol = bool(report.protocol)
+    paper = any(not math.isnan(r.paper) for r in report.rows)
+    proc = report.method
+    head = ["Quantity", "Conf. [%]", f"{proc} simulated", "predicted", "bias"]
+    head += ["paper protocol"] if protocol else []
+    head += ["best fit (fed as the procedure) simulated", "predicted", "bias"]
+    head += ["paper protocol"] if protocol else []
+    head += ["paper"] if paper else []
+    lines = [
+        f"Procedure: {report.method}, sensor: {report.sensor}. Trials: {report.n_trials}, "
+        f"calibrated: {report.n_ok}, time: {report.elapsed_s:.2f} s on {report.workers} "
+        "worker(s)" + (f"; paper protocol: {report.protocol}" if protocol else ""),
+        "",
+        "| " + " | ".join(head) + " |",
+        "|" + "---|" * len(head),
+    ]
+    lines += ["| " + " | ".join(_row_cells(r, protocol, paper)) + " |" for r in report.rows]
+    if report.noise:
+        figures = ", ".join(f"{k} {v * 1e3:.4g} mm" for k, v in report.noise.items())
+        lines += ["", f"Noise figures (1 sigma): {figures}."]
+    if paper:
+        lines += ["", ROTATION_NOTE]
+    lines += [
+        "",
+        f"Reachability and collisions of the displaced searches checked in the cell on "
+        f"{report.reach_checked} of {report.n_trials} trials."
+        if report.reach_checked
+        else "Reachability and collisions of the displaced searches: not checked.",
+    ]
+    if report.outcomes:
+        lines += [
             "",
-            "| Normal distribution | Confidence [%] | A-H procedure | bias | best fit | bias "
-            "| paper |",
-            "|---|---|---|---|---|---|---|",
+            "| Search | runs | failed | landed off its face | footprint partly over a hole "
+            "or an edge | mean / max fraction off |",
+            "|---|---|---|---|---|---|",
         ]
-        for r in self.rows:
-            digits = 4 if r.unit == "deg" else 2
-            paper = "" if np.isnan(r.paper) else f"± {r.paper:.{digits}f} {r.unit}"
+        for o in report.outcomes:
+            failed = "; ".join(f"{why}: {n}" for why, n in sorted(o.failed.items())) or "0"
+            frac = f"{o.off_fraction_mean:.0%} / {o.off_fraction_max:.0%}" if o.partly_off else "—"
             lines.append(
-                f"| {r.label} | {r.level_percent:g} | ± {r.procedure:.{digits}f} {r.unit} "
-                f"| {r.procedure_bias:+.{digits}f} | ± {r.best_fit:.{digits}f} {r.unit} "
-                f"| {r.best_fit_bias:+.{digits}f} | {paper} |"
+                f"| {o.point_id} | {o.searches} | {failed} | {o.landed_off} | {o.partly_off} "
+                f"| {frac} |"
             )
-        lines += [
-            "",
-            "The paper's rotation rows (+-0.0002 deg about x, ...) are about 100x smaller than its"
-            " own origin and epsilon rows imply (0.02 deg about x); they look like quaternion"
-            " components rather than degrees: compare the origin and epsilon rows"
-            " (docs/simulation.md).",
-        ]
-        lines += [
-            "",
-            f"Reachability and collisions of the displaced searches checked in the cell on "
-            f"{self.reach_checked} of {self.n_trials} trials."
-            if self.reach_checked
-            else "Reachability and collisions of the displaced searches: not checked.",
-        ]
-        lines += ["", "Failures:" if self.failures else "Failures: none"]
-        lines += [f"- {k}: {v}" for k, v in sorted(self.failures.items())]
-        lines += ["", "Landings:" if self.landings else "Landings: none over holes or off faces"]
-        lines += [f"- {k}: {v}" for k, v in sorted(self.landings.items())]
-        return "\n".join(lines) + "\n"
-
-
-def _point_errors(delta: FloatArray, p_wobj: FloatArray) -> FloatArray:
-    """Errors ``(n, M, 3)`` of wobj points ``(M, 3)`` under frame errors ``(n, 6)``."""
-    T = small_motion(delta)  # T_true_est, (n, 4, 4)
-    return np.einsum("nij,mj->nmi", T[:, :3, :3], p_wobj) + T[:, None, :3, 3] - p_wobj
-
-
-def _samples(delta: FloatArray, geometry: StatorGeometry) -> tuple[dict, dict]:
-    """Centred samples and biases (SI) per row key from frame errors ``(n, 6)``."""
-    keys = ("origin_x", "origin_y", "origin_z", "rot_x", "rot_y", "rot_z")
-    out = {k: delta[:, i] - delta[:, i].mean() for i, k in enumerate(keys)}
-    bias = {k: float(delta[:, i].mean()) for i, k in enumerate(keys)}
-    pts = {
-        "yz_origin": np.zeros((1, 3)),
-        "yz_epsilon": geometry.epsilon_m[None],
-        "yz_slots": geometry.slot_centres_m() * np.array([0.0, 1.0, 1.0]),
-    }
-    for key, p in pts.items():
-        e = _point_errors(delta, p)
-        mean = e.mean(axis=0)
-        out[key] = signed_radial_error(e - mean, "yz").ravel()
-        bias[key] = float(np.mean(np.hypot(mean[:, 1], mean[:, 2])))
-    return out, bias
-
-
-def build_report(
-    geometry: StatorGeometry,
-    delta_procedure: FloatArray,
-    delta_best_fit: FloatArray,
-    failures: dict[str, int],
-    landings: dict[str, int],
-    elapsed_s: float,
-    workers: int,
-    reach_checked: int = 0,
-) -> ValidationReport:
-    """Summarise per-trial frame errors ``(n, 6)`` (NaN rows: failed trials) as Table 1."""
-    ok = np.all(np.isfinite(delta_procedure), axis=1) & np.all(np.isfinite(delta_best_fit), axis=1)
-    dp, df = delta_procedure[ok], delta_best_fit[ok]
-    if len(dp) >= 2:
-        sp, bp = _samples(dp, geometry)
-        sf, bf = _samples(df, geometry)
-    else:
-        sp = sf = {k: np.zeros(0) for k, *_ in TABLE1_ROWS}
-        bp = bf = {k: float("nan") for k, *_ in TABLE1_ROWS}
-    rows = []
-    for key, label, unit, levels in TABLE1_ROWS:
-        scale = _SCALE[unit]
-        fractions = [lv / 100.0 for lv in levels]
-        si: Literal["m", "rad"] = "rad" if unit == "deg" else "m"
-        nan = [float("nan")] * len(levels)
-        hw_p = (
-            [r.half_width for r in confidence_intervals(sp[key], label, si, fractions).rows]
-            if len(sp[key]) > 1
-            else nan
-        )
-        hw_f = (
-            [r.half_width for r in confidence_intervals(sf[key], label, si, fractions).rows]
-            if len(sf[key]) > 1
-            else nan
-        )
-        for level, h_p, h_f in zip(levels, hw_p, hw_f, strict=True):
-            rows.append(
-                IntervalRow(
-                    key=key,
-                    label=label,
-                    unit=unit,
-                    level_percent=level,
-                    procedure=h_p * scale,
-                    best_fit=h_f * scale,
-                    procedure_bias=bp[key] * scale,
-                    best_fit_bias=bf[key] * scale,
-                    paper=PAPER_TABLE1.get((key, level), float("nan")),
-                )
-            )
-    return ValidationReport(
-        n_trials=len(delta_procedure),
-        n_ok=int(ok.sum()),
-        rows=tuple(rows),
-        samples_procedure=sp,
-        samples_best_fit=sf,
-        delta_procedure=dp,
-        delta_best_fit=df,
-        failures=failures,
-        landings=landings,
-        elapsed_s=elapsed_s,
-        workers=workers,
-        reach_checked=reach_checked,
-    )
+    lines += ["", "Failures:" if report.failures else "Failures: none"]
+    lines += [f"- {k}: {v}" for k, v in sorted(report.failures.items())]
+    lines += ["", "Landings:" if report.landings else "Landings: none over holes or off faces"]
+    lines += [f"- {k}: {v}" for k, v in sorted(report.landings.items())]
+    if report.notes:
+        lines += [""] + [f"- {n}" for n in report.notes]
+    return "\n".join(lines) + "\n"

@@ -1,13 +1,17 @@
 """Bookkeeping of simulated searches: events, where a footprint landed, reachability hooks.
 
-Used by :class:`planner.sim.probe.SimulatedProbe` to report, besides the measured point, what
-happened in each search (the Monte Carlo failure report counts these), and to vet the path a
-search really ran against a :class:`planner.cell.cell.Cell`.
+Used by the simulated sensors (:mod:`planner.sim.probe`, :mod:`planner.sim.touch`) to report,
+besides the measured point, what happened in each search (the report counts these per point,
+with the reason), and to vet the path a search really ran against a
+:class:`planner.cell.cell.Cell`. Landings are judged over the whole footprint against the
+planar faces of the true mesh (:class:`FaceLookup`), so a sensor face partly over a hole or an
+edge is counted with the fraction of its area that is off the face.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import re
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -15,7 +19,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.probing import SearchCommand
-from planner.parts.stator import StatorGeometry
 
 FloatArray = NDArray[np.float64]
 
@@ -38,15 +41,35 @@ def cell_search_hook(cell: Any, step_m: float = 0.002) -> ReachabilityHook:
     return hook
 
 
+#: Searches of the x-offset run (``PX<layer>_<tooth>``) are counted together under this id.
+XOFFSET_GROUP = "PX (x-offset run)"
+_PX = re.compile(r"^PX\d+_\d+$")
+
+
+def search_group(search_id: str) -> str:
+    """The id a search is counted under: its own, or :data:`XOFFSET_GROUP` for the x-offset
+    run's searches."""
+    return XOFFSET_GROUP if _PX.match(search_id) else search_id
+
+
+#: Landing of an approach whose footprint centre is not on the face it was meant for.
+LANDED_OFF_FACE = "landed off its face"
+#: Landing of an approach with part of its footprint over a hole or past an edge of its face.
+PARTLY_OFF_FACE = "footprint partly over a hole or an edge"
+
+
 @dataclass(frozen=True)
 class ProbeEvent:
-    """What happened in one simulated search (for the failure report).
+    """What happened in one simulated search (for the per-point outcome report).
 
     Attributes:
-        point_id: id of the probe point.
+        point_id: the search's id as the procedure names it (``"D"``, a retake ``"D2"``).
         kind: ``"approach"`` or ``"edge"``.
         reason: empty on success, else why the search failed.
-        landing: ``"over slot hole"``, ``"off face"`` or ``""``: where an approach really landed.
+        landing: ``""``, :data:`LANDED_OFF_FACE` or :data:`PARTLY_OFF_FACE`: where an
+            approach really landed.
+        off_fraction: the part of the footprint (sensor face, or the ball's contact) not over
+            the face the point was meant for, 0 to 1.
         travel_m: travel from the start to the event, m (``nan`` on failure).
     """
 
@@ -54,27 +77,41 @@ class ProbeEvent:
     kind: str
     reason: str = ""
     landing: str = ""
+    off_fraction: float = 0.0
     travel_m: float = float("nan")
 
 
-def footprint_landing(
-    geom: StatorGeometry, tcp_wobj_m: FloatArray, axis_wobj: FloatArray, radius_m: float
-) -> str:
-    """Classify where a sensor footprint lies on the true part (wobj of the true part).
+@dataclass(frozen=True)
+class FaceLookup:
+    """Where a simulated footprint landed: the planar faces of the true part.
 
-    Returns:
-        ``"over slot hole"`` when the footprint centre is over a hole of the side face,
-        ``"off face"`` when the footprint hangs over an edge of the face it looks at, else ``""``.
+    Attributes:
+        triangle_face: ``(F,)`` planar-face id of each triangle of the part mesh, ``-1`` for
+            triangles on no planar face (:func:`planner.faces.detection.find_planar_faces`).
+        intended: the planar face each search should land on, by the search's id (a plan id,
+            or a role or retake key the procedure names its searches by); searches not listed
+            are not classified.
     """
-    n = -np.asarray(axis_wobj, float)
-    i = int(np.argmax(np.abs(n)))
-    x, y, z = (float(c) for c in tcp_wobj_m)
-    lo = {0: -geom.depth_m, 1: -geom.length_m, 2: -geom.height_m}
-    in_plane = [a for a in range(3) if a != i]
-    coords = {0: x, 1: y, 2: z}
-    if i == 0 and n[0] > 0 and bool(geom.hole_near(y, z)):
-        return "over slot hole"
-    for a in in_plane:
-        if coords[a] + radius_m > 1e-9 or coords[a] - radius_m < lo[a] - 1e-9:
-            return "off face"
-    return ""
+
+    triangle_face: NDArray[np.int64]
+    intended: Mapping[str, int]
+
+    def landing(self, point_id: str, triangles: NDArray[np.int64]) -> tuple[str, float]:
+        """Classify a footprint from the triangles its samples hit (``-1``: nothing).
+
+        The first sample is the footprint's centre (or nearest it); the samples are of equal
+        area, so the fraction of samples off the intended face is that of the footprint.
+
+        Returns:
+            ``(landing, off_fraction)``: ``("", 0.0)`` when the whole footprint is on its face.
+        """
+        want = self.intended.get(point_id, -1)
+        if want < 0 or len(triangles) == 0:
+            return "", 0.0
+        tri = np.asarray(triangles, dtype=np.int64)
+        face = np.where(tri >= 0, self.triangle_face[np.maximum(tri, 0)], -1)
+        off = face != want
+        frac = float(np.mean(off))
+        if bool(off[0]):
+            return LANDED_OFF_FACE, frac
+        return (PARTLY_OFF_FACE, frac) if frac > 0.0 else ("", 0.0)

@@ -1,12 +1,13 @@
 """The sensor registry: which simulated search runs for each sensor model.
 
-A sensor kind is one model struct in :mod:`calib.models` (the plan holds it; it satisfies
-:class:`calib.models.sensor.SensorModel`) plus one simulator here: a class built as
-``Simulator(caster, T_base_wobj_true, rng, sensor=..., robot_error=..., accuracy_field=...,
-geometry=..., reachability=..., edge_inset_m=..., edge_tolerance_m=...)`` that is a
-:data:`calib.probing.Probe` (one commanded search in, a :class:`calib.probing.ProbeResult`
-out) and lists what happened in ``events``. Adding a sensor is a model, a simulator module and
-one entry in :data:`SENSORS`::
+A sensor kind is one model struct in :mod:`calib.models` (the plan holds it, tagged by
+``kind``; it satisfies :class:`calib.models.sensor.SensorModel`) plus one simulator here: a
+class built as ``Simulator(caster, T_base_wobj_true, rng, sensor=..., robot_error=...,
+accuracy_field=..., faces=..., tcp_error_m=..., reachability=..., edge_inset_m=...,
+edge_tolerance_m=...)`` that is a :data:`calib.probing.Probe` (one commanded search in, a
+:class:`calib.probing.ProbeResult` out) and lists what happened in ``events``. Adding a sensor
+is a model, a simulator module and one entry in :data:`SENSORS` (and a member of
+:data:`calib.models.SensorSettings`), as the touch probe went in::
 
     SENSORS["touch"] = SensorKind(
         "touch", TouchProbe, "planner.sim.touch:SimulatedTouchProbe", "ball-tip touch probe"
@@ -18,13 +19,14 @@ Simulators are imported when first used.
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
 from typing import Protocol
 
 from calib.errors import PlanError
 from calib.models.proximity import ProximitySensor
 from calib.models.sensor import SensorModel
+from calib.models.touch import TouchProbe
 from calib.probing import ProbeResult, SearchCommand
 from planner.sim.search_events import ProbeEvent
 
@@ -52,12 +54,15 @@ class SensorKind:
         model: the model struct (in :mod:`calib.models`).
         simulator: ``"module:attr"`` of its simulator class.
         summary: one line for humans.
+        noise_terms: the sensor's noise terms for the sensitivity table: name -> the model's
+            fields that turn the term off (:mod:`planner.sim.sensitivity`).
     """
 
     name: str
     model: type
     simulator: str
     summary: str
+    noise_terms: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
 
     def load(self) -> SimulatorFactory:
         """The simulator class (imports its module)."""
@@ -73,6 +78,21 @@ SENSORS: dict[str, SensorKind] = {
         ProximitySensor,
         "planner.sim.probe:SimulatedProbe",
         "inductive proximity sensor: ray bundle over the face, exponential damping, hysteresis",
+        {"sensor repeatability": {"repeatability_sigma_m": 0.0}},
+    ),
+    "touch": SensorKind(
+        "touch",
+        TouchProbe,
+        "planner.sim.touch:SimulatedTouchProbe",
+        "touch-trigger probe: ball contact on the mesh, radius compensation, pre-travel lobing",
+        {
+            "probe trigger scatter": {"trigger_repeatability_sigma_m": 0.0},
+            "probe pre-travel lobing": {
+                "axial_pretravel_m": 0.0,
+                "side_pretravel_m": 0.0,
+                "lobing_amplitude_m": 0.0,
+            },
+        },
     ),
 }
 

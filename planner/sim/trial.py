@@ -1,101 +1,46 @@
 """One Monte Carlo trial, and the per-process state the trials share (see
-:func:`planner.sim.montecarlo.validate`).
+:func:`planner.sim.montecarlo.simulate`).
 
-A worker process holds one :class:`SimulationSetup` and one ray caster of the part
-(:func:`init_worker`); each trial draws its own misplacement and noise from its own seed
-(:func:`run_trial`), so results do not depend on which process runs which trial.
+A worker process holds one :class:`~planner.sim.setup.SimulationSetup` and one ray caster of
+the part (:func:`init_worker`); each trial draws its own misplacement and noise from its own
+seed (:meth:`TrialRunner.run_trial`), so results do not depend on which process runs which
+trial. A trial runs the plan's procedure from the registry (``ProcedureKind.run``) with the
+simulator registered for the plan's sensor, so every procedure validates the same way; then
+the best fit of the same measurements fed as the procedure is fed
+(:class:`calib.procedures.comparison.FedFit`), and the x-offset run when the plan has one.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-import msgspec
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
 from calib.errors import InputError, ProbeFailedError
-from calib.estimators.best_fit import best_fit
-from calib.estimators.layout import constraint_set
 from calib.frames import motion_between
-from calib.models import AccuracyField, Misplacement, RobotErrorModel
-from calib.models.proximity import ProximitySensor
-from calib.paper.settings import Hultman2013
-from calib.paper.stator_procedure import check_stator_points, run_stator_procedure
-from calib.probing import ProbePoint
-from calib.procedures.hultman2013 import ROLES
-from planner.parts.stator import StatorGeometry
-from planner.sim.probe import ReachabilityHook
+from calib.procedures import procedure_kind
+from calib.procedures.comparison import FedFit
 from planner.sim.raycast import MeshRayCaster
+from planner.sim.search_events import ProbeEvent, ReachabilityHook, search_group
 from planner.sim.sensors import sensor_kind
+from planner.sim.setup import DEFAULT_EDGE_INSET_M, SimulationSetup
+from planner.sim.xoffset import run_xoffset
+
+__all__ = [
+    "DEFAULT_EDGE_INSET_M",
+    "SimulationSetup",
+    "TrialResult",
+    "TrialRunner",
+    "init_worker",
+    "run_chunk_in_worker",
+]
 
 FloatArray = NDArray[np.float64]
-
-#: Edge searches run this far inside the face along the sensor axis by default, m.
-DEFAULT_EDGE_INSET_M = 0.003
-
-
-def default_settings(
-    sensor: ProximitySensor, edge_inset_m: float = DEFAULT_EDGE_INSET_M, **kwargs: Any
-) -> Hultman2013:
-    """A-H settings for a simulation: ``kwargs`` (e.g. ``beta1_rad``) plus, unless given, the
-    sensor's analytic straight-edge offset for ``edge_inset_m`` as ``edge_event_offset_m``.
-
-    Without it F and H are taken where the sensor stops detecting, ~6 mm past the edge with the
-    default sensor, and the WOCS z origin is off by as much.
-    """
-    kwargs.setdefault("edge_event_offset_m", sensor.edge_event_offset_m(edge_inset_m))
-    return Hultman2013(**kwargs)
-
-
-def resolved_settings(
-    settings: Hultman2013, sensor: ProximitySensor, edge_inset_m: float = DEFAULT_EDGE_INSET_M
-) -> Hultman2013:
-    """``settings`` with an unset edge-event offset replaced by the sensor's analytic
-    straight-edge offset at ``edge_inset_m`` (what a robot cell measures once on a reference
-    edge; see :meth:`ProximitySensor.edge_event_offset_m`)."""
-    if settings.edge_event_offset_m is not None:
-        return settings
-    offset = sensor.edge_event_offset_m(edge_inset_m)
-    return msgspec.structs.replace(settings, edge_event_offset_m=offset)
-
-
-@dataclass(frozen=True)
-class SimulationSetup:
-    """Everything a worker needs to run trials (picklable).
-
-    Attributes:
-        points: the nominal probe points A-H, wobj frame.
-        geometry: the stator geometry (for the mesh, slot holes and landings).
-        T_base_wobj_nominal: ``(4, 4)`` the nominal part pose, base frame.
-        sensor: sensor model.
-        robot_error: robot error model.
-        misplacement: part placement tolerance.
-        pivot_wobj_m: ``(3,)`` pivot of the misplacement rotation, nominal wobj, m.
-        accuracy_field: the robot's absolute-accuracy field for this run, or None.
-        settings: settings of the A-H procedure; ``None`` (default): the paper's, with the
-            sensor's analytic straight-edge offset for ``edge_inset_m`` as the known edge offset.
-        edge_inset_m: edge searches run this far inside the face along the sensor axis.
-    """
-
-    points: Mapping[str, ProbePoint]
-    geometry: StatorGeometry
-    T_base_wobj_nominal: FloatArray
-    sensor: ProximitySensor
-    robot_error: RobotErrorModel
-    misplacement: Misplacement
-    pivot_wobj_m: FloatArray
-    accuracy_field: AccuracyField | None = None
-    settings: Hultman2013 | None = None
-    edge_inset_m: float = DEFAULT_EDGE_INSET_M
-    edge_tolerance_m: float = 2e-5
-
-    def __post_init__(self) -> None:
-        if self.settings is None:
-            object.__setattr__(self, "settings", default_settings(self.sensor, self.edge_inset_m))
+#: A trial's seed, or ``(noise seed, position seed)`` for the paper's protocol.
+TrialSeed = np.random.SeedSequence | tuple[np.random.SeedSequence, np.random.SeedSequence]
 
 
 @dataclass(frozen=True)
@@ -103,21 +48,33 @@ class TrialResult:
     """One trial.
 
     Attributes:
-        failure: ``""`` or ``"<point>: <reason>"``.
-        landings: ``"<point>: <landing>"`` of approaches that landed over a hole or off a face.
+        failure: ``""`` or ``"<search>: <reason>"``.
+        searched: the id of every search run, in order.
+        events: the searches that failed or landed off their face (or partly).
         delta_procedure: ``(6,)`` procedure frame error ``(dx, dy, dz, rx, ry, rz)`` in the true
             wobj axes (m, rad); NaN on failure.
-        delta_best_fit: ``(6,)`` the same for the least-squares fit.
+        delta_best_fit: ``(6,)`` the same for the best fit of the same measurements.
+        xoffset_x_m: ``(H,)`` x errors of the slot targets with the x-offset matrix (true wobj
+            axes, m), or ``None`` without an x-offset run (NaN when it failed).
+        xoffset_failure: ``""`` or ``"<search>: <reason>"`` of a failed x-offset run.
     """
 
     failure: str
-    landings: tuple[str, ...]
+    searched: tuple[str, ...]
+    events: tuple[ProbeEvent, ...]
     delta_procedure: FloatArray
     delta_best_fit: FloatArray
+    xoffset_x_m: FloatArray | None = None
+    xoffset_failure: str = ""
+
+    @property
+    def landings(self) -> tuple[str, ...]:
+        """``"<search>: <landing>"`` of the approaches that landed off their face (or partly)."""
+        return tuple(f"{search_group(e.point_id)}: {e.landing}" for e in self.events if e.landing)
 
 
 class TrialRunner:
-    """Runs trials of one setup: holds the part's ray caster and the A-H layout (built once).
+    """Runs trials of one setup: holds the part's ray caster (built once).
 
     Args:
         setup: what every trial shares.
@@ -130,19 +87,26 @@ class TrialRunner:
     def __init__(self, setup: SimulationSetup, mesh: trimesh.Trimesh, cell: Any = None) -> None:
         self.setup = setup
         self.caster = MeshRayCaster(mesh)
-        self.layout = check_stator_points(setup.points)
-        self.constraints = constraint_set([setup.points[k] for k in ROLES])
-        self.cell = cell
+        self.kind = procedure_kind(setup.method)
         self.simulator = sensor_kind(setup.sensor).load()
+        self.fed_fit = FedFit([rp.point for rp in setup.points], setup.edge_offset_m)
+        self.cell = cell
 
-    def run_trial(
-        self, seed: np.random.SeedSequence, reach: ReachabilityHook | None
-    ) -> TrialResult:
-        """One simulated calibration with its own misplacement and noise from ``seed``."""
+    def run_trial(self, seed: TrialSeed, reach: ReachabilityHook | None) -> TrialResult:
+        """One simulated calibration with its own misplacement and noise from ``seed``.
+
+        ``seed`` may be a pair ``(noise, position)``: the misplacement is then drawn from the
+        position seed, so trials that share it see the same part pose (the paper's protocol).
+        """
         setup = self.setup
-        rng = np.random.default_rng(seed)
+        noise_seed, position_seed = seed if isinstance(seed, tuple) else (seed, None)
+        rng = np.random.default_rng(noise_seed)
+        pos_rng = rng if position_seed is None else np.random.default_rng(position_seed)
         T_nom = setup.T_base_wobj_nominal
-        T_true = T_nom @ setup.misplacement.sample(rng, setup.pivot_wobj_m)
+        T_true = T_nom @ setup.misplacement.sample(pos_rng, setup.pivot_wobj_m)
+        tcp_error = (
+            setup.robot_error.sample_tcp_error_m(rng) if setup.robot_error.tcp_sigma_m else None
+        )
         if self.cell is not None and reach is not None:  # the cell's part goes where it really is
             self.cell.move_work_object(self.cell.T_world_base @ T_true)
         probe = self.simulator(
@@ -152,34 +116,41 @@ class TrialRunner:
             sensor=setup.sensor,
             robot_error=setup.robot_error,
             accuracy_field=setup.accuracy_field,
-            geometry=setup.geometry,
+            faces=setup.faces,
+            tcp_error_m=tcp_error,
             reachability=reach,
             edge_inset_m=setup.edge_inset_m,
             edge_tolerance_m=setup.edge_tolerance_m,
         )
         nan6 = np.full(6, np.nan)
-        failure = ""
+        failure = xfail = ""
         d_proc = d_fit = nan6
-        settings = setup.settings
-        assert settings is not None  # set in SimulationSetup.__post_init__
+        x_err: FloatArray | None = None
         try:
-            res = run_stator_procedure(self.layout, T_nom, probe, settings)
-            d_proc = motion_between(T_true, res.T_base_wobj)
-            q = np.array([res.measured_m[k] for k in ROLES])
-            edge = settings.edge_offset_m  # the same known edge offset as the procedure
-            for k in ("F", "H"):
-                q[ROLES.index(k)] -= edge * res.commands[k].direction
-            fit = best_fit(self.constraints, q, T_nom, sigma_m=1e-4)
-            d_fit = motion_between(T_true, fit.T_base_wobj)
+            run = self.kind.run(list(setup.points), T_nom, probe, setup.settings)
+            d_proc = motion_between(T_true, run.T_base_wobj)
+            d_fit = motion_between(T_true, self.fed_fit(run).T_base_wobj)
         except ProbeFailedError as exc:
             failure = f"{exc.point_id}: {exc.reason}"
+            d_proc = d_fit = nan6
         except InputError as exc:  # degenerate measurements: a failed calibration, not a crash
             failure = f"procedure: {exc}"
-        landings = tuple(f"{e.point_id}: {e.landing}" for e in probe.events if e.landing)
-        return TrialResult(failure, landings, d_proc, d_fit)
+            d_proc = d_fit = nan6
+        if setup.xoffset is not None:
+            x_err = np.full(setup.xoffset.targets_wobj[..., 0].size, np.nan)
+            if not failure:
+                try:
+                    x_err = run_xoffset(setup.xoffset, probe, run.T_base_wobj, T_true)[:, 0]
+                except ProbeFailedError as exc:
+                    xfail = f"{exc.point_id}: {exc.reason}"
+                except InputError as exc:
+                    xfail = f"x-offset: {exc}"
+        searched = tuple(e.point_id for e in probe.events)
+        notable = tuple(e for e in probe.events if e.reason or e.landing)
+        return TrialResult(failure, searched, notable, d_proc, d_fit, x_err, xfail)
 
     def run_chunk(
-        self, seeds: list[np.random.SeedSequence], reach: ReachabilityHook | None = None
+        self, seeds: list[TrialSeed], reach: ReachabilityHook | None = None
     ) -> list[TrialResult]:
         """Trials of ``seeds`` in order."""
         return [self.run_trial(s, reach) for s in seeds]
@@ -194,6 +165,6 @@ def init_worker(setup: SimulationSetup, mesh: trimesh.Trimesh) -> None:
     _PROCESS_RUNNER[:] = [TrialRunner(setup, mesh)]
 
 
-def run_chunk_in_worker(seeds: list[np.random.SeedSequence]) -> list[TrialResult]:
+def run_chunk_in_worker(seeds: list[TrialSeed]) -> list[TrialResult]:
     """Run ``seeds`` on this worker process's runner (see :func:`init_worker`)."""
     return _PROCESS_RUNNER[0].run_chunk(seeds)

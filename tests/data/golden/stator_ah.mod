@@ -141,6 +141,91 @@ MODULE WobjcalStatorSectionAh
         RETURN PoseVect(wobjCal.uframe,w);
     ENDFUNC
 
+    ! x-offset run (section 3.2, eq. 13-14): PX over the teeth (pxY) at the levels (pxZ),
+    ! searched along -x of wobjCal with pD's orientation; mxW{(layer-1)*nSlots+slot}
+    ! is the x-offset of each slot hole (mm, wobjCal)
+    CONST num nPxLevels:=2;
+    CONST num nPxTeeth:=21;
+    CONST num pxY{21}:=[-28,-76,-124,-172,-220,-268,-316,-364,-412,-460,-508,-556,-604,-652,-700,-748,-796,-844,-892,-940,-988];
+    CONST num pxZ{2}:=[-25,-100];
+    CONST num nPxStart:=20;
+    CONST num nPxOver:=20;
+    CONST num nSlots:=42;
+    CONST num nLayers:=6;
+    CONST num slotY{42}:=[-16,-40,-64,-88,-112,-136,-160,-184,-208,-232,-256,-280,-304,-328,-352,-376,-400,-424,-448,-472,-496,-520,-544,-568,-592,-616,-640,-664,-688,-712,-736,-760,-784,-808,-832,-856,-880,-904,-928,-952,-976,-1000];
+    CONST num layerZ{6}:=[-25,-40,-55,-70,-85,-100];
+    PERS pos pxMeas{42}:=[[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0]];
+    PERS num mxW{252}:=[0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0];
+
+    ! One x-offset search: level k, tooth l; the point is kept in wobjCal (mm)
+    PROC ProbePX(num k,num l)
+        VAR robtarget pS;
+        VAR robtarget pE;
+        pS:=pD_start;
+        pS.trans:=[nFaceX+nPxStart,pxY{l},pxZ{k}];
+        pE:=pS;
+        pE.trans.x:=nFaceX-nPxOver;
+        MoveJ pS,vApproach,fine,tSensor\WObj:=wobjCal;
+        SearchL\SStop,diSensor,pMeas,pE,vSearch_pD,tSensor\WObj:=wobjCal;
+        pxMeas{(k-1)*nPxTeeth+l}:=pMeas.trans;
+        MoveL pS,vApproach,fine,tSensor\WObj:=wobjCal;
+    ERROR
+        IF ERRNO=ERR_WHLSEARCH OR ERRNO=ERR_SIGSUPSEARCH THEN
+            Fail "x-offset point PX"+NumToStr(k,0)+"_"+NumToStr(l,0)+" not found";
+        ENDIF
+        RAISE;
+    ENDPROC
+
+    ! Eq. 14: x at (y, z) on the plane through PX[k,l], PX[k,l+1], PX[k+1,l], the levels
+    ! and teeth bracketing (y, z) (the end pair outside them: extrapolation)
+    FUNC num XOffsetAt(num y,num z)
+        VAR num k:=1;
+        VAR num l:=1;
+        VAR num sk:=1;
+        VAR num sl:=1;
+        VAR num det;
+        VAR pos p0;
+        VAR pos d1;
+        VAR pos d2;
+        IF pxMeas{nPxTeeth+1}.z<pxMeas{1}.z sk:=-1;
+        FOR m FROM 1 TO nPxLevels DO
+            IF m>1 AND m<nPxLevels AND sk*pxMeas{(m-1)*nPxTeeth+1}.z<=sk*z k:=m;
+        ENDFOR
+        IF pxMeas{(k-1)*nPxTeeth+2}.y<pxMeas{(k-1)*nPxTeeth+1}.y sl:=-1;
+        FOR m FROM 1 TO nPxTeeth DO
+            IF m>1 AND m<nPxTeeth AND sl*pxMeas{(k-1)*nPxTeeth+m}.y<=sl*y l:=m;
+        ENDFOR
+        p0:=pxMeas{(k-1)*nPxTeeth+l};
+        d1:=pxMeas{(k-1)*nPxTeeth+l+1}-p0;
+        d2:=pxMeas{k*nPxTeeth+l}-p0;
+        det:=d1.y*d2.z-d1.z*d2.y;
+        IF Abs(det)<1E-6 Fail "x-offset points span no plane";
+        RETURN p0.x+(y-p0.y)*(d1.x*d2.z-d1.z*d2.x)/det+(z-p0.z)*(d1.y*d2.x-d1.x*d2.y)/det;
+    ENDFUNC
+
+    ! Measure the PX points and fill the x-offset matrix
+    PROC XOffsetRun()
+        FOR k FROM 1 TO nPxLevels DO
+            FOR l FROM 1 TO nPxTeeth DO
+                ProbePX k,l;
+            ENDFOR
+        ENDFOR
+        FOR i FROM 1 TO nLayers DO
+            FOR j FROM 1 TO nSlots DO
+                mxW{(i-1)*nSlots+j}:=XOffsetAt(slotY{j},layerZ{i});
+            ENDFOR
+        ENDFOR
+    ENDPROC
+
+    ! The robot target at a slot hole (section 3.2): its y and z, the x-offset matrix's x
+    ! plus standoff (mm, along wobjCal +x), with pD's orientation, in wobjCal
+    FUNC robtarget SlotTarget(num slot,num layer,num standoff)
+        VAR robtarget t;
+        t:=pD_start;
+        t.trans:=[mxW{(layer-1)*nSlots+slot}+standoff,slotY{slot},layerZ{layer}];
+        RETURN t;
+    ENDFUNC
+
     PROC main()
         ConfJ\On;
         ConfL\On;
@@ -192,6 +277,9 @@ MODULE WobjcalStatorSectionAh
         Require 10;
         ShiftOrigin [1,0,0],measured{10},nFaceX;
         TPWrite "wobjcal: A-H done, wobjCal is the calibrated work object";
+        ! 10: the x-offset run over every second tooth at two slot-hole levels, in the
+        !     calibrated frame, and the x-offset matrix (eq. 13-14)
+        XOffsetRun;
         WriteMeasurements;
     ENDPROC
 

@@ -1,0 +1,88 @@
+"""The accuracy of a plan predicted from the procedure's linearisation, with the same noise.
+
+:func:`predict` runs the plan's procedure (and the best fit fed as it is fed, and the x-offset
+run) against the ideal part at the nominal pose through
+:func:`calib.procedures.linearize.linearize`, and combines the resulting Jacobians with the
+event covariance of every search (:func:`calib.procedures.linearize.event_covariance`: the
+sensor's own noise from :meth:`SensorModel.search_noise`, the robot's repeatability, the TCP
+error). The report puts the resulting intervals beside the simulated ones.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from calib.frames import motion_between
+from calib.probing import Probe
+from calib.procedures import procedure_kind
+from calib.procedures.comparison import FedFit
+from calib.procedures.linearize import event_covariance, linearize
+from planner.sim.setup import SimulationSetup
+from planner.sim.xoffset import run_xoffset
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """Predicted covariances of a plan's calibration.
+
+    Attributes:
+        cov_procedure: ``(6, 6)`` covariance of the procedure's frame error (m, rad).
+        cov_best_fit: ``(6, 6)`` that of the best fit fed as the procedure is fed.
+        xoffset_sigma_m: pooled 1-sigma of the slot targets' x error with the x-offset
+            matrix, metres (NaN without an x-offset run).
+        n_searches: searches of one calibration (with the x-offset run).
+    """
+
+    cov_procedure: FloatArray = field(repr=False)
+    cov_best_fit: FloatArray = field(repr=False)
+    xoffset_sigma_m: float = float("nan")
+    n_searches: int = 0
+
+
+def predict(setup: SimulationSetup, step_m: float = 1e-6) -> Prediction:
+    """Linearise the plan's calibration and propagate the noise figures of ``setup``.
+
+    Raises:
+        InputError: the ideal calibration fails (the plan cannot calibrate even without
+            noise), or the procedure is not smooth around it.
+    """
+    kind = procedure_kind(setup.method)
+    fed = FedFit([rp.point for rp in setup.points], setup.edge_offset_m)
+    T_nom = setup.T_base_wobj_nominal
+    xs = setup.xoffset.with_holes(setup.xoffset.targets_wobj) if setup.xoffset else None
+
+    def run(probe: Probe) -> dict[str, FloatArray]:
+        res = kind.run(list(setup.points), T_nom, probe, setup.settings)
+        out = {
+            "procedure": motion_between(T_nom, res.T_base_wobj),
+            "best_fit": motion_between(T_nom, fed(res).T_base_wobj),
+        }
+        if xs is not None:
+            out["xoffset"] = run_xoffset(xs, probe, res.T_base_wobj, T_nom)[:, 0]
+        return out
+
+    gain = (
+        setup.sensor.search_noise("edge", setup.edge_inset_m).axis_gain
+        if setup.sensor.runs_edge_searches
+        else 0.0
+    )
+    lin = linearize(run, T_nom, setup.edge_offset_m, step_m, gain)
+    noise = [setup.sensor.search_noise(c.kind, setup.edge_inset_m) for c in lin.commands]
+    C = event_covariance(
+        lin.commands, noise, setup.robot_error.repeatability_sigma_m, setup.robot_error.tcp_sigma_m
+    )
+    x_sigma = float("nan")
+    if xs is not None:
+        var = np.diag(lin.covariance("xoffset", C))
+        x_sigma = float(np.sqrt(max(float(np.mean(var)), 0.0)))
+    return Prediction(
+        cov_procedure=lin.covariance("procedure", C),
+        cov_best_fit=lin.covariance("best_fit", C),
+        xoffset_sigma_m=x_sigma,
+        n_searches=len(lin.commands),
+    )

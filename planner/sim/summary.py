@@ -1,0 +1,233 @@
+"""From trial results to the report's rows and per-point outcomes.
+
+:func:`build_rows` turns each estimator's frame errors (and predicted covariance) into the
+report's :class:`~planner.sim.report.IntervalRow` s (:mod:`planner.sim.rows` has what each row
+measures); :func:`point_outcomes` counts every search by its id, with the reason of a failure
+and the landing of an approach (the x-offset run's searches pooled under one id).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections import Counter
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from calib.stats import confidence_intervals
+from planner.sim.predict import Prediction
+from planner.sim.report import IntervalRow, PointOutcome, ValidationReport
+from planner.sim.report_points import XOFFSET_KEYS
+from planner.sim.rows import SCALE, RowSpec, predicted_sigma, samples_and_bias
+from planner.sim.search_events import (
+    LANDED_OFF_FACE,
+    PARTLY_OFF_FACE,
+    ProbeEvent,
+    search_group,
+)
+from planner.sim.setup import SimulationSetup
+from planner.sim.trial import TrialResult
+
+FloatArray = NDArray[np.float64]
+
+#: What the linear prediction leaves out (a note of every report).
+PREDICTION_NOTE = (
+    "predicted: the procedure linearised around the ideal part at the nominal pose, with the "
+    "sensor, robot-repeatability and TCP noise above; it leaves out what depends on where the "
+    "misplaced part puts a search (holes and edges under the footprint, the stator's bulge), "
+    "the sensor's response to tilted faces, the ray bundle's quantisation of edge events, and "
+    "the robot's accuracy field"
+)
+
+
+def point_outcomes(searched: list[str], events: list[ProbeEvent]) -> tuple[PointOutcome, ...]:
+    """Per-point outcomes from every search's id (in order) and the notable events (the
+    x-offset run's searches pooled, :func:`search_group`)."""
+    searched = [search_group(s) for s in searched]
+    events = [dataclasses.replace(e, point_id=search_group(e.point_id)) for e in events]
+    order = list(dict.fromkeys(searched))
+    count: dict[str, int] = {}
+    for pid in searched:
+        count[pid] = count.get(pid, 0) + 1
+    out = []
+    for pid in order:
+        mine = [e for e in events if e.point_id == pid]
+        failed: dict[str, int] = {}
+        for e in mine:
+            if e.reason:
+                failed[e.reason] = failed.get(e.reason, 0) + 1
+        partly = [e.off_fraction for e in mine if e.landing == PARTLY_OFF_FACE]
+        out.append(
+            PointOutcome(
+                point_id=pid,
+                searches=count[pid],
+                failed=failed,
+                landed_off=sum(1 for e in mine if e.landing == LANDED_OFF_FACE),
+                partly_off=len(partly),
+                off_fraction_mean=float(np.mean(partly)) if partly else 0.0,
+                off_fraction_max=float(np.max(partly)) if partly else 0.0,
+            )
+        )
+    return tuple(out)
+
+
+def _half_widths(samples: FloatArray, unit: str, levels: tuple[float, ...]) -> list[float]:
+    if len(samples) < 2 or not np.all(np.isfinite(samples)):
+        return [float("nan")] * len(levels)
+    si: Literal["m", "rad"] = "rad" if unit == "deg" else "m"
+    table = confidence_intervals(samples, "row", si, [lv / 100.0 for lv in levels])
+    return [r.half_width for r in table.rows]
+
+
+def _z(levels: tuple[float, ...]) -> FloatArray:
+    from scipy.special import ndtri
+
+    return np.asarray(ndtri(0.5 + np.asarray(levels) / 200.0), dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class RowInputs:
+    """What one estimator contributes to a row.
+
+    Attributes:
+        delta: ``(n, 6)`` frame errors of the trials that calibrated (m, rad).
+        cov: ``(6, 6)`` predicted covariance of the frame error.
+        point_errors: per row key, ``(n, M, 3)`` point errors that are not those of ``delta``
+            (e.g. x-offset corrected targets), with their predicted sigma (SI), or absent.
+        protocol_delta: ``(n', 6)`` frame errors under the paper's protocol, centred on each
+            position's mean, or None.
+    """
+
+    delta: FloatArray
+    cov: FloatArray
+    point_errors: Mapping[str, tuple[FloatArray, float]] = field(default_factory=dict)
+    protocol_delta: FloatArray | None = None
+
+
+def build_rows(
+    specs: list[RowSpec],
+    procedure: RowInputs,
+    best_fit: RowInputs,
+    paper: Mapping[tuple[str, float], float] | None = None,
+) -> tuple[tuple[IntervalRow, ...], dict[str, FloatArray], dict[str, FloatArray]]:
+    """The report's rows and the samples of each (procedure, best fit)."""
+    rows: list[IntervalRow] = []
+    samples: list[dict[str, FloatArray]] = [{}, {}]
+    nan = float("nan")
+    for spec in specs:
+        scale = SCALE[spec.unit]
+        z = _z(spec.levels_percent)
+        per: list[tuple[list[float], list[float], float, list[float]]] = []
+        for k, inp in enumerate((procedure, best_fit)):
+            levels = spec.levels_percent
+            extra = inp.point_errors.get(spec.key)
+            if len(inp.delta) >= 2:
+                s, bias = samples_and_bias(spec, inp.delta, None if extra is None else extra[0])
+            else:
+                s, bias = np.zeros(0), nan
+            samples[k][spec.key] = s
+            sigma = extra[1] if extra is not None else predicted_sigma(spec, inp.cov)
+            proto = [nan] * len(levels)
+            if inp.protocol_delta is not None and extra is None and len(inp.protocol_delta) >= 2:
+                proto = _half_widths(
+                    samples_and_bias(spec, inp.protocol_delta)[0], spec.unit, levels
+                )
+            per.append((_half_widths(s, spec.unit, levels), list(z * sigma), bias, proto))
+        for i, level in enumerate(spec.levels_percent):
+            (hp, pp, bp, qp), (hf, pf, bf, qf) = per
+            rows.append(
+                IntervalRow(
+                    key=spec.key,
+                    label=spec.label,
+                    unit=spec.unit,
+                    level_percent=level,
+                    procedure=hp[i] * scale,
+                    procedure_predicted=pp[i] * scale,
+                    procedure_bias=bp * scale,
+                    best_fit=hf[i] * scale,
+                    best_fit_predicted=pf[i] * scale,
+                    best_fit_bias=bf * scale,
+                    paper=(paper or {}).get((spec.key, level), nan),
+                    procedure_protocol=qp[i] * scale,
+                    best_fit_protocol=qf[i] * scale,
+                )
+            )
+    return tuple(rows), samples[0], samples[1]
+
+
+def build_report(
+    setup: SimulationSetup,
+    results: list[TrialResult],
+    proto: list[TrialResult],
+    protocol: tuple[int, int] | None,
+    rows: list[RowSpec],
+    prediction: Prediction,
+    paper: Mapping[tuple[str, float], float] | None,
+    elapsed: float,
+    n_workers: int,
+    n_reach: int,
+) -> ValidationReport:
+    """The report of a run: rows of the main trials (and of the protocol's, centred on each
+    position's mean), outcomes and failures of all, the prediction beside them."""
+    dp = np.array([r.delta_procedure for r in results]).reshape(-1, 6)
+    df = np.array([r.delta_best_fit for r in results]).reshape(-1, 6)
+    ok = np.all(np.isfinite(dp), axis=1) & np.all(np.isfinite(df), axis=1)
+    extra_p: dict[str, tuple[FloatArray, float]] = {}
+    extra_f: dict[str, tuple[FloatArray, float]] = {}
+    if setup.xoffset is not None:
+        x = np.array([r.xoffset_x_m for r in results], dtype=np.float64)[ok]
+        e = np.zeros((*x.shape, 3))
+        e[..., 0] = x
+        extra_p[XOFFSET_KEYS[1]] = (e, prediction.xoffset_sigma_m)
+        extra_f[XOFFSET_KEYS[1]] = (np.full_like(e, np.nan), float("nan"))
+    centred = [None, None]
+    if proto and protocol is not None:
+        for k, attr in enumerate(("delta_procedure", "delta_best_fit")):
+            d = np.array([getattr(r, attr) for r in proto]).reshape(protocol[0], protocol[1], 6)
+            good = np.all(np.isfinite(d), axis=2)
+            mean = np.array(
+                [
+                    d[i][good[i]].mean(axis=0) if good[i].any() else np.zeros(6)
+                    for i in range(len(d))
+                ]
+            )
+            centred[k] = (d - mean[:, None, :])[good]
+    table, sp, sf = build_rows(
+        rows,
+        RowInputs(dp[ok], prediction.cov_procedure, extra_p, centred[0]),
+        RowInputs(df[ok], prediction.cov_best_fit, extra_f, centred[1]),
+        paper,
+    )
+    all_results = results + proto
+    failures = Counter(r.failure for r in all_results if r.failure)
+    failures.update(f"x-offset {r.xoffset_failure}" for r in all_results if r.xoffset_failure)
+    landings = Counter(item for r in all_results for item in r.landings)
+    outcomes = point_outcomes(
+        [pid for r in all_results for pid in r.searched],
+        [e for r in all_results for e in r.events],
+    )
+    return ValidationReport(
+        n_trials=len(results),
+        n_ok=int(ok.sum()),
+        rows=table,
+        samples_procedure=sp,
+        samples_best_fit=sf,
+        delta_procedure=dp[ok],
+        delta_best_fit=df[ok],
+        failures=dict(failures),
+        landings=dict(landings),
+        elapsed_s=elapsed,
+        workers=n_workers,
+        reach_checked=n_reach,
+        method=setup.method,
+        sensor=str(type(setup.sensor).KIND),
+        outcomes=outcomes,
+        predicted_cov_procedure=prediction.cov_procedure,
+        predicted_cov_best_fit=prediction.cov_best_fit,
+        noise=setup.noise_figures,
+        protocol="" if protocol is None else f"{protocol[0]} positions x {protocol[1]} repeats",
+        notes=(PREDICTION_NOTE,),
+    )
