@@ -205,7 +205,7 @@ def preflight(plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh) -> No
     from planner.faces.checks import plan_face_reasons
 
     probes = [p.to_probe_point() for p in plan.points]
-    r = models.sensor.footprint_radius_m
+    r = max(float(models.sensor.footprint_radius_m), 1e-4)  # a point sensor: a tiny disk
     why = {
         p.id: f"not on a planar face: {reason}"
         for p, reason in zip(

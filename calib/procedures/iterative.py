@@ -57,7 +57,7 @@ class Iterative(
             model's value, ``wobjcal calibrate`` 0).
     """
 
-    tolerance_m: float = 1e-4
+    tolerance_m: float = 5e-4
     max_rounds: int = 5
     edge_event_offset_m: float | None = None
 

@@ -47,9 +47,10 @@ class PlaneProbe:
     onto the true part), an edge search ``edge_offset_m`` further (where the sensor reports the
     edge), and the ``j``-th search's event moves by ``eps[j]`` along its direction.
 
-    An edge search's event also moves with its track's standoff (``edge_axis_gain`` metres
-    per metre the track runs closer to the face it slides over than commanded): a track
-    commanded in an estimate whose face plane is off runs closer or farther.
+    An edge search's event also moves with its track's standoff where it crosses the edge
+    (``edge_axis_gain`` metres per metre the track runs closer to the face it slides over than
+    commanded): a track commanded in an estimate whose face plane is off, or tilted, runs
+    closer or farther there.
 
     Args:
         T_base_wobj_true: ``(4, 4)`` where the part is, base frame.
@@ -79,9 +80,9 @@ class PlaneProbe:
             return ProbeResult(None, "search runs parallel to the face that should stop it")
         start = np.asarray(cmd.start_m, dtype=np.float64)
         t = float((p - start) @ m) / denom
-        if cmd.kind == "edge":
+        if cmd.kind == "edge":  # the track's standoff where it crosses the edge
             face_n = -(T_move[:3, :3] @ np.asarray(cmd.sensor_axis, dtype=np.float64))
-            closer = -float((np.asarray(cmd.start_m, dtype=np.float64) - p) @ face_n)
+            closer = -float((start + t * d - p) @ face_n)
             t += self.edge_offset_m + self.edge_axis_gain * closer
         t += float(self.eps.get(j, 0.0))
         return ProbeResult(start + t * d, travel_m=t)

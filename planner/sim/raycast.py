@@ -139,6 +139,10 @@ class MeshRayCaster:
         """``(3,)`` unit normal of a triangle, mesh frame (float64)."""
         return self._normals[triangle].copy()
 
+    def triangle_vertices(self, triangle: int) -> FloatArray:
+        """``(3, 3)`` the corners of a triangle, mesh frame (float64)."""
+        return self._triangles[triangle]
+
     def triangle_offset(self, triangle: int) -> float:
         """Plane offset ``d`` of a triangle: its plane is ``normal . x = d``, metres."""
         return float(self._offsets[triangle])

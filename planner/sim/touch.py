@@ -3,18 +3,19 @@
 A :data:`calib.probing.Probe` for :class:`calib.models.touch.TouchProbe`. The robot moves the
 TCP (the ball's pole) along the commanded approach, off by its repeatability, accuracy field
 and TCP error (:func:`planner.sim.probe.robot_offset`). Rays cast along the approach from the
-ball's front half find the first triangle the ball meets; the contact is then solved exactly
-against that triangle's plane (the sphere touches the plane when its centre is one radius
-away) as long as the tangent point lies on the same planar face, else (an edge or a hole rim)
-the sampled contact is kept. The probe triggers after the pre-travel left over from axial
-qualification for that contact's direction (lobing) plus the trigger's scatter, and the
-program compensates the ball radius along the face normal of the estimate the search was
-commanded in (``calib.models.touch``); that compensated point is returned.
+ball's front half find the triangles the ball meets first; the contact is then solved exactly
+for the sweeping ball against each of them (:func:`sweep_contact`: its face when the tangent
+point lies inside it, else an edge or a corner, e.g. a hole's rim or the face's end). The
+probe triggers after the pre-travel left over from axial qualification for that contact's
+direction (lobing) plus the trigger's scatter, and the program compensates the ball radius
+along the face normal of the estimate the search was commanded in (``calib.models.touch``);
+that compensated point is returned.
 
 Failures are reasons, never numbers: no contact within the search length, the ball already
 inside the part at the start, an edge search (a touch probe cannot run one), or an unreachable
 commanded path (reachability hook). Every approach's landing is judged over the ball's
-silhouette against the planar faces of the part.
+silhouette against the planar faces of the part, and a ball that meets an edge or another face
+first is counted as landed off its face.
 """
 
 from __future__ import annotations
@@ -31,12 +32,9 @@ from calib.models.touch import TouchProbe
 from calib.probing import ProbeResult, SearchCommand
 from planner.sim.probe import robot_offset
 from planner.sim.raycast import MeshRayCaster
-from planner.sim.search_events import FaceLookup, ProbeEvent, ReachabilityHook
+from planner.sim.search_events import LANDED_OFF_FACE, FaceLookup, ProbeEvent, ReachabilityHook
 
 FloatArray = NDArray[np.float64]
-
-#: The tangent point is checked by a ray started this far before it, m.
-_CHECK_LIFT_M = 1e-3
 
 
 @dataclass
@@ -97,17 +95,15 @@ class SimulatedTouchProbe:
         a = R @ axis
         origins = centre0 + self.sensor.front_points_m(a)
         dist, tri = self.caster.first_hits_ids(origins, np.broadcast_to(a, origins.shape))
+        length = float(cmd.length_m)
         if np.any(dist <= 0.0):
             return self._fail(cmd, "stylus ball inside the part at start")
-        k = int(np.argmin(dist))
-        travel = float(dist[k])
-        length = float(cmd.length_m)
-        if not math.isfinite(travel):
+        if not np.any(np.isfinite(dist)):
             return self._fail(cmd, f"no contact within {length * 1e3:.0f} mm")
-        normal = self.caster.triangle_normal(int(tri[k]))
-        exact = self._plane_contact(centre0, a, int(tri[k]), normal)
-        if exact is not None:
-            travel = exact
+        # the exact first contact of the sweeping ball with the triangles the rays met near
+        # the first hit: a face (tangent point inside it), an edge or a corner
+        near = np.unique(tri[np.isfinite(dist) & (dist <= float(dist.min()) + r)])
+        travel, normal, on_face_of = sweep_contact(self.caster, centre0, a, r, near)
         if travel <= 0.0:
             return self._fail(cmd, "stylus ball touching the part at start")
         normal_base = R.T @ normal  # the lobes turn with the probe: its tool frame is in base
@@ -121,6 +117,11 @@ class SimulatedTouchProbe:
             if why:
                 return self._fail(cmd, why)
         landing, frac = ("", 0.0) if self.faces is None else self.faces.landing(cmd.point_id, tri)
+        if self.faces is not None and not landing:
+            want = self.faces.intended.get(cmd.point_id, -1)
+            face = self.faces.triangle_face[on_face_of] if on_face_of >= 0 else -1
+            if want >= 0 and face != want:  # the ball met an edge or another face first
+                landing = LANDED_OFF_FACE
         self.events.append(
             ProbeEvent(cmd.point_id, cmd.kind, landing=landing, off_fraction=frac, travel_m=travel)
         )
@@ -129,26 +130,61 @@ class SimulatedTouchProbe:
         point = pole - r * axis - r * n_est  # ball centre, then one radius along the normal
         return ProbeResult(point_m=point, travel_m=travel)
 
-    def _plane_contact(
-        self, centre0: FloatArray, a: FloatArray, triangle: int, normal: FloatArray
-    ) -> float | None:
-        """Travel at which the ball touches the plane of ``triangle`` (part frame), when its
-        tangent point lies on the same planar face (else ``None``: an edge or rim contact)."""
-        cos = float(a @ normal)
-        if cos > -1e-9:
-            return None
-        gap = float(normal @ centre0) - self.caster.triangle_offset(triangle) - self.sensor.radius_m
-        travel = gap / -cos
-        tangent = centre0 + travel * a - self.sensor.radius_m * normal
-        lift = tangent - _CHECK_LIFT_M * a
-        d, hit = self.caster.first_hits_ids(lift[None], a[None])
-        if not abs(float(d[0]) - _CHECK_LIFT_M) <= 1e-7:
-            return None
-        if self.faces is None:
-            same = int(hit[0]) == triangle or bool(
-                np.allclose(self.caster.triangle_normal(int(hit[0])), normal, atol=1e-9)
+
+def sweep_contact(
+    caster: MeshRayCaster,
+    centre0: FloatArray,
+    a: FloatArray,
+    r: float,
+    triangles: NDArray[np.int64],
+) -> tuple[float, FloatArray, int]:
+    """First contact of a ball of radius ``r`` moving from ``centre0`` along unit ``a`` with
+    ``triangles`` (mesh frame): ``(travel, contact normal, triangle)``.
+
+    Each triangle is met at its face (the tangent point inside it), an edge or a corner,
+    whichever comes first; the normal points from the contact to the ball's centre. The
+    triangle is returned when the contact is on its face, else ``-1`` (an edge or corner).
+    """
+    best = (math.inf, -a, -1)
+    for k in triangles:
+        n = caster.triangle_normal(int(k))
+        v = caster.triangle_vertices(int(k))
+        cos = float(a @ n)
+        if cos < -1e-12:  # the face, when the tangent point falls inside the triangle
+            tt = (float(n @ centre0) - caster.triangle_offset(int(k)) - r) / -cos
+            q = centre0 + tt * a - r * n
+            if tt < best[0] and _inside(q, v, n):
+                best = (tt, n, int(k))
+        for i in range(3):  # the edges and corners
+            p, e = v[i], v[(i + 1) % 3] - v[i]
+            length = float(np.linalg.norm(e))
+            e = e / length
+            u = centre0 - p
+            u_perp, a_perp = u - (u @ e) * e, a - (a @ e) * e
+            tt = _first_root(
+                float(a_perp @ a_perp), float(u_perp @ a_perp), float(u_perp @ u_perp) - r * r
             )
-        else:
-            faces = self.faces.triangle_face
-            same = int(hit[0]) >= 0 and faces[int(hit[0])] == faces[triangle] >= 0
-        return travel if same else None
+            if tt < best[0]:
+                s = float((centre0 + tt * a - p) @ e)
+                if 0.0 <= s <= length:
+                    c = centre0 + tt * a
+                    best = (tt, (c - p - s * e) / r, -1)
+            tt = _first_root(1.0, float(u @ a), float(u @ u) - r * r)
+            if tt < best[0]:
+                best = (tt, (centre0 + tt * a - p) / r, -1)
+    return best[0], np.asarray(best[1], dtype=np.float64), best[2]
+
+
+def _first_root(A: float, half_b: float, c: float) -> float:
+    """Smaller root of ``A t^2 + 2 half_b t + c = 0`` (``inf`` when none, or A is 0)."""
+    if A <= 1e-18:
+        return math.inf
+    disc = half_b * half_b - A * c
+    if disc < 0.0:
+        return math.inf
+    return (-half_b - math.sqrt(disc)) / A
+
+
+def _inside(q: FloatArray, v: FloatArray, n: FloatArray) -> bool:
+    """True when ``q`` (in the triangle's plane) lies inside triangle ``v`` ``(3, 3)``."""
+    return all(float(np.cross(v[(i + 1) % 3] - v[i], q - v[i]) @ n) >= -1e-12 for i in range(3))

@@ -1,0 +1,62 @@
+"""The best fit fed as the procedure is fed (calib.procedures.comparison)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from calib.estimators.layout import constraint_set, search_constraint_set
+from calib.frames import make_transform, matrix_from_rotvec, motion_between
+from calib.paper.stator_layout import example_stator_points
+from calib.procedures import HULTMAN2013, RolePoint
+from calib.procedures.base import ProcedureRun
+from calib.procedures.comparison import FedFit, last_measurements
+from tests.box_part import BoxProbe
+
+T_NOM = make_transform(None, [1.0, 0.2, 0.5])
+T_TRUE = T_NOM @ make_transform(matrix_from_rotvec([0.01, -0.02, 0.015]), [0.004, -0.006, 0.003])
+AH = example_stator_points()
+
+
+def test_retakes_replace_the_first_measurements() -> None:
+    run = ProcedureRun(
+        np.eye(4), ("C",), {"C": np.zeros(3), "C#2": np.ones(3), "D": np.full(3, 2.0)}
+    )
+    last = last_measurements(run, ["C", "D", "E"])
+    assert set(last) == {"C", "D"} and np.all(last["C"] == 1.0) and np.all(last["D"] == 2.0)
+
+
+def test_an_edge_search_counts_by_its_edge_coordinate_only() -> None:
+    pts = list(AH.values())
+    both, edge_only = constraint_set(pts), search_constraint_set(pts)
+    assert both.n_constraints == 10 and edge_only.n_constraints == 8
+    f = [i for i, pid in enumerate(edge_only.constraint_ids) if pid == "F"]
+    np.testing.assert_allclose(edge_only.normals[f], [[0.0, 0.0, 1.0]])
+
+
+def test_fed_fit_of_the_a_h_run_finds_the_part() -> None:
+    """On an ideal box the fit of A-H's own measurements (retakes last, F and H by z only)
+    finds the true frame, and moving F's recorded point across the face changes nothing."""
+    pts = [RolePoint(r, p) for r, p in AH.items()]
+    run = HULTMAN2013.run(pts, T_NOM, BoxProbe(T_TRUE), None)
+    fed = FedFit(list(AH.values()))
+    assert np.abs(motion_between(T_TRUE, fed(run).T_base_wobj)).max() < 1e-9
+    moved = dict(run.measured_m)
+    moved["F"] = moved["F"] + T_TRUE[:3, 0] * 0.003  # 3 mm off the side face: unmeasured
+    again = fed(ProcedureRun(run.T_base_wobj, run.used_ids, moved))
+    assert np.abs(motion_between(T_TRUE, again.T_base_wobj)).max() < 1e-9
+    # ... while C's first measurement moved changes nothing either: C2 is used
+    moved = dict(run.measured_m)
+    moved["C"] = moved["C"] + T_TRUE[:3, 1] * 0.002
+    again = fed(ProcedureRun(run.T_base_wobj, run.used_ids, moved))
+    assert np.abs(motion_between(T_TRUE, again.T_base_wobj)).max() < 1e-9
+
+
+def test_edge_offset_is_removed_along_the_search() -> None:
+    pts = [RolePoint(r, p) for r, p in AH.items()]
+    run = HULTMAN2013.run(pts, T_NOM, BoxProbe(T_TRUE), None)
+    shifted = dict(run.measured_m)
+    for k in ("F", "H"):
+        shifted[k] = shifted[k] + 0.006 * T_TRUE[:3, 2]  # reported 6 mm past the edge
+    fit = FedFit(list(AH.values()), edge_offset_m=0.006)
+    res = fit(ProcedureRun(run.T_base_wobj, run.used_ids, shifted))
+    assert np.abs(motion_between(T_TRUE, res.T_base_wobj)).max() < 1e-9
