@@ -351,7 +351,7 @@ def _setup(plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh) -> Simul
     xs = None
     if xo is not None and models.geometry is not None:
         g = models.geometry
-        grid = xo.grid()
+        grid = xo.grid
         y, z = np.meshgrid(grid.slot_y_m, grid.layer_z_m, indexing="xy")  # (layers, slots)
         if not np.all(g.hole_near(y, z)):
             raise PlanError(

@@ -44,7 +44,7 @@ def test_x_offset_matrix_and_slot_targets_match_the_python_of_eq_14() -> None:
     m.globals["wobjCal"] = m.globals["wobjNominal"]  # the frame after A-H: here the nominal
     m.call("XOffsetRun", [])
     run = plan.procedure.xoffset  # type: ignore[union-attr]
-    grid = run.grid()
+    grid = run.grid
     px = np.array([[p.f["x"], p.f["y"], p.f["z"]] for p in m.globals["pxMeas"]]) / 1e3
     px = px.reshape(2, 21, 3)
     assert np.allclose(px[..., 0], c + a * px[..., 1] + b * px[..., 2], atol=1e-9)

@@ -151,7 +151,7 @@ def min_norm_update(
         step = -np.linalg.pinv(J, rcond=1e-9) @ r
         w = step[3:] / L
         T = T @ small_motion_matrix(np.concatenate([step[:3] - cross_rows(w, c), w]))
-        if float(np.max(np.abs(step))) < 1e-11:  # 0.01 nm: it only steers the next search
+        if float(np.max(np.abs(step))) < 1e-9:  # 1 nm: the estimate only steers the next search
             break
     return T
 

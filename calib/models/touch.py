@@ -71,7 +71,7 @@ class TouchProbe(Strict, frozen=True, kw_only=True, tag="touch", tag_field="kind
     lobing_amplitude_m: float = 0.000002
     lobing_phase_rad: float = 0.0
     trigger_repeatability_sigma_m: float = 0.0000005
-    n_rays: int = 241
+    n_rays: int = 121
 
     def __post_init__(self) -> None:
         check_positive(self.tip_diameter_m, "tip_diameter_m")

@@ -13,7 +13,7 @@ import msgspec
 
 from calib.errors import PlanError
 from calib.paper.xoffset import SlotGrid
-from calib.structs import Strict, check_count, check_positive
+from calib.structs import Strict, check_positive
 
 
 class XOffsetRun(Strict, frozen=True, kw_only=True):
@@ -24,12 +24,7 @@ class XOffsetRun(Strict, frozen=True, kw_only=True):
     hole (:func:`calib.paper.xoffset.xoffset_matrix`), which the slot targets then use.
 
     Attributes:
-        n_slots: slots (columns) of the side face the robot works on.
-        n_layers: slot-hole layers (rows).
-        first_slot_y_m: y of slot 1, wobj frame, metres.
-        first_layer_z_m: z of layer 1, wobj frame, metres.
-        slot_step_y_m: signed y step from one slot to the next, metres.
-        layer_step_z_m: signed z step from one layer to the next, metres.
+        grid: the slot holes of the side face the robot works on (WOCS).
         layers: 1-based layers whose level the measurements are taken at (default: the first
             and the last, the paper's "two different slot hole levels").
         teeth: teeth measured over (tooth t lies between slots t and t + 1; default every
@@ -38,29 +33,18 @@ class XOffsetRun(Strict, frozen=True, kw_only=True):
         overtravel_m: allowed travel past the calibrated face, metres.
     """
 
-    n_slots: int
-    n_layers: int
-    first_slot_y_m: float
-    first_layer_z_m: float
-    slot_step_y_m: float
-    layer_step_z_m: float
+    grid: SlotGrid
     layers: tuple[int, ...] | None = None
     teeth: tuple[int, ...] | None = None
     start_offset_m: float = 0.020
     overtravel_m: float = 0.020
 
     def __post_init__(self) -> None:
-        check_count(self.n_slots, "n_slots", minimum=2)
-        check_count(self.n_layers, "n_layers", minimum=2)
         check_positive(self.start_offset_m, "start_offset_m")
         check_positive(self.overtravel_m, "overtravel_m")
-        try:
-            grid = self.grid()
-        except ValueError as exc:
-            raise PlanError(f"{str(exc).removeprefix('grid.')}") from None
         for field, values, check in (
-            ("layers", self.layers, lambda v: grid.check_slot(1, v)),
-            ("teeth", self.teeth, grid.tooth_y_m),
+            ("layers", self.layers, lambda v: self.grid.check_slot(1, v)),
+            ("teeth", self.teeth, self.grid.tooth_y_m),
         ):
             if values is not None and len(set(values)) < 2:
                 raise PlanError(f"{field}: needs at least 2 distinct values, got {list(values)}")
@@ -69,17 +53,6 @@ class XOffsetRun(Strict, frozen=True, kw_only=True):
                     check(v)
                 except ValueError as exc:
                     raise PlanError(f"{field}: {exc}") from None
-
-    def grid(self) -> SlotGrid:
-        """The slot grid of :mod:`calib.paper.xoffset`."""
-        return SlotGrid(
-            n_slots=self.n_slots,
-            n_layers=self.n_layers,
-            first_slot_y_m=self.first_slot_y_m,
-            first_layer_z_m=self.first_layer_z_m,
-            slot_step_y_m=self.slot_step_y_m,
-            layer_step_z_m=self.layer_step_z_m,
-        )
 
 
 class Hultman2013(

@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import math
 import numbers
-from dataclasses import dataclass
 
+import msgspec
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -48,9 +48,10 @@ def _finite(value: object, name: str) -> float:
     return x
 
 
-@dataclass(frozen=True)
-class SlotGrid:
+class SlotGrid(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     """Where the slot holes lie on the stator side face (the WOCS plane ``x = 0``).
+
+    A plan holds it in its x-offset run (``procedure.xoffset.grid``).
 
     Slot ``j`` (1-based) of layer ``i`` (1-based) has its centre at
     ``(0, first_slot_y_m + (j - 1) * slot_step_y_m, first_layer_z_m + (i - 1) * layer_step_z_m)``

@@ -11,14 +11,19 @@ Owns:
     - the registry :data:`PROCEDURES`, the settings union :data:`ProcedureSettings` and
       :func:`procedure_kind`.
 
+Also: :mod:`calib.procedures.comparison` (the best fit of a procedure's own measurements, fed
+as the procedure is fed) and :mod:`calib.procedures.linearize` (the predicted covariance of any
+procedure, from its own run against the ideal part).
+
 Every caller (the plan file, ``wobjcal calibrate``, the validation, the exporters, the UI)
 looks a procedure up here; none tests the method's name. Adding a procedure is one module
 (a settings struct tagged ``method="<name>"`` and a class following the protocol) plus its entry
-in :data:`PROCEDURES` and in the :data:`ProcedureSettings` union::
+in :data:`PROCEDURES` and in the :data:`ProcedureSettings` union, as the iterative best fit went
+in::
 
     # calib/procedures/iterative.py: class Iterative(msgspec.Struct, tag="iterative", ...)
     #                                ITERATIVE = IterativeProcedure()
-    PROCEDURES["iterative"] = ITERATIVE
+    PROCEDURES = {k.method: k for k in (HULTMAN2013, THREE_TWO_ONE, BEST_FIT, ITERATIVE)}
     ProcedureSettings = Hultman2013 | ThreeTwoOne | BestFit | Iterative
 """
 

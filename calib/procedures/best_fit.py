@@ -72,13 +72,13 @@ class BestFitProcedure:
         if problem or not complete:
             return problem
         if sum(r == ROLE for r in roles) < MIN_POINTS:
-            return f"points: best_fit needs at least {MIN_POINTS} points, got {len(roles)}"
+            return f"points: {self.method} needs at least {MIN_POINTS} points, got {len(roles)}"
         return ""
 
     def assign(self, points: Sequence[RolePoint]) -> list[RolePoint]:
         """Every point, with the role ``fit``."""
         if len(points) < MIN_POINTS:
-            raise PlanError(f"best_fit needs at least {MIN_POINTS} points, got {len(points)}")
+            raise PlanError(f"{self.method} needs at least {MIN_POINTS} points, got {len(points)}")
         return [RolePoint(ROLE, rp.point) for rp in points]
 
     def run(

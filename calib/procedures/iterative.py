@@ -19,7 +19,6 @@ from calib.errors import PlanError
 from calib.estimators.best_fit import best_fit
 from calib.estimators.layout import search_constraint_set
 from calib.estimators.runners import run_iterative_fit
-from calib.paper.stator_layout import StatorLayout
 from calib.probing import Probe
 from calib.procedures.base import (
     FloatArray,
@@ -29,12 +28,9 @@ from calib.procedures.base import (
     check_edge_offset,
     edge_corrected,
     edge_offset_of,
-    unknown_role_problem,
 )
+from calib.procedures.best_fit import BestFitProcedure
 from calib.structs import check_count, check_positive
-
-ROLE = "fit"
-MIN_POINTS = 3
 
 
 class Iterative(
@@ -67,28 +63,13 @@ class Iterative(
         check_edge_offset(self.edge_event_offset_m)
 
 
-class IterativeProcedure:
-    """The iterative best fit as a :class:`~calib.procedures.base.ProcedureKind`."""
+class IterativeProcedure(BestFitProcedure):
+    """The iterative best fit as a :class:`~calib.procedures.base.ProcedureKind`: the best
+    fit's roles and role checks, its own run and estimate."""
 
     method = "iterative"
     settings_type: type = Iterative
-    roles: tuple[str, ...] = (ROLE,)
     summary = "measure all, fit, re-command every search in the new frame, until it settles"
-
-    def role_problem(self, roles: Sequence[str], complete: bool) -> str:
-        """See :meth:`ProcedureKind.role_problem`."""
-        problem = unknown_role_problem(self.method, roles, self.roles)
-        if problem or not complete:
-            return problem
-        if sum(r == ROLE for r in roles) < MIN_POINTS:
-            return f"points: iterative needs at least {MIN_POINTS} points, got {len(roles)}"
-        return ""
-
-    def assign(self, points: Sequence[RolePoint]) -> list[RolePoint]:
-        """Every point, with the role ``fit``."""
-        if len(points) < MIN_POINTS:
-            raise PlanError(f"iterative needs at least {MIN_POINTS} points, got {len(points)}")
-        return [RolePoint(ROLE, rp.point) for rp in points]
 
     def run(
         self,
@@ -130,10 +111,6 @@ class IterativeProcedure:
         res = best_fit(search_constraint_set(pts), q, T_base_wobj_nominal)
         ids = tuple(p.id for p in pts)
         return ProcedureRun(res.T_base_wobj, ids, dict(zip(ids, q, strict=True)))
-
-    def adaptive_layout(self, points: Sequence[RolePoint]) -> StatorLayout | None:
-        """``None``: programs run the searches in the nominal frame."""
-        return None
 
 
 def _settings(settings: object) -> Iterative:

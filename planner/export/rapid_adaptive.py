@@ -191,7 +191,7 @@ def xoffset_procs(job: ExportJob, names: list[str]) -> list[str]:
     if a is None or a.settings.xoffset is None:
         return []
     run: XOffsetRun = a.settings.xoffset
-    grid = run.grid()
+    grid = run.grid
     rows = xoffset_probe_points(grid, run.layers, run.teeth)
     k_n, l_n = len(rows), len(rows[0])
     ys = [p.position_m[1] for p in rows[0]]

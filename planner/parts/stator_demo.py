@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 from calib.errors import ShapeError
 from calib.frames import make_transform
 from calib.paper.settings import XOffsetRun
+from calib.paper.xoffset import SlotGrid
 from calib.plan.report_spec import PointOfInterest, RegionSpec, ReportSpec
 from calib.probing import ProbePoint, SearchSpec
 from planner.parts.stator import StatorGeometry
@@ -163,10 +164,12 @@ def stator_xoffset(geom: StatorGeometry) -> XOffsetRun:
     slots = geom.slot_y_m
     n_slots = int(sum(slots >= -geom.reach_length_m - 1e-9))
     return XOffsetRun(
-        n_slots=n_slots,
-        n_layers=geom.n_layers,
-        first_slot_y_m=float(slots[0]),
-        first_layer_z_m=float(geom.layer_z_m[0]),
-        slot_step_y_m=-geom.slot_pitch_m,
-        layer_step_z_m=-geom.layer_pitch_m,
+        grid=SlotGrid(
+            n_slots=n_slots,
+            n_layers=geom.n_layers,
+            first_slot_y_m=float(slots[0]),
+            first_layer_z_m=float(geom.layer_z_m[0]),
+            slot_step_y_m=-geom.slot_pitch_m,
+            layer_step_z_m=-geom.layer_pitch_m,
+        )
     )

@@ -1,16 +1,28 @@
-"""Simulated calibrations: sensors against the true mesh, robot errors, the Monte Carlo.
+"""Simulated calibrations of any plan: sensors against the true mesh, robot errors, the Monte
+Carlo, the prediction beside it, and the report.
 
 Owns:
     - :mod:`planner.sim.sensors`: the sensor registry (:data:`SENSORS`: model -> simulator);
     - :mod:`planner.sim.probe`: :class:`SimulatedProbe`, the proximity sensor's searches
       against the misplaced part (closed-form approach, scanned and refined edge search);
-    - :mod:`planner.sim.raycast`: batched first-hit ray casting (Embree);
-    - :mod:`planner.sim.search_events`: what happened in a search (landings, reachability);
-    - :mod:`planner.sim.trial`: one trial (:class:`TrialRunner`), the simulation setup;
-    - :mod:`planner.sim.montecarlo`: :func:`validate`, many seeded trials on up to 2 processes;
-    - :mod:`planner.sim.report` and :mod:`planner.sim.plots`: the Table-1 report and its PNGs.
+    - :mod:`planner.sim.touch`: the touch probe's searches (the sweeping ball's exact contact);
+    - :mod:`planner.sim.raycast`: batched first-hit ray casting (Embree), with triangle ids;
+    - :mod:`planner.sim.search_events`: what happened in a search (reasons, landings over the
+      whole footprint against the planar faces, reachability hooks);
+    - :mod:`planner.sim.setup`: :class:`SimulationSetup`, what every trial of a plan shares;
+    - :mod:`planner.sim.trial`: one trial (:class:`TrialRunner`) of any procedure;
+    - :mod:`planner.sim.xoffset`: the paper's x-offset run and its slot-target errors;
+    - :mod:`planner.sim.montecarlo`: :func:`simulate` (any plan) and :func:`validate` (A-H on
+      a stator), many seeded trials on up to 2 processes;
+    - :mod:`planner.sim.predict`: the intervals predicted from the procedure's linearisation;
+    - :mod:`planner.sim.rows`, :mod:`planner.sim.report_points`, :mod:`planner.sim.summary`,
+      :mod:`planner.sim.report`: what each row measures, the rows of a plan, the report built
+      from the trials, and the report with its Markdown;
+    - :mod:`planner.sim.sensitivity`: each noise term off in turn;
+    - :mod:`planner.sim.error_map` and :mod:`planner.sim.plots`: the error over the part and
+      the PNGs.
 
-The physical models themselves (sensor, robot error, misplacement) are in :mod:`calib.models`;
+The physical models themselves (sensors, robot error, misplacement) are in :mod:`calib.models`;
 a cell, when a trial vets its searches in one, is passed in explicitly. The plan-level entry
 point is :func:`planner.validate.validate_plan`. ``docs/simulation.md`` has the models.
 """

@@ -135,17 +135,17 @@ class MeshRayCaster:
             tri_out[r] = more_tri
         return out, tri_out
 
-    def triangle_normal(self, triangle: int) -> FloatArray:
-        """``(3,)`` unit normal of a triangle, mesh frame (float64)."""
-        return self._normals[triangle].copy()
+    def triangle_normal(self, triangle: int | NDArray[np.int64]) -> FloatArray:
+        """``(3,)`` (or ``(K, 3)``) unit normal of a triangle (or triangles), mesh frame."""
+        return np.array(self._normals[triangle], dtype=np.float64)
 
-    def triangle_vertices(self, triangle: int) -> FloatArray:
-        """``(3, 3)`` the corners of a triangle, mesh frame (float64)."""
-        return self._triangles[triangle]
+    def triangle_vertices(self, triangle: int | NDArray[np.int64]) -> FloatArray:
+        """``(3, 3)`` (or ``(K, 3, 3)``) the corners of a triangle (or triangles), mesh frame."""
+        return np.array(self._triangles[triangle], dtype=np.float64)
 
-    def triangle_offset(self, triangle: int) -> float:
-        """Plane offset ``d`` of a triangle: its plane is ``normal . x = d``, metres."""
-        return float(self._offsets[triangle])
+    def triangle_offset(self, triangle: int | NDArray[np.int64]) -> FloatArray:
+        """Plane offset ``d`` of a triangle (or triangles): its plane is ``normal . x = d``, m."""
+        return np.asarray(self._offsets[triangle], dtype=np.float64)
 
     def _beyond_real_edge(self, p: FloatArray, tri: NDArray[np.int64]) -> NDArray[np.bool_]:
         """True where hit points ``(K, 3)`` lie outside their triangle across a real edge."""

@@ -102,7 +102,7 @@ class SimulatedTouchProbe:
             return self._fail(cmd, f"no contact within {length * 1e3:.0f} mm")
         # the exact first contact of the sweeping ball with the triangles the rays met near
         # the first hit: a face (tangent point inside it), an edge or a corner
-        near = np.unique(tri[np.isfinite(dist) & (dist <= float(dist.min()) + r)])
+        near = np.unique(tri[np.isfinite(dist) & (dist <= float(dist.min()) + 0.25 * r)])
         travel, normal, on_face_of = sweep_contact(self.caster, centre0, a, r, near)
         if travel <= 0.0:
             return self._fail(cmd, "stylus ball touching the part at start")
@@ -144,47 +144,58 @@ def sweep_contact(
     Each triangle is met at its face (the tangent point inside it), an edge or a corner,
     whichever comes first; the normal points from the contact to the ball's centre. The
     triangle is returned when the contact is on its face, else ``-1`` (an edge or corner).
+    All triangles are solved at once.
     """
-    best = (math.inf, -a, -1)
-    for k in triangles:
-        n = caster.triangle_normal(int(k))
-        v = caster.triangle_vertices(int(k))
-        cos = float(a @ n)
-        if cos < -1e-12:  # the face, when the tangent point falls inside the triangle
-            tt = (float(n @ centre0) - caster.triangle_offset(int(k)) - r) / -cos
-            q = centre0 + tt * a - r * n
-            if tt < best[0] and _inside(q, v, n):
-                best = (tt, n, int(k))
-        for i in range(3):  # the edges and corners
-            p, e = v[i], v[(i + 1) % 3] - v[i]
-            length = float(np.linalg.norm(e))
-            e = e / length
-            u = centre0 - p
-            u_perp, a_perp = u - (u @ e) * e, a - (a @ e) * e
-            tt = _first_root(
-                float(a_perp @ a_perp), float(u_perp @ a_perp), float(u_perp @ u_perp) - r * r
-            )
-            if tt < best[0]:
-                s = float((centre0 + tt * a - p) @ e)
-                if 0.0 <= s <= length:
-                    c = centre0 + tt * a
-                    best = (tt, (c - p - s * e) / r, -1)
-            tt = _first_root(1.0, float(u @ a), float(u @ u) - r * r)
-            if tt < best[0]:
-                best = (tt, (centre0 + tt * a - p) / r, -1)
-    return best[0], np.asarray(best[1], dtype=np.float64), best[2]
+    tri = np.asarray(triangles, dtype=np.int64)
+    n = caster.triangle_normal(tri)  # (K, 3)
+    v = caster.triangle_vertices(tri)  # (K, 3, 3)
+    cos = n @ a
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t_face = (n @ centre0 - caster.triangle_offset(tri) - r) / -cos
+    t_face = np.where(cos < -1e-12, t_face, np.inf)
+    q = centre0 + t_face[:, None] * a - r * n
+    edges = v[:, [1, 2, 0]] - v  # (K, 3, 3): v1 - v0, v2 - v1, v0 - v2
+    inside = np.all(
+        np.einsum("kij,kj->ki", np.cross(edges, q[:, None, :] - v), n) >= -1e-12, axis=1
+    )
+    t_face = np.where(inside, t_face, np.inf)
+    # edges: the distance from the moving centre to each edge's line reaches r
+    length = np.linalg.norm(edges, axis=2)
+    e = edges / length[..., None]
+    u = centre0 - v  # (K, 3, 3)
+    u_perp = u - np.sum(u * e, axis=2, keepdims=True) * e
+    a_perp = a - (e @ a)[..., None] * e
+    t_edge = _first_roots(
+        np.sum(a_perp * a_perp, axis=2),
+        np.sum(u_perp * a_perp, axis=2),
+        np.sum(u_perp * u_perp, axis=2) - r * r,
+    )
+    finite = np.isfinite(t_edge)
+    s = np.sum((centre0 + np.where(finite, t_edge, 0.0)[..., None] * a - v) * e, axis=2)
+    t_edge = np.where(finite & (s >= 0.0) & (s <= length), t_edge, np.inf)
+    # corners: the distance from the moving centre to each corner reaches r
+    t_corner = _first_roots(np.ones(u.shape[:2]), u @ a, np.sum(u * u, axis=2) - r * r)
+    best = [float(np.min(t_face)), float(np.min(t_edge)), float(np.min(t_corner))]
+    kind = int(np.argmin(best))
+    travel = best[kind]
+    if not np.isfinite(travel):
+        return math.inf, -a, -1
+    centre = centre0 + travel * a
+    if kind == 0:
+        k = int(np.argmin(t_face))
+        return travel, n[k].copy(), int(tri[k])
+    if kind == 1:
+        ke, ie = (int(x) for x in np.unravel_index(int(np.argmin(t_edge)), t_edge.shape))
+        foot = v[ke, ie] + s[ke, ie] * e[ke, ie]
+        return travel, (centre - foot) / r, -1
+    kc, ic = (int(x) for x in np.unravel_index(int(np.argmin(t_corner)), t_corner.shape))
+    return travel, (centre - v[kc, ic]) / r, -1
 
 
-def _first_root(A: float, half_b: float, c: float) -> float:
-    """Smaller root of ``A t^2 + 2 half_b t + c = 0`` (``inf`` when none, or A is 0)."""
-    if A <= 1e-18:
-        return math.inf
+def _first_roots(A: FloatArray, half_b: FloatArray, c: FloatArray) -> FloatArray:
+    """Smaller roots of ``A t^2 + 2 half_b t + c = 0`` (``inf`` where none or ``A`` is 0)."""
     disc = half_b * half_b - A * c
-    if disc < 0.0:
-        return math.inf
-    return (-half_b - math.sqrt(disc)) / A
-
-
-def _inside(q: FloatArray, v: FloatArray, n: FloatArray) -> bool:
-    """True when ``q`` (in the triangle's plane) lies inside triangle ``v`` ``(3, 3)``."""
-    return all(float(np.cross(v[(i + 1) % 3] - v[i], q - v[i]) @ n) >= -1e-12 for i in range(3))
+    ok = (A > 1e-18) & (disc >= 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        root = (-half_b - np.sqrt(np.where(ok, disc, 0.0))) / np.where(ok, A, 1.0)
+    return np.where(ok, root, np.inf)

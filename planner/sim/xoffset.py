@@ -53,7 +53,7 @@ class XOffsetSetup:
 
 def xoffset_setup(run: XOffsetRun, holes_wobj: FloatArray | None = None) -> XOffsetSetup:
     """The x-offset run of ``run``; ``holes_wobj`` ``(m, n, 3)`` default the nominal holes."""
-    grid = run.grid()
+    grid = run.grid
     spec = SearchSpec("approach", run.start_offset_m, run.overtravel_m)
     points = xoffset_probe_points(grid, run.layers, run.teeth, spec)
     targets = slot_positions_wobj(grid)
@@ -83,7 +83,7 @@ def run_xoffset(
             if res.point_m is None:
                 raise ProbeFailedError(p.id, res.reason or "no reason given")
             px[k, j] = transform_points(T_wobj_base, np.asarray(res.point_m, dtype=np.float64))
-    mx = xoffset_matrix(px, xs.run.grid())
+    mx = xoffset_matrix(px, xs.run.grid)
     targets = xs.targets_wobj.copy()
     targets[..., 0] = mx
     T_true_cal = invert_transform(T_base_wobj_true) @ T_base_wobj_cal
