@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from calib.errors import InputError
+from calib.errors import InputError, PlanError
 from planner.sim.report import ValidationReport
 from planner.validate import check_simulatable
 from webui import validation
@@ -109,6 +109,10 @@ class ValidatePanel:
     def _show(self, fut: Future[validation.ValidationSummary]) -> None:
         try:
             summary = fut.result()
+        except PlanError as exc:  # refused before any trial ran: the point and why
+            self.result_md.content = f"**Validation not started:** {exc}"
+            self._app.notify("Validation not started", str(exc))
+            return
         except Exception as exc:
             logger.exception("validation failed")
             self.result_md.content = f"**Validation failed:** {exc}"

@@ -34,7 +34,7 @@ from calib.estimators.layout import (
 )
 from calib.estimators.observability import require_observable
 from calib.estimators.three_two_one import ThreeTwoOneLayout, ThreeTwoOneResult, three_two_one
-from calib.frames import check_transform, motion_between
+from calib.frames import check_transform
 from calib.probing import Probe, ProbePoint, SearchCommand
 from calib.validation import check_vector3
 
@@ -287,67 +287,3 @@ def run_best_fit(
 def _check_rounds(rounds: int) -> None:
     if not isinstance(rounds, int | np.integer) or isinstance(rounds, bool) or rounds < 1:
         raise ShapeError(f"rounds must be an integer >= 1, got {rounds!r}")
-
-
-def run_iterative_fit(
-    points: Sequence[ProbePoint],
-    probe: Probe,
-    T_base_wobj_start: ArrayLike,
-    *,
-    tolerance_m: float = 1e-4,
-    max_rounds: int = 5,
-    edge_offset_m: float = 0.0,
-    sigma_m: float | None = None,
-) -> ProcedureResult:
-    """The iterative best fit: measure every point, fit, re-command every search in the new
-    estimate, and repeat until a round's fit moves the frame less than ``tolerance_m``.
-
-    The general form of the paper's step-by-step idea and of the iterative alignment of CMM
-    software: each round commands all searches where the previous fit says the part is, so
-    the searches land where the plan put them. The final frame is the fit of the last round's
-    measurements; an edge search contributes only its edge coordinate
-    (:func:`calib.estimators.layout.search_constraint_set`).
-
-    Args:
-        points: the probe points (must constrain all 6 DOF with edge searches counted by
-            their edge coordinate only).
-        probe: runs one search.
-        T_base_wobj_start: ``(4, 4)`` start estimate (the first round is commanded in it).
-        tolerance_m: stop when a round's fit moves the frame it was commanded in by less than
-            this: translation in metres, rotation in radians times the layout size. A round's
-            fit moves by about the frame's noise even at the fixed point, so the tolerance must
-            exceed that (0.1 mm by default).
-        max_rounds: at most this many rounds (>= 1); the last round's fit is returned even
-            when it moved more than the tolerance.
-        edge_offset_m: the sensor's edge-event offset removed from edge searches, metres.
-        sigma_m: measurement standard deviation for the covariance, metres.
-
-    Raises:
-        UnobservableError: the layout leaves a motion unconstrained (checked before probing).
-        ProbeFailedError: a probe failed.
-        ShapeError: a bad tolerance or round count.
-    """
-    T = check_transform(T_base_wobj_start, "T_base_wobj_start").copy()
-    _check_rounds(max_rounds)
-    if not (np.isfinite(tolerance_m) and tolerance_m > 0):
-        raise ShapeError(f"tolerance_m must be > 0, got {tolerance_m!r}")
-    cs = constraint_set(points, edge_rows="edge")
-    require_observable(cs)
-    pts = tuple(points)
-    steps: list[ProbeStep] = []
-    estimates: list[FloatArray] = []
-    fit: BestFitResult | None = None
-    for rnd in range(max_rounds):
-        done = [probe_point(probe, p, T, rnd) for p in pts]
-        q = np.array([corrected_point(s, edge_offset_m) for s in done])
-        fit = best_fit(cs, q, T, sigma_m=sigma_m)
-        moved = motion_between(T, fit.T_base_wobj)
-        T = fit.T_base_wobj
-        estimates.append(T)
-        steps += done
-        size = max(float(np.linalg.norm(moved[:3])), float(np.linalg.norm(moved[3:])) * cs.scale_m)
-        logger.info("iterative fit round %d: moved %.3g mm", rnd, size * 1e3)
-        if size < tolerance_m:
-            break
-    assert fit is not None  # max_rounds >= 1 is checked above
-    return ProcedureResult(T, tuple(steps), np.array(estimates), fit, cs.point_ids)

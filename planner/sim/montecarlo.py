@@ -19,12 +19,9 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-import math
-import multiprocessing as mp
 import os
 import time
 from collections.abc import Callable, Mapping
-from concurrent.futures import ProcessPoolExecutor
 from typing import Any
 
 import numpy as np
@@ -57,7 +54,7 @@ from planner.sim.setup import (
     resolved_settings,
 )
 from planner.sim.summary import build_report
-from planner.sim.trial import TrialResult, TrialRunner, TrialSeed, init_worker, run_chunk_in_worker
+from planner.sim.trial import TrialResult, TrialSeed, run_all
 
 __all__ = [
     "DEFAULT_EDGE_INSET_M",
@@ -155,9 +152,9 @@ def simulate(
         results: list[TrialResult] = []
         if n_reach:
             # vetted trials run here: they move the cell's part to where it really lies
-            results = _run_all(setup, mesh, seeds[:n_reach], 1, reachability, vetted, cell)
+            results = run_all(setup, mesh, seeds[:n_reach], 1, reachability, vetted, cell)
         if n_reach < total:
-            results += _run_all(setup, mesh, seeds[n_reach:] + extra, n_workers, None, later)
+            results += run_all(setup, mesh, seeds[n_reach:] + extra, n_workers, None, later)
     finally:
         if cell is not None:
             cell.move_work_object(T_cell)
@@ -279,34 +276,3 @@ def validate(
         workers=workers,
         progress=progress,
     )
-
-
-def _run_all(
-    setup: SimulationSetup,
-    mesh: trimesh.Trimesh,
-    seeds: list[TrialSeed],
-    n_workers: int,
-    reach: ReachabilityHook | None,
-    progress: ProgressCallback | None,
-    cell: Any = None,
-) -> list[TrialResult]:
-    """Run ``seeds`` in this process (1 worker; the only place a ``reach`` hook or a ``cell``
-    is used) or on a process pool, each process with its own :class:`TrialRunner`."""
-    total = len(seeds)
-    chunk = max(1, min(100, math.ceil(total / (8 * n_workers))))
-    chunks = [seeds[i : i + chunk] for i in range(0, total, chunk)]
-    out: list[TrialResult] = []
-    if n_workers == 1:
-        runner = TrialRunner(setup, mesh, cell)
-        for c in chunks:
-            out.extend(runner.run_chunk(c, reach))
-            if progress is not None:
-                progress(len(out), total)
-        return out
-    ctx = mp.get_context("fork") if "fork" in mp.get_all_start_methods() else None
-    with ProcessPoolExecutor(n_workers, ctx, init_worker, (setup, mesh)) as pool:
-        for res in pool.map(run_chunk_in_worker, chunks):
-            out.extend(res)
-            if progress is not None:
-                progress(len(out), total)
-    return out

@@ -32,7 +32,6 @@ from numpy.typing import ArrayLike, NDArray
 from calib.frames import check_transform, invert_transform
 from calib.models.proximity import ProximitySensor
 from calib.models.robot_error import AccuracyField, RobotErrorModel
-from calib.models.sensor import tool_rotation
 from calib.probing import ProbeResult, SearchCommand
 from planner.sim.raycast import MeshRayCaster
 from planner.sim.search_events import (
@@ -40,31 +39,10 @@ from planner.sim.search_events import (
     ProbeEvent,
     ReachabilityHook,
     cell_search_hook,
+    robot_offset,
 )
 
 __all__ = ["ProbeEvent", "ReachabilityHook", "SimulatedProbe", "cell_search_hook", "robot_offset"]
-
-
-def robot_offset(
-    start_m: FloatArray,
-    axis: FloatArray,
-    rng: np.random.Generator,
-    robot_error: RobotErrorModel,
-    accuracy_field: AccuracyField | None,
-    tcp_error_m: FloatArray | None,
-) -> FloatArray:
-    """``(3,)`` where the robot's TCP really runs minus where it is commanded, base frame, m.
-
-    A fresh repeatability offset per search, the robot's accuracy field at the start, and the
-    TCP calibration error (sensor tool frame, :func:`calib.models.sensor.tool_rotation`).
-    """
-    offset = robot_error.sample_repeatability_m(rng)
-    if accuracy_field is not None:
-        offset = offset + accuracy_field(start_m)
-    if tcp_error_m is not None:
-        offset = offset + tool_rotation(axis) @ tcp_error_m
-    return offset
-
 
 FloatArray = NDArray[np.float64]
 

@@ -18,6 +18,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from calib.models.robot_error import AccuracyField, RobotErrorModel
+from calib.models.sensor import tool_rotation
 from calib.probing import SearchCommand
 
 FloatArray = NDArray[np.float64]
@@ -39,6 +41,27 @@ def cell_search_hook(cell: Any, step_m: float = 0.002) -> ReachabilityHook:
         return "" if res.feasible else f"unreachable or colliding: {res.reason}"
 
     return hook
+
+
+def robot_offset(
+    start_m: FloatArray,
+    axis: FloatArray,
+    rng: np.random.Generator,
+    robot_error: RobotErrorModel,
+    accuracy_field: AccuracyField | None,
+    tcp_error_m: FloatArray | None,
+) -> FloatArray:
+    """``(3,)`` where the robot's TCP really runs minus where it is commanded, base frame, m.
+
+    A fresh repeatability offset per search, the robot's accuracy field at the start, and the
+    TCP calibration error (sensor tool frame, :func:`calib.models.sensor.tool_rotation`).
+    """
+    offset = robot_error.sample_repeatability_m(rng)
+    if accuracy_field is not None:
+        offset = offset + accuracy_field(start_m)
+    if tcp_error_m is not None:
+        offset = offset + tool_rotation(axis) @ tcp_error_m
+    return offset
 
 
 #: Searches of the x-offset run (``PX<layer>_<tooth>``) are counted together under this id.

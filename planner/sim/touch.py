@@ -2,9 +2,9 @@
 
 A :data:`calib.probing.Probe` for :class:`calib.models.touch.TouchProbe`. The robot moves the
 TCP (the ball's pole) along the commanded approach, off by its repeatability, accuracy field
-and TCP error (:func:`planner.sim.probe.robot_offset`). Rays cast along the approach from the
-ball's front half find the triangles the ball meets first; the contact is then solved exactly
-for the sweeping ball against each of them (:func:`sweep_contact`: its face when the tangent
+and TCP error (:func:`planner.sim.search_events.robot_offset`). Rays cast along the approach
+from the ball's front half find the triangles the ball meets first; the contact is then solved
+exactly for the sweeping ball against each of them (:func:`sweep_contact`: its face when the tangent
 point lies inside it, else an edge or a corner, e.g. a hole's rim or the face's end). The
 probe triggers after the pre-travel left over from axial qualification for that contact's
 direction (lobing) plus the trigger's scatter, and the program compensates the ball radius
@@ -30,9 +30,14 @@ from calib.frames import check_transform, invert_transform
 from calib.models.robot_error import AccuracyField, RobotErrorModel
 from calib.models.touch import TouchProbe
 from calib.probing import ProbeResult, SearchCommand
-from planner.sim.probe import robot_offset
 from planner.sim.raycast import MeshRayCaster
-from planner.sim.search_events import LANDED_OFF_FACE, FaceLookup, ProbeEvent, ReachabilityHook
+from planner.sim.search_events import (
+    LANDED_OFF_FACE,
+    FaceLookup,
+    ProbeEvent,
+    ReachabilityHook,
+    robot_offset,
+)
 
 FloatArray = NDArray[np.float64]
 

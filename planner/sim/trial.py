@@ -12,6 +12,10 @@ the best fit of the same measurements fed as the procedure is fed
 
 from __future__ import annotations
 
+import math
+import multiprocessing as mp
+from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
@@ -35,10 +39,13 @@ __all__ = [
     "TrialResult",
     "TrialRunner",
     "init_worker",
+    "run_all",
     "run_chunk_in_worker",
 ]
 
 FloatArray = NDArray[np.float64]
+#: progress(done_trials, total_trials)
+ProgressCallback = Callable[[int, int], None]
 #: A trial's seed, or ``(noise seed, position seed)`` for the paper's protocol.
 TrialSeed = np.random.SeedSequence | tuple[np.random.SeedSequence, np.random.SeedSequence]
 
@@ -168,3 +175,35 @@ def init_worker(setup: SimulationSetup, mesh: trimesh.Trimesh) -> None:
 def run_chunk_in_worker(seeds: list[TrialSeed]) -> list[TrialResult]:
     """Run ``seeds`` on this worker process's runner (see :func:`init_worker`)."""
     return _PROCESS_RUNNER[0].run_chunk(seeds)
+
+
+def run_all(
+    setup: SimulationSetup,
+    mesh: trimesh.Trimesh,
+    seeds: list[TrialSeed],
+    n_workers: int,
+    reach: ReachabilityHook | None,
+    progress: ProgressCallback | None,
+    cell: Any = None,
+) -> list[TrialResult]:
+    """Run ``seeds`` in this process (1 worker; the only place a ``reach`` hook or a ``cell``
+    is used) or on a process pool, each process with its own :class:`TrialRunner`, built
+    once per process (:func:`init_worker`); ``progress(done, total)`` after every chunk."""
+    total = len(seeds)
+    chunk = max(1, min(100, math.ceil(total / (8 * n_workers))))
+    chunks = [seeds[i : i + chunk] for i in range(0, total, chunk)]
+    out: list[TrialResult] = []
+    if n_workers == 1:
+        runner = TrialRunner(setup, mesh, cell)
+        for c in chunks:
+            out.extend(runner.run_chunk(c, reach))
+            if progress is not None:
+                progress(len(out), total)
+        return out
+    ctx = mp.get_context("fork") if "fork" in mp.get_all_start_methods() else None
+    with ProcessPoolExecutor(n_workers, ctx, init_worker, (setup, mesh)) as pool:
+        for res in pool.map(run_chunk_in_worker, chunks):
+            out.extend(res)
+            if progress is not None:
+                progress(len(out), total)
+    return out
