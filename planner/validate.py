@@ -9,11 +9,11 @@ filled in from the sensor model when unset) and its report settings go into
 both call it, so a plan validates the same way everywhere.
 
 A plan that cannot work is refused *before* the run, with a message naming the point and why
-(:func:`check_simulatable` and :func:`preflight`): roles that do not fit the procedure, a layout
-that leaves a degree of freedom free, an edge search with a touch probe, a point off its planar
-face or with the sensor's footprint over a hole or an edge, a search too short to reach its
-face (or starting too close to it) under the plan's misplacement. A run never crashes half-way:
-a search that fails in a trial is counted with its reason.
+(:mod:`planner.validate_checks`, whose checks are re-exported here): roles that do not fit the
+procedure, a layout that leaves a degree of freedom free, an edge search with a touch probe, a
+point off its planar face or with the sensor's footprint over a hole or an edge, a search too
+short to reach its face (or starting too close to it) under the plan's misplacement. A run
+never crashes half-way: a search that fails in a trial is counted with its reason.
 
 Example::
 
@@ -26,36 +26,30 @@ Example::
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import trimesh
 
-from calib.errors import InputError
-from calib.estimators.layout import search_constraint_set
-from calib.estimators.observability import analyze_layout
-from calib.models import Misplacement, RobotErrorModel
-from calib.plan.file import Plan, PlanError, resolve_ref
-from calib.procedures import RolePoint, procedure_kind
-from planner.export.safety import SafetySpec
-from planner.parts.stator import StatorGeometry
+from calib.plan.file import Plan, PlanError
+from calib.procedures import RolePoint
 from planner.plan_cell import nominal_T_base_wobj, open_cell
 from planner.sim.montecarlo import simulate
 from planner.sim.report import PAPER_TABLE1, ValidationReport
 from planner.sim.report_points import report_rows
 from planner.sim.sensitivity import SensitivityTable, sensitivity
-from planner.sim.sensors import sensor_kind
-from planner.sim.setup import (
-    DEFAULT_EDGE_INSET_M,
-    SimulationSetup,
-    default_pivot,
-    face_lookup,
-    resolved_settings,
-)
+from planner.sim.setup import SimulationSetup, default_pivot, face_lookup
 from planner.sim.xoffset import xoffset_setup
+from planner.validate_checks import (
+    SIMULATED_PARTS,
+    ProgressCallback,
+    ValidationModels,
+    check_simulatable,
+    preflight,
+    validation_models,
+    work_object_mesh,
+)
 
 __all__ = [
     "SIMULATED_PARTS",
@@ -67,189 +61,6 @@ __all__ = [
     "validation_models",
     "work_object_mesh",
 ]
-
-#: Built-in stators -> the ``StatorGeometry`` constructor (their slot holes, bulge, epsilon).
-SIMULATED_PARTS: dict[str, str] = {
-    "builtin:stator_section": "full_section",
-    "builtin:stator_prototype": "prototype",
-}
-
-#: progress(done_trials, total_trials)
-ProgressCallback = Callable[[int, int], None]
-
-
-@dataclass(frozen=True)
-class ValidationModels:
-    """What the simulation of a plan uses, built from the plan by :func:`validation_models`.
-
-    Attributes:
-        sensor: the sensor model (``plan.validation.sensor``, any kind).
-        robot_error: the robot error model (``plan.validation.robot_error``).
-        misplacement: the part placement tolerance (``plan.validation.misplacement``).
-        method: the procedure's registry name.
-        settings: the procedure's settings; an unset ``edge_event_offset_m`` is the sensor's
-            analytic straight-edge offset at ``edge_inset_m``.
-        points: the plan's points with the procedure's roles.
-        geometry: the stator geometry of a built-in stator work object, else ``None``.
-        edge_inset_m: how far inside the face edge searches run, metres.
-    """
-
-    sensor: Any
-    robot_error: RobotErrorModel
-    misplacement: Misplacement
-    method: str
-    settings: Any
-    points: tuple[RolePoint, ...]
-    geometry: StatorGeometry | None
-    edge_inset_m: float = DEFAULT_EDGE_INSET_M
-
-
-def _name(plan: Plan, point_id: str) -> str:
-    ids = [p.id for p in plan.points]
-    return f"points[{ids.index(point_id)}] ({point_id})" if point_id in ids else point_id
-
-
-def validation_models(plan: Plan) -> ValidationModels:
-    """The models, procedure and roles of ``plan`` (see :func:`check_simulatable`)."""
-    return check_simulatable(plan)
-
-
-def check_simulatable(plan: Plan) -> ValidationModels:
-    """Raise unless the validation can simulate ``plan`` (checks that need no mesh).
-
-    Returns:
-        The plan's :class:`ValidationModels`.
-
-    Raises:
-        PlanError: the points lack a role the procedure needs, the procedure cannot use them
-            (e.g. an A-H layout against the paper's conditions, 3-2-1 faces parallel), the
-            layout leaves a degree of freedom free, the sensor has no simulator, a touch probe
-            is asked for an edge search, or an x-offset run is asked for on a part without
-            slot holes; the message names the point or field.
-    """
-    plan.require_complete()
-    kind = procedure_kind(plan.procedure)
-    v = plan.validation
-    sensor_kind(v.sensor)  # a simulator for this sensor
-    try:
-        points = tuple(kind.assign(plan.role_points()))
-    except PlanError:
-        raise
-    except InputError as exc:
-        raise PlanError(f"points: {plan.method} cannot use this layout: {exc}") from None
-    if not v.sensor.runs_edge_searches:
-        for p in plan.points:
-            if p.search.kind == "edge":
-                raise PlanError(
-                    f"{_name(plan, p.id)}.search.kind: a {v.sensor.KIND} sensor cannot run an "
-                    "edge search (it cannot find where a face ends while sliding over it)"
-                )
-    report = analyze_layout(search_constraint_set([rp.point for rp in points]))
-    if report.rating == "unobservable":
-        free = "; ".join(m.message for m in report.unconstrained)
-        raise PlanError(
-            f"points: the layout does not fix all 6 degrees of freedom (an edge search counts "
-            f"by its edge coordinate only): {free}"
-        )
-    geometry = None
-    if plan.work_object.mesh in SIMULATED_PARTS:
-        geometry = getattr(StatorGeometry, SIMULATED_PARTS[plan.work_object.mesh])()
-    if getattr(plan.procedure, "xoffset", None) is not None and geometry is None:
-        raise PlanError(
-            "procedure.xoffset: the x-offset run is simulated only on a built-in stator "
-            f"(its true slot holes), not on {plan.work_object.mesh!r}"
-        )
-    return ValidationModels(
-        sensor=v.sensor,
-        robot_error=v.robot_error,
-        misplacement=v.misplacement,
-        method=plan.method,
-        settings=resolved_settings(plan.procedure, v.sensor, DEFAULT_EDGE_INSET_M),
-        points=points,
-        geometry=geometry,
-        edge_inset_m=DEFAULT_EDGE_INSET_M,
-    )
-
-
-def work_object_mesh(plan: Plan, plan_dir: Path, models: ValidationModels) -> trimesh.Trimesh:
-    """The true part's mesh in wobj, metres: a built-in stator's from its geometry, else the
-    plan's file (or built-in) loaded in its units and lightly repaired, as the cell does.
-
-    Raises:
-        InputError: the mesh cannot be loaded (the message names the file).
-    """
-    if models.geometry is not None:
-        from planner.parts.stator_mesh import build_stator_mesh
-
-        return build_stator_mesh(models.geometry)
-    from planner.cell.workobject import load_work_object
-
-    wo = plan.work_object
-    return load_work_object(resolve_ref(wo.mesh, plan_dir), units=wo.units).mesh
-
-
-def preflight(plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh) -> None:
-    """Refuse a plan whose points or searches cannot work on ``mesh``, before any trial.
-
-    Every point must lie on a planar face with the sensor's footprint on it
-    (:func:`planner.faces.checks.plan_face_reasons`); every search must reach its face under
-    the plan's misplacement (the bound of :class:`planner.export.safety.SafetySpec`, the same
-    the exported programs use): an approach must start at least the face's largest shift plus
-    the sensor's standoff out, and run at least the shift past it; an edge search must start
-    at least the shift before the edge and run at least the shift plus the sensor's edge-event
-    offset past it.
-
-    Raises:
-        PlanError: naming every point that fails, and why.
-    """
-    from planner.faces.checks import plan_face_reasons
-
-    probes = [p.to_probe_point() for p in plan.points]
-    r = max(float(models.sensor.footprint_radius_m), 1e-4)  # a point sensor: a tiny disk
-    why = {
-        p.id: f"not on a planar face: {reason}"
-        for p, reason in zip(
-            plan.points, plan_face_reasons(mesh, probes, footprint_radius_m=r), strict=True
-        )
-        if reason
-    }
-    m = models.misplacement
-    pivot = default_pivot(list(models.points))
-    safety = SafetySpec(
-        max_translation_m=m.max_translation_m,
-        max_angle_rad=m.max_angle_rad,
-        pivot_wobj_m=(float(pivot[0]), float(pivot[1]), float(pivot[2])),
-        sensing_distance_m=models.sensor.standoff_m,
-        margin_m=0.0,
-    )
-    edge_offset = float(getattr(models.settings, "edge_event_offset_m", 0.0) or 0.0)
-    for p in probes:
-        if p.id in why:
-            continue
-        shift = safety.surface_shift_bound_m(p.position_m)
-        s = p.search
-        if s.kind == "approach":
-            start_needed = safety.start_clearance_m(p.position_m)
-            run_needed = shift
-        else:
-            start_needed = shift
-            run_needed = shift + edge_offset
-        if s.start_offset_m < start_needed:
-            why[p.id] = (
-                f"the search starts {s.start_offset_m * 1e3:.1f} mm "
-                f"{'out' if s.kind == 'approach' else 'before the edge'}, but the part may lie "
-                f"up to {shift * 1e3:.1f} mm closer; it needs at least "
-                f"{start_needed * 1e3:.1f} mm"
-            )
-        elif s.overtravel_m < run_needed:
-            why[p.id] = (
-                f"the search runs {s.overtravel_m * 1e3:.1f} mm past the nominal "
-                f"{'face' if s.kind == 'approach' else 'edge'}, but the part may lie up to "
-                f"{shift * 1e3:.1f} mm farther; it needs at least {run_needed * 1e3:.1f} mm"
-            )
-    if why:
-        lines = "; ".join(f"{_name(plan, pid)}: {w}" for pid, w in why.items())
-        raise PlanError(f"cannot validate this plan: {lines}")
 
 
 def validate_plan(

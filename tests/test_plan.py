@@ -212,3 +212,16 @@ def test_infinite_numbers_are_rejected_with_path(literal: str, shown: str) -> No
         PlanError, match=rf"points\[2\]\.normal\[0\]: must be a finite number, got {shown}"
     ):
         plan_from_json(text)
+
+
+def test_a_plan_from_before_the_touch_probe_loads_its_proximity_sensor() -> None:
+    """A plan file without ``validation.sensor.kind`` (written before the sensor union) loads
+    as the proximity sensor it was, and saves with ``kind`` added."""
+    from calib.models import ProximitySensor
+
+    raw = json.loads((SCHEMA_FILE.parent / "plans" / "stator_section_ah.json").read_text())
+    del raw["validation"]["sensor"]["kind"]
+    raw["validation"]["sensor"]["n_rays"] = 64
+    plan = plan_from_json(json.dumps(raw))
+    assert plan.validation.sensor == ProximitySensor(n_rays=64)
+    assert json.loads(plan_to_json(plan))["validation"]["sensor"]["kind"] == "proximity"
