@@ -57,3 +57,38 @@ def test_predicted_spread_of_a_point_row_matches_a_gaussian_sample(
 def test_point_sigma_of_one_axis_is_exact() -> None:
     S = np.array([np.diag([1.0, 4.0, 9.0]), np.diag([1.0, 16.0, 1.0])])
     assert point_sigma(S, "y") == pytest.approx(np.sqrt(10.0))
+
+
+def test_a_failed_x_offset_run_leaves_the_row_to_the_other_trials(
+    rng: np.random.Generator,
+) -> None:
+    """One trial whose x-offset search failed is listed as a failure; the row is the others'."""
+    from types import SimpleNamespace
+
+    from calib.models import ProximitySensor
+    from planner.sim.predict import Prediction
+    from planner.sim.report_points import XOFFSET_KEYS
+    from planner.sim.summary import build_report
+    from planner.sim.trial import TrialResult
+
+    targets = np.zeros((2, 3, 3))
+    setup = SimpleNamespace(
+        xoffset=SimpleNamespace(targets_wobj=targets),
+        method="hultman2013",
+        sensor=ProximitySensor(),
+        noise_figures=(),
+    )
+    spec = RowSpec(
+        XOFFSET_KEYS[1], "x", "mm", (95.5,), points_wobj=targets.reshape(-1, 3), components="x"
+    )
+    x = rng.normal(0.0, 1e-4, (50, 6))
+    x[7] = np.nan
+    results = [
+        TrialResult("", (), (), np.zeros(6), np.zeros(6), xi, "PX1_11: why" if i == 7 else "")
+        for i, xi in enumerate(x)
+    ]
+    pred = Prediction(np.eye(6) * 1e-8, np.eye(6) * 1e-8, xoffset_sigma_m=1e-4)
+    report = build_report(setup, results, [], None, [spec], pred, None, 1.0, 1, 0)  # type: ignore[arg-type]
+    assert report.failures == {"x-offset PX1_11: why": 1} and report.n_ok == 50
+    assert np.isfinite(report.rows[0].procedure)
+    assert len(report.samples_procedure[XOFFSET_KEYS[1]]) == 49 * 6

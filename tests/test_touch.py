@@ -19,7 +19,7 @@ from calib.probing import ProbePoint, SearchCommand, SearchSpec
 from planner.demo import stator_plan
 from planner.sim.raycast import MeshRayCaster
 from planner.sim.search_events import LANDED_OFF_FACE, FaceLookup
-from planner.sim.touch import SimulatedTouchProbe
+from planner.sim.touch import SimulatedTouchProbe, sweep_contact
 
 BOX = trimesh.creation.box(extents=(0.4, 0.4, 0.1))
 BOX.apply_translation((0.0, 0.0, -0.05))  # top face z = 0
@@ -70,6 +70,17 @@ def test_square_face_is_measured_exactly() -> None:
     res = probe(SearchCommand.from_point(TOP, np.eye(4)))
     assert res.ok and np.abs(res.point_m - TOP.position_m).max() < 1e-12
     assert res.travel_m == pytest.approx(0.02, abs=1e-12) and probe.events[0].landing == ""
+
+
+@pytest.mark.filterwarnings("error")
+def test_sweep_along_an_axis_past_side_faces_is_clean() -> None:
+    """Faces parallel to the motion are never met and raise no floating-point warnings."""
+    tri = np.arange(len(BOX.faces))
+    travel, normal, k = sweep_contact(
+        MeshRayCaster(BOX), np.array([0.05, 0.02, 0.023]), np.array([0.0, 0.0, -1.0]), 0.003, tri
+    )
+    assert travel == pytest.approx(0.02, abs=1e-12) and k >= 0
+    np.testing.assert_allclose(normal, [0.0, 0.0, 1.0], atol=1e-12)
 
 
 @pytest.mark.parametrize("deg", [1.0, 3.0, 8.0])

@@ -179,6 +179,7 @@ def build_report(
     extra_f: dict[str, tuple[FloatArray, float]] = {}
     if setup.xoffset is not None:
         x = np.array([r.xoffset_x_m for r in results], dtype=np.float64)[ok]
+        x = x[np.all(np.isfinite(x), axis=1)]  # a failed x-offset run is listed as a failure
         e = np.zeros((*x.shape, 3))
         e[..., 0] = x
         extra_p[XOFFSET_KEYS[1]] = (e, prediction.xoffset_sigma_m)

@@ -157,10 +157,11 @@ def sweep_contact(
     cos = n @ a
     with np.errstate(divide="ignore", invalid="ignore"):
         t_face = (n @ centre0 - caster.triangle_offset(tri) - r) / -cos
-    t_face = np.where(cos < -1e-12, t_face, np.inf)
-    q = centre0 + t_face[:, None] * a - r * n
+    facing = cos < -1e-12
+    t_face = np.where(facing, t_face, np.inf)
+    q = centre0 + np.where(facing, t_face, 0.0)[:, None] * a - r * n  # no inf * 0
     edges = v[:, [1, 2, 0]] - v  # (K, 3, 3): v1 - v0, v2 - v1, v0 - v2
-    inside = np.all(
+    inside = facing & np.all(
         np.einsum("kij,kj->ki", np.cross(edges, q[:, None, :] - v), n) >= -1e-12, axis=1
     )
     t_face = np.where(inside, t_face, np.inf)
