@@ -98,6 +98,9 @@ class CellScene:
         self._reach: ReachModel | None = None
         self.work_object: WorkObject | None = None
         self._wobj_links: BodyLinks | None = None
+        #: structures the query modules build once per scene and keep here (e.g. the broad
+        #: phase of :mod:`planner.cell.broad_phase`); they read the environment afresh.
+        self.query_cache: dict[str, object] = {}
         self.fixtures: dict[str, Fixture] = {}
         self._client: int | None = connect_direct()
         try:
