@@ -339,13 +339,6 @@ def _shape_vs_mesh(
     so, to = b_soff[f], b_toff[f]
     ny, nz = b_n[f, 1], b_n[f, 2]
     work = 0
-    for i in range(lo[0], hi[0] + 1):
-        for j in range(lo[1], hi[1] + 1):
-            for k in range(lo[2], hi[2] + 1):
-                cell = (i * ny + j) * nz + k
-                work += b_start[so + cell + 1] - b_start[so + cell]
-    if work > MAX_TRIANGLE_TESTS:
-        return 0
     c0, c1, c2 = center[0], center[1], center[2]
     h0, h1, h2 = half[0], half[1], half[2]
     for i in range(lo[0], hi[0] + 1):
@@ -353,6 +346,9 @@ def _shape_vs_mesh(
             for k in range(lo[2], hi[2] + 1):
                 cell = (i * ny + j) * nz + k
                 for q in range(b_start[so + cell], b_start[so + cell + 1]):
+                    work += 1
+                    if work > MAX_TRIANGLE_TESTS:
+                        return 0  # too many to look at: left to Bullet
                     face = b_tris[to + q]
                     for v in range(3):
                         row = m_voff[f] + m_faces[m_foff[f] + face, v]
@@ -395,13 +391,15 @@ def parts_state(
     b_origin, b_size, b_n, b_soff, b_start, b_toff, b_tris, m_voff, m_foff, m_verts, m_faces,
     exact,
 ):  # fmt: skip
-    """``state (M, P)`` int8 of the env parts (link, body, clear and near thresholds) for
-    the ``todo (M, P)`` entries (others 0): 1 when the link's sphere tree clears it or
-    (``exact``) GJK certifies its shapes ``part_thr`` from the body (for a mesh: from the
-    triangles near the leaves not cleared); -1 when (``exact``) GJK certifies a shape nearer
-    than ``part_near``; else 0."""
+    """``(state (M, P) int8, opened (M,))`` of the env parts (link, body, clear and near
+    thresholds) for the ``todo (M, P)`` entries (others 0): 1 when the link's sphere tree
+    clears it or (``exact``) GJK certifies its shapes ``part_thr`` from the body (for a mesh:
+    from the triangles near the leaves not cleared); -1 when (``exact``) GJK certifies a shape
+    nearer than ``part_near``; else 0. ``opened``: the leaves not cleared by the trees, per
+    candidate (a rough measure of how deep it sits in the obstacles)."""
     M, P = todo.shape
     out = np.zeros((M, P), dtype=np.int8)
+    opened = np.zeros(M, dtype=np.int64)
     stack = np.empty(_STACK, np.int64)
     leaves = np.empty(_LEAVES, np.int64)
     Ts = np.empty((3, 4))
@@ -442,6 +440,8 @@ def parts_state(
             top = 0
             stack[0] = link_root[link]
             nf = 0
+            n_open = 0
+            full = False  # more open leaves than examined: the part cannot be cleared here
             while top >= 0:
                 node = stack[top]
                 top -= 1
@@ -462,24 +462,26 @@ def parts_state(
                     continue
                 child = node_child[node]
                 if child < 0:
+                    n_open += 1
                     if nf == _LEAVES:
-                        nf = -1
+                        full = True
                         break
                     leaves[nf] = node
                     nf += 1
                     continue
                 if top + 2 >= _STACK:
-                    nf = -1
+                    full = True
                     break
                 stack[top + 1] = child
                 stack[top + 2] = child + 1
                 top += 2
-            if nf == 0:
+            opened[m] += n_open
+            if nf == 0 and not full:
                 out[m, p] = 1
                 continue
-            if nf < 0 or not exact:
+            if not exact:
                 continue
-            state = 1
+            state = 0 if full else 1
             if env_kind[e] == FIELD:
                 f = env_field[e]
                 _compose(env_Tinv[e], T, Tml)
@@ -499,9 +501,11 @@ def parts_state(
                         sh_vs[s], sh_vc[s], f, b_origin, b_size, b_n, b_soff, b_start, b_toff,
                         b_tris, m_voff, m_foff, m_verts, m_faces, thr, near, tri, eye, qlo, qhi,
                     )  # fmt: skip
-                    if r != 1:
-                        state = r
+                    if r == -1:
+                        state = -1
                         break
+                    if r == 0:
+                        state = 0  # not clear; a later leaf may still show it below
             else:
                 k = env_kind[e]
                 gk = G.BOX if k == BOX else G.CYLINDER if k == CYLINDER else G.SPHERE
@@ -517,7 +521,7 @@ def parts_state(
                     if r == 0:
                         state = 0
             out[m, p] = state
-    return out
+    return out, opened
 
 
 @nb.njit(cache=True)

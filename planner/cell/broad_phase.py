@@ -152,6 +152,10 @@ class BroadPhase:
     _tree_arrays: tuple[NDArray, ...] | None = None
     _shape_arrays: tuple[NDArray, ...] | None = None
     _fixed: dict[float, BoolArray] = field(default_factory=dict)
+    _fields_key: tuple[tuple[str, int], ...] | None = None
+    _fields_cat: tuple[NDArray, ...] = ()
+    _part_map_key: object = None
+    _part_map: PartMap | None = None
     #: run the exact (GJK) step where the sphere trees do not clear a part.
     exact: bool = True
 
@@ -315,6 +319,10 @@ class BroadPhase:
             excess.append(0.0 if fld is not None else BULLET_ROUNDING_M)
             if fld is not None:
                 fields.append((fld, mesh))
+        key = tuple((f.key, id(m)) for f, m in fields)
+        if self._fields_key != key:  # concatenating the fields costs a copy of them
+            self._fields_cat = _concat_fields(fields)
+            self._fields_key = key
         T_all = np.array(Ts).reshape(-1, 4, 4)
         arrays = (
             np.array(kinds, dtype=np.int64),
@@ -330,7 +338,7 @@ class BroadPhase:
             np.array(infl),
             np.array(excess),
             arrays,
-            _concat_fields(fields),
+            self._fields_cat,
         )
 
     def _field(self, body: int, mesh: trimesh.Trimesh) -> DistanceField:
@@ -347,7 +355,16 @@ class BroadPhase:
         return float(t.radius[0]) if t is not None else float("inf")
 
     def part_map(self, scene: CellScene, plan: QueryPlan, env: EnvArrays) -> PartMap:
-        """The plan's parts on this broad phase's links and ``env``'s bodies."""
+        """The plan's parts on this broad phase's links and ``env``'s bodies (kept for the
+        next query with the same plan and bodies)."""
+        key = (plan, tuple(env.index.items()), tuple(env.inflation_m), tuple(env.excess_m))
+        if self._part_map_key != key:
+            self._part_map = self._build_part_map(scene, plan, env)
+            self._part_map_key = key
+        assert self._part_map is not None
+        return self._part_map
+
+    def _build_part_map(self, scene: CellScene, plan: QueryPlan, env: EnvArrays) -> PartMap:
         pl, pe, pt, pn, pk, pi = [], [], [], [], [], []
         margin = plan.margin_m
         for part in plan.parts:
@@ -455,16 +472,17 @@ class BroadPhase:
 
     def states(
         self, parts: PartMap, env: EnvArrays, T_links: FloatArray
-    ) -> tuple[NDArray[np.int8], NDArray[np.int8]]:
-        """``(part states (M, P), pair states (M, S))`` for link poses ``T_links (M, L, 3, 4)``:
-        1 the part (pair) reports nothing in Bullet's query; -1 its slack is below the margin;
-        0 not known here (see :func:`planner.cell.broad_kernels.parts_state`)."""
+    ) -> tuple[NDArray[np.int8], NDArray[np.int8], NDArray[np.int64]]:
+        """``(part states (M, P), pair states (M, S), opened (M,))`` for link poses
+        ``T_links (M, L, 3, 4)``: 1 the part (pair) reports nothing in Bullet's query; -1 its
+        slack is below the margin; 0 not known here; ``opened``: sphere-tree leaves near the
+        environment, per candidate (see :func:`planner.cell.broad_kernels.parts_state`)."""
         M = T_links.shape[0]
         trees = self.tree_arrays()
         shapes = self.shape_arrays()
         todo_p = np.broadcast_to(parts.known, (M, parts.known.size)).copy()
         T = np.ascontiguousarray(T_links)
-        ps = _parts_state(
+        ps, opened = _parts_state(
             T, todo_p, parts.part_link, parts.part_env, parts.part_thr, parts.part_near,
             *trees, *shapes, *env.arrays, *env.fields, self.exact,
         )  # fmt: skip
@@ -475,7 +493,7 @@ class BroadPhase:
             *trees, *shapes, self.exact,
         )  # fmt: skip
         ss[:, parts.pair_fixed_clear] = 1
-        return ps, ss
+        return ps, ss, opened
 
 
 def broad_phase_of(scene: CellScene) -> BroadPhase:

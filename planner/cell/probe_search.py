@@ -25,6 +25,7 @@ The work is done in four passes; the answers do not depend on them:
 
 from __future__ import annotations
 
+import heapq
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -85,6 +86,11 @@ def select(
     return least_bad(seen)
 
 
+def part_pair(part: QueryPart) -> tuple[str, str]:
+    """``(link, obstacle)`` of a part, for bounds that name no contact."""
+    return (str(part.link), part.env_name)
+
+
 def passes(cl: Clearance, margin_m: float) -> bool:
     """No collision and slack at least the margin."""
     return cl.ok and cl.slack_m >= margin_m
@@ -133,7 +139,7 @@ class ProbeSearch:
             return out
         K = cands.per_rotation
         c0 = first[idx]
-        pc, sc = self._broad(cands, idx, c0)
+        pc, sc, _ = self._broad(cands, idx, c0)
         near = cands.near_limit[idx, c0]
         look = Clearance(True, self.stages.plan.look_m, self.stages.look_slack_m, None)
         open_pts = []
@@ -161,11 +167,12 @@ class ProbeSearch:
             orders = [cands.order(i, self.max_checks) for i in rest]
             heads = [o[:FIRST_BLOCK] for o in orders]
             pts = np.repeat(np.array(rest), [len(h) for h in heads])
-            pc_all, sc_all = self._broad(cands, pts, np.concatenate(heads))
+            pc_all, sc_all, op_all = self._broad(cands, pts, np.concatenate(heads))
             start = 0
             for i, order, head in zip(rest, orders, heads):
                 flags = _Flags(self, cands, i, order)
-                flags.put(pc_all[start : start + len(head)], sc_all[start : start + len(head)])
+                sl = slice(start, start + len(head))
+                flags.put(pc_all[sl], sc_all[sl], op_all[sl])
                 start += len(head)
                 out[i] = self._search(cands, i, order, flags)
                 self.decided_by["search"] += 1
@@ -174,7 +181,7 @@ class ProbeSearch:
     # ------------------------------------------------------------------ passes
     def _broad(
         self, cands: ProbeCandidates, pts: NDArray[np.int_], cs: NDArray[np.int_]
-    ) -> tuple[NDArray[np.int8], NDArray[np.int8]]:
+    ) -> tuple[NDArray[np.int8], NDArray[np.int8], NDArray[np.int64]]:
         """Broad-phase states of candidates ``cs`` of points ``pts`` (see
         :meth:`planner.cell.broad_phase.BroadPhase.states`)."""
         K = cands.per_rotation
@@ -190,14 +197,18 @@ class ProbeSearch:
         pairs_clear: BoolArray,
         results: dict[int, Clearance | None],
         stop_below: float = -math.inf,
-        certify: bool = False,
         max_cost: int = 1,
+        max_parts: int = -1,
+        certify: bool = False,
     ) -> tuple[Clearance, bool]:
         """The candidate's open parts with Bullet, cheapest first (cached ones before all).
 
-        Stops once the slack is shown below ``stop_below`` (with ``certify``, by certificates
-        where they are cheaper) or after the parts of cost up to ``max_cost``. ``results``
-        collects the parts evaluated (plan index -> result, kept between calls).
+        Stops once the slack is shown below ``stop_below``, before a part costing more than
+        ``max_cost``, or after ``max_parts`` parts not cached (-1: no limit). With
+        ``certify``, a work-object part not cached is first asked only whether it goes below
+        ``stop_below`` (:meth:`ProbeClearance.certify`, a fraction of a full query when the
+        collision is deep); if so the candidate stops there. ``results`` collects the parts
+        evaluated (plan index -> result, kept between calls).
 
         Returns:
             The merge of the parts known so far (the exact clearance when complete, else an
@@ -205,34 +216,37 @@ class ProbeSearch:
         """
         st = self.stages
         running = min((r.slack_m for r in results.values() if r is not None), default=math.inf)
-        todo: list[tuple[int, int, float, int]] = []  # (cached first, cost, size, k)
+        todo: list[tuple[int, int, float, int]] = []  # (not cached, cost, size, k)
         for k in range(len(self._env_parts)):
             part = self._env_parts[k]
             if not clear[k] and part.index not in results:
-                todo.append((int(not st.known(rotation, q, part)), self._cost[k], self._size[k], k))
+                cached = st.known(rotation, q, part)
+                todo.append((int(not cached), self._cost[k], self._size[k], k))
         todo.sort()
         self_open = not pairs_clear.all() and st.self_part.index not in results
-        complete = True
-        if running >= stop_below and self_open:
+        fresh = 0
+        if running >= stop_below and self_open and max_parts != 0:
             res = st.evaluate(rotation, q, st.self_part, ~pairs_clear)
             results[st.self_part.index] = res
             self_open = False
+            fresh += 1
             if res is not None:
                 running = min(running, res.slack_m)
-        for _, cost, _, k in todo:
-            if running < stop_below or cost > max_cost:
+        complete = not self_open
+        for new, cost, _, k in todo:
+            if running < stop_below or cost > max_cost or (new and fresh == max_parts):
                 complete = False
                 break
             part = self._env_parts[k]
-            if certify and cost >= 1 and not st.known(rotation, q, part):
-                bound = math.nextafter(stop_below, -math.inf)
-                if st.certify(rotation, q, part, bound):
-                    return Clearance(False, bound + part.need_m, bound, None), False
+            if certify and new and cost >= 1:  # on failure, the full query follows
+                below = math.nextafter(stop_below, -math.inf)
+                if st.certify(rotation, q, part, below):
+                    return Clearance(False, below + part.need_m, below, part_pair(part)), False
             res = st.evaluate(rotation, q, part)
             results[part.index] = res
+            fresh += new
             if res is not None:
                 running = min(running, res.slack_m)
-        complete = complete and not self_open
         return st.merge(results), complete
 
     def _search(
@@ -247,12 +261,14 @@ class ProbeSearch:
         bound: dict[int, float] = {}  # j -> upper bound of the slack
         look = self.stages.look_slack_m
 
-        def run(j: int, stop_below: float, certify: bool = False, max_cost: int = 1) -> None:
+        def run(
+            j: int, stop_below: float, max_cost: int = 1, max_parts: int = -1, certify: bool = False
+        ) -> None:
             c = int(order[j])
             clear, pairs_clear = flags.clear(j)
             cl, complete = self._exact(
-                c // K, cands.q[i, c], clear, pairs_clear, results[j], stop_below, certify,
-                max_cost,
+                c // K, cands.q[i, c], clear, pairs_clear, results[j], stop_below, max_cost,
+                max_parts, certify,
             )  # fmt: skip
             if complete:
                 exact[j] = cl
@@ -280,21 +296,25 @@ class ProbeSearch:
                 if j not in exact:
                     run(j, -math.inf, max_cost=0)
             top = max((cl.slack_m for cl in exact.values()), default=-math.inf)
-        pending = [j for j in range(len(order)) if j not in exact]
-        pending.sort(key=lambda j: (-bound.get(j, look), j))
-        for j in pending:
-            lead = next(
-                (k for k in sorted(exact) if exact[k].slack_m >= top - CLEARANCE_TIE_M), None
-            )
-            b = bound.get(j, look)  # no slack exceeds the look distance's
-            if b < top - CLEARANCE_TIE_M:
-                continue  # cannot reach the tie
-            if lead is not None and j > lead and b <= exact[lead].slack_m + CLEARANCE_TIE_M:
+        # best first: refine the candidate with the highest bound (no slack exceeds the look
+        # distance's), one part at a time, until no open candidate can reach the tie
+        heap = [
+            (-bound.get(j, look), flags.opened(j), j) for j in range(len(order)) if j not in exact
+        ]
+        heapq.heapify(heap)
+        while heap:
+            neg, opened, j = heapq.heappop(heap)
+            floor = top - CLEARANCE_TIE_M
+            if -neg < floor:
+                break  # nor can any other
+            lead = next((k for k in sorted(exact) if exact[k].slack_m >= floor), None)
+            if lead is not None and j > lead and -neg <= exact[lead].slack_m + CLEARANCE_TIE_M:
                 continue  # comes after a tie member it cannot push out of the tie
-            stop = top - CLEARANCE_TIE_M
-            run(j, stop, certify=stop < 0)
+            run(j, floor, max_parts=1, certify=floor < 0)
             if j in exact:
                 top = max(top, exact[j].slack_m)
+            else:
+                heapq.heappush(heap, (-bound[j], opened, j))
         seen = [(int(order[j]), exact[j]) for j in sorted(exact)]
         return least_bad(seen)
 
@@ -308,17 +328,23 @@ class _Flags:
         self._search, self._cands, self._i, self._order = search, cands, i, order
         self._pc: list[NDArray[np.int8]] = []
         self._sc: list[NDArray[np.int8]] = []
+        self._opened: list[int] = []
 
-    def put(self, pc: NDArray[np.int8], sc: NDArray[np.int8]) -> None:
+    def put(self, pc: NDArray[np.int8], sc: NDArray[np.int8], opened: NDArray[np.int64]) -> None:
         self._pc.extend(pc)
         self._sc.extend(sc)
+        self._opened.extend(opened.tolist())
 
     def _get(self, j: int) -> tuple[NDArray[np.int8], NDArray[np.int8]]:
         if j >= len(self._pc):  # the rest of the point's candidates, in one call
             cs = self._order[len(self._pc) :]
-            pc, sc = self._search._broad(self._cands, np.full(cs.size, self._i), cs)
-            self.put(pc, sc)
+            self.put(*self._search._broad(self._cands, np.full(cs.size, self._i), cs))
         return self._pc[j], self._sc[j]
+
+    def opened(self, j: int) -> int:
+        """Sphere-tree leaves of candidate row ``j`` near the environment."""
+        self._get(j)
+        return self._opened[j]
 
     def clear(self, j: int) -> tuple[BoolArray, BoolArray]:
         """``(parts clear (P,), pairs clear (S,))`` of candidate row ``j``."""

@@ -145,20 +145,22 @@ def no_ik_reasons(
     if rest and opw is not None:
         idx = np.array(rest)
         q8, ok8 = opw.ik_branches(T[idx].reshape(-1, 4, 4))
-        q8 = q8.reshape(len(idx), R * 8, -1)
+        n_j = q8.shape[-1]
+        q8 = q8.reshape(len(idx), R * 8, n_j)
         ok8 = ok8.reshape(len(idx), R * 8)
+        owner, row = np.nonzero(ok8)
+        q = q8[owner, row]  # (K, n): the branches that exist
         lo, hi = chain.lower, chain.upper
         with np.errstate(invalid="ignore"):
-            best = np.full(q8.shape, np.inf)  # violation of each joint over its 2*pi variants
+            best = np.full(q.shape, np.inf)  # violation of each joint over its 2*pi variants
             for k in (-2, -1, 0, 1, 2):
-                qk = q8 + k * (2 * np.pi)
+                qk = q + k * (2 * np.pi)
                 best = np.minimum(best, np.maximum(lo - qk, 0) + np.maximum(qk - hi, 0))
-        worst = np.argmax(np.where(ok8[..., None], best, -np.inf), axis=2)  # (P', R * 8)
-        counts = np.zeros((len(idx), q8.shape[2]), dtype=np.int64)
-        for j in range(q8.shape[2]):
-            counts[:, j] = np.sum(ok8 & (worst == j), axis=1)
+        worst = np.argmax(best, axis=1)  # each branch's worst joint
+        counts = np.bincount(owner * n_j + worst, minlength=len(idx) * n_j).reshape(-1, n_j)
+        any_ok = ok8.any(axis=1)
         for n, i in enumerate(rest):
-            if not ok8[n].any():
+            if not any_ok[n]:
                 out[i] = opw_wrist_reason(opw, T[i])
             else:
                 j = int(np.argmax(counts[n]))
