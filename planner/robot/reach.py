@@ -158,7 +158,7 @@ def no_ik_reasons(
                 best = np.minimum(best, np.maximum(lo - qk, 0) + np.maximum(qk - hi, 0))
         worst = np.argmax(best, axis=1)  # each branch's worst joint
         counts = np.bincount(owner * n_j + worst, minlength=len(idx) * n_j).reshape(-1, n_j)
-        any_ok = ok8.any(axis=1)
+        any_ok = np.asarray(ok8.any(axis=1), dtype=bool)
         for n, i in enumerate(rest):
             if not any_ok[n]:
                 out[i] = opw_wrist_reason(opw, T[i])
