@@ -161,7 +161,7 @@ class WobjcalApp:
         elif self.selected in changed:
             self._show_selected()
 
-    def show_reachability(self, n_samples: int = 120) -> None:
+    def show_reachability(self, n_samples: int = 1000) -> None:
         """Start the reachability heat map (computed in chunks on the cell worker)."""
         self.heatmap.stop()
         self.heatmap.start(n_samples)
