@@ -10,7 +10,7 @@ evaluates the others with Bullet, one part at a time, in the state the part need
 - robot parts with the robot at ``q``; cached by the joint values the link follows (revolute
   joints modulo ``2 pi``), so the ``2 pi`` variants of the wrist share them;
 - the self part (the link pairs the broad phase left open) with the robot at ``q`` and the tool
-  on its flange.
+  at the planned flange pose.
 
 Merged in the plan's order (:meth:`planner.cell.clearance.QueryPlan.merge`) with ``None`` for
 the cleared parts, the results are exactly the whole query's, except that the tool stands at
@@ -102,11 +102,11 @@ class ProbeClearance:
         if part.kind == "robot":
             rkey = self._robot_key(part, q)
             if rkey not in self._robot:
-                self._set_q(q)
+                self._set_q(q, rotation)
                 self.parts_evaluated += 1
                 self._robot[rkey] = checker.evaluate(part)
             return self._robot[rkey]
-        self._set_q(q)
+        self._set_q(q, rotation)
         self.parts_evaluated += 1
         return checker.evaluate(part, pairs)
 
@@ -119,7 +119,7 @@ class ProbeClearance:
         if part.kind == "tool":
             self._place_tool(rotation)
         else:
-            self._set_q(q)
+            self._set_q(q, rotation)
         self.parts_certified += 1
         return checker.certify_below(part, slack_m)
 
@@ -133,15 +133,18 @@ class ProbeClearance:
         wrapped = np.where(self._revolute[:k], np.mod(qk, _TWO_PI), qk)
         return (float(part.index), *np.round(wrapped, 9).tolist())
 
-    def _set_q(self, q: FloatArray) -> None:
+    def _set_q(self, q: FloatArray, rotation: int) -> None:
+        """The robot at ``q`` and the tool at the rotation's planned flange pose (``q``'s
+        flange: the tool stands where PyBullet's single-precision kinematics put it within
+        ~1e-7 m)."""
         if self._q_at is None or not np.array_equal(self._q_at, q):
-            self._cell.set_joint_positions(q)
+            cell = self._cell
+            cell.robot_body.set_q(cell.client, q)
             self._q_at = q
-            self._tool_at = None  # the tool now sits on PyBullet's flange
+        self._place_tool(rotation)
 
     def _place_tool(self, rotation: int) -> None:
         tool = self._cell.tool_body
         if tool is not None and self._tool_at != rotation:
             set_link_pose(self._cell.client, tool, self._T_world_flange[rotation])
             self._tool_at = rotation
-            self._q_at = None  # the tool no longer sits on the flange of q
