@@ -109,3 +109,20 @@ def test_a_moved_part_is_checked_where_it_lies(cell: Cell) -> None:
     finally:
         cell.move_work_object(T0)
     assert all(same(a, b) for a, b in zip(fast, exact))
+
+
+def test_self_collision_near_misses_answer_as_the_exact_check() -> None:
+    """On the benchmark's box, the points whose answer is the forearm near the tool mount (the
+    self part decides them) and a random share of the rest, to the last bit of the clearance's
+    Bullet value where the exact check computes it the same way."""
+    from bench.feasibility_cell import bench_cell
+
+    with bench_cell(trimesh.creation.box([0.8, 0.6, 0.4]).subdivide_to_size(0.03)) as c:
+        pts, nrm, _ = sample_surface(c.work_object.mesh, 3000, np.random.default_rng(0))
+        fast = c.check_probes(pts, nrm)
+        near = [i for i, r in enumerate(fast) if "tool_mount" in r.reason]
+        idx = sorted(set(near) | set(range(0, 3000, 20)))
+        exact = c.check_probes(pts[idx], nrm[idx], staged=False)
+    assert len(near) >= 5
+    assert all(same(fast[i], e) for i, e in zip(idx, exact))
+    assert all(fast[i].clearance_m == e.clearance_m for i, e in zip(idx, exact) if i in near)

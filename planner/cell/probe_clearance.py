@@ -10,7 +10,7 @@ evaluates the others with Bullet, one part at a time, in the state the part need
 - robot parts with the robot at ``q``; cached by the joint values the link follows (revolute
   joints modulo ``2 pi``), so the ``2 pi`` variants of the wrist share them;
 - the self part (the link pairs the broad phase left open) with the robot at ``q`` and the tool
-  at the planned flange pose.
+  on PyBullet's flange, as in the whole query.
 
 Merged in the plan's order (:meth:`planner.cell.clearance.QueryPlan.merge`) with ``None`` for
 the cleared parts, the results are exactly the whole query's, except that the tool stands at
@@ -62,6 +62,7 @@ class ProbeClearance:
         self._robot: dict[tuple[float, ...], Clearance | None] = {}
         self._tool_at: int | None = None
         self._q_at: FloatArray | None = None
+        self._tool_on_flange = False
         #: parts evaluated in full, and certificate queries made (for profiling and tests).
         self.parts_evaluated = 0
         self.parts_certified = 0
@@ -102,11 +103,11 @@ class ProbeClearance:
         if part.kind == "robot":
             rkey = self._robot_key(part, q)
             if rkey not in self._robot:
-                self._set_q(q, rotation)
+                self._set_q(q)
                 self.parts_evaluated += 1
                 self._robot[rkey] = checker.evaluate(part)
             return self._robot[rkey]
-        self._set_q(q, rotation)
+        self._set_q_and_tool(q)
         self.parts_evaluated += 1
         return checker.evaluate(part, pairs)
 
@@ -119,7 +120,7 @@ class ProbeClearance:
         if part.kind == "tool":
             self._place_tool(rotation)
         else:
-            self._set_q(q, rotation)
+            self._set_q(q)
         self.parts_certified += 1
         return checker.certify_below(part, slack_m)
 
@@ -133,18 +134,27 @@ class ProbeClearance:
         wrapped = np.where(self._revolute[:k], np.mod(qk, _TWO_PI), qk)
         return (float(part.index), *np.round(wrapped, 9).tolist())
 
-    def _set_q(self, q: FloatArray, rotation: int) -> None:
-        """The robot at ``q`` and the tool at the rotation's planned flange pose (``q``'s
-        flange: the tool stands where PyBullet's single-precision kinematics put it within
-        ~1e-7 m)."""
+    def _set_q(self, q: FloatArray) -> None:
+        """The robot at ``q`` (the tool wherever it was: robot parts do not see it)."""
         if self._q_at is None or not np.array_equal(self._q_at, q):
             cell = self._cell
             cell.robot_body.set_q(cell.client, q)
             self._q_at = q
-        self._place_tool(rotation)
+            self._tool_on_flange = False
+
+    def _set_q_and_tool(self, q: FloatArray) -> None:
+        """The robot at ``q`` and the tool on PyBullet's flange, as the whole query has them
+        (the self part: GJK between two links answers within ~1e-6 m of a pose ~1e-7 m
+        away)."""
+        if not self._tool_on_flange or self._q_at is None or not np.array_equal(self._q_at, q):
+            self._cell.set_joint_positions(q)
+            self._q_at = q
+            self._tool_on_flange = True
+            self._tool_at = None
 
     def _place_tool(self, rotation: int) -> None:
         tool = self._cell.tool_body
         if tool is not None and self._tool_at != rotation:
             set_link_pose(self._cell.client, tool, self._T_world_flange[rotation])
             self._tool_at = rotation
+            self._tool_on_flange = False

@@ -16,8 +16,8 @@ The work is done in four passes; the answers do not depend on them:
    when no part is left open, its clearance is the look distance and the point is decided;
 2. a lean loop over the others: the open parts of the first candidate with Bullet (often just
    the sensor, which stands at the sensing distance from the surface);
-3. one broad-phase call for all candidates of the points still open (at most ``max_checks``
-   each);
+3. one broad-phase call for the first :data:`FIRST_BLOCK` candidates of the points still open
+   (the rest of a point's, up to ``max_checks``, in one call when it needs them);
 4. per point: candidates in order until one passes, each one's open parts cheapest first,
    stopping as soon as its slack is shown below the margin; then the least-bad one, best
    candidates first (by an upper bound from the parts already known), a candidate dropped as
@@ -47,6 +47,9 @@ if TYPE_CHECKING:
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 
+#: Candidates of an open point whose broad phase runs with the batch (most such points pass
+#: within them); a point that needs more gets the rest in one call.
+FIRST_BLOCK = 8
 #: Clearances closer than this are a tie (Bullet's GJK answers vary by micrometres with the
 #: scene's pose); among ties the earlier candidate (less joint motion) wins, m.
 CLEARANCE_TIE_M = 1e-4
@@ -162,16 +165,17 @@ class ProbeSearch:
                 self.decided_by["first"] += 1
             else:
                 rest.append(i)
-        if rest:  # one broad-phase call for every candidate of these points
+        if rest:  # one broad-phase call for the first candidates of all these points
             orders = [cands.order(i, self.max_checks) for i in rest]
-            pts = np.repeat(np.array(rest), [len(o) for o in orders])
-            pc_all, sc_all, op_all = self._broad(cands, pts, np.concatenate(orders))
+            heads = [o[:FIRST_BLOCK] for o in orders]
+            pts = np.repeat(np.array(rest), [len(h) for h in heads])
+            pc_all, sc_all, op_all = self._broad(cands, pts, np.concatenate(heads))
             start = 0
-            for i, order in zip(rest, orders):
+            for i, order, head in zip(rest, orders, heads):
                 flags = _Flags(self, cands, i, order)
-                sl = slice(start, start + len(order))
+                sl = slice(start, start + len(head))
                 flags.put(pc_all[sl], sc_all[sl], op_all[sl])
-                start += len(order)
+                start += len(head)
                 out[i] = self._search(cands, i, order, flags)
                 self.decided_by["search"] += 1
         return out
