@@ -17,7 +17,7 @@ The work is done in four passes; the answers do not depend on them:
 2. a lean loop over the others: the open parts of the first candidate with Bullet (often just
    the sensor, which stands at the sensing distance from the surface);
 3. one broad-phase call for the first :data:`FIRST_BLOCK` candidates of the points still open
-   (the rest of a point's, up to ``max_checks``, in one call when it needs them);
+   (more of a point's, up to ``max_checks``, in doubling blocks when it needs them);
 4. per point: candidates in order until one passes, each one's open parts cheapest first,
    stopping as soon as its slack is shown below the margin; then the least-bad one, best
    candidates first (by an upper bound from the parts already known), a candidate dropped as
@@ -322,8 +322,8 @@ class ProbeSearch:
 
 
 class _Flags:
-    """Broad-phase states of one point's candidates (computed with the batch; any missing
-    on demand, in one call)."""
+    """Broad-phase states of one point's candidates (the first with the batch; more on
+    demand, each block as large as all before it)."""
 
     def __init__(
         self, search: ProbeSearch, cands: ProbeCandidates, i: int, order: NDArray[np.int_]
@@ -339,8 +339,9 @@ class _Flags:
         self._opened.extend(opened.tolist())
 
     def _get(self, j: int) -> tuple[NDArray[np.int8], NDArray[np.int8]]:
-        if j >= len(self._pc):  # the rest of the point's candidates, in one call
-            cs = self._order[len(self._pc) :]
+        while j >= len(self._pc):  # the next block, twice as many as computed so far
+            n = len(self._pc)
+            cs = self._order[n : max(j + 1, 2 * n)]
             self.put(*self._search._broad(self._cands, np.full(cs.size, self._i), cs))
         return self._pc[j], self._sc[j]
 
