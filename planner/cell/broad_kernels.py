@@ -124,68 +124,13 @@ def rasterize_band(
 
 
 @nb.njit(cache=True, inline="always")
-def field_lower_bound(
-    x: float,
-    y: float,
-    z: float,
-    f: int,
-    f_origin: np.ndarray,
-    f_h: np.ndarray,
-    f_n: np.ndarray,
-    f_off: np.ndarray,
-    f_val: np.ndarray,
-    f_lo: np.ndarray,
-    f_hi: np.ndarray,
-) -> float:
-    """Lower bound of the distance from body-frame point ``(x, y, z)`` to mesh ``f``, m.
-
-    The distance to the mesh's bounding box, and inside the grid the trilinear interpolation
-    of the node values minus its error bound ``h * sqrt(sum t (1 - t))`` (the distance is
-    1-Lipschitz; see ``docs/cell.md``): whichever is larger.
-    """
-    dx = max(f_lo[f, 0] - x, 0.0, x - f_hi[f, 0])
-    dy = max(f_lo[f, 1] - y, 0.0, y - f_hi[f, 1])
-    dz = max(f_lo[f, 2] - z, 0.0, z - f_hi[f, 2])
-    box = math.sqrt(dx * dx + dy * dy + dz * dz)
-    h = f_h[f]
-    gx = (x - f_origin[f, 0]) / h
-    gy = (y - f_origin[f, 1]) / h
-    gz = (z - f_origin[f, 2]) / h
-    nx, ny, nz = f_n[f, 0], f_n[f, 1], f_n[f, 2]
-    if not (gx >= 0.0 and gy >= 0.0 and gz >= 0.0):
-        return box
-    i, j, k = int(gx), int(gy), int(gz)
-    if i >= nx - 1 or j >= ny - 1 or k >= nz - 1:
-        return box
-    tx, ty, tz = gx - i, gy - j, gz - k
-    base = f_off[f] + (i * ny + j) * nz + k
-    sy, sx = nz, ny * nz
-    v000 = f_val[base]
-    v001 = f_val[base + 1]
-    v010 = f_val[base + sy]
-    v011 = f_val[base + sy + 1]
-    v100 = f_val[base + sx]
-    v101 = f_val[base + sx + 1]
-    v110 = f_val[base + sx + sy]
-    v111 = f_val[base + sx + sy + 1]
-    c00 = v000 + (v001 - v000) * tz
-    c01 = v010 + (v011 - v010) * tz
-    c10 = v100 + (v101 - v100) * tz
-    c11 = v110 + (v111 - v110) * tz
-    c0 = c00 + (c01 - c00) * ty
-    c1 = c10 + (c11 - c10) * ty
-    val = c0 + (c1 - c0) * tx
-    err = h * math.sqrt(tx * (1.0 - tx) + ty * (1.0 - ty) + tz * (1.0 - tz))
-    return max(box, val - err)
-
-
-@nb.njit(cache=True, inline="always")
 def _field_lb(
     f_val: np.ndarray, x: float, y: float, z: float, o0: float, o1: float, o2: float, h: float,
     nx: int, ny: int, nz: int, off: int, lo0: float, lo1: float, lo2: float, hi0: float,
     hi1: float, hi2: float,
 ) -> float:  # fmt: skip
-    """:func:`field_lower_bound` with the field's parameters as scalars (one array)."""
+    """:func:`field_lower_bound` with the field's parameters as scalars (one array argument:
+    array arguments cost reference counting on every call)."""
     dx = max(lo0 - x, 0.0, x - hi0)
     dy = max(lo1 - y, 0.0, y - hi1)
     dz = max(lo2 - z, 0.0, z - hi2)
@@ -214,16 +159,12 @@ def _field_lb(
     return max(box, val - err)
 
 
-@nb.njit(cache=True, inline="always")
-def env_lower_bound(
-    px: float,
-    py: float,
-    pz: float,
-    e: int,
-    env_kind: np.ndarray,
-    env_Tinv: np.ndarray,
-    env_dims: np.ndarray,
-    env_field: np.ndarray,
+@nb.njit(cache=True)
+def field_lower_bound(
+    x: float,
+    y: float,
+    z: float,
+    f: int,
     f_origin: np.ndarray,
     f_h: np.ndarray,
     f_n: np.ndarray,
@@ -232,24 +173,17 @@ def env_lower_bound(
     f_lo: np.ndarray,
     f_hi: np.ndarray,
 ) -> float:
-    """Lower bound of the distance from world point ``p`` to environment body ``e``, m."""
-    T = env_Tinv[e]
-    x = T[0, 0] * px + T[0, 1] * py + T[0, 2] * pz + T[0, 3]
-    y = T[1, 0] * px + T[1, 1] * py + T[1, 2] * pz + T[1, 3]
-    z = T[2, 0] * px + T[2, 1] * py + T[2, 2] * pz + T[2, 3]
-    kind = env_kind[e]
-    if kind == BOX:
-        dx = max(abs(x) - env_dims[e, 0], 0.0)
-        dy = max(abs(y) - env_dims[e, 1], 0.0)
-        dz = max(abs(z) - env_dims[e, 2], 0.0)
-        return math.sqrt(dx * dx + dy * dy + dz * dz)
-    if kind == CYLINDER:
-        dr = max(math.sqrt(x * x + y * y) - env_dims[e, 0], 0.0)
-        dz = max(abs(z) - env_dims[e, 1], 0.0)
-        return math.sqrt(dr * dr + dz * dz)
-    if kind == SPHERE:
-        return max(math.sqrt(x * x + y * y + z * z) - env_dims[e, 0], 0.0)
-    return field_lower_bound(x, y, z, env_field[e], f_origin, f_h, f_n, f_off, f_val, f_lo, f_hi)
+    """Lower bound of the distance from body-frame point ``(x, y, z)`` to mesh ``f``, m.
+
+    The distance to the mesh's bounding box, and inside the grid the trilinear interpolation
+    of the node values minus its error bound ``h * sqrt(sum t (1 - t))`` (the distance is
+    1-Lipschitz; see ``docs/cell.md``): whichever is larger.
+    """
+    return _field_lb(
+        f_val, x, y, z, f_origin[f, 0], f_origin[f, 1], f_origin[f, 2], f_h[f],
+        f_n[f, 0], f_n[f, 1], f_n[f, 2], f_off[f], f_lo[f, 0], f_lo[f, 1], f_lo[f, 2],
+        f_hi[f, 0], f_hi[f, 1], f_hi[f, 2],
+    )  # fmt: skip
 
 
 @nb.njit(cache=True, inline="always")

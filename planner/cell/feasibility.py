@@ -128,11 +128,11 @@ def check_probes(
         rotation_step_deg: step of the free rotation about the sensor axis, degrees.
         margin_m: clearance to work object and fixtures, m (default the cell's 5 mm).
         q_ref: ``(n,)`` reference configuration for "least joint motion" (default home).
-        max_checks: largest number of candidates collision-checked per point.
-        staged: check candidates through :class:`planner.cell.probe_clearance.ProbeClearance`
-            (tool once per rotation, a candidate dropped as soon as it can change nothing);
-            ``False``: one whole clearance query per candidate, the plain reference. Both
-            give the same answers.
+        max_checks: largest number of candidates collision-checked per point (>= 1).
+        staged: decide candidates with :class:`planner.cell.probe_search.ProbeSearch` (a
+            broad phase for the whole batch, Bullet only for the parts it leaves open);
+            ``False``: one whole clearance query per candidate, the exact check. Both give
+            the same answers.
 
     Returns:
         One :class:`ProbeFeasibility` per point, in the order given. The cell's joint state is

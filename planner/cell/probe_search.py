@@ -202,15 +202,18 @@ class ProbeSearch:
         max_cost: int = 1,
         max_parts: int = -1,
         certify: bool = False,
+        tried: dict[int, float] | None = None,
     ) -> tuple[Clearance, bool]:
         """The candidate's open parts with Bullet, cheapest first (cached ones before all).
 
         Stops once the slack is shown below ``stop_below``, before a part costing more than
         ``max_cost``, or after ``max_parts`` parts not cached (-1: no limit). With
-        ``certify``, a work-object part not cached is first asked only whether it goes below
-        ``stop_below`` (:meth:`ProbeClearance.certify`, a fraction of a full query when the
-        collision is deep); if so the candidate stops there. ``results`` collects the parts
-        evaluated (plan index -> result, kept between calls).
+        ``certify``, the work-object parts not cached are first asked only whether they go
+        below ``stop_below`` (:meth:`ProbeClearance.certify`, a fraction of a full query
+        when the collision is deep), smallest links first; one that does stops the candidate.
+        ``tried`` keeps, per part, the deepest bound a certificate failed to show (not asked
+        again). ``results`` collects the parts evaluated (plan index -> result, kept between
+        calls).
 
         Returns:
             The merge of the parts known so far (the exact clearance when complete, else an
@@ -235,15 +238,21 @@ class ProbeSearch:
             if res is not None:
                 running = min(running, res.slack_m)
         complete = not self_open
+        if certify and running >= stop_below and tried is not None:
+            # certificates first, smallest links first: any one shows the candidate below
+            below = math.nextafter(stop_below, -math.inf)
+            for new, cost, _, k in todo:
+                part = self._env_parts[k]
+                if not new or cost < 1 or tried.get(k, -math.inf) >= below:
+                    continue
+                if st.certify(rotation, q, part, below):
+                    return Clearance(False, below + part.need_m, below, part_pair(part)), False
+                tried[k] = below  # not that deep: no deeper bound can be shown either
         for new, cost, _, k in todo:
             if running < stop_below or cost > max_cost or (new and fresh == max_parts):
                 complete = False
                 break
             part = self._env_parts[k]
-            if certify and new and cost >= 1:  # on failure, the full query follows
-                below = math.nextafter(stop_below, -math.inf)
-                if st.certify(rotation, q, part, below):
-                    return Clearance(False, below + part.need_m, below, part_pair(part)), False
             res = st.evaluate(rotation, q, part)
             results[part.index] = res
             fresh += new
@@ -259,6 +268,7 @@ class ProbeSearch:
         near = cands.near_limit[i]
         self.stages.start_point(cands.T_base_flange[i])
         results: list[dict[int, Clearance | None]] = [{} for _ in order]
+        tried: list[dict[int, float]] = [{} for _ in order]
         exact: dict[int, Clearance] = {}
         bound: dict[int, float] = {}  # j -> upper bound of the slack
         look = self.stages.look_slack_m
@@ -270,7 +280,7 @@ class ProbeSearch:
             clear, pairs_clear = flags.clear(j)
             cl, complete = self._exact(
                 c // K, cands.q[i, c], clear, pairs_clear, results[j], stop_below, max_cost,
-                max_parts, certify,
+                max_parts, certify, tried[j],
             )  # fmt: skip
             if complete:
                 exact[j] = cl
