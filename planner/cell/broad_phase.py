@@ -7,7 +7,8 @@ look distance. The broad phase shows, for whole batches of candidates, that a pa
 pair) cannot report anything: every sphere of the link's sphere tree
 (:mod:`planner.cell.sphere_tree`) lies at least ``dist_m + margin`` from a lower bound of the
 distance to the body (exact for boxes, cylinders and spheres; a distance field for meshes,
-:mod:`planner.cell.distance_field`), where ``margin`` is :data:`SAFETY_M` plus Bullet's inflation
+:mod:`planner.cell.distance_field`), where ``margin`` is a safety (:mod:`planner.cell.broad_parts`)
+plus Bullet's inflation
 of each side (1 mm for a convex hull or a concave triangle mesh, 0 for boxes and cylinders,
 which Bullet shrinks and rounds; see :mod:`planner.cell.link_geometry`). Such a part's result is
 ``None`` in the exact query; the others go to Bullet (:mod:`planner.cell.probe_clearance`), so
@@ -29,18 +30,24 @@ from numpy.typing import NDArray
 
 from calib.frames import invert_transform
 from planner.cell import broad_kernels as kernels
-from planner.cell import gjk_kernels as G
 from planner.cell.bodies import world_link_pose
+from planner.cell.broad_arrays import (
+    BroadLink,
+    EnvArrays,
+    PartMap,
+    concat_fields,
+    shape_arrays,
+    tree_arrays,
+)
+from planner.cell.broad_parts import build_part_map
 from planner.cell.distance_field import DistanceField, distance_field
 from planner.cell.link_geometry import (
     BULLET_MESH_MARGIN_M,
     BULLET_ROUNDING_M,
-    LinkShape,
     bullet_excess,
     link_shapes,
 )
-from planner.cell.pybullet_client import pb
-from planner.cell.sphere_tree import SphereTree, link_tree
+from planner.cell.sphere_tree import link_tree
 
 if TYPE_CHECKING:
     from planner.cell.clearance import QueryPlan
@@ -52,88 +59,6 @@ BoolArray = NDArray[np.bool_]
 # numba dispatchers take any arguments (their stubs say otherwise)
 _parts_state: Any = kernels.parts_state
 _pairs_state: Any = kernels.pairs_state
-
-#: Added to every part's look distance before a part is called clear, m (covers Bullet's
-#: single-precision poses and the GJK tolerance with a wide margin).
-SAFETY_M = 0.0005
-
-
-@dataclass(frozen=True)
-class BroadLink:
-    """One robot or tool link of the broad phase.
-
-    Attributes:
-        body: PyBullet body id; link: link index in it.
-        name: the link's report name.
-        shapes: its collision shapes (link frame).
-        tree: its sphere tree (link frame), ``None`` when it cannot be covered.
-        inflation_m: Bullet's inflation of its shapes, m.
-        excess_m: how much Bullet's distance to it can exceed the true one, m (its rounded
-            box and cylinder edges).
-        joint: robot links: index of the moving joint the link follows (-1: the base);
-            tool links: ``None``.
-        T_const: robot links: ``T_joint_link`` (or ``T_base_link``); tool links:
-            ``T_flange_link``; ``None`` when the pose is unknown.
-    """
-
-    body: int
-    link: int
-    name: str
-    shapes: tuple[LinkShape, ...]
-    tree: SphereTree | None
-    inflation_m: float
-    excess_m: float
-    joint: int | None
-    T_const: FloatArray | None
-
-
-@dataclass(frozen=True)
-class EnvArrays:
-    """Environment bodies in the kernels' layout (see :mod:`planner.cell.broad_kernels`).
-
-    Attributes:
-        index: body id -> row.
-        inflation_m: ``(E,)`` Bullet's inflation of each body's shape, m.
-        excess_m: ``(E,)`` how much Bullet's distance to it can exceed the true one, m.
-        arrays: ``(kind, Tinv, T, dims, field)``: the bodies.
-        fields: the distance fields, bucket grids and triangles of the mesh bodies.
-    """
-
-    index: dict[int, int]
-    inflation_m: FloatArray
-    excess_m: FloatArray
-    arrays: tuple[NDArray, ...]
-    fields: tuple[NDArray, ...]
-
-
-@dataclass
-class PartMap:
-    """The parts of one query plan mapped onto broad-phase links and bodies.
-
-    Attributes:
-        part_link, part_env, part_thr, part_near: ``(P,)`` per env part (robot/tool kind, in
-            plan order): link index, env index, clear threshold (look distance plus margins),
-            near threshold (a part certified nearer than this has slack below the margin), m;
-            ``known (P,)`` whether it can be decided here.
-        part_index: ``(P,)`` index of each in ``plan.parts``.
-        pair_a, pair_b, pair_thr, pair_near: ``(S,)`` per self pair of the checker's pair table;
-            ``pair_known (S,)``; ``pair_fixed_clear (S,)``: pairs of links that never move
-            against each other (both on one joint, e.g. the flange link and the tool) which
-            Bullet, asked once, finds clear.
-    """
-
-    part_link: NDArray[np.int64]
-    part_env: NDArray[np.int64]
-    part_thr: FloatArray
-    part_near: FloatArray
-    known: BoolArray
-    part_index: NDArray[np.int64]
-    pair_a: NDArray[np.int64]
-    pair_b: NDArray[np.int64]
-    pair_thr: FloatArray
-    pair_near: FloatArray
-    pair_known: BoolArray
-    pair_fixed_clear: BoolArray
 
 
 @dataclass
@@ -201,88 +126,17 @@ class BroadPhase:
 
     # ------------------------------------------------------------------ arrays
     def tree_arrays(self) -> tuple[NDArray, ...]:
-        """``(node_c, node_r, node_child, link_root, node_shape)`` of all links: their trees
-        concatenated, leaves tagged with the global index of their shape in
-        :meth:`shape_arrays` (links without a tree get an empty root; they are never
-        queried)."""
+        """The links' sphere trees in the kernels' layout (:func:`~planner.cell.broad_arrays.
+        tree_arrays`), built once."""
         if self._tree_arrays is None:
-            cs, rs, ch, sh, roots = [], [], [], [], []
-            offset = 0
-            shape0 = 0
-            for b in self.links:
-                t = b.tree
-                if t is None:
-                    roots.append(0)
-                    continue
-                cs.append(t.center)
-                rs.append(t.radius)
-                ch.append(np.where(t.child >= 0, t.child + offset, -1))
-                sh.append(np.where(t.shape >= 0, t.shape + shape0, -1))
-                roots.append(offset)
-                offset += len(t.radius)
-                shape0 += len(b.shapes)
-            if not cs:
-                cs, rs, ch, sh = (
-                    [np.zeros((1, 3))],
-                    [np.zeros(1)],
-                    [np.full(1, -1)],
-                    [np.full(1, -1)],
-                )
-            self._tree_arrays = (
-                np.ascontiguousarray(np.concatenate(cs)),
-                np.ascontiguousarray(np.concatenate(rs)),
-                np.ascontiguousarray(np.concatenate(ch).astype(np.int64)),
-                np.array(roots, dtype=np.int64),
-                np.ascontiguousarray(np.concatenate(sh).astype(np.int64)),
-            )
+            self._tree_arrays = tree_arrays(self.links)
         return self._tree_arrays
 
     def shape_arrays(self) -> tuple[NDArray, ...]:
-        """``(kind, T_link_shape (S, 3, 4), dims, center, half, vstart, vcount, verts,
-        link_start (L,), link_count (L,))``: the links' shapes in the GJK layout
-        (:mod:`planner.cell.gjk_kernels`); ``center``/``half``: each shape's box, shape frame."""
+        """The links' shapes in the GJK layout (:func:`~planner.cell.broad_arrays.
+        shape_arrays`), built once."""
         if self._shape_arrays is None:
-            kind: list[int] = []
-            T: list[FloatArray] = []
-            dims: list[FloatArray] = []
-            center: list[FloatArray] = []
-            half: list[FloatArray] = []
-            vs: list[int] = []
-            vc: list[int] = []
-            verts = [np.zeros((1, 3))]
-            nverts = 1
-            l0, ln = [], []
-            for b in self.links:
-                usable = b.tree is not None
-                l0.append(len(kind))
-                ln.append(len(b.shapes) if usable else 0)
-                if not usable:
-                    continue
-                for sh in b.shapes:
-                    k, d, c, h, v = _gjk_shape(sh)
-                    kind.append(k)
-                    T.append(sh.T_link_shape[:3])
-                    dims.append(d)
-                    center.append(c)
-                    half.append(h)
-                    vs.append(nverts if v is not None else 0)
-                    vc.append(len(v) if v is not None else 0)
-                    if v is not None:
-                        verts.append(v)
-                        nverts += len(v)
-            S = len(kind)
-            self._shape_arrays = (
-                np.array(kind, dtype=np.int64),
-                np.ascontiguousarray(np.array(T, dtype=float).reshape(S, 3, 4)),
-                np.array(dims, dtype=float).reshape(S, 3),
-                np.array(center, dtype=float).reshape(S, 3),
-                np.array(half, dtype=float).reshape(S, 3),
-                np.array(vs, dtype=np.int64),
-                np.array(vc, dtype=np.int64),
-                np.ascontiguousarray(np.concatenate(verts)),
-                np.array(l0, dtype=np.int64),
-                np.array(ln, dtype=np.int64),
-            )
+            self._shape_arrays = shape_arrays(self.links)
         return self._shape_arrays
 
     def environment(self, scene: CellScene) -> EnvArrays:
@@ -321,7 +175,7 @@ class BroadPhase:
                 fields.append((fld, mesh))
         key = tuple((f.key, id(m)) for f, m in fields)
         if self._fields_key != key:  # concatenating the fields costs a copy of them
-            self._fields_cat = _concat_fields(fields)
+            self._fields_cat = concat_fields(fields)
             self._fields_key = key
         T_all = np.array(Ts).reshape(-1, 4, 4)
         arrays = (
@@ -359,98 +213,11 @@ class BroadPhase:
         next query with the same plan and bodies)."""
         key = (plan, tuple(env.index.items()), tuple(env.inflation_m), tuple(env.excess_m))
         if self._part_map_key != key:
-            self._part_map = self._build_part_map(scene, plan, env)
+            self._part_map = build_part_map(scene, self.links, plan, env, self._fixed)
             self._part_map_key = key
         assert self._part_map is not None
         return self._part_map
 
-    def _build_part_map(self, scene: CellScene, plan: QueryPlan, env: EnvArrays) -> PartMap:
-        pl, pe, pt, pn, pk, pi = [], [], [], [], [], []
-        margin = plan.margin_m
-        for part in plan.parts:
-            if part.kind == "self":
-                continue
-            k = self._by_body_link.get((part.body, part.link), -1)
-            e = env.index.get(part.env, -1)
-            known = k >= 0 and e >= 0 and self._known(k)
-            infl = (self.links[k].inflation_m if k >= 0 else 0.0) + (
-                env.inflation_m[e] if e >= 0 else 0.0
-            )
-            excess = (self.links[k].excess_m if k >= 0 else 0.0) + (
-                env.excess_m[e] if e >= 0 else 0.0
-            )
-            pl.append(max(k, 0))
-            pe.append(max(e, 0))
-            pt.append(part.dist_m + infl + SAFETY_M)
-            pn.append(part.need_m + margin - excess - SAFETY_M)
-            pk.append(known)
-            pi.append(part.index)
-        self_look = plan.parts[-1].dist_m
-        bodies, link_idx, pa, pb_ = scene.checker._self_pair_table()
-        ka = [self._by_body_link.get((bodies[a], link_idx[a]), -1) for a in pa.tolist()]
-        kb = [self._by_body_link.get((bodies[b], link_idx[b]), -1) for b in pb_.tolist()]
-        pair_known = [
-            a >= 0 and b >= 0 and self._known(a) and self._known(b) for a, b in zip(ka, kb)
-        ]
-        pair_thr = [
-            self_look + SAFETY_M + (self.links[a].inflation_m if a >= 0 else 0.0)
-            + (self.links[b].inflation_m if b >= 0 else 0.0)
-            for a, b in zip(ka, kb)
-        ]  # fmt: skip
-        self_need = plan.parts[-1].need_m
-        pair_near = [
-            self_need + margin - SAFETY_M - (self.links[a].excess_m if a >= 0 else 0.0)
-            - (self.links[b].excess_m if b >= 0 else 0.0)
-            for a, b in zip(ka, kb)
-        ]  # fmt: skip
-        fixed = self._fixed_pairs_clear(scene, ka, kb, pair_known, self_look + SAFETY_M)
-        return PartMap(
-            np.array(pl, dtype=np.int64),
-            np.array(pe, dtype=np.int64),
-            np.array(pt, dtype=float),
-            np.array(pn, dtype=float),
-            np.array(pk, dtype=bool),
-            np.array(pi, dtype=np.int64),
-            np.array([max(a, 0) for a in ka], dtype=np.int64),
-            np.array([max(b, 0) for b in kb], dtype=np.int64),
-            np.array(pair_thr, dtype=float),
-            np.array(pair_near, dtype=float),
-            np.array(pair_known, dtype=bool),
-            fixed,
-        )
-
-    def _fixed_pairs_clear(
-        self, scene: CellScene, ka: list[int], kb: list[int], known: list[bool], look: float
-    ) -> BoolArray:
-        """Pairs of links on the same joint (they never move against each other) that Bullet
-        finds farther apart than ``look`` (asked once per look distance, at the home pose)."""
-        key = round(look, 12)
-        if key not in self._fixed:
-            n_last = scene.chain.n_joints - 1
-            out = np.zeros(len(ka), dtype=bool)
-            with scene.saved_state():
-                scene.set_joint_positions(scene.home_q)
-                for s_, (a, b) in enumerate(zip(ka, kb)):
-                    if not known[s_]:
-                        continue
-                    la, lb_ = self.links[a], self.links[b]
-                    ja = n_last if la.joint is None else la.joint
-                    jb = n_last if lb_.joint is None else lb_.joint
-                    if ja != jb:
-                        continue
-                    hits = pb.getClosestPoints(
-                        la.body, lb_.body, look, linkIndexA=la.link, linkIndexB=lb_.link,
-                        physicsClientId=scene.client,
-                    )  # fmt: skip
-                    out[s_] = not hits
-            self._fixed[key] = out
-        return self._fixed[key].copy()
-
-    def _known(self, k: int) -> bool:
-        b = self.links[k]
-        return b.tree is not None and b.T_const is not None
-
-    # ------------------------------------------------------------------ queries
     def link_poses(self, scene: CellScene, q: FloatArray, T_base_flange: FloatArray) -> FloatArray:
         """``T_world_link (M, L, 3, 4)`` of every link for configurations ``q (M, n)`` whose
         flange (where the tool sits) is ``T_base_flange (M, 4, 4)``."""
@@ -502,61 +269,3 @@ def broad_phase_of(scene: CellScene) -> BroadPhase:
     if not isinstance(bp, BroadPhase):
         bp = scene.query_cache["broad_phase"] = BroadPhase.of(scene)
     return bp
-
-
-def _gjk_shape(sh: LinkShape) -> tuple[int, FloatArray, FloatArray, FloatArray, FloatArray | None]:
-    """``(kind, dims, box centre, box half extents, hull vertices)`` of a shape for GJK."""
-    if sh.kind == "box":
-        half = np.asarray(sh.size_m, dtype=float) / 2
-        return G.BOX, half, np.zeros(3), half, None
-    if sh.kind in ("cylinder", "capsule"):
-        r, hz = sh.size_m[0], sh.size_m[1] / 2
-        cap = sh.kind == "capsule"
-        box = np.array([r, r, hz + (r if cap else 0.0)])
-        return (G.CAPSULE if cap else G.CYLINDER), np.array([r, hz, 0.0]), np.zeros(3), box, None
-    if sh.kind == "sphere":
-        r = sh.size_m[0]
-        return G.SPHERE, np.array([r, 0.0, 0.0]), np.zeros(3), np.full(3, r), None
-    assert sh.vertices_m is not None
-    v = np.ascontiguousarray(sh.vertices_m, dtype=float)
-    lo, hi = v.min(axis=0), v.max(axis=0)
-    return G.HULL, np.zeros(3), (lo + hi) / 2, (hi - lo) / 2, v
-
-
-def _concat_fields(fields: list[tuple[DistanceField, trimesh.Trimesh]]) -> tuple[NDArray, ...]:
-    """The fields, bucket grids and triangles of the mesh bodies, concatenated (see
-    :mod:`planner.cell.broad_kernels`)."""
-    if not fields:
-        flds: list[DistanceField] = []
-        meshes: list[trimesh.Trimesh] = []
-    else:
-        flds = [f for f, _ in fields]
-        meshes = [m for _, m in fields]
-
-    def offsets(sizes: list[int]) -> NDArray[np.int64]:
-        return np.cumsum([0, *sizes[:-1]]).astype(np.int64) if sizes else np.zeros(0, np.int64)
-
-    def cat(arrays: list[NDArray], empty: NDArray) -> NDArray:
-        return np.ascontiguousarray(np.concatenate(arrays)) if arrays else empty
-
-    F = len(flds)
-    return (
-        np.array([f.origin for f in flds], dtype=float).reshape(F, 3),
-        np.array([f.spacing for f in flds], dtype=float),
-        np.array([f.values.shape for f in flds], dtype=np.int64).reshape(F, 3),
-        offsets([f.values.size for f in flds]),
-        cat([f.values.ravel() for f in flds], np.zeros(0, np.float32)),
-        np.array([f.lo for f in flds], dtype=float).reshape(F, 3),
-        np.array([f.hi for f in flds], dtype=float).reshape(F, 3),
-        np.array([f.bucket_origin for f in flds], dtype=float).reshape(F, 3),
-        np.array([f.bucket_size for f in flds], dtype=float),
-        np.array([f.bucket_n for f in flds], dtype=np.int64).reshape(F, 3),
-        offsets([f.bucket_start.size for f in flds]),
-        cat([f.bucket_start for f in flds], np.zeros(0, np.int64)),
-        offsets([f.bucket_tris.size for f in flds]),
-        cat([f.bucket_tris for f in flds], np.zeros(0, np.int64)),
-        offsets([len(m.vertices) for m in meshes]),
-        offsets([len(m.faces) for m in meshes]),
-        cat([np.asarray(m.vertices, dtype=float) for m in meshes], np.zeros((0, 3))),
-        cat([np.asarray(m.faces, dtype=np.int64) for m in meshes], np.zeros((0, 3), np.int64)),
-    )

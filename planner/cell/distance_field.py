@@ -6,14 +6,14 @@ mesh's box grown by :data:`PAD_M`; each node holds a lower bound of the distance
 :data:`CAP_M`:
 
 - each triangle computes the exact distance of the nodes within ``band = BAND_CELLS * h`` of
-  its box (:func:`planner.cell.broad_kernels.rasterize_band`); a node whose smallest such
+  its box (:func:`planner.cell.field_kernels.rasterize_band`); a node whose smallest such
   distance is within the band has its exact distance (its nearest triangle was among them);
 - the others are farther than the band from the mesh, and get the larger of the band and
   ``EDT - h * sqrt(3) / 2``: ``EDT`` is the distance to the nearest corner of a grid cell that
   a triangle's box touches, and the nearest surface point lies in such a cell, within
   ``h * sqrt(3) / 2`` of one of its corners.
 
-A query (:func:`planner.cell.broad_kernels.field_lower_bound`) interpolates trilinearly and
+A query (:func:`planner.cell.field_kernels.field_lower_bound`) interpolates trilinearly and
 subtracts the interpolation's error bound, and outside the grid uses the distance to the
 mesh's box.
 
@@ -38,7 +38,7 @@ import trimesh
 from numpy.typing import NDArray
 from scipy import ndimage
 
-from planner.cell import broad_kernels as kernels
+from planner.cell import field_kernels as kernels
 from planner.cell.disk_cache import load_arrays, save_arrays
 
 log = logging.getLogger(__name__)

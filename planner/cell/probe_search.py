@@ -35,8 +35,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from planner.cell.broad_arrays import EnvArrays, PartMap
 from planner.cell.broad_kernels import FIELD
-from planner.cell.broad_phase import BroadPhase, EnvArrays, PartMap, broad_phase_of
+from planner.cell.broad_phase import BroadPhase, broad_phase_of
 from planner.cell.clearance import Clearance, QueryPart
 from planner.cell.probe_clearance import ProbeClearance
 
