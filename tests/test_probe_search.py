@@ -17,7 +17,7 @@ import trimesh
 from calib.frames import make_transform, matrix_from_rotvec
 from planner.cell.cell import Cell
 from planner.cell.clearance import Clearance
-from planner.cell.probe_search import CLEARANCE_TIE_M, least_bad, select
+from planner.cell.probe_rule import CLEARANCE_TIE_M, least_bad, select
 from planner.cell.reachability_map import sample_surface
 
 

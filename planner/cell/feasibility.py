@@ -39,7 +39,8 @@ from planner.cell.probe_candidates import (
     singular,
     tcp_frames,
 )
-from planner.cell.probe_search import CLEARANCE_TIE_M, Decision, ProbeSearch, select
+from planner.cell.probe_rule import CLEARANCE_TIE_M, Decision, select
+from planner.cell.probe_search import ProbeSearch
 
 if TYPE_CHECKING:
     from planner.cell.scene import CellScene
