@@ -130,4 +130,3 @@ class CellSession:
         if self.cell is not None:
             self.cell.close()
         self.cell = None
-

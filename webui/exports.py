@@ -36,9 +36,7 @@ class ExportResult:
     note: str = ""
 
 
-def export_program(
-    plan: Plan, fmt: str, plan_dir: Path, cell: Cell | None = None
-) -> ExportResult:
+def export_program(plan: Plan, fmt: str, plan_dir: Path, cell: Cell | None = None) -> ExportResult:
     """The robot program(s) of ``plan`` in ``fmt`` (a key of :data:`FORMATS`).
 
     Args:

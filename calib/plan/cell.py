@@ -19,7 +19,8 @@ from calib.frames import (
     quat_wxyz_from_matrix,
 )
 from calib.plan.base import MeshUnits, check_sha256
-from calib.structs import Strict, Vec3, check_finite, check_unit
+from calib.structs import Strict, Vec3, check_coordinates, check_unit
+from calib.tolerances import COORDINATE_LIMIT_M
 
 
 class Pose(Strict, frozen=True, kw_only=True):
@@ -34,7 +35,7 @@ class Pose(Strict, frozen=True, kw_only=True):
     quat_wxyz: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
 
     def __post_init__(self) -> None:
-        check_finite(self.position_m, "position_m")
+        check_coordinates(self.position_m, "position_m")
         check_unit(self.quat_wxyz, "quat_wxyz")
 
     def matrix(self) -> NDArray[np.float64]:
@@ -100,8 +101,11 @@ class FixtureSpec(Strict, frozen=True, kw_only=True):
         if (self.mesh is None) == (self.box_size_m is None):
             raise PlanError("mesh: give exactly one of mesh and box_size_m")
         if self.box_size_m is not None:
-            if not all(math.isfinite(v) and v > 0 for v in self.box_size_m):
-                raise PlanError(f"box_size_m: must be 3 lengths > 0, got {list(self.box_size_m)}")
+            if not all(math.isfinite(v) and 0 < v <= COORDINATE_LIMIT_M for v in self.box_size_m):
+                raise PlanError(
+                    f"box_size_m: must be 3 lengths > 0 and <= {COORDINATE_LIMIT_M:g} m, "
+                    f"got {list(self.box_size_m)}"
+                )
             if self.sha256 is not None:
                 raise PlanError("sha256: must be null for a box")
         else:

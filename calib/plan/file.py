@@ -43,7 +43,14 @@ from calib.plan.models import ValidationSpec
 from calib.probing import ProbePoint, SearchSpec
 from calib.procedures import METHODS, ProcedureSettings, method_of, procedure_kind
 from calib.procedures.base import RolePoint
-from calib.structs import UNIT_TOL, Strict, Vec3, check_finite, check_positive, check_unit
+from calib.structs import (
+    UNIT_TOL,
+    Strict,
+    Vec3,
+    check_coordinates,
+    check_positive,
+    check_unit,
+)
 
 __all__ = [
     "BUILTIN_PREFIX",
@@ -123,7 +130,7 @@ class PlanPoint(Strict, frozen=True, kw_only=True):
     def __post_init__(self) -> None:
         if not self.id or not self.id.strip():
             raise PlanError("id: must be a non-empty string")
-        check_finite(self.position_m, "position_m")
+        check_coordinates(self.position_m, "position_m")
         check_unit(self.normal, "normal")
         check_unit(self.edge_normal, "edge_normal")
         if self.search.edge_direction is not None:
