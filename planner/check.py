@@ -16,6 +16,11 @@ Per point, three checks:
 
 A point is ``infeasible`` when any of the three fails, ``marginal`` when only the pose is
 marginal, else ``feasible``.
+
+Per plan, the procedure's own preconditions (:func:`layout_problem`): the plan has points, every
+role the procedure needs, and the procedure computes the nominal frame from exact measurements
+of the nominal points (a dry run of the same ``estimate`` that ``wobjcal calibrate`` runs), so
+a plan that ``calibrate`` would refuse fails at ``check``, before the robot has measured.
 """
 
 from __future__ import annotations
@@ -30,8 +35,12 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from calib.errors import InputError, ProbeFailedError
+from calib.frames import transform_points
 from calib.plan.file import Plan, PlanPoint
 from calib.probing import SearchCommand
+from calib.procedures import procedure_kind
+from calib.tolerances import FACE_MAX_DEVIATION_M
 from planner.plan_cell import nominal_T_base_wobj, open_cell
 
 if TYPE_CHECKING:
@@ -135,17 +144,21 @@ class PlanCheck:
         ik_note: why the analytic IK does not apply (``""`` for ``opw``).
         error: a problem of the whole plan on this part (e.g. the part has no planar face),
             ``""`` when none.
+        layout: why the plan's procedure would refuse its points (:func:`layout_problem`:
+            no points, a missing role, a layout that breaks the procedure's assumptions),
+            ``""`` when none.
     """
 
     points: tuple[PointCheck, ...]
     ik_kind: str
     ik_note: str = ""
     error: str = ""
+    layout: str = ""
 
     @property
     def feasible(self) -> bool:
-        """Every point and path is feasible and the plan has no error."""
-        return not self.error and all(p.feasible for p in self.points)
+        """Every point and path is feasible and the plan has no error or layout problem."""
+        return not self.error and not self.layout and all(p.feasible for p in self.points)
 
     @property
     def infeasible(self) -> tuple[PointCheck, ...]:
@@ -164,14 +177,15 @@ class PlanCheck:
         raise KeyError(f"no point {point_id!r}; points: {[p.point_id for p in self.points]}")
 
     def to_json(self) -> dict[str, Any]:
-        """A JSON-ready dict; ``error`` appears only when there is one."""
+        """A JSON-ready dict; ``ik_note``, ``error`` and ``layout`` appear only when set."""
         out: dict[str, Any] = {
             "feasible": self.feasible,
             "ik_kind": self.ik_kind,
             "points": [p.to_json() for p in self.points],
         }
-        if self.error:
-            out["error"] = self.error
+        for key in ("ik_note", "error", "layout"):
+            if getattr(self, key):
+                out[key] = getattr(self, key)
         return out
 
 
@@ -192,7 +206,45 @@ def check_plan(plan: Plan, plan_dir: Path | None = None, *, cell: Cell | None = 
         with open_cell(plan, plan_dir or Path.cwd()) as own:
             return check_plan(plan, cell=own)
     checks, error = _check(plan, list(plan.points), cell)
-    return PlanCheck(checks, cell.solver.kind, cell.solver.why_not_opw or "", error)
+    return PlanCheck(
+        checks, cell.solver.kind, cell.solver.why_not_opw or "", error, layout_problem(plan)
+    )
+
+
+def layout_problem(plan: Plan) -> str:
+    """Why the plan's procedure would refuse its points, ``""`` when it would not.
+
+    A dry run of ``wobjcal calibrate``: the procedure (:data:`calib.procedures.PROCEDURES`)
+    estimates the frame from exact measurements of the nominal points, in the nominal frame.
+    It must accept them (roles, faces, observability) and give back the nominal frame: a
+    layout that breaks the procedure's assumptions (e.g. A and B of the A-H procedure not at
+    one height) shows as the distance, at the worst point, between the two frames; more than
+    :data:`calib.tolerances.FACE_MAX_DEVIATION_M` is a problem.
+    """
+    if not plan.points:
+        return "the plan has no points: nothing to measure"
+    kind = procedure_kind(plan.procedure)
+    problem = kind.role_problem([p.role for p in plan.points], True)
+    if problem:
+        return problem
+    T = nominal_T_base_wobj(plan)
+    exact = {p.id: transform_points(T, p.position_m)[None] for p in plan.points}
+    try:
+        T_est = kind.estimate(plan.role_points(), exact, T, plan.procedure).T_base_wobj
+    except (InputError, ProbeFailedError) as exc:
+        return f"{plan.method}: {exc}"
+    positions = np.array([p.position_m for p in plan.points], dtype=np.float64)
+    off = np.linalg.norm(
+        transform_points(T_est, positions) - transform_points(T, positions), axis=1
+    )
+    worst = int(np.argmax(off))
+    if off[worst] > FACE_MAX_DEVIATION_M:
+        return (
+            f"{plan.method}: from exact measurements of the nominal points the procedure's "
+            f"frame moves point {plan.points[worst].id} by {off[worst] * 1e3:.3f} mm: the layout "
+            "breaks the procedure's assumptions (see docs/paper_method.md)"
+        )
+    return ""
 
 
 def check_points(cell: Cell, plan: Plan, points: Sequence[PlanPoint]) -> tuple[PointCheck, ...]:

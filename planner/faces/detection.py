@@ -41,6 +41,7 @@ import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
+from calib.tolerances import FACE_ANGLE_TOL_RAD, FACE_FLATNESS_RMS_M, FACE_MAX_DEVIATION_M
 from calib.validation import check_points
 from planner.errors import MeshError
 from planner.faces.footprint import DEFAULT_FOOTPRINT_RADIUS_M, holds_footprint
@@ -54,12 +55,13 @@ IntArray = NDArray[np.int64]
 
 #: Default smallest face area: the sensor footprint, m^2.
 MIN_AREA_M2 = math.pi * DEFAULT_FOOTPRINT_RADIUS_M**2
-#: Default largest angle between triangle normals (and to the fitted plane) in a face, rad.
-ANGLE_TOL_RAD = math.radians(3.0)
+#: Default largest angle between triangle normals (and to the fitted plane) in a face, rad
+#: (the one table of tolerances, :mod:`calib.tolerances`).
+ANGLE_TOL_RAD = FACE_ANGLE_TOL_RAD
 #: Default largest RMS distance of a face from its fitted plane, m.
-FLATNESS_TOL_M = 1.0e-4
+FLATNESS_TOL_M = FACE_FLATNESS_RMS_M
 #: Default largest distance of any vertex of a face from its fitted plane, m.
-MAX_DEVIATION_M = 5.0e-4
+MAX_DEVIATION_M = FACE_MAX_DEVIATION_M
 _CACHE_SIZE = 8
 
 
