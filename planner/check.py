@@ -83,6 +83,8 @@ class PointCheck:
         q_path: ``(M, n)`` joint values along the path samples that passed, rad, or ``None``.
         T_base_flange: ``(4, 4)`` flange pose of ``q``, robot base frame, m, or ``None``.
         elapsed_s: time this point's check took, s.
+        T_base_tcp: ``(4, 4)`` the probing TCP at ``q`` (through the tool's mount), robot base
+            frame, m, or ``None``.
     """
 
     point_id: str
@@ -105,6 +107,7 @@ class PointCheck:
     q_path: FloatArray | None
     T_base_flange: FloatArray | None
     elapsed_s: float = 0.0
+    T_base_tcp: FloatArray | None = None
 
     @property
     def feasible(self) -> bool:
@@ -280,15 +283,23 @@ def _check(plan: Plan, points: list[PlanPoint], cell: Cell) -> tuple[tuple[Point
     T_nom = nominal_T_base_wobj(plan)
     ik_kind = cell.solver.kind
     out = []
+    T_flange_tcp = cell.T_flange_tcp(plan.cell.tool.tcp)
     for p, probe, pose, face in zip(points, probes, poses, faces, strict=True):
         path = cell.check_search(SearchCommand.from_point(probe, T_nom), q_ref=pose.q)
-        out.append(_point_check(cell, p, pose, path, face, ik_kind, t0))
+        out.append(_point_check(cell, p, pose, path, face, ik_kind, t0, T_flange_tcp))
         t0 = time.perf_counter()
     return tuple(out), error
 
 
 def _point_check(
-    cell: Cell, p: PlanPoint, pose: ProbeFeasibility, path: Any, face: str, ik_kind: str, t0: float
+    cell: Cell,
+    p: PlanPoint,
+    pose: ProbeFeasibility,
+    path: Any,
+    face: str,
+    ik_kind: str,
+    t0: float,
+    T_flange_tcp: FloatArray,
 ) -> PointCheck:
     from planner.cell.collision import DEFAULT_MARGIN_M, report_distance_m
 
@@ -320,6 +331,9 @@ def _point_check(
         q_path=None if path.q_path is None else np.asarray(path.q_path, dtype=float),
         T_base_flange=None if pose.T_base_flange is None else np.asarray(pose.T_base_flange),
         elapsed_s=time.perf_counter() - t0,
+        T_base_tcp=None
+        if pose.T_base_flange is None
+        else np.asarray(pose.T_base_flange) @ T_flange_tcp,
     )
 
 

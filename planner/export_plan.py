@@ -67,8 +67,8 @@ def export_job_for(
     else:
         T_wobj_base = invert_transform(T_nom)
         for r in check.points:
-            if r.T_base_flange is not None and r.pose_status != "infeasible":  # chosen pose
-                T_wobj_tcp = T_wobj_base @ r.T_base_flange @ tool.T_flange_tcp
+            if r.T_base_tcp is not None and r.pose_status != "infeasible":  # chosen pose
+                T_wobj_tcp = T_wobj_base @ r.T_base_tcp
                 rotations[r.point_id] = T_wobj_tcp[:3, :3]
             if r.confdata is not None:
                 confs[r.point_id] = r.confdata

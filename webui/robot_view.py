@@ -81,7 +81,7 @@ class RobotView:
             self._urdf.update_cfg(q_arr[self._to_urdf])
             T = self._view.T_world_flange(q_arr)
             if T is not None and self._tool_frame is not None:
-                pose = pose_kwargs(T)
+                pose = pose_kwargs(T @ self._view.T_flange_tool)
                 self._tool_frame.wxyz = pose["wxyz"]
                 self._tool_frame.position = pose["position"]
 

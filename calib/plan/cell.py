@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 
+import msgspec
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -71,11 +72,26 @@ class RobotSpec(Strict, frozen=True, kw_only=True):
 
 
 class ToolSpec(Strict, frozen=True, kw_only=True):
-    """The robot-held tool: ``name`` is a URDF path or ``builtin:cable_feeder``; ``tcp`` is the
-    probing TCP (the proximity sensor at its sensing distance)."""
+    """The robot-held tool.
+
+    Attributes:
+        name: a tool URDF or description path, or ``builtin:cable_feeder``.
+        tcp: the probing TCP (the proximity sensor at its sensing distance).
+        T_flange_tool: the tool's mount: its root frame (+z out of the flange) in the robot's
+            tip-link frame (``tool0``). Left out (default): along the last joint's axis,
+            whichever axis of the tip frame that is (some vendor URDFs have x out of the
+            flange); give it when the cell cannot tell (it says so, naming this field), or to
+            add an adapter plate. Read it through :attr:`mount`.
+    """
 
     name: str = "builtin:cable_feeder"
     tcp: str = "sensor"
+    T_flange_tool: Pose | msgspec.UnsetType = msgspec.UNSET
+
+    @property
+    def mount(self) -> Pose | None:
+        """``T_flange_tool`` when the plan sets it, else ``None`` (found from the robot)."""
+        return self.T_flange_tool if isinstance(self.T_flange_tool, Pose) else None
 
 
 class FixtureSpec(Strict, frozen=True, kw_only=True):
