@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -284,9 +284,11 @@ def _check(plan: Plan, points: list[PlanPoint], cell: Cell) -> tuple[tuple[Point
     ik_kind = cell.solver.kind
     out = []
     T_flange_tcp = cell.T_flange_tcp(plan.cell.tool.tcp)
+    part = f"work object {wo.name}: {wo.report.size_text}"
     for p, probe, pose, face in zip(points, probes, poses, faces, strict=True):
         path = cell.check_search(SearchCommand.from_point(probe, T_nom), q_ref=pose.q)
-        out.append(_point_check(cell, p, pose, path, face, ik_kind, t0, T_flange_tcp))
+        check = _point_check(cell, p, pose, path, face, ik_kind, t0, T_flange_tcp)
+        out.append(_with_part_size(check, wo.name, part))
         t0 = time.perf_counter()
     return tuple(out), error
 
@@ -334,6 +336,27 @@ def _point_check(
         T_base_tcp=None
         if pose.T_base_flange is None
         else np.asarray(pose.T_base_flange) @ T_flange_tcp,
+    )
+
+
+def _with_part_size(check: PointCheck, name: str, part: str) -> PointCheck:
+    """The check with the part's size and units added to reasons about the part (out of
+    reach, off its surface, hitting it): a part read in the wrong units shows as such."""
+
+    def add(reason: str) -> str:
+        about_part = name in reason or "out of reach" in reason or "from the surface" in reason
+        return f"{reason} ({part})" if reason and about_part else reason
+
+    pose, path, face = add(check.pose_reason), add(check.path_reason), add(check.face_reason)
+    if (pose, path, face) == (check.pose_reason, check.path_reason, check.face_reason):
+        return check
+    parts = [pose, f"search path: {path}" if path else "", face]
+    return replace(
+        check,
+        pose_reason=pose,
+        path_reason=path,
+        face_reason=face,
+        reason="; ".join(x for x in parts if x),
     )
 
 

@@ -97,3 +97,16 @@ def test_numeric_ik_is_named_with_why(reference_dir: Path, tmp_path: Path) -> No
     assert result.to_json()["ik_note"] == result.ik_note
     assert all(p.ik_kind == "numeric" for p in result.points)
     assert np.isfinite([p.clearance_m for p in result.points if p.q is not None]).all()
+
+
+def test_a_part_in_the_wrong_units_is_named_with_its_size(reference_dir: Path) -> None:
+    """Item 4: the plate in mm loaded as metres put points metres off, with no word of size or
+    units; now every reason about the part says how big it came out and in which units."""
+    plan = load_plan(SMALL)
+    wo = msgspec.structs.replace(
+        plan.work_object, mesh=str(reference_dir / "parts" / "plate_holes.STL"), units="m"
+    )
+    result = check_plan(msgspec.structs.replace(plan, work_object=wo), SMALL.parent)
+    about_part = [p.reason for p in result.points if "work object plate_holes" in p.reason]
+    assert about_part, [p.reason for p in result.points]
+    assert all("203 x 305 x 12.7 m (file units 'm', given)" in r for r in about_part)

@@ -311,7 +311,11 @@ class CellScene:
         Raises:
             MeshError: missing, unreadable or empty mesh (the message names the file).
         """
-        wobj = mesh if isinstance(mesh, WorkObject) else load_work_object(mesh, units, name)
+        wobj = (
+            mesh
+            if isinstance(mesh, WorkObject)
+            else load_work_object(mesh, units, name, reach_m=self.reach_model.reach_m)
+        )
         T = np.eye(4) if T_world_wobj is None else check_transform(T_world_wobj, "T_world_wobj")
         if self.checker.wobj_body is not None:
             pb.removeBody(self.checker.wobj_body, physicsClientId=self.client)

@@ -2,9 +2,20 @@
 
 Units: a name of :data:`calib.units.MESH_UNITS` (``"m"``, ``"mm"``, ``"cm"``, ``"in"``, ``"auto"``)
 or an alias of :data:`calib.units.ALIASES` (e.g. ``"inch"``), the same table the plan uses.
-The ``auto`` rule: a mesh whose largest bounding-box extent exceeds :data:`AUTO_MM_EXTENT` (20)
-is taken as millimetres, with a warning; otherwise as metres. A 20 m work object is implausible
-for a robot cell, and a part drawn in mm is rarely smaller than 20 mm.
+The ``auto`` rule (:func:`auto_units`) weighs the file's own unit hints and the cell's scale:
+
+1. a unit the file names (the loader's ``units``, a token of the STL header or the file name
+   such as ``_mm`` or ``inch``) is taken when it gives a plausible part;
+2. otherwise each unit is tried in the order m, mm, in, cm and the first that gives a plausible
+   part is taken: largest extent at least :data:`MIN_PART_M` (10 mm, about the sensor face)
+   and at most twice the robot's reach (a part the robot can work on from one side to the
+   other; the reach is the cell's :class:`planner.robot.reach.ReachModel`, or
+   :data:`DEFAULT_REACH_M` without a cell);
+3. when no unit does, metres, with a warning.
+
+Loading always says, in :attr:`RepairReport.units_note` and the log, the unit it used (and why,
+for ``auto``) and the part's resulting size; a part given in explicit units that comes out
+larger than twice the reach or smaller than 10 mm gets a warning naming the unit that would fit.
 
 Repair is light and reported: merge duplicate vertices, drop degenerate faces (zero area, or
 smaller than (1e-6 x the largest extent)^2) and duplicate faces
@@ -18,6 +29,7 @@ without that flag PyBullet would use the convex hull and fill every hole and slo
 from __future__ import annotations
 
 import logging
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -34,8 +46,31 @@ from planner.errors import MeshError
 FloatArray = NDArray[np.float64]
 log = logging.getLogger(__name__)
 
-#: ``units="auto"``: a larger extent than this (in file units) means millimetres.
-AUTO_MM_EXTENT = 20.0
+#: A work object is at least this large (largest extent), m: about the sensor face.
+MIN_PART_M = 0.010
+#: The reach used by ``auto`` without a cell (a large industrial arm), m.
+DEFAULT_REACH_M = 3.0
+#: The order ``auto`` tries units in when the file names none.
+AUTO_ORDER = ("m", "mm", "in", "cm")
+#: Words of a file name or header that name a unit.
+_HINT_WORDS = {
+    "m": "m",
+    "meter": "m",
+    "meters": "m",
+    "metre": "m",
+    "metres": "m",
+    "mm": "mm",
+    "millimeter": "mm",
+    "millimeters": "mm",
+    "millimetre": "mm",
+    "millimetres": "mm",
+    "cm": "cm",
+    "centimeter": "cm",
+    "centimeters": "cm",
+    "inch": "in",
+    "inches": "in",
+}
+_TRIMESH_UNITS = {"meters": "m", "millimeters": "mm", "centimeters": "cm", "inches": "in"}
 
 
 @dataclass(frozen=True)
@@ -47,6 +82,8 @@ class RepairReport:
         units: the canonical unit used (``"m"``, ``"mm"``, ``"cm"``, ``"in"``).
         units_detected: True when ``units`` came from the ``auto`` rule.
         scale: metres per file unit applied.
+        extents_m: ``(3,)`` the part's bounding-box size after scaling, metres.
+        units_note: the unit used, why (for ``auto``) and the part's size, in words.
         merged_vertices: vertices removed by merging duplicates.
         removed_degenerate_faces: zero-area faces removed.
         removed_duplicate_faces: duplicate faces removed.
@@ -71,6 +108,57 @@ class RepairReport:
     n_vertices: int
     n_faces: int
     warnings: tuple[str, ...] = ()
+    extents_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    units_note: str = ""
+
+    @property
+    def size_text(self) -> str:
+        """The part's size and units in words, e.g. ``"0.203 x 0.305 x 0.013 m (file in mm)"``."""
+        dims = " x ".join(f"{v:.3g}" for v in self.extents_m)
+        how = "detected" if self.units_detected else "given"
+        return f"{dims} m (file units {self.units!r}, {how})"
+
+
+def unit_hint(mesh: trimesh.Trimesh, source: str) -> str | None:
+    """The unit the file itself names, or ``None``: the loader's ``units`` (formats that carry
+    them), else a word of the STL header or of the file name (``plate_mm.stl``, ``inch``)."""
+    loaded = getattr(mesh, "units", None)
+    if isinstance(loaded, str) and loaded in _TRIMESH_UNITS:
+        return _TRIMESH_UNITS[loaded]
+    meta = mesh.metadata or {}
+    texts = [str(meta.get("header", "")), Path(str(source)).stem]
+    for text in texts:
+        words = re.split(r"[^a-z]+", text.lower().replace("units", " "))
+        for word in words:
+            if word in _HINT_WORDS and word != "m":  # a lone "m" in a name is rarely a unit
+                return _HINT_WORDS[word]
+    return None
+
+
+def _plausible(size_m: float, reach_m: float) -> bool:
+    return MIN_PART_M <= size_m <= 2.0 * reach_m
+
+
+def auto_units(extent: float, hint: str | None, reach_m: float) -> tuple[str, str]:
+    """The unit ``auto`` takes for a mesh whose largest extent is ``extent`` (file units), and
+    why (see the module docstring).
+
+    Args:
+        extent: largest bounding-box extent in file units.
+        hint: the unit the file names (:func:`unit_hint`), or ``None``.
+        reach_m: the robot's reach, m (what a work object may span at most).
+    """
+    limits = f"a part of {MIN_PART_M * 1e3:g} mm to twice the robot's reach {reach_m:.2f} m"
+    if hint is not None:
+        if _plausible(extent * METRES_PER_UNIT[hint], reach_m):
+            return hint, f"the file names {hint!r}"
+        why = f"the file names {hint!r}, but that gives {extent * METRES_PER_UNIT[hint]:.4g} m; "
+    else:
+        why = "the file names no unit; "
+    for unit in AUTO_ORDER:
+        if _plausible(extent * METRES_PER_UNIT[unit], reach_m):
+            return unit, why + f"{unit!r} is the first of {list(AUTO_ORDER)} that gives {limits}"
+    return "m", why + f"no unit gives {limits}: metres"
 
 
 @dataclass(frozen=True)
@@ -112,7 +200,10 @@ def _read(source: str | Path | trimesh.Trimesh) -> tuple[trimesh.Trimesh, str]:
 
 
 def load_work_object(
-    source: str | Path | trimesh.Trimesh, units: str = "auto", name: str | None = None
+    source: str | Path | trimesh.Trimesh,
+    units: str = "auto",
+    name: str | None = None,
+    reach_m: float | None = None,
 ) -> WorkObject:
     """Load, scale and lightly repair a work-object mesh.
 
@@ -122,6 +213,8 @@ def load_work_object(
         units: a unit of :mod:`calib.units` (``"m"``, ``"mm"``, ``"cm"``, ``"in"``, an alias
             such as ``"inch"``) or ``"auto"`` (see the module docstring).
         name: a short name; default the file stem.
+        reach_m: the robot's reach, m, for ``auto`` and the size warning; default
+            :data:`DEFAULT_REACH_M`.
 
     Raises:
         MeshError: missing or unreadable file, empty mesh, NaN/infinite vertices, bad units;
@@ -137,14 +230,28 @@ def load_work_object(
     if not np.all(np.isfinite(mesh.vertices)):
         raise MeshError(f"mesh {src} holds NaN or infinite vertex coordinates")
     warnings: list[str] = []
+    reach = DEFAULT_REACH_M if reach_m is None else float(reach_m)
+    extent = float(np.max(mesh.extents))
     detected = units == AUTO
     if detected:
-        extent = float(np.max(mesh.extents))
-        units = "mm" if extent > AUTO_MM_EXTENT else "m"
-        if units == "mm":
+        units, why = auto_units(extent, unit_hint(mesh, src), reach)
+        note = f"units 'auto' read as {units!r}: {why}"
+    else:
+        note = f"units {units!r} as given"
+        size = extent * METRES_PER_UNIT[units]
+        if not _plausible(size, reach):
+            fits = [u for u in AUTO_ORDER if _plausible(extent * METRES_PER_UNIT[u], reach)]
+            other = ""
+            if fits:
+                other = f"; {fits[0]!r} would make it {extent * METRES_PER_UNIT[fits[0]]:.3g} m"
+            what = (
+                f"larger than twice the robot's reach {reach:.2f} m"
+                if size > reach
+                else f"smaller than {MIN_PART_M * 1e3:g} mm"
+            )
             warnings.append(
-                f"{src}: largest extent {extent:.4g} > {AUTO_MM_EXTENT:g}, taken as millimetres "
-                f"(pass units='m' or 'in' if wrong)"
+                f"{src}: read in {units!r} the part is {size:.4g} m across, {what}: wrong units?"
+                + other
             )
     n_v, n_f = len(mesh.vertices), len(mesh.faces)
     mesh.merge_vertices()
@@ -170,6 +277,13 @@ def load_work_object(
         warnings.append(f"{src}: open mesh with {boundary} boundary edges; normals kept as given")
     scale = METRES_PER_UNIT[units]
     mesh.apply_scale(scale)
+    ext = tuple(float(v) for v in mesh.extents)
+    dims = " x ".join(f"{v:.3g}" for v in ext)
+    note = f"{src}: {note}; the part is {dims} m"
+    if detected:
+        warnings.insert(0, note)
+    else:
+        log.info(note)
     for w in warnings:
         log.warning(w)
     report = RepairReport(
@@ -186,6 +300,8 @@ def load_work_object(
         n_vertices=len(mesh.vertices),
         n_faces=len(mesh.faces),
         warnings=tuple(warnings),
+        extents_m=(ext[0], ext[1], ext[2]),
+        units_note=note,
     )
     stem = src.split(":", 1)[1] if is_builtin(src) else Path(src).stem or src
     return WorkObject(name=name or stem, mesh=mesh, report=report)
