@@ -5,6 +5,11 @@ builds the :class:`planner.export.job.ExportJob` with each target's sensor orien
 configuration from the check, and formats it with the writer registered for the format
 (:data:`planner.export.FORMATS`). Whether infeasible points stop the export is the caller's
 decision (``wobjcal export`` exits 1 unless ``--force``); the result says which they are.
+
+The plan's layout is checked even without the cell check (:func:`planner.check.layout_problem`):
+an A-H plan that lacks a role would otherwise become a program that runs every search in the
+nominal frame, silently not the paper's procedure; the result's ``layout`` says so and the
+command line refuses it unless ``--force``.
 """
 
 from __future__ import annotations
@@ -18,7 +23,7 @@ from numpy.typing import NDArray
 
 from calib.frames import invert_transform
 from calib.plan.file import Plan
-from planner.check import ConfData, PlanCheck, check_plan
+from planner.check import ConfData, PlanCheck, check_plan, layout_problem
 from planner.export import export_files
 from planner.export.job import ExportJob, build_job
 from planner.plan_cell import nominal_T_base_wobj, tool_data
@@ -37,11 +42,14 @@ class ProgramExport:
         files: ``{suffix: text}`` of the program, e.g. ``{".src": ..., ".dat": ...}``.
         notes: what the user should know (estimated tool load, points without a checked pose).
         check: the plan check the orientations came from, or ``None`` when not run.
+        layout: why the plan's procedure refuses its points (e.g. an A-H plan without a
+            role: the program is then not adaptive), ``""`` when it does not.
     """
 
     files: dict[str, str]
     notes: tuple[str, ...]
     check: PlanCheck | None
+    layout: str = ""
 
     @property
     def infeasible(self) -> tuple[str, ...]:
@@ -98,5 +106,8 @@ def export_program(
         InputError: unknown format, or a file of the plan cannot be loaded.
     """
     check = check_plan(plan, plan_dir, cell=cell) if run_check else None
+    layout = check.layout if check is not None else layout_problem(plan)
     job, notes = export_job_for(plan, plan_dir, check)
-    return ProgramExport(export_files(job, fmt), notes, check)
+    if layout:
+        notes = (*notes, f"layout: {layout}")
+    return ProgramExport(export_files(job, fmt), notes, check, layout)

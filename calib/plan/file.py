@@ -16,8 +16,9 @@ from __future__ import annotations
 
 import hashlib
 from pathlib import Path
-from typing import Final, Literal, get_args
+from typing import Annotated, Final, Literal, get_args
 
+import msgspec
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -79,6 +80,15 @@ __all__ = [
 PLAN_SCHEMA: Final = "wobjcal.plan/1"
 SUPPORTED_PLAN_SCHEMAS = (PLAN_SCHEMA,)
 
+#: A point id: what every robot language can hold in an identifier and a string (letters,
+#: digits, ``_``, ``.``, ``-``; at most 32), so no id can end a comment or a string in a program.
+POINT_ID_PATTERN = r"^[A-Za-z0-9_][A-Za-z0-9_.-]{0,31}$"
+#: A plan name (written into program comments): printable ASCII without quotes, ``\\``, ``!``,
+#: ``;`` or line breaks, at most 80 characters.
+PLAN_NAME_PATTERN = r"^[A-Za-z0-9 _.,:+()/-]{0,80}$"
+PointId = Annotated[str, msgspec.Meta(pattern=POINT_ID_PATTERN)]
+PlanName = Annotated[str, msgspec.Meta(pattern=PLAN_NAME_PATTERN)]
+
 
 class Search(Strict, frozen=True, kw_only=True):
     """How a point is searched for; see :class:`calib.probing.SearchSpec`.
@@ -120,7 +130,7 @@ class PlanPoint(Strict, frozen=True, kw_only=True):
         edge_normal: ``(3,)`` unit normal of the face whose end an edge search finds, or ``None``.
     """
 
-    id: str
+    id: PointId
     role: str
     position_m: Vec3
     normal: Vec3
@@ -128,8 +138,7 @@ class PlanPoint(Strict, frozen=True, kw_only=True):
     edge_normal: Vec3 | None = None
 
     def __post_init__(self) -> None:
-        if not self.id or not self.id.strip():
-            raise PlanError("id: must be a non-empty string")
+        check_pattern(self.id, POINT_ID_PATTERN, "id", "a point id")
         check_coordinates(self.position_m, "position_m")
         check_unit(self.normal, "normal")
         check_unit(self.edge_normal, "edge_normal")
@@ -187,7 +196,7 @@ class Plan(Strict, frozen=True, kw_only=True):
     """A complete measurement plan (file format ``wobjcal.plan/1``)."""
 
     schema: Literal["wobjcal.plan/1"] = PLAN_SCHEMA
-    name: str = ""
+    name: PlanName = ""
     description: str = ""
     cell: CellSpec = CellSpec()
     work_object: WorkObjectSpec = WorkObjectSpec()
@@ -196,6 +205,7 @@ class Plan(Strict, frozen=True, kw_only=True):
     validation: ValidationSpec = ValidationSpec()
 
     def __post_init__(self) -> None:
+        check_pattern(self.name, PLAN_NAME_PATTERN, "name", "a plan name")
         seen: dict[str, int] = {}
         for i, p in enumerate(self.points):
             if p.id in seen:
@@ -239,6 +249,22 @@ class Plan(Strict, frozen=True, kw_only=True):
     def role_points(self) -> list[RolePoint]:
         """Every point with its role, in plan order (what the procedures take)."""
         return [RolePoint(p.role, p.to_probe_point()) for p in self.points]
+
+
+def check_pattern(value: str, pattern: str, field: str, what: str) -> None:
+    """Raise :class:`PlanError` unless ``value`` matches ``pattern`` (for structs built in code;
+    files are checked by msgspec from the same pattern, reworded in :mod:`calib.plan.json_io`)."""
+    import re
+
+    if not isinstance(value, str) or not re.fullmatch(pattern, value):
+        raise PlanError(f"{field}: {value!r} is not {what} ({PATTERN_WORDS[pattern]})")
+
+
+#: The patterns in words, for error messages.
+PATTERN_WORDS = {
+    POINT_ID_PATTERN: "letters, digits, _ . -, starting with a letter, digit or _, at most 32",
+    PLAN_NAME_PATTERN: "letters, digits, spaces and _ . , : + ( ) / -, at most 80",
+}
 
 
 def file_sha256(path: str | Path) -> str:

@@ -39,6 +39,11 @@ _REWORDS: tuple[tuple[re.Pattern[str], str], ...] = (
     (re.compile(r"^Expected `array`, got `(\w+)`$"), r"must be a list, got \1"),
     (re.compile(r"^Expected `object`, got `(\w+)`$"), r"must be an object, got \1"),
     (re.compile(r"^Expected `(.+)`, got `(\w+)`$"), r"must be \1, got \2"),
+    (
+        re.compile(r"^Expected `str` matching regex '(.+)'$"),
+        r"must be a name matching \1 (no quotes, line breaks or other punctuation)",
+    ),
+    (re.compile(r"^Expected `str` of length <= (\d+)$"), r"must be at most \1 characters"),
 )
 
 

@@ -72,7 +72,7 @@ def stdout() -> Console:
 
 def stderr() -> Console:
     """A console on the current ``sys.stderr`` for progress and notes."""
-    return Console(file=sys.stderr, highlight=False)
+    return Console(file=sys.stderr, highlight=False, soft_wrap=True)
 
 
 def read_plan(path: str) -> tuple[Plan, Path]:

@@ -142,11 +142,24 @@ class ExportJob:
 
 
 def identifier(text: str, prefix: str = "p") -> str:
-    """A robot-language identifier made of ``text``: letters, digits and ``_`` only."""
-    ident = re.sub(r"\W", "_", text)
+    """A robot-language identifier made of ``text``: ASCII letters, digits and ``_`` only."""
+    ident = re.sub(r"[^A-Za-z0-9_]", "_", text)
     if not ident or not ident[0].isalpha():
         ident = prefix + ident
     return ident
+
+
+def comment_text(text: object) -> str:
+    """``text`` safe inside a one-line program comment: control characters (line breaks,
+    tabs) become spaces, so nothing after them can become a statement. Every writer passes
+    names and ids through it (plans restrict ids already; jobs built in code may not)."""
+    return re.sub(r"[\x00-\x1f\x7f\u2028\u2029\x85]", " ", str(text))
+
+
+def literal_text(text: object) -> str:
+    """``text`` safe inside a string literal of any robot language: letters, digits and
+    ``_ . -`` kept, anything else (quotes, backslashes, line breaks) replaced by ``_``."""
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", str(text))
 
 
 def module_name(plan_name: str) -> str:
