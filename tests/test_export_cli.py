@@ -70,6 +70,10 @@ def test_every_writer_escapes_ids_and_names(fmt: str) -> None:
     job = build_job(plan, nominal_T_base_wobj(plan), ToolData(np.eye(4)))
     targets = (replace(job.targets[0], point_id=HOSTILE, role=HOSTILE), *job.targets[1:])
     job = replace(job, targets=targets, plan_name=HOSTILE, adaptive=None)
+    if fmt == "fanuc":  # its CONFIG needs a configuration at every target
+        from tests.test_export_fanuc import with_arms
+
+        job = with_arms(job)
     comment = {"rapid": "!", "krl": ";", "urscript": "#", "fanuc": "!"}[fmt]
     for text in export_files(job, fmt).values():
         for line in text.splitlines():

@@ -8,7 +8,10 @@ z-y'-x'' angles with (alpha, beta, gamma) = (R, P, W)
 into ``PR[PR_UFRAME]`` and sets ``UFRAME[UFRAME_NO]`` from it (relative to WORLD, taken to be the
 robot base of the plan, as KRL takes ``$WORLD``), and the sensor TCP into ``PR[PR_UTOOL]`` ->
 ``UTOOL[UTOOL_NO]``; every ``P[]`` is a sensor-TCP pose in that user frame with that tool, with
-``CONFIG 'N U T, 0, 0, 0'`` (the check's ABB confdata does not carry over: verify in T1).
+the ``CONFIG`` of the robot's configuration there (:func:`config_text`: flip, up, top and the
+turn numbers of :data:`TURN_AXES`, from the IK solution at that target next to the pose
+``wobjcal check`` chose). Without a checked pose the configuration cannot be derived and the
+export is refused (:class:`calib.errors.InputError`), never written as a guess.
 
 Every search runs in the nominal user frame (not adaptive; the frame comes from ``wobjcal
 calibrate``) and starts at the safe start of :mod:`planner.export.safety`. A search is
@@ -38,7 +41,7 @@ import numpy as np
 from calib._version import __version__
 from calib.errors import InputError
 from calib.frames import tait_bryan_zyx_from_matrix
-from planner.export.job import ExportJob, TargetPair, fmt, identifier, safety_header
+from planner.export.job import ArmPose, ExportJob, TargetPair, fmt, identifier, safety_header
 
 #: User frame of the nominal work object (``UFRAME[9]``).
 UFRAME_NO = 9
@@ -74,8 +77,9 @@ POS_COMMENT_MAX = 16
 #: Joint speed to the safe starts (%), linear speed of the moves that are no search (mm/sec).
 JOINT_PCT = 20
 LINEAR_MM_S = 100
-#: Configuration written on every position (flip, up, top; turns of J4, J5, J6).
-CONFIG = "N U T, 0, 0, 0"
+#: The axes (1-based) whose turn numbers ``CONFIG`` lists, in order: the usual
+#: ``$SCR_GRP[1].$TURN_AXIS`` of 6-axis FANUC arms (check it on the controller).
+TURN_AXES = (4, 6, 1)
 
 _NOT_IN_COMMENT = re.compile(r"[^A-Za-z0-9 _+*/=.,:()<>\[\]#%&?@-]")
 
@@ -107,6 +111,27 @@ def xyzwpr(T: np.ndarray) -> list[float]:
     return [*(float(v) * 1000.0 for v in T[:3, 3]), *wpr_deg(T[:3, :3])]
 
 
+def turn_number(angle_rad: float) -> int:
+    """FANUC turn number of a joint angle: ``k`` with ``angle - 360 k`` in ``[-180, 180)`` deg."""
+    return int(np.floor((float(angle_rad) + np.pi) / (2 * np.pi)))
+
+
+def config_text(arm: ArmPose) -> str:
+    """FANUC ``CONFIG`` of a robot configuration, e.g. ``"N U T, 0, 0, 0"``.
+
+    ``N``/``F``: axis 5 bent like FANUC's negative J5 (the tool-down home J5 = -90 deg) or
+    flipped; ``U``/``D``: elbow up or down; ``T``/``B``: the wrist centre in front of axis 1 or
+    behind it; then the turn numbers of :data:`TURN_AXES` (joint values in the URDF's
+    directions, which ROS-Industrial FANUC URDFs give in FANUC's).
+    """
+    turns = ", ".join(str(turn_number(arm.q_rad[a - 1])) for a in TURN_AXES)
+    flags = (
+        f"{'F' if arm.wrist_flipped else 'N'} {'U' if arm.elbow_up else 'D'} "
+        f"{'T' if arm.front else 'B'}"
+    )
+    return f"{flags}, {turns}"
+
+
 def _const(x: float) -> str:
     """A TP numeric constant (6 decimals; a negative one in parentheses, ``(-1.5)``)."""
     s = fmt(x, 6)
@@ -134,14 +159,26 @@ class _Program:
     def comment(self, text: str) -> None:
         self.lines += ["!" + c for c in comment_lines(text)]
 
-    def position(self, T: np.ndarray, label: str) -> int:
-        """Add the sensor-TCP pose ``T`` (user frame, m) as the next ``P[n]``; return ``n``."""
+    def position(self, t: TargetPair, kind: str, label: str) -> int:
+        """Add the sensor-TCP pose of target ``kind`` of ``t`` (user frame) as the next
+        ``P[n]`` with its configuration; return ``n``.
+
+        Raises:
+            InputError: the robot's configuration there is not known (no checked pose).
+        """
+        arm = t.arm_pose(kind)
+        if arm is None:
+            raise InputError(
+                f"FANUC export: point {_ascii_ident(t.point_id)}: no checked robot pose at its "
+                f"{kind} target, so its CONFIG cannot be derived (export with the check, on a "
+                "6-axis arm with a spherical wrist, and a feasible pose for every point)"
+            )
         n = len(self.positions) + 1
-        x, y, z, w, p, r = (_pos_num(v) for v in xyzwpr(T))
+        x, y, z, w, p, r = (_pos_num(v) for v in xyzwpr(t.target(kind)))
         self.positions.append(
             f'P[{n}:"{label[:POS_COMMENT_MAX]}"]{{\n'
             "   GP1:\n"
-            f"\tUF : {UFRAME_NO}, UT : {UTOOL_NO},\t\tCONFIG : '{CONFIG}',\n"
+            f"\tUF : {UFRAME_NO}, UT : {UTOOL_NO},\t\tCONFIG : '{config_text(arm)}',\n"
             f"\tX = {x}  mm,\tY = {y}  mm,\tZ = {z}  mm,\n"
             f"\tW = {w} deg,\tP = {p} deg,\tR = {r} deg\n"
             "};"
@@ -245,8 +282,10 @@ def _header(prog: _Program, job: ExportJob, name: str) -> None:
         "below, and write a wobjcal.measurements/1 file (frame base, units mm) for wobjcal "
         "calibrate.",
         f"Overwrites PR[{PR_UFRAME}]..PR[{PR_FACE}], PR[{first}]..PR[{last}], "
-        f"R[{R_TMP[0]}]..R[{R_TMP[1]}], R[{R_CODE_BASE + 1}]..R[{R_CODE_BASE + n}]. CONFIG "
-        f"{CONFIG} on every position, not from the check: run the first time in T1. Limits "
+        f"R[{R_TMP[0]}]..R[{R_TMP[1]}], R[{R_CODE_BASE + 1}]..R[{R_CODE_BASE + n}]. CONFIG of "
+        "every position from the pose wobjcal check chose (turn numbers of "
+        + ", ".join(f"J{a}" for a in TURN_AXES)
+        + ": check $SCR_GRP[1].$TURN_AXIS); run the first time in T1. Limits "
         f"assumed: name {NAME_MAX}, comment {COMMENT_MAX} chars, PR[1..{PR_COUNT}], "
         f"R[1..{R_COUNT}].",
     ):
@@ -260,7 +299,7 @@ def _point(prog: _Program, i: int, t: TargetPair) -> None:
     code, meas, label = R_CODE_BASE + i, PR_MEAS_BASE + i, i
     speed = max(1, round(t.speed_m_s * 1000.0))
     keep = POS_COMMENT_MAX - 6
-    safe = prog.position(t.safe_start, f"{ident[:keep]} safe")
+    safe = prog.position(t, "safe", f"{ident[:keep]} safe")
     prog.comment(f"--- point {i} {ident}: {t.kind} search")
     prog.add(f"J P[{safe}] {JOINT_PCT}% FINE")
     prog.add(f"R[{code}]=2")
@@ -268,12 +307,12 @@ def _point(prog: _Program, i: int, t: TargetPair) -> None:
     prog.add(f"R[{code}]=1")
     prog.add(f"SKIP CONDITION DI[{SENSOR_DI}]=ON")
     if t.kind == "approach":
-        end = prog.position(t.T_wobj_end, f"{ident[:keep]} end")
+        end = prog.position(t, "end", f"{ident[:keep]} end")
         prog.add(f"L P[{end}] {speed}mm/sec FINE Skip,LBL[{label}],PR[{meas}]=LPOS")
     else:
-        face = prog.position(t.face_end, f"{ident[:keep]} face")
-        start = prog.position(t.T_wobj_start, f"{ident[:keep]} start")
-        end = prog.position(t.T_wobj_end, f"{ident[:keep]} end")
+        face = prog.position(t, "face", f"{ident[:keep]} face")
+        start = prog.position(t, "start", f"{ident[:keep]} start")
+        end = prog.position(t, "end", f"{ident[:keep]} end")
         prog.add(f"L P[{face}] {speed}mm/sec FINE Skip,LBL[{label}],PR[{PR_FACE}]=LPOS")
         prog.comment("edge start: the measured face point, plan orientation")
         s, e = PR_EDGE_START, PR_EDGE_END

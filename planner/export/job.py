@@ -29,6 +29,28 @@ ConfData = tuple[int, int, int, int]
 
 
 @dataclass(frozen=True)
+class ArmPose:
+    """The robot's joint values and configuration at one target (from the checked pose).
+
+    Attributes:
+        q_rad: ``(n,)`` joint values, rad, in the robot URDF's joint directions.
+        front: the wrist centre lies in front of axis 1 (FANUC ``T``, KUKA status bit 0 = 0).
+        elbow_up: the elbow bent forward (FANUC ``U``, KUKA status bit 1 = 1).
+        wrist_flipped: axis 5 bent against ABB's positive direction (FANUC ``F``, KUKA status
+            bit 2 = 1); see :func:`planner.robot.kinematics.branches.posture`.
+    """
+
+    q_rad: tuple[float, ...]
+    front: bool
+    elbow_up: bool
+    wrist_flipped: bool
+
+
+#: The targets of one search a writer may place, each with its :class:`ArmPose`.
+TARGET_KINDS = ("start", "end", "safe", "face")
+
+
+@dataclass(frozen=True)
 class TargetPair:
     """The search of one probe point, as the robot program runs it.
 
@@ -47,6 +69,9 @@ class TargetPair:
             moved out along the normal (the approach to the face the edge search runs along).
         T_wobj_face: ``(4, 4)`` end of that approach search, wobj frame, m (for an approach
             point the plan's end, for an edge point past the face by the safe overtravel).
+        arm: ``{kind: ArmPose}`` the robot's joint values and configuration at each target of
+            :data:`TARGET_KINDS` (from IK next to the checked pose), or ``None`` without a
+            check (or for robots that are not 6-axis OPW arms).
     """
 
     point_id: str
@@ -59,6 +84,20 @@ class TargetPair:
     normal_wobj: tuple[float, float, float] = (0.0, 0.0, 1.0)
     T_wobj_safe: FloatArray | None = None
     T_wobj_face: FloatArray | None = None
+    arm: Mapping[str, ArmPose] | None = None
+
+    def target(self, kind: str) -> FloatArray:
+        """``(4, 4)`` the target of ``kind`` (one of :data:`TARGET_KINDS`), wobj frame."""
+        return {
+            "start": self.T_wobj_start,
+            "end": self.T_wobj_end,
+            "safe": self.safe_start,
+            "face": self.face_end,
+        }[kind]
+
+    def arm_pose(self, kind: str) -> ArmPose | None:
+        """The :class:`ArmPose` at the target of ``kind``, or ``None`` when not known."""
+        return None if self.arm is None else self.arm.get(kind)
 
     @property
     def safe_start(self) -> FloatArray:
