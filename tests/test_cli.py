@@ -213,14 +213,25 @@ def test_calibrate_missing_point_exits_2(
 def test_ui_passes_flags_to_webui(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
+    from types import SimpleNamespace
+
     import webui.app
 
     calls = []
-    monkeypatch.setattr(webui.app, "run", lambda *a, **k: calls.append((a, k)))
+
+    def fake_run(*a, **k):  # type: ignore[no-untyped-def]
+        calls.append((a, k))
+        server = SimpleNamespace(get_port=lambda: k["port"])
+        state = SimpleNamespace(autosave_path=None)
+        return SimpleNamespace(server=server, state=state, autosave_note="")
+
+    monkeypatch.setattr(webui.app, "run", fake_run)
+    monkeypatch.setattr(webui.app, "serve", lambda app: None)
     assert main(["ui", str(STATOR), "--host", "0.0.0.0", "--port", "8123"]) == 0
     assert main(["demo"]) == 0
-    assert calls[0] == ((str(STATOR),), {"host": "0.0.0.0", "port": 8123, "block": True})
-    assert calls[1] == ((None,), {"host": "127.0.0.1", "port": 8080, "block": True})
+    flags = {"block": False, "fresh": False}
+    assert calls[0] == ((str(STATOR),), {"host": "0.0.0.0", "port": 8123, **flags})
+    assert calls[1] == ((None,), {"host": "127.0.0.1", "port": 8080, **flags})
     code, _, err = run(capsys, "ui", "no_such_plan.json")
     assert code == 2 and "no_such_plan.json: No such file or directory" in err
     code, _, err = run(capsys, "ui", str(DATA / "bad_nan.json"))

@@ -9,6 +9,7 @@ plan (:mod:`webui.state`), and every edit is checked in the cell on the one work
 from __future__ import annotations
 
 import logging
+import signal
 import threading
 from pathlib import Path
 from typing import Any
@@ -21,13 +22,21 @@ from calib.plan.file import CellSpec, Plan, WorkObjectSpec
 from calib.probing import ProbePoint
 from planner.check import PointCheck
 from webui import clients, demo, plan_doc
+from webui.autosave import (
+    AutosaveLock,
+    AutosaveLockedError,
+    FoundAutosave,
+    default_autosave_path,
+    find_newer_autosave,
+    set_aside,
+)
 from webui.backend import CellSession, CellView
 from webui.heatmap import HeatMap
 from webui.plan_adapter import autosave_bytes, plan_point, ui_plan_from_file
 from webui.plan_doc import UiPlan
 from webui.robot_view import RobotView
 from webui.scene import PlanScene
-from webui.state import DEFAULT_AUTOSAVE, Change, SessionState, default_autosave_path
+from webui.state import DEFAULT_AUTOSAVE, Change, SessionState
 from webui.surface import SurfacePicker
 from webui.worker import CellWorker
 
@@ -73,6 +82,9 @@ class WobjcalApp:
         self.files_panel = files_panel.FilesPanel(self)
         self.calibrate_panel = calibrate_panel.CalibratePanel(self)
         self.state.subscribe(self._on_change)
+        #: What the app said about the autosave at start (restored, set aside), for new tabs.
+        self.autosave_note = ""
+        self.autosave_lock: AutosaveLock | None = None
         server.on_client_connect(self._on_connect)
         if isinstance(plan.source, Plan):
             self.load_cell(plan.source, self.plan_dir)
@@ -232,6 +244,8 @@ class WobjcalApp:
     def _on_connect(self, client: viser.ClientHandle) -> None:
         if self.view is not None:
             clients.set_default_camera(client, self.view)
+        if self.autosave_note:
+            self.notify("Autosave", self.autosave_note, client=client, error=False)
 
     def notify(
         self, title: str, body: str, client: viser.ClientHandle | None = None, error: bool = True
@@ -246,11 +260,35 @@ class WobjcalApp:
         self.validate_panel.close()
         self.server.stop()
         self.worker.close()
+        if self.autosave_lock is not None:
+            self.autosave_lock.release()
+            self.autosave_lock = None
 
 
 def _cell_key(plan: Plan) -> tuple[CellSpec, WorkObjectSpec]:
     """What decides the cell: when it changes, the cell is rebuilt."""
     return (plan.cell, plan.work_object)
+
+
+def check_port(port: object) -> int:
+    """``port`` as a TCP port number 0-65535 (0: any free port).
+
+    Raises:
+        InputError: not an integer in that range (``--port 99999`` used to hang the server).
+    """
+    if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
+        raise InputError(f"port: must be a whole number 0-65535 (0: any free port), got {port!r}")
+    return port
+
+
+def _restore(found: FoundAutosave, plan_dir: Path) -> UiPlan:
+    """The session plan an autosave holds (its file references resolve from ``plan_dir``)."""
+    from calib.plan.file import check_plan_files, plan_from_json
+    from webui.plan_adapter import ui_plan_from_plan
+
+    plan = plan_from_json(found.path.read_text(encoding="utf-8"), source=str(found.path))
+    check_plan_files(plan, plan_dir, source=str(found.path))
+    return ui_plan_from_plan(plan, name=plan.name or found.path.stem)
 
 
 def run(
@@ -259,44 +297,101 @@ def run(
     port: int = 8080,
     block: bool = True,
     autosave_path: str | Path | None = "auto",
+    fresh: bool = False,
 ) -> WobjcalApp:
     """Start the wobjcal UI on ``http://host:port`` with a plan file or the built-in demo.
 
     Args:
         plan_path: a ``wobjcal.plan/1`` file; ``None`` opens the built-in stator-section demo.
         host: interface to bind; 127.0.0.1 (this machine only) unless told otherwise.
-        port: TCP port.
-        block: serve until interrupted (Ctrl-C), then stop; ``False`` returns at once.
+        port: TCP port (0-65535; 0 any free one); when it is busy viser binds the next free
+            one: ``app.server.get_port()`` is the one bound.
+        block: serve until interrupted (Ctrl-C or SIGTERM), then stop; ``False`` returns at
+            once.
         autosave_path: where the session plan autosaves; ``"auto"`` (default): one file per
-            plan and port under ``~/.cache/wobjcal/autosave/`` (see
-            :func:`webui.state.default_autosave_path`); ``None`` disables autosave.
+            plan and bound port under ``~/.cache/wobjcal/autosave/`` (see
+            :func:`webui.autosave.default_autosave_path`); ``None`` disables autosave.
+        fresh: start from the plan file even when a newer autosave of an earlier session
+            exists (it is renamed ``<file>.<time>.bak``, not overwritten); by default it is
+            restored. Either way ``app.autosave_note`` says what happened (the CLI prints it,
+            each new tab shows it).
 
     Returns:
         The running app (``app.server`` is the viser server; ``app.stop()`` ends it).
+
+    Raises:
+        InputError: a bad port, a plan that cannot be loaded, or an autosave file held by
+            another running server.
     """
+    check_port(port)
     if plan_path is not None:
         ui_plan, plan_dir = ui_plan_from_file(Path(plan_path)), Path(plan_path).parent
     else:
         ui_plan, plan_dir = demo.demo_ui_plan()
-    if autosave_path == "auto":
-        autosave_path = default_autosave_path(plan_path, port)
     server = viser.ViserServer(host=host, port=port, label="wobjcal", verbose=block)
+    bound = server.get_port()
+    try:
+        auto = autosave_path == "auto"
+        path = (
+            default_autosave_path(plan_path, bound)
+            if auto
+            else (None if autosave_path is None else Path(autosave_path))
+        )
+        lock = None
+        note = ""
+        if path is not None:
+            found = find_newer_autosave(  # before taking our lock: it would hide our file
+                plan_path,
+                autosave_bytes(ui_plan),
+                folder=None if auto else path.parent / ".none",
+                also=path,
+            )
+            try:
+                lock = AutosaveLock(path)
+            except AutosaveLockedError as exc:
+                raise InputError(str(exc)) from None
+            if found is not None and not fresh:
+                try:
+                    ui_plan = _restore(found, plan_dir)
+                    note = f"restored the edits of the last session from {found.describe()}"
+                except (InputError, OSError) as exc:
+                    aside = set_aside(found.path)
+                    note = (
+                        f"not restored: {found.path} is unusable ({exc}); started from the plan, "
+                        f"the autosave is kept as {aside}"
+                    )
+            elif found is not None:
+                aside = set_aside(found.path)
+                note = f"started fresh; the last session's autosave is kept as {aside}"
+    except BaseException:
+        server.stop()
+        raise
     server.gui.configure_theme(control_width="large", show_share_button=False)
-    logger.info("wobjcal UI at http://%s:%d", host, server.get_port())
-    if autosave_path is not None:
-        logger.info("the session plan autosaves to %s", autosave_path)
-    app = WobjcalApp(
-        server,
-        ui_plan,
-        plan_dir,
-        autosave_path=None if autosave_path is None else Path(autosave_path),
-    )
+    logger.info("wobjcal UI at http://%s:%d", host, bound)
+    if path is not None:
+        logger.info("the session plan autosaves to %s", path)
+    app = WobjcalApp(server, ui_plan, plan_dir, autosave_path=path)
+    app.autosave_lock, app.autosave_note = lock, note
+    if note:
+        logger.warning("%s", note)
     if not block:
         return app
+    serve(app)
+    return app
+
+
+def serve(app: WobjcalApp) -> None:
+    """Serve until Ctrl-C or SIGTERM, then stop the app (server, worker, autosave lock)."""
+    stop = threading.Event()
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, lambda *_: stop.set())
     try:
-        threading.Event().wait()
+        while not stop.wait(0.5):
+            pass
     except KeyboardInterrupt:
         logger.info("stopping the wobjcal UI")
     finally:
         app.stop()
-    return app
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
