@@ -63,7 +63,12 @@ def check_positive(value: float, field: str, allow_zero: bool = False) -> None:
         raise PlanError(f"{field}: must be {'>= 0' if allow_zero else '> 0'}, got {value}")
 
 
-def check_count(value: int, field: str, minimum: int = 1) -> None:
-    """Raise :class:`PlanError` unless ``value`` is an integer ``>= minimum``."""
+def check_count(value: int, field: str, minimum: int = 1, maximum: int | None = None) -> None:
+    """Raise :class:`PlanError` unless ``value`` is an integer ``>= minimum`` (and
+    ``<= maximum`` when given: a count that would allocate without bound is refused here,
+    naming the field, not met later as an overflow)."""
     if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
         raise PlanError(f"{field}: must be an integer >= {minimum}, got {value!r}")
+    if maximum is not None and value > maximum:
+        shown = f"{value:,}" if value < 10**15 else f"{value:.3g}"
+        raise PlanError(f"{field}: must be at most {maximum:,}, got {shown}")

@@ -205,3 +205,39 @@ def test_large_mesh_goes_through_a_file(monkeypatch) -> None:
     finally:
         pb.disconnect(client)
     assert d == pytest.approx(0.04, abs=1e-6)
+
+
+# ---- bad mesh files (issue 10, items 7 and 8) -------------------------------------------------
+def test_bad_mesh_files_say_what_is_wrong(tmp_path) -> None:
+    import os
+
+    rand = tmp_path / "random.stl"
+    rand.write_bytes(os.urandom(2000))
+    with pytest.raises(
+        MeshError, match=r"corrupt binary STL: its header says .* the file has 2,000"
+    ):
+        load_work_object(rand)
+    ascii_ = tmp_path / "garbage.stl"
+    ascii_.write_text("solid x\nfacet garbage\n")
+    with pytest.raises(MeshError, match=r"no triangle could be read from its 22 bytes"):
+        load_work_object(ascii_)
+    with pytest.raises(MeshError, match=r"is a directory, not a mesh file"):
+        load_work_object(tmp_path)
+    with pytest.raises(MeshError, match=r"/dev/zero: not a regular file"):
+        load_work_object("/dev/zero")
+
+
+def test_a_five_million_triangle_mesh_is_refused_before_parsing(tmp_path) -> None:
+    """Item 7: 5 million triangles took 145 s and 7.2 GB to say 'no planar face'. A binary STL's
+    header gives the count: refused at once, with the number (a sparse file, nothing parsed)."""
+    import time
+
+    n = 5_000_000
+    path = tmp_path / "scan.stl"
+    with path.open("wb") as handle:
+        handle.write(b"\0" * 80 + n.to_bytes(4, "little"))
+        handle.truncate(84 + 50 * n)
+    t0 = time.perf_counter()
+    with pytest.raises(MeshError, match=r"scan\.stl: 5,000,000 triangles; wobjcal takes at most"):
+        load_work_object(path)
+    assert time.perf_counter() - t0 < 5.0

@@ -34,10 +34,11 @@ from webui.backend import CellSession, CellView
 from webui.heatmap import HeatMap
 from webui.plan_adapter import autosave_bytes, plan_point, ui_plan_from_file
 from webui.plan_doc import UiPlan
-from webui.robot_view import RobotView
+from webui.robot_view import RobotView, robot_view_or_reason
 from webui.scene import PlanScene
 from webui.state import DEFAULT_AUTOSAVE, Change, SessionState
 from webui.surface import SurfacePicker
+from webui.upload_guard import guard_uploads
 from webui.worker import CellWorker
 
 logger = logging.getLogger(__name__)
@@ -81,6 +82,7 @@ class WobjcalApp:
         self.validate_panel = validate_panel.ValidatePanel(self)
         self.files_panel = files_panel.FilesPanel(self)
         self.calibrate_panel = calibrate_panel.CalibratePanel(self)
+        guard_uploads(server, files_panel.MAX_UPLOAD_BYTES, self._upload_refused)
         self.state.subscribe(self._on_change)
         #: What the app said about the autosave at start (restored, set aside), for new tabs.
         self.autosave_note = ""
@@ -112,7 +114,10 @@ class WobjcalApp:
             self.robot.remove()
             self.robot = None
         if view.robot_urdf is not None:
-            self.robot = RobotView(self.server, view)
+            self.robot, why = robot_view_or_reason(self.server, view)
+            if why:
+                logger.warning("%s", why)
+                self.notify("Robot not drawn", why, error=True)
         self.recheck(self.state.doc.ids)
 
     # ---- checks ---------------------------------------------------------------------------
@@ -241,6 +246,10 @@ class WobjcalApp:
             self.notify("Point not placed", f"{type(exc).__name__}: {exc}", client=event.client)
 
     # ---- clients ---------------------------------------------------------------------------
+    def _upload_refused(self, client_id: int, name: str, message: str) -> None:
+        client = self.server.get_clients().get(client_id)
+        self.notify("Upload refused", message, client=client, error=True)
+
     def _on_connect(self, client: viser.ClientHandle) -> None:
         if self.view is not None:
             clients.set_default_camera(client, self.view)

@@ -337,7 +337,7 @@ def load_plan(path: str | Path, check_files: bool = True) -> Plan:
         OSError: the file cannot be read.
     """
     p = Path(path)
-    text = read_text_file(p, PlanError)
+    text = read_text_file(p, PlanError, "plan file")
     plan = plan_from_json(text, source=str(p))
     if check_files:
         check_plan_files(plan, p.parent, source=str(p))

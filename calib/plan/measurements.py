@@ -171,7 +171,9 @@ def measurements_from_json(text: str, source: str = "measurements") -> Measureme
 def load_measurements(path: str | Path) -> Measurements:
     """Read a measurements file strictly (see :func:`measurements_from_json`)."""
     p = Path(path)
-    return measurements_from_json(read_text_file(p, MeasurementsError), source=str(p))
+    return measurements_from_json(
+        read_text_file(p, MeasurementsError, "measurements file"), source=str(p)
+    )
 
 
 def save_measurements(measurements: Measurements, path: str | Path) -> Path:

@@ -32,6 +32,7 @@ import trimesh
 from numpy.typing import ArrayLike, NDArray
 
 from calib.frames import check_transform, make_transform, matrix_from_rotvec
+from calib.reading import MAX_JSON_BYTES, read_bytes_capped
 from calib.tolerances import ROLE_NORMAL_TOL_RAD
 from planner.builtins import is_builtin, tool_description
 from planner.cell.bodies import BodyLinks, load_urdf_body, mesh_collision_shape, static_body
@@ -248,10 +249,10 @@ def load_tool(spec: str | Path | Tool) -> Tool:
     path = tool_description(str(spec)) if is_builtin(spec) else Path(spec)
     if path.suffix.lower() == ".urdf":
         return Tool.from_urdf(path)
-    if not path.is_file():
+    if not path.exists():
         raise URDFError(f"tool description not found: {path}")
     try:
-        desc = json.loads(path.read_text())
+        desc = json.loads(read_bytes_capped(path, MAX_JSON_BYTES, "tool description", URDFError))
         tool = Tool.from_urdf(
             path.parent / desc["urdf"],
             tcps=list(desc["tcps"]),

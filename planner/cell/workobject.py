@@ -38,6 +38,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from calib.errors import InputError
+from calib.reading import MAX_MESH_BYTES, check_regular_file
 from calib.units import AUTO, METRES_PER_UNIT, canonical_unit
 from planner.builtins import builtin_mesh, is_builtin
 from planner.cell.bodies import BodyLinks, mesh_collision_shape, static_body
@@ -46,6 +47,8 @@ from planner.errors import MeshError
 FloatArray = NDArray[np.float64]
 log = logging.getLogger(__name__)
 
+#: Most triangles a work object may have (face detection: ~6 s and ~1 GB per million).
+MAX_MESH_TRIANGLES = 2_000_000
 #: A work object is at least this large (largest extent), m: about the sensor face.
 MIN_PART_M = 0.010
 #: The reach used by ``auto`` without a cell (a large industrial arm), m.
@@ -181,21 +184,67 @@ class WorkObject:
         return static_body(client, shape, T_world_wobj, self.name)
 
 
+def _too_many(path: object, n: int) -> MeshError:
+    return MeshError(
+        f"{path}: {n:,} triangles; wobjcal takes at most {MAX_MESH_TRIANGLES:,} (planar-face "
+        "detection needs about 6 s and 1 GB per million): decimate it first (e.g. MeshLab's "
+        "quadric edge collapse)"
+    )
+
+
+def stl_triangle_count(path: Path, size: int) -> int | None:
+    """The triangle count of a binary STL from its header, ``None`` for an ASCII STL.
+
+    Raises:
+        MeshError: a binary STL whose size does not match its header (truncated, corrupt).
+    """
+    with path.open("rb") as handle:
+        head = handle.read(84)
+    if len(head) < 84:
+        if head.lstrip().lower().startswith(b"solid"):
+            return None
+        raise MeshError(f"{path}: {size} bytes is too short for an STL file (corrupt?)")
+    n = int.from_bytes(head[80:84], "little")
+    if size == 84 + 50 * n:
+        return n
+    if head.lstrip().lower().startswith(b"solid"):
+        return None  # ASCII (a binary STL may also start with "solid": then the size matches)
+    raise MeshError(
+        f"{path}: corrupt binary STL: its header says {n:,} triangles ({84 + 50 * n:,} bytes), "
+        f"the file has {size:,} bytes"
+    )
+
+
 def _read(source: str | Path | trimesh.Trimesh) -> tuple[trimesh.Trimesh, str]:
     if isinstance(source, trimesh.Trimesh):
         meta = source.metadata or {}
+        if len(source.faces) > MAX_MESH_TRIANGLES:
+            raise _too_many(meta.get("name") or "work object", len(source.faces))
         return source.copy(), str(meta.get("name") or "work object")
     if is_builtin(source):
         return builtin_mesh(str(source)), str(source)
     path = Path(source)
-    if not path.is_file():
-        raise MeshError(f"mesh file not found: {path}")
+    try:
+        size = check_regular_file(path, MAX_MESH_BYTES, "mesh file", MeshError)
+    except FileNotFoundError:
+        raise MeshError(f"mesh file not found: {path}") from None
+    if path.suffix.lower() == ".stl":
+        n = stl_triangle_count(path, size)
+        if n is not None and n > MAX_MESH_TRIANGLES:
+            raise _too_many(path, n)  # before a byte of geometry is parsed
     try:
         mesh = trimesh.load(str(path), force="mesh", process=False)
     except Exception as exc:  # trimesh raises many types for unreadable files
         raise MeshError(f"cannot read mesh file {path}: {exc}") from None
     if not isinstance(mesh, trimesh.Trimesh):
         raise MeshError(f"mesh file {path} holds no triangle mesh (got {type(mesh).__name__})")
+    if len(mesh.faces) == 0 and size > 0:
+        raise MeshError(
+            f"mesh file {path}: no triangle could be read from its {size:,} bytes (corrupt, or "
+            f"not a {path.suffix.lstrip('.').upper() or 'mesh'} file)"
+        )
+    if len(mesh.faces) > MAX_MESH_TRIANGLES:
+        raise _too_many(path, len(mesh.faces))
     return mesh, str(path)
 
 
