@@ -42,3 +42,17 @@ def test_a_huge_file_is_refused_from_its_size(tmp_path: Path) -> None:
     with pytest.raises(InputError, match=r"more than a thing may have"):
         check_regular_file(small, 9, "thing")
     assert MAX_JSON_BYTES == 16 << 20
+
+
+def test_a_mesh_path_that_is_a_directory_is_named(tmp_path: Path) -> None:
+    """Item 8: a directory was reported as 'file not found'."""
+    import json
+
+    from calib.plan.file import check_plan_files, plan_from_json
+
+    doc = json.loads((Path(__file__).parent / "data/plans/valid_three_two_one.json").read_text())
+    doc["work_object"]["mesh"] = str(tmp_path)
+    doc["work_object"]["sha256"] = None
+    plan = plan_from_json(json.dumps(doc))
+    with pytest.raises(PlanError, match=r"work_object\.mesh: .* is a directory, not a mesh file"):
+        check_plan_files(plan, tmp_path)

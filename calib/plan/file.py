@@ -44,6 +44,7 @@ from calib.plan.models import ValidationSpec
 from calib.probing import ProbePoint, SearchSpec
 from calib.procedures import METHODS, ProcedureSettings, method_of, procedure_kind
 from calib.procedures.base import RolePoint
+from calib.reading import MAX_MESH_BYTES, check_regular_file
 from calib.structs import (
     UNIT_TOL,
     Strict,
@@ -315,8 +316,14 @@ def check_plan_files(plan: Plan, plan_dir: str | Path, source: str = "plan") -> 
         path = resolve_ref(ref, plan_dir)
         if isinstance(path, str):
             continue
-        if not path.is_file():
+        if path.is_dir():
+            raise PlanError(f"{source}: {where}.mesh: {path} is a directory, not a mesh file")
+        if not path.exists():
             raise PlanError(f"{source}: {where}.mesh: file not found: {path}")
+        try:
+            check_regular_file(path, MAX_MESH_BYTES, "mesh file", PlanError)
+        except PlanError as exc:
+            raise PlanError(f"{source}: {where}.mesh: {exc}") from None
         if sha is not None and file_sha256(path) != sha:
             raise PlanError(
                 f"{source}: {where}.sha256: {path} has digest {file_sha256(path)}, "
