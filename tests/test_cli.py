@@ -215,7 +215,7 @@ def test_ui_passes_flags_to_webui(
 ) -> None:
     from types import SimpleNamespace
 
-    import webui.app
+    import webui.server
 
     calls = []
 
@@ -225,8 +225,8 @@ def test_ui_passes_flags_to_webui(
         state = SimpleNamespace(autosave_path=None)
         return SimpleNamespace(server=server, state=state, autosave_note="")
 
-    monkeypatch.setattr(webui.app, "run", fake_run)
-    monkeypatch.setattr(webui.app, "serve", lambda app: None)
+    monkeypatch.setattr(webui.server, "run", fake_run)
+    monkeypatch.setattr(webui.server, "serve", lambda app: None)
     assert main(["ui", str(STATOR), "--host", "0.0.0.0", "--port", "8123"]) == 0
     assert main(["demo"]) == 0
     flags = {"block": False, "fresh": False}

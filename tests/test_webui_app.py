@@ -11,7 +11,8 @@ import pytest
 
 from calib.frames import transform_points
 from calib.plan.file import plan_from_json
-from webui.app import WobjcalApp, run
+from webui.app import WobjcalApp
+from webui.server import run
 from webui.testing import T_WORLD_WOBJ_BOX, box_plan, free_port
 
 

@@ -16,7 +16,7 @@ import pytest
 from calib.errors import InputError
 from planner.cli.main import main
 from webui import autosave
-from webui.app import run
+from webui.server import run
 from webui.testing import box_plan, free_port
 
 REPO = Path(__file__).resolve().parent.parent
@@ -35,7 +35,7 @@ def _edit_then_kill(plan: Path, port: int, home: Path) -> None:
         f"""
         import time
         from webui import plan_doc
-        from webui.app import run
+        from webui.server import run
         app = run({str(plan)!r}, port={port}, block=False)
         app.state.apply(plan_doc.delete_point(app.state.doc, "P1"), "delete P1")
         print("edited", app.state.autosave_path, flush=True)
@@ -110,9 +110,9 @@ def test_a_busy_port_is_said_and_each_server_has_its_own_locked_autosave(
 def test_the_cli_prints_the_port_actually_bound(
     tmp_path: Path, autosave_dir: Path, monkeypatch: pytest.MonkeyPatch, capsys
 ) -> None:  # type: ignore[no-untyped-def]
-    import webui.app
+    import webui.server
 
-    monkeypatch.setattr(webui.app, "serve", lambda app: app.stop())
+    monkeypatch.setattr(webui.server, "serve", lambda app: app.stop())
     plan = box_plan(tmp_path)
     with socket.socket() as busy:
         busy.bind(("127.0.0.1", 0))

@@ -12,7 +12,7 @@ import pytest
 import trimesh
 
 from planner.builtins import robot_urdf
-from webui.app import run
+from webui.server import run
 from webui.testing import free_port
 
 REPO = Path(__file__).resolve().parent.parent

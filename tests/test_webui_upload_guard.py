@@ -7,8 +7,9 @@ from collections.abc import Iterator
 import pytest
 from viser import _messages
 
-from webui.app import WobjcalApp, run
+from webui.app import WobjcalApp
 from webui.files_panel import MAX_UPLOAD_BYTES
+from webui.server import run
 from webui.testing import box_plan, free_port
 
 

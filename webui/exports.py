@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 from calib.errors import InputError
 from calib.plan.file import Plan
 from planner.export import FORMATS as EXPORT_FORMATS
-from planner.export.job import module_name
+from planner.export.text import module_name
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell

@@ -14,17 +14,25 @@ msgspec and numpy only, no simulator.
 
 from __future__ import annotations
 
-import hashlib
 from pathlib import Path
-from typing import Annotated, Final, Literal, get_args
+from typing import Final, Literal, get_args
 
-import msgspec
 import numpy as np
 from numpy.typing import ArrayLike
 
 from calib.atomic_io import write_text_atomic
 from calib.errors import PlanError
-from calib.plan.base import BUILTIN_PREFIX, MeshUnits
+from calib.plan.base import (
+    BUILTIN_PREFIX,
+    PLAN_NAME_PATTERN,
+    POINT_ID_PATTERN,
+    MeshUnits,
+    PlanName,
+    PointId,
+    check_pattern,
+    file_sha256,
+    resolve_ref,
+)
 from calib.plan.cell import (
     CellSpec,
     FixtureSpec,
@@ -80,15 +88,6 @@ __all__ = [
 
 PLAN_SCHEMA: Final = "wobjcal.plan/1"
 SUPPORTED_PLAN_SCHEMAS = (PLAN_SCHEMA,)
-
-#: A point id: what every robot language can hold in an identifier and a string (letters,
-#: digits, ``_``, ``.``, ``-``; at most 32), so no id can end a comment or a string in a program.
-POINT_ID_PATTERN = r"^[A-Za-z0-9_][A-Za-z0-9_.-]{0,31}$"
-#: A plan name (written into program comments): printable ASCII without quotes, ``\\``, ``!``,
-#: ``;`` or line breaks, at most 80 characters.
-PLAN_NAME_PATTERN = r"^[A-Za-z0-9 _.,:+()/-]{0,80}$"
-PointId = Annotated[str, msgspec.Meta(pattern=POINT_ID_PATTERN)]
-PlanName = Annotated[str, msgspec.Meta(pattern=PLAN_NAME_PATTERN)]
 
 
 class Search(Strict, frozen=True, kw_only=True):
@@ -250,39 +249,6 @@ class Plan(Strict, frozen=True, kw_only=True):
     def role_points(self) -> list[RolePoint]:
         """Every point with its role, in plan order (what the procedures take)."""
         return [RolePoint(p.role, p.to_probe_point()) for p in self.points]
-
-
-def check_pattern(value: str, pattern: str, field: str, what: str) -> None:
-    """Raise :class:`PlanError` unless ``value`` matches ``pattern`` (for structs built in code;
-    files are checked by msgspec from the same pattern, reworded in :mod:`calib.plan.json_io`)."""
-    import re
-
-    if not isinstance(value, str) or not re.fullmatch(pattern, value):
-        raise PlanError(f"{field}: {value!r} is not {what} ({PATTERN_WORDS[pattern]})")
-
-
-#: The patterns in words, for error messages.
-PATTERN_WORDS = {
-    POINT_ID_PATTERN: "letters, digits, _ . -, starting with a letter, digit or _, at most 32",
-    PLAN_NAME_PATTERN: "letters, digits, spaces and _ . , : + ( ) / -, at most 80",
-}
-
-
-def file_sha256(path: str | Path) -> str:
-    """Hex SHA-256 digest of a file's bytes."""
-    digest = hashlib.sha256()
-    with Path(path).open("rb") as handle:
-        for block in iter(lambda: handle.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
-
-
-def resolve_ref(ref: str, plan_dir: str | Path) -> str | Path:
-    """A file reference of the plan: ``builtin:NAME`` unchanged, else a path under ``plan_dir``."""
-    if ref.startswith(BUILTIN_PREFIX):
-        return ref
-    path = Path(ref)
-    return path if path.is_absolute() else Path(plan_dir) / path
 
 
 _CHOICES = {

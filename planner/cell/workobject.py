@@ -29,7 +29,6 @@ without that flag PyBullet would use the convex hull and fill every hole and slo
 from __future__ import annotations
 
 import logging
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -42,6 +41,12 @@ from calib.reading import MAX_MESH_BYTES, check_regular_file
 from calib.units import AUTO, METRES_PER_UNIT, canonical_unit
 from planner.builtins import builtin_mesh, is_builtin
 from planner.cell.bodies import BodyLinks, mesh_collision_shape, static_body
+from planner.cell.mesh_units import (
+    DEFAULT_REACH_M,
+    auto_units,
+    implausible_units_warning,
+    unit_hint,
+)
 from planner.errors import MeshError
 
 FloatArray = NDArray[np.float64]
@@ -49,31 +54,6 @@ log = logging.getLogger(__name__)
 
 #: Most triangles a work object may have (face detection: ~6 s and ~1 GB per million).
 MAX_MESH_TRIANGLES = 2_000_000
-#: A work object is at least this large (largest extent), m: about the sensor face.
-MIN_PART_M = 0.010
-#: The reach used by ``auto`` without a cell (a large industrial arm), m.
-DEFAULT_REACH_M = 3.0
-#: The order ``auto`` tries units in when the file names none.
-AUTO_ORDER = ("m", "mm", "in", "cm")
-#: Words of a file name or header that name a unit.
-_HINT_WORDS = {
-    "m": "m",
-    "meter": "m",
-    "meters": "m",
-    "metre": "m",
-    "metres": "m",
-    "mm": "mm",
-    "millimeter": "mm",
-    "millimeters": "mm",
-    "millimetre": "mm",
-    "millimetres": "mm",
-    "cm": "cm",
-    "centimeter": "cm",
-    "centimeters": "cm",
-    "inch": "in",
-    "inches": "in",
-}
-_TRIMESH_UNITS = {"meters": "m", "millimeters": "mm", "centimeters": "cm", "inches": "in"}
 
 
 @dataclass(frozen=True)
@@ -120,48 +100,6 @@ class RepairReport:
         dims = " x ".join(f"{v:.3g}" for v in self.extents_m)
         how = "detected" if self.units_detected else "given"
         return f"{dims} m (file units {self.units!r}, {how})"
-
-
-def unit_hint(mesh: trimesh.Trimesh, source: str) -> str | None:
-    """The unit the file itself names, or ``None``: the loader's ``units`` (formats that carry
-    them), else a word of the STL header or of the file name (``plate_mm.stl``, ``inch``)."""
-    loaded = getattr(mesh, "units", None)
-    if isinstance(loaded, str) and loaded in _TRIMESH_UNITS:
-        return _TRIMESH_UNITS[loaded]
-    meta = mesh.metadata or {}
-    texts = [str(meta.get("header", "")), Path(str(source)).stem]
-    for text in texts:
-        words = re.split(r"[^a-z]+", text.lower().replace("units", " "))
-        for word in words:
-            if word in _HINT_WORDS and word != "m":  # a lone "m" in a name is rarely a unit
-                return _HINT_WORDS[word]
-    return None
-
-
-def _plausible(size_m: float, reach_m: float) -> bool:
-    return MIN_PART_M <= size_m <= 2.0 * reach_m
-
-
-def auto_units(extent: float, hint: str | None, reach_m: float) -> tuple[str, str]:
-    """The unit ``auto`` takes for a mesh whose largest extent is ``extent`` (file units), and
-    why (see the module docstring).
-
-    Args:
-        extent: largest bounding-box extent in file units.
-        hint: the unit the file names (:func:`unit_hint`), or ``None``.
-        reach_m: the robot's reach, m (what a work object may span at most).
-    """
-    limits = f"a part of {MIN_PART_M * 1e3:g} mm to twice the robot's reach {reach_m:.2f} m"
-    if hint is not None:
-        if _plausible(extent * METRES_PER_UNIT[hint], reach_m):
-            return hint, f"the file names {hint!r}"
-        why = f"the file names {hint!r}, but that gives {extent * METRES_PER_UNIT[hint]:.4g} m; "
-    else:
-        why = "the file names no unit; "
-    for unit in AUTO_ORDER:
-        if _plausible(extent * METRES_PER_UNIT[unit], reach_m):
-            return unit, why + f"{unit!r} is the first of {list(AUTO_ORDER)} that gives {limits}"
-    return "m", why + f"no unit gives {limits}: metres"
 
 
 @dataclass(frozen=True)
@@ -287,21 +225,9 @@ def load_work_object(
         note = f"units 'auto' read as {units!r}: {why}"
     else:
         note = f"units {units!r} as given"
-        size = extent * METRES_PER_UNIT[units]
-        if not _plausible(size, reach):
-            fits = [u for u in AUTO_ORDER if _plausible(extent * METRES_PER_UNIT[u], reach)]
-            other = ""
-            if fits:
-                other = f"; {fits[0]!r} would make it {extent * METRES_PER_UNIT[fits[0]]:.3g} m"
-            what = (
-                f"larger than twice the robot's reach {reach:.2f} m"
-                if size > reach
-                else f"smaller than {MIN_PART_M * 1e3:g} mm"
-            )
-            warnings.append(
-                f"{src}: read in {units!r} the part is {size:.4g} m across, {what}: wrong units?"
-                + other
-            )
+        warning = implausible_units_warning(src, extent, units, reach)
+        if warning:
+            warnings.append(warning)
     n_v, n_f = len(mesh.vertices), len(mesh.faces)
     mesh.merge_vertices()
     merged = n_v - len(mesh.vertices)

@@ -97,7 +97,7 @@ def cmd_schema(args: argparse.Namespace) -> int:
 
 
 def cmd_ui(args: argparse.Namespace) -> int:
-    """Start the web UI (``webui.app.run``), imported only here."""
+    """Start the web UI (``webui.server.run``), imported only here."""
     write_plan = getattr(args, "write_plan", None)
     if write_plan:
         from planner.demo import stator_plan_text
@@ -109,7 +109,7 @@ def cmd_ui(args: argparse.Namespace) -> int:
     if plan is not None:
         load_plan(plan)  # a clear error now, before a server starts
 
-    from webui.app import run, serve  # the one place planner imports webui (viser), lazily
+    from webui.server import run, serve  # the one place planner imports webui (viser), lazily
 
     app = run(plan, host=args.host, port=args.port, block=False, fresh=args.fresh)
     bound = app.server.get_port()

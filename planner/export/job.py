@@ -9,7 +9,6 @@ orientations and configurations chosen by ``wobjcal check``.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -22,6 +21,7 @@ from calib.plan.file import Plan
 from calib.probing import SearchCommand
 from calib.procedures import procedure_kind
 from planner.export.safety import SafetySpec
+from planner.export.text import module_name
 
 FloatArray = NDArray[np.float64]
 #: ABB ``confdata`` (cf1, cf4, cf6, cfx).
@@ -180,33 +180,6 @@ class ExportJob:
     adaptive: AdaptiveSpec | None = None
 
 
-def identifier(text: str, prefix: str = "p") -> str:
-    """A robot-language identifier made of ``text``: ASCII letters, digits and ``_`` only."""
-    ident = re.sub(r"[^A-Za-z0-9_]", "_", text)
-    if not ident or not ident[0].isalpha():
-        ident = prefix + ident
-    return ident
-
-
-def comment_text(text: object) -> str:
-    """``text`` safe inside a one-line program comment: control characters (line breaks,
-    tabs) become spaces, so nothing after them can become a statement. Every writer passes
-    names and ids through it (plans restrict ids already; jobs built in code may not)."""
-    return re.sub(r"[\x00-\x1f\x7f\u2028\u2029\x85]", " ", str(text))
-
-
-def literal_text(text: object) -> str:
-    """``text`` safe inside a string literal of any robot language: letters, digits and
-    ``_ . -`` kept, anything else (quotes, backslashes, line breaks) replaced by ``_``."""
-    return re.sub(r"[^A-Za-z0-9_.-]", "_", str(text))
-
-
-def module_name(plan_name: str) -> str:
-    """``"stator_section_ah"`` -> ``"WobjcalStatorSectionAh"`` (max 32 characters)."""
-    words = re.split(r"[^A-Za-z0-9]+", plan_name)
-    return ("Wobjcal" + "".join(w[:1].upper() + w[1:] for w in words if w))[:32]
-
-
 def default_sensor_rotation(
     normal: ArrayLike, edge_direction: ArrayLike | None = None
 ) -> FloatArray:
@@ -342,9 +315,3 @@ def safety_header(job: ExportJob, prefix: str, width: int = 92) -> list[str]:
         "travel * sin(angle)."
     )
     return [prefix + line for line in textwrap.wrap(text, width - len(prefix))]
-
-
-def fmt(x: float, decimals: int = 4) -> str:
-    """A number for program text: fixed decimals, no ``-0``, trailing zeros trimmed."""
-    s = f"{x:.{decimals}f}".rstrip("0").rstrip(".")
-    return "0" if s in ("-0", "") else s

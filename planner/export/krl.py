@@ -25,15 +25,8 @@ import numpy as np
 
 from calib._version import __version__
 from calib.frames import tait_bryan_zyx_from_matrix
-from planner.export.job import (
-    ArmPose,
-    ExportJob,
-    TargetPair,
-    comment_text,
-    fmt,
-    identifier,
-    safety_header,
-)
+from planner.export.job import ArmPose, ExportJob, TargetPair, safety_header
+from planner.export.text import comment_text, fmt, identifier
 
 BASE_NO = 10
 TOOL_NO = 10

@@ -31,9 +31,10 @@ import numpy as np
 
 from calib._version import __version__
 from calib.frames import quat_wxyz_from_matrix
-from planner.export.job import ExportJob, comment_text, fmt, identifier
+from planner.export.job import ExportJob
 from planner.export.rapid_probe import WOBJ, probe_proc
 from planner.export.rapid_write import MEASURED_FILE, write_proc
+from planner.export.text import comment_text, fmt, identifier
 
 EXTAX = "[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]"
 

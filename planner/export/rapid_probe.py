@@ -11,7 +11,8 @@ a measured point passed in (``startBase``, base frame). ``measured{i}`` is in th
 
 from __future__ import annotations
 
-from planner.export.job import TargetPair, fmt, literal_text
+from planner.export.job import TargetPair
+from planner.export.text import fmt, literal_text
 
 #: The wobjdata every search is commanded in.
 WOBJ = "wobjCal"

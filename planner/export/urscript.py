@@ -20,14 +20,8 @@ import numpy as np
 
 from calib._version import __version__
 from calib.frames import rotvec_from_matrix
-from planner.export.job import (
-    ExportJob,
-    comment_text,
-    fmt,
-    identifier,
-    literal_text,
-    safety_header,
-)
+from planner.export.job import ExportJob, safety_header
+from planner.export.text import comment_text, fmt, identifier, literal_text
 
 SENSOR_IN = 0
 

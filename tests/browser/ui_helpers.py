@@ -15,7 +15,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from webui.app import WobjcalApp, run
+from webui.app import WobjcalApp
+from webui.server import run
 from webui.testing import free_port
 
 CHROMIUM = "/usr/bin/chromium"
