@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import os
 import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
 from ui_helpers import REPO, UiSession, rendered, set_camera, wait_for
 
+from calib.atomic_io import write_bytes_atomic
 from webui.plan_doc import PAPER_IDS
 
 pytestmark = pytest.mark.browser
@@ -47,7 +49,7 @@ def test_validate_button_produces_table_and_histograms(demo: UiSession) -> None:
     assert demo.app.validate_panel.last_report.n_trials == 30
 
 
-def test_screenshot_of_demo_cell(demo: UiSession) -> None:
+def test_screenshot_of_demo_cell(demo: UiSession, tmp_path: Path) -> None:
     demo.page.set_viewport_size({"width": 1500, "height": 900})
     # hide transient notifications (e.g. SwiftShader's "software WebGL" warning)
     demo.page.add_style_tag(content=".mantine-Notification-root { display: none !important; }")
@@ -57,11 +59,13 @@ def test_screenshot_of_demo_cell(demo: UiSession) -> None:
     demo.app.select("F")  # the robot at F's probe pose, at the start of its edge search
     wait_for(lambda: demo.app.robot is not None and demo.app.robot.q is not None, what="robot")
     rendered(demo.page)  # SwiftShader has drawn the new view
+    shot = tmp_path / "demo_cell.png"  # this run's own file: two suites at once never mix
+    demo.page.screenshot(path=str(shot))  # the page's default timeout: generous
+    assert shot.stat().st_size > 20_000, "the screenshot looks empty"
     ARTIFACT.parent.mkdir(parents=True, exist_ok=True)
-    demo.page.screenshot(path=str(ARTIFACT))  # the page's default timeout: generous
-    assert ARTIFACT.stat().st_size > 20_000, "the screenshot looks empty"
+    write_bytes_atomic(ARTIFACT, shot.read_bytes())
     if UPDATE_SCREENSHOTS:
-        shutil.copyfile(ARTIFACT, SCREENSHOT)
+        shutil.copyfile(shot, SCREENSHOT)
     assert np.isfinite(client.camera.fov)
 
 
