@@ -49,7 +49,7 @@ def _start_validation() -> tuple[subprocess.Popen[bytes], set[int]]:
     return proc, workers
 
 
-def _gone(pids: set[int], timeout_s: float = 60.0) -> bool:
+def _gone(pids: set[int], timeout_s: float = 120.0) -> bool:
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
         if not any(_alive(p) for p in pids):
@@ -64,7 +64,7 @@ def test_workers_stop_with_the_validation(sig: signal.Signals) -> None:
     proc, workers = _start_validation()
     try:
         proc.send_signal(sig)
-        code = proc.wait(timeout=60)
+        code = proc.wait(timeout=120)
         assert _gone(workers), f"workers {workers} still running after {sig.name}"
         if sig == signal.SIGTERM:
             assert code == 143

@@ -16,6 +16,7 @@ import signal
 import sys
 import threading
 from collections.abc import Callable, Sequence
+from typing import NoReturn
 
 from calib._version import __version__
 from calib.errors import WobjcalError
@@ -33,6 +34,16 @@ class Terminated(BaseException):
 
 def _raise_terminated(signum: int, frame: object) -> None:
     raise Terminated()
+
+
+def _exit_now(code: int) -> NoReturn:
+    """Leave at once after SIGTERM, once the main thread has cleaned up (``finally`` blocks ran
+    while :class:`Terminated` propagated): the interpreter's normal exit would wait for helper
+    threads (a process pool's manager, a progress bar) that a terminated command must not."""
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    os._exit(code)
 
 
 _FORMATTER = argparse.RawDescriptionHelpFormatter
@@ -106,7 +117,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _run(args)
     except Terminated:
         print(f"wobjcal {args.command}: terminated", file=sys.stderr)
-        return EXIT_TERMINATED
+        _exit_now(EXIT_TERMINATED)
     except BrokenPipeError:  # e.g. `wobjcal check --json plan.json | head`: the reader left
         with contextlib.suppress(OSError):
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

@@ -231,18 +231,19 @@ def _run_all(
                 progress(len(out), total)
         return out
     ctx = mp.get_context("fork") if "fork" in mp.get_all_start_methods() else None
-    with ProcessPoolExecutor(n_workers, ctx, _init_pool_worker, (setup, mesh)) as pool:
-        try:
-            for res in pool.map(run_chunk_in_worker, chunks):
-                out.extend(res)
-                if progress is not None:
-                    progress(len(out), total)
-        except BaseException:  # Ctrl-C, SIGTERM, an error: no worker left running
-            procs = list((getattr(pool, "_processes", None) or {}).values())
-            for proc in procs:
-                proc.terminate()
-            pool.shutdown(wait=False, cancel_futures=True)
-            raise
+    pool = ProcessPoolExecutor(n_workers, ctx, _init_pool_worker, (setup, mesh))
+    try:
+        for res in pool.map(run_chunk_in_worker, chunks):
+            out.extend(res)
+            if progress is not None:
+                progress(len(out), total)
+    except BaseException:  # Ctrl-C, SIGTERM, an error: no worker left running, no waiting
+        procs = list((getattr(pool, "_processes", None) or {}).values())
+        for proc in procs:
+            proc.kill()
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
     return out
 
 
