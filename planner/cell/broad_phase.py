@@ -111,13 +111,15 @@ class BroadPhase:
             hull = mesh.convex_hull.vertices if mesh is not None else None
             for i in scene.checker._tool_links():
                 shapes = link_shapes(c, tool, i, hull if i == -1 else None)
+                # the tool's links in the flange frame, through the tool's mount on the flange
                 T_root_link = invert_transform(T_world_root) @ world_link_pose(c, tool, i)
+                T_flange_link = scene.T_flange_tool @ T_root_link
                 links.append(
                     BroadLink(
                         tool.body_id, i, scene.checker.names(tool.body_id, i), shapes,
                         link_tree(shapes),
                         max((s.inflation_m for s in shapes), default=0.0),
-                        max((bullet_excess(s) for s in shapes), default=0.0), None, T_root_link,
+                        max((bullet_excess(s) for s in shapes), default=0.0), None, T_flange_link,
                     )
                 )  # fmt: skip
         bp = cls(links)

@@ -155,6 +155,7 @@ class ProbeClearance:
     def _place_tool(self, rotation: int) -> None:
         tool = self._cell.tool_body
         if tool is not None and self._tool_at != rotation:
-            set_link_pose(self._cell.client, tool, self._T_world_flange[rotation])
+            T_world_tool = self._T_world_flange[rotation] @ self._cell.T_flange_tool  # the mount
+            set_link_pose(self._cell.client, tool, T_world_tool)
             self._tool_at = rotation
             self._tool_on_flange = False

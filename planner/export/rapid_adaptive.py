@@ -24,8 +24,9 @@ from __future__ import annotations
 import math
 
 from calib.paper.stator_layout import STATOR_POINT_IDS as ROLES
-from planner.export.job import AdaptiveSpec, ExportJob, fmt
+from planner.export.job import AdaptiveSpec, ExportJob
 from planner.export.rapid_probe import WOBJ
+from planner.export.text import fmt
 
 
 def _adaptive(job: ExportJob) -> AdaptiveSpec:

@@ -34,6 +34,7 @@ from calib.models import Misplacement, RobotErrorModel
 from calib.models.proximity import ProximitySensor
 from calib.paper.settings import Hultman2013
 from calib.paper.stator_procedure import check_stator_points
+from calib.plan.models import MAX_TRIALS
 from calib.probing import ProbePoint
 from planner.parts.stator import StatorGeometry
 from planner.parts.stator_mesh import build_stator_mesh
@@ -132,8 +133,8 @@ def validate(
     """
     if procedure not in PROCEDURES:
         raise InputError(f"procedure must be one of {PROCEDURES}, got {procedure!r}")
-    if not isinstance(n_trials, int) or n_trials < 2:
-        raise ShapeError(f"n_trials must be an integer >= 2, got {n_trials!r}")
+    if not isinstance(n_trials, int) or not 2 <= n_trials <= MAX_TRIALS:
+        raise ShapeError(f"n_trials must be an integer 2 to {MAX_TRIALS:,}, got {n_trials!r}")
     T_nom = check_transform(T_base_wobj_nominal, "T_base_wobj_nominal")
     check_stator_points(points)
     if misplacement is None:
@@ -230,9 +231,44 @@ def _run_all(
                 progress(len(out), total)
         return out
     ctx = mp.get_context("fork") if "fork" in mp.get_all_start_methods() else None
-    with ProcessPoolExecutor(n_workers, ctx, init_worker, (setup, mesh)) as pool:
+    pool = ProcessPoolExecutor(n_workers, ctx, _init_pool_worker, (setup, mesh))
+    try:
         for res in pool.map(run_chunk_in_worker, chunks):
             out.extend(res)
             if progress is not None:
                 progress(len(out), total)
+    except BaseException:  # Ctrl-C, SIGTERM, an error: no worker left running, no waiting
+        procs = list((getattr(pool, "_processes", None) or {}).values())
+        for proc in procs:
+            proc.kill()
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
     return out
+
+
+def _init_pool_worker(setup: SimulationSetup, mesh: trimesh.Trimesh) -> None:
+    """Pool initializer: die with the parent process (Linux), then :func:`init_worker`.
+
+    Without it a parent killed by SIGTERM or SIGKILL leaves its workers running.
+    """
+    _die_with_parent()
+    init_worker(setup, mesh)
+
+
+def _die_with_parent() -> None:
+    """Ask Linux to SIGKILL this process when its parent dies (``prctl(PR_SET_PDEATHSIG)``)."""
+    import ctypes
+    import signal
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return
+    parent = os.getppid()
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # PR_SET_PDEATHSIG = 1
+    except (OSError, AttributeError):
+        return
+    if os.getppid() != parent:  # the parent died before the call
+        os._exit(1)
