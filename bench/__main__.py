@@ -13,7 +13,8 @@ import sys
 #: (module, full-size arguments, quick arguments)
 BENCHMARKS: list[tuple[str, list[str], list[str]]] = [
     ("bench.bench_ik", [], ["--n", "2000"]),
-    ("bench.bench_feasibility", [], ["--n", "100", "--pybullet-n", "50"]),
+    ("bench.bench_feasibility", [], ["--n", "500", "--loop-n", "50", "--map-n", "2000"]),
+    ("bench.bench_broad_phase", [], ["--n", "300"]),
     ("bench.bench_rays", [], ["--rays", "20000"]),
     ("bench.bench_validate", [], ["--small", "100", "--large", "400"]),
     ("bench.bench_ui_latency", ["--browser"], ["--clicks", "10"]),

@@ -26,7 +26,7 @@ import trimesh
 
 from calib.atomic_io import write_text_atomic
 from calib.frames import transform_points
-from webui.app import run
+from webui.server import run
 from webui.testing import BOX_EXTENTS, T_WORLD_WOBJ_BOX, box_plan, free_port, project_to_screen
 
 RESULTS = Path(__file__).resolve().parent / "results" / "ui_latency.json"

@@ -14,6 +14,7 @@ import math
 import msgspec
 
 from calib.errors import PlanError
+from calib.tolerances import COORDINATE_LIMIT_M
 
 Vec3 = tuple[float, float, float]
 #: Tolerance on the length of a unit vector given in a file.
@@ -28,6 +29,21 @@ def check_finite(values: tuple[float, ...] | None, field: str) -> None:
     """Raise :class:`PlanError` unless every value is finite (``None`` passes)."""
     if values is not None and not all(math.isfinite(v) for v in values):
         raise PlanError(f"{field}: must hold finite numbers, got {list(values)}")
+
+
+def check_coordinates(
+    values: tuple[float, ...] | None, field: str, limit_m: float = COORDINATE_LIMIT_M
+) -> None:
+    """Raise :class:`PlanError` unless every value is finite and at most ``limit_m`` in size
+    (a position in metres: 1e308 is a typo, refused before any arithmetic sees it)."""
+    check_finite(values, field)
+    if values is not None:
+        big = [v for v in values if abs(v) > limit_m]
+        if big:
+            raise PlanError(
+                f"{field}: {big[0]:g} m is not a plausible coordinate (limit +-{limit_m:g} m; "
+                "a value in mm given as metres?)"
+            )
 
 
 def check_unit(values: tuple[float, ...] | None, field: str) -> None:
@@ -47,7 +63,12 @@ def check_positive(value: float, field: str, allow_zero: bool = False) -> None:
         raise PlanError(f"{field}: must be {'>= 0' if allow_zero else '> 0'}, got {value}")
 
 
-def check_count(value: int, field: str, minimum: int = 1) -> None:
-    """Raise :class:`PlanError` unless ``value`` is an integer ``>= minimum``."""
+def check_count(value: int, field: str, minimum: int = 1, maximum: int | None = None) -> None:
+    """Raise :class:`PlanError` unless ``value`` is an integer ``>= minimum`` (and
+    ``<= maximum`` when given: a count that would allocate without bound is refused here,
+    naming the field, not met later as an overflow)."""
     if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
         raise PlanError(f"{field}: must be an integer >= {minimum}, got {value!r}")
+    if maximum is not None and value > maximum:
+        shown = f"{value:,}" if value < 10**15 else f"{value:.3g}"
+        raise PlanError(f"{field}: must be at most {maximum:,}, got {shown}")

@@ -7,6 +7,22 @@ measurements (retakes after the first measurement of a point). ``hultman2013`` r
 paper's A-H procedure on the recorded points, ``three_two_one`` uses the plan's 3-2-1 roles (or
 picks them from the faces when the plan was made for another method), ``best_fit`` fits every
 measured point to its face(s). Pure numpy and ``calib``: no simulator.
+
+Every result is screened before anyone pastes it into a robot (:func:`trust_problems`):
+
+- gross errors: all measured points are fitted by least squares and each point-to-face residual
+  is compared with the noise the plan expects (:func:`expected_sigma_m`: the plan's sensor and
+  robot error models and the planar-face flatness); a point beyond ``k_sigma`` is flagged and,
+  with redundant points, the point to re-measure is named by leave-one-out
+  (:func:`calib.estimators.gross_errors.screen_measurements`);
+- misplacement: a frame farther from nominal than the plan's misplacement bound
+  (``validation.misplacement``) is flagged;
+- uncertainty: the frame's 6x6 covariance for that noise, propagated through the method
+  (:func:`calib.procedures.uncertainty.propagated_covariance`), and 1 sigma per degree of
+  freedom.
+
+A result with problems is not ``trusted``: ``wobjcal calibrate`` then exits 1 without the
+lines to paste unless ``--force``, and the UI does not draw the frame as calibrated.
 """
 
 from __future__ import annotations
@@ -18,10 +34,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.errors import InputError
-from calib.frames import invert_transform, transform_points
+from calib.estimators.gross_errors import K_SIGMA, GrossErrorScreen, screen_measurements
+from calib.frames import invert_transform, rotvec_from_matrix, transform_points
 from calib.plan.file import Plan
 from calib.plan.measurements import Measurements
 from calib.procedures import PROCEDURES, procedure_kind
+from calib.procedures.uncertainty import propagated_covariance
+from calib.tolerances import FACE_FLATNESS_RMS_M
 from planner.plan_cell import T_base_world, nominal_T_base_wobj
 
 FloatArray = NDArray[np.float64]
@@ -72,6 +91,11 @@ class CalibrationOutput:
             the search found, metres.
         used_ids: the point ids the method used.
         skipped_ids: plan points without a measurement that the method could do without.
+        screen: the gross-error screen of the measured points.
+        covariance: ``(6, 6)`` covariance of the frame for the expected noise, order
+            ``(dx, dy, dz, rx, ry, rz)`` in the calibrated frame's axes (m^2, m rad, rad^2).
+        problems: why the frame must not be used as it is (empty when ``trusted``).
+        notes: what the user should know that does not stop the result (e.g. no redundancy).
     """
 
     method: str
@@ -81,17 +105,35 @@ class CalibrationOutput:
     edge_residuals_m: dict[str, float]
     used_ids: tuple[str, ...]
     skipped_ids: tuple[str, ...] = ()
+    screen: GrossErrorScreen | None = None
+    covariance: FloatArray | None = None
+    problems: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
+
+    @property
+    def trusted(self) -> bool:
+        """No gross error and within the misplacement bound: safe to paste."""
+        return not self.problems
+
+    @property
+    def sigma_dof(self) -> FloatArray | None:
+        """``(6,)`` 1 sigma of ``(x, y, z)`` (m) and of the rotations about ``(x, y, z)`` (rad),
+        calibrated frame's axes; ``None`` without a covariance."""
+        if self.covariance is None:
+            return None
+        return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
 
 
 def calibrate_plan(
-    plan: Plan, measurements: Measurements, method: str | None = None
+    plan: Plan, measurements: Measurements, method: str | None = None, k_sigma: float = K_SIGMA
 ) -> CalibrationOutput:
-    """Compute ``T_base_wobj`` from measured points (see the module docstring).
+    """Compute ``T_base_wobj`` from measured points and screen it (see the module docstring).
 
     Args:
         plan: the plan the points were measured with.
         measurements: the measured points (base or world frame, m or mm).
         method: a procedure of :data:`calib.procedures.PROCEDURES`; default: the plan's.
+        k_sigma: a residual beyond ``k_sigma`` times the expected noise flags its point.
 
     Raises:
         InputError: unknown method, a measured id the plan does not have, missing
@@ -111,25 +153,137 @@ def calibrate_plan(
     settings = plan.procedure if kind.method == plan.method else None
     T_nom = nominal_T_base_wobj(plan)
     measured = MeasuredPoints(measurements, T_base_world(plan))
-    run = kind.estimate(plan.role_points(), measured, T_nom, settings)
+    points = plan.role_points()
+    run = kind.estimate(points, measured, T_nom, settings)
     first = {pid: measured[pid][0] for pid in measured}
     residuals, edge_res = point_residuals(plan, run.T_base_wobj, first)
     skipped = tuple(p.id for p in plan.points if p.id not in measured)
+    sigma = expected_sigma_m(plan)
+    screen = screen_plan_measurements(plan, first, run.T_base_wobj, sigma, k_sigma)
+    sequences = {pid: measured[pid] for pid in measured}
+    cov = propagated_covariance(kind, points, sequences, T_nom, settings, sigma)
+    problems = [*screen.messages(), *misplacement_problems(plan, run.T_base_wobj, screen)]
+    notes = [screen.note] if screen.note else []
     return CalibrationOutput(
-        method, run.T_base_wobj, T_nom, residuals, edge_res, run.used_ids, skipped
+        method,
+        run.T_base_wobj,
+        T_nom,
+        residuals,
+        edge_res,
+        run.used_ids,
+        skipped,
+        screen,
+        cov,
+        tuple(problems),
+        tuple(notes),
     )
+
+
+def expected_sigma_m(plan: Plan) -> float:
+    """Noise of one measured point along its face normal that the plan expects, metres.
+
+    The root sum of squares of the sensor's scatter along an approach search (the proximity
+    sensor's switching jitter, the touch probe's trigger repeatability), the robot's
+    repeatability and absolute-accuracy amplitude (``validation.sensor``,
+    ``validation.robot_error``) and the flatness a planar face may have
+    (:data:`calib.tolerances.FACE_FLATNESS_RMS_M`: the part itself is not an exact plane where
+    the sensor lands).
+    """
+    v = plan.validation
+    parts = (
+        v.sensor.search_noise("approach", 0.0).sensor_sigma_m,
+        v.robot_error.repeatability_sigma_m,
+        v.robot_error.accuracy_amplitude_m,
+        FACE_FLATNESS_RMS_M,
+    )
+    return float(np.sqrt(sum(x * x for x in parts)))
+
+
+def edge_offset_m(plan: Plan) -> float:
+    """How far past the edge the sensor reports an edge, m: the plan procedure's
+    ``edge_event_offset_m`` where it has one (the A-H settings), else 0."""
+    return float(getattr(plan.procedure, "edge_offset_m", 0.0) or 0.0)
+
+
+def screen_plan_measurements(
+    plan: Plan,
+    measured_m: Mapping[str, FloatArray],
+    T_base_wobj: FloatArray,
+    sigma_m: float,
+    k_sigma: float = K_SIGMA,
+) -> GrossErrorScreen:
+    """Screen the first measurement of every measured point (see the module docstring).
+
+    Edge points are moved back by the plan's edge-event offset along their search direction
+    (turned into the base frame by ``T_base_wobj``, then by the least-squares fit itself).
+    """
+    probes = [p.to_probe_point() for p in plan.points if p.id in measured_m]
+    offset = edge_offset_m(plan)
+    T_nom = nominal_T_base_wobj(plan)
+
+    def corrected(R: FloatArray) -> FloatArray:
+        rows = []
+        for p in probes:
+            q = np.asarray(measured_m[p.id], dtype=np.float64)
+            if p.search.kind == "edge" and p.search.edge_direction is not None and offset:
+                q = q - offset * (R @ np.asarray(p.search.edge_direction, dtype=np.float64))
+            rows.append(q)
+        return np.array(rows, dtype=np.float64).reshape(-1, 3)
+
+    screen = screen_measurements(probes, corrected(T_base_wobj[:3, :3]), T_nom, sigma_m, k_sigma)
+    if offset and screen.fit is not None:
+        R_fit = screen.fit.T_base_wobj[:3, :3]
+        screen = screen_measurements(probes, corrected(R_fit), T_nom, sigma_m, k_sigma)
+    return screen
+
+
+def misplacement_problems(
+    plan: Plan, T_base_wobj: FloatArray, screen: GrossErrorScreen
+) -> list[str]:
+    """Why the frame lies beyond the plan's misplacement bound (``[]`` when within).
+
+    The part may move by ``validation.misplacement``: a translation of the centroid of the
+    probe points and a rotation about it. A frame beyond that (plus the screen's noise limit)
+    is a gross error or a part that is not where the cell says.
+    """
+    if not plan.points:
+        return []
+    mis = plan.validation.misplacement
+    T_nom = nominal_T_base_wobj(plan)
+    c = np.mean([p.position_m for p in plan.points], axis=0)
+    moved_m = float(np.linalg.norm(transform_points(T_base_wobj, c) - transform_points(T_nom, c)))
+    angle = float(np.linalg.norm(rotvec_from_matrix(T_nom[:3, :3].T @ T_base_wobj[:3, :3])))
+    positions = np.array([p.position_m for p in plan.points], dtype=np.float64)
+    spread = max(float(np.sqrt(np.mean(np.sum((positions - c) ** 2, axis=1)))), 1e-3)
+    out = []
+    if moved_m > mis.max_translation_m + screen.limit_m:
+        out.append(
+            f"the calibrated frame moves the centre of the probe points by {moved_m * 1e3:.1f} mm "
+            f"from nominal, beyond validation.misplacement.max_translation_m "
+            f"({mis.max_translation_m * 1e3:.1f} mm)"
+        )
+    if angle > mis.max_angle_rad + screen.limit_m / spread:
+        out.append(
+            f"the calibrated frame is turned {np.degrees(angle):.2f} deg from nominal, beyond "
+            f"validation.misplacement.max_angle_rad ({np.degrees(mis.max_angle_rad):.2f} deg)"
+        )
+    return out
 
 
 def point_residuals(
     plan: Plan, T_base_wobj: FloatArray, measured_m: Mapping[str, FloatArray]
 ) -> tuple[dict[str, float], dict[str, float]]:
-    """Signed face distances of measured points (base frame) from the part at ``T_base_wobj``."""
+    """Signed face distances of measured points (base frame) from the part at ``T_base_wobj``;
+    edge points moved back by the plan's edge-event offset (:func:`edge_offset_m`)."""
     T_wobj_base = invert_transform(T_base_wobj)
+    offset = edge_offset_m(plan)
     res, edge = {}, {}
     for p in plan.points:
         if p.id not in measured_m:
             continue
         q = transform_points(T_wobj_base, measured_m[p.id]) - np.asarray(p.position_m)
+        if p.search.edge_direction is not None:
+            q = q - offset * np.asarray(p.search.edge_direction)
         res[p.id] = float(np.dot(p.normal, q))
         if p.edge_normal is not None:
             edge[p.id] = float(np.dot(p.edge_normal, q))

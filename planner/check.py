@@ -16,6 +16,11 @@ Per point, three checks:
 
 A point is ``infeasible`` when any of the three fails, ``marginal`` when only the pose is
 marginal, else ``feasible``.
+
+Per plan, the procedure's own preconditions (:func:`layout_problem`): the plan has points, every
+role the procedure needs, and the procedure computes the nominal frame from exact measurements
+of the nominal points (a dry run of the same ``estimate`` that ``wobjcal calibrate`` runs), so
+a plan that ``calibrate`` would refuse fails at ``check``, before the robot has measured.
 """
 
 from __future__ import annotations
@@ -23,15 +28,20 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from calib.errors import InputError, ProbeFailedError
+from calib.frames import transform_points
 from calib.plan.file import Plan, PlanPoint
 from calib.probing import SearchCommand
+from calib.procedures import procedure_kind
+from calib.tolerances import FACE_MAX_DEVIATION_M
+from planner.check_results import ConfData, PlanCheck, PointCheck, Status
 from planner.plan_cell import nominal_T_base_wobj, open_cell
 
 if TYPE_CHECKING:
@@ -39,140 +49,16 @@ if TYPE_CHECKING:
     from planner.cell.feasibility import ProbeFeasibility
 
 FloatArray = NDArray[np.float64]
-Status = Literal["feasible", "marginal", "infeasible"]
-#: ABB ``confdata`` (cf1, cf4, cf6, cfx).
-ConfData = tuple[int, int, int, int]
 
-
-@dataclass(frozen=True)
-class PointCheck:
-    """The check of one probe point and its search.
-
-    Attributes:
-        point_id: the plan's point id.
-        role: its role in the procedure.
-        kind: ``"approach"`` or ``"edge"`` search.
-        status: ``feasible``, ``marginal`` or ``infeasible``: the pose, the path and the face
-            together (see the module docstring).
-        reason: why not feasible, all parts joined with ``"; "`` (``""`` when feasible).
-        pose_status: the probe pose alone.
-        pose_reason: why the pose is marginal or infeasible (``""`` when feasible).
-        path_feasible: the whole search path can be run.
-        path_reason: why not, with the distance along the path (``""`` when feasible).
-        path_fail_at_m: distance from the search start of the first failing sample, m (NaN
-            when the path is feasible).
-        face_reason: why the point is not on a planar face with the sensor footprint on it
-            (``""`` when it is).
-        clearance_m: clearance of the limiting pair at the chosen pose, m (NaN: no pose);
-            nothing nearer than the query's look-ahead when ``clearance_is_lower_bound``.
-        clearance_pair: ``(robot or tool link, obstacle)`` of that clearance, or ``None``.
-        clearance_is_lower_bound: the clearance is the look-ahead distance (nothing nearer).
-        confdata: ABB ``(cf1, cf4, cf6, cfx)`` of the chosen IK branch (OPW arms, feasible or
-            marginal pose), else ``None``.
-        ik_kind: the cell's IK: ``"opw"`` (analytic) or ``"numeric"``.
-        q: ``(n,)`` joint values of the chosen (or least-bad) pose, rad; ``None`` when no IK.
-        q_path: ``(M, n)`` joint values along the path samples that passed, rad, or ``None``.
-        T_base_flange: ``(4, 4)`` flange pose of ``q``, robot base frame, m, or ``None``.
-        elapsed_s: time this point's check took, s.
-    """
-
-    point_id: str
-    role: str
-    kind: str
-    status: Status
-    reason: str
-    pose_status: Status
-    pose_reason: str
-    path_feasible: bool
-    path_reason: str
-    path_fail_at_m: float
-    face_reason: str
-    clearance_m: float
-    clearance_pair: tuple[str, str] | None
-    clearance_is_lower_bound: bool
-    confdata: ConfData | None
-    ik_kind: str
-    q: FloatArray | None
-    q_path: FloatArray | None
-    T_base_flange: FloatArray | None
-    elapsed_s: float = 0.0
-
-    @property
-    def feasible(self) -> bool:
-        """The point can be measured as planned (marginal counts as feasible)."""
-        return self.status != "infeasible"
-
-    def to_json(self) -> dict[str, Any]:
-        """A JSON-ready dict (distances in metres; NaN as ``null``)."""
-        return {
-            "id": self.point_id,
-            "role": self.role,
-            "kind": self.kind,
-            "status": self.status,
-            "reason": self.reason,
-            "pose_status": self.pose_status,
-            "pose_reason": self.pose_reason,
-            "path_feasible": self.path_feasible,
-            "path_reason": self.path_reason,
-            "path_fail_at_m": _finite_or_none(self.path_fail_at_m),
-            "face_reason": self.face_reason,
-            "clearance_m": _finite_or_none(self.clearance_m),
-            "clearance_pair": list(self.clearance_pair) if self.clearance_pair else None,
-            "clearance_is_lower_bound": self.clearance_is_lower_bound,
-            "confdata": list(self.confdata) if self.confdata else None,
-            "ik_kind": self.ik_kind,
-            "feasible": self.feasible,
-        }
-
-
-@dataclass(frozen=True)
-class PlanCheck:
-    """The check of a whole plan.
-
-    Attributes:
-        points: one :class:`PointCheck` per plan point, in plan order.
-        ik_kind: the cell's IK: ``"opw"`` (analytic) or ``"numeric"``.
-        ik_note: why the analytic IK does not apply (``""`` for ``opw``).
-        error: a problem of the whole plan on this part (e.g. the part has no planar face),
-            ``""`` when none.
-    """
-
-    points: tuple[PointCheck, ...]
-    ik_kind: str
-    ik_note: str = ""
-    error: str = ""
-
-    @property
-    def feasible(self) -> bool:
-        """Every point and path is feasible and the plan has no error."""
-        return not self.error and all(p.feasible for p in self.points)
-
-    @property
-    def infeasible(self) -> tuple[PointCheck, ...]:
-        """The points that fail."""
-        return tuple(p for p in self.points if not p.feasible)
-
-    def point(self, point_id: str) -> PointCheck:
-        """The check of ``point_id``.
-
-        Raises:
-            KeyError: no such point (the message lists the ids).
-        """
-        for p in self.points:
-            if p.point_id == point_id:
-                return p
-        raise KeyError(f"no point {point_id!r}; points: {[p.point_id for p in self.points]}")
-
-    def to_json(self) -> dict[str, Any]:
-        """A JSON-ready dict; ``error`` appears only when there is one."""
-        out: dict[str, Any] = {
-            "feasible": self.feasible,
-            "ik_kind": self.ik_kind,
-            "points": [p.to_json() for p in self.points],
-        }
-        if self.error:
-            out["error"] = self.error
-        return out
+__all__ = [
+    "ConfData",
+    "PlanCheck",
+    "PointCheck",
+    "Status",
+    "check_plan",
+    "check_points",
+    "layout_problem",
+]
 
 
 def check_plan(plan: Plan, plan_dir: Path | None = None, *, cell: Cell | None = None) -> PlanCheck:
@@ -192,7 +78,45 @@ def check_plan(plan: Plan, plan_dir: Path | None = None, *, cell: Cell | None = 
         with open_cell(plan, plan_dir or Path.cwd()) as own:
             return check_plan(plan, cell=own)
     checks, error = _check(plan, list(plan.points), cell)
-    return PlanCheck(checks, cell.solver.kind, cell.solver.why_not_opw or "", error)
+    return PlanCheck(
+        checks, cell.solver.kind, cell.solver.why_not_opw or "", error, layout_problem(plan)
+    )
+
+
+def layout_problem(plan: Plan) -> str:
+    """Why the plan's procedure would refuse its points, ``""`` when it would not.
+
+    A dry run of ``wobjcal calibrate``: the procedure (:data:`calib.procedures.PROCEDURES`)
+    estimates the frame from exact measurements of the nominal points, in the nominal frame.
+    It must accept them (roles, faces, observability) and give back the nominal frame: a
+    layout that breaks the procedure's assumptions (e.g. A and B of the A-H procedure not at
+    one height) shows as the distance, at the worst point, between the two frames; more than
+    :data:`calib.tolerances.FACE_MAX_DEVIATION_M` is a problem.
+    """
+    if not plan.points:
+        return "the plan has no points: nothing to measure"
+    kind = procedure_kind(plan.procedure)
+    problem = kind.role_problem([p.role for p in plan.points], True)
+    if problem:
+        return problem
+    T = nominal_T_base_wobj(plan)
+    exact = {p.id: transform_points(T, p.position_m)[None] for p in plan.points}
+    try:
+        T_est = kind.estimate(plan.role_points(), exact, T, plan.procedure).T_base_wobj
+    except (InputError, ProbeFailedError) as exc:
+        return f"{plan.method}: {exc}"
+    positions = np.array([p.position_m for p in plan.points], dtype=np.float64)
+    off = np.linalg.norm(
+        transform_points(T_est, positions) - transform_points(T, positions), axis=1
+    )
+    worst = int(np.argmax(off))
+    if off[worst] > FACE_MAX_DEVIATION_M:
+        return (
+            f"{plan.method}: from exact measurements of the nominal points the procedure's "
+            f"frame moves point {plan.points[worst].id} by {off[worst] * 1e3:.3f} mm: the layout "
+            "breaks the procedure's assumptions (see docs/paper_method.md)"
+        )
+    return ""
 
 
 def check_points(cell: Cell, plan: Plan, points: Sequence[PlanPoint]) -> tuple[PointCheck, ...]:
@@ -228,15 +152,25 @@ def _check(plan: Plan, points: list[PlanPoint], cell: Cell) -> tuple[tuple[Point
     T_nom = nominal_T_base_wobj(plan)
     ik_kind = cell.solver.kind
     out = []
+    T_flange_tcp = cell.T_flange_tcp(plan.cell.tool.tcp)
+    part = f"work object {wo.name}: {wo.report.size_text}"
     for p, probe, pose, face in zip(points, probes, poses, faces, strict=True):
         path = cell.check_search(SearchCommand.from_point(probe, T_nom), q_ref=pose.q)
-        out.append(_point_check(cell, p, pose, path, face, ik_kind, t0))
+        check = _point_check(cell, p, pose, path, face, ik_kind, t0, T_flange_tcp)
+        out.append(_with_part_size(check, wo.name, part))
         t0 = time.perf_counter()
     return tuple(out), error
 
 
 def _point_check(
-    cell: Cell, p: PlanPoint, pose: ProbeFeasibility, path: Any, face: str, ik_kind: str, t0: float
+    cell: Cell,
+    p: PlanPoint,
+    pose: ProbeFeasibility,
+    path: Any,
+    face: str,
+    ik_kind: str,
+    t0: float,
+    T_flange_tcp: FloatArray,
 ) -> PointCheck:
     from planner.cell.collision import DEFAULT_MARGIN_M, report_distance_m
 
@@ -268,6 +202,30 @@ def _point_check(
         q_path=None if path.q_path is None else np.asarray(path.q_path, dtype=float),
         T_base_flange=None if pose.T_base_flange is None else np.asarray(pose.T_base_flange),
         elapsed_s=time.perf_counter() - t0,
+        T_base_tcp=None
+        if pose.T_base_flange is None
+        else np.asarray(pose.T_base_flange) @ T_flange_tcp,
+    )
+
+
+def _with_part_size(check: PointCheck, name: str, part: str) -> PointCheck:
+    """The check with the part's size and units added to reasons about the part (out of
+    reach, off its surface, hitting it): a part read in the wrong units shows as such."""
+
+    def add(reason: str) -> str:
+        about_part = name in reason or "out of reach" in reason or "from the surface" in reason
+        return f"{reason} ({part})" if reason and about_part else reason
+
+    pose, path, face = add(check.pose_reason), add(check.path_reason), add(check.face_reason)
+    if (pose, path, face) == (check.pose_reason, check.path_reason, check.face_reason):
+        return check
+    parts = [pose, f"search path: {path}" if path else "", face]
+    return replace(
+        check,
+        pose_reason=pose,
+        path_reason=path,
+        face_reason=face,
+        reason="; ".join(x for x in parts if x),
     )
 
 
@@ -282,7 +240,3 @@ def _confdata(cell: Cell, q: FloatArray | None) -> ConfData | None:
     except NotOPWError:
         return None
     return int(cf1), int(cf4), int(cf6), int(cfx)
-
-
-def _finite_or_none(x: float) -> float | None:
-    return x if math.isfinite(x) else None

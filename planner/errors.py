@@ -17,5 +17,10 @@ class UnknownFrameError(InputError):
     """A frame, link, joint or TCP name is not known; the message lists the valid names."""
 
 
+class ToolMountError(InputError):
+    """The tool cannot be mounted on the robot's flange as given; the message names the plan
+    field that sets the mount (``cell.tool.T_flange_tool``)."""
+
+
 class UnreachableError(WobjcalError):
     """A target cannot be reached by the robot; the message says why."""

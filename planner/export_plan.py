@@ -2,14 +2,21 @@
 
 :func:`export_program` checks the plan (:func:`planner.check.check_plan`, unless told not to),
 builds the :class:`planner.export.job.ExportJob` with each target's sensor orientation and ABB
-configuration from the check, and formats it with the writer registered for the format
+configuration from the check, and the robot's joint values and configuration at every target
+(:func:`with_arm_poses`: IK next to the checked pose; FANUC ``CONFIG`` and KUKA ``S``/``T`` come
+from them), and formats it with the writer registered for the format
 (:data:`planner.export.FORMATS`). Whether infeasible points stop the export is the caller's
 decision (``wobjcal export`` exits 1 unless ``--force``); the result says which they are.
+
+The plan's layout is checked even without the cell check (:func:`planner.check.layout_problem`):
+an A-H plan that lacks a role would otherwise become a program that runs every search in the
+nominal frame, silently not the paper's procedure; the result's ``layout`` says so and the
+command line refuses it unless ``--force``.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -18,10 +25,10 @@ from numpy.typing import NDArray
 
 from calib.frames import invert_transform
 from calib.plan.file import Plan
-from planner.check import ConfData, PlanCheck, check_plan
+from planner.check import ConfData, PlanCheck, check_plan, layout_problem
 from planner.export import export_files
-from planner.export.job import ExportJob, build_job
-from planner.plan_cell import nominal_T_base_wobj, tool_data
+from planner.export.job import TARGET_KINDS, ArmPose, ExportJob, build_job
+from planner.plan_cell import nominal_T_base_wobj, open_cell, tool_data
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
@@ -37,11 +44,14 @@ class ProgramExport:
         files: ``{suffix: text}`` of the program, e.g. ``{".src": ..., ".dat": ...}``.
         notes: what the user should know (estimated tool load, points without a checked pose).
         check: the plan check the orientations came from, or ``None`` when not run.
+        layout: why the plan's procedure refuses its points (e.g. an A-H plan without a
+            role: the program is then not adaptive), ``""`` when it does not.
     """
 
     files: dict[str, str]
     notes: tuple[str, ...]
     check: PlanCheck | None
+    layout: str = ""
 
     @property
     def infeasible(self) -> tuple[str, ...]:
@@ -67,8 +77,8 @@ def export_job_for(
     else:
         T_wobj_base = invert_transform(T_nom)
         for r in check.points:
-            if r.T_base_flange is not None and r.pose_status != "infeasible":  # chosen pose
-                T_wobj_tcp = T_wobj_base @ r.T_base_flange @ tool.T_flange_tcp
+            if r.T_base_tcp is not None and r.pose_status != "infeasible":  # chosen pose
+                T_wobj_tcp = T_wobj_base @ r.T_base_tcp
                 rotations[r.point_id] = T_wobj_tcp[:3, :3]
             if r.confdata is not None:
                 confs[r.point_id] = r.confdata
@@ -97,6 +107,48 @@ def export_program(
     Raises:
         InputError: unknown format, or a file of the plan cannot be loaded.
     """
+    if run_check and cell is None:
+        with open_cell(plan, plan_dir) as own:
+            return export_program(plan, plan_dir, fmt, run_check=True, cell=own)
     check = check_plan(plan, plan_dir, cell=cell) if run_check else None
+    layout = check.layout if check is not None else layout_problem(plan)
     job, notes = export_job_for(plan, plan_dir, check)
-    return ProgramExport(export_files(job, fmt), notes, check)
+    if check is not None and cell is not None:
+        job = with_arm_poses(job, cell, check, plan.cell.tool.tcp)
+    if layout:
+        notes = (*notes, f"layout: {layout}")
+    return ProgramExport(export_files(job, fmt), notes, check, layout)
+
+
+def with_arm_poses(job: ExportJob, cell: Cell, check: PlanCheck, tcp: str) -> ExportJob:
+    """``job`` with the robot's joint values and configuration at every target of each point
+    whose pose the check found (:class:`planner.export.job.ArmPose`).
+
+    Each target (start, end, safe start, face end) is solved by IK and the solution nearest the
+    checked pose's joint values taken, so every target keeps that pose's branch where it can.
+    Robots that are not 6-axis OPW arms get none (the writers then say what they cannot write).
+    """
+    from planner.robot.kinematics.branches import posture
+
+    opw = cell.solver.opw
+    if opw is None or cell.chain.n_joints != 6:
+        return job
+    T_tcp_flange = invert_transform(cell.T_flange_tcp(tcp))
+    checked = {p.point_id: p for p in check.points}
+    targets = []
+    for t in job.targets:
+        c = checked.get(t.point_id)
+        if c is None or c.q is None or c.pose_status == "infeasible":
+            targets.append(t)
+            continue
+        poses = np.array([job.T_base_wobj @ t.target(k) @ T_tcp_flange for k in TARGET_KINDS])
+        q, found = cell.solver.solve(poses).nearest(c.q)
+        arm = {}
+        for kind, q_k, ok in zip(TARGET_KINDS, q, found, strict=True):
+            if ok:
+                flags = posture(opw, q_k)
+                arm[kind] = ArmPose(
+                    tuple(float(v) for v in q_k), flags.front, flags.elbow_up, flags.wrist_flipped
+                )
+        targets.append(replace(t, arm=arm))
+    return replace(job, targets=tuple(targets))

@@ -59,12 +59,14 @@ def open_cell(plan: Plan, plan_dir: Path) -> Cell:
 
     refs = resolved_refs(plan, plan_dir)
     robot = plan.cell.robot
+    mount = plan.cell.tool.mount
     cell = Cell(
         robot=str(refs["robot"]),
         tool=str(refs["tool"]),
         T_world_base=robot.T_world_base.matrix(),
         base_link=robot.base_link,
         tip_link=robot.tip_link,
+        T_flange_tool=None if mount is None else mount.matrix(),
     )
     try:
         wo = plan.work_object
@@ -84,8 +86,35 @@ def open_cell(plan: Plan, plan_dir: Path) -> Cell:
     return cell
 
 
+def controller_T_flange_tool(plan: Plan, plan_dir: Path) -> FloatArray:
+    """``(4, 4)`` the tool's root frame in the robot controller's flange frame, m.
+
+    Controllers put the flange's +z out of the flange; the tool's mount
+    (:func:`planner.cell.tool.tool_mount`) turns the URDF's tip frame that way. The controller's
+    flange is the tip frame turned by the mount's rotation, so what is left is the mount's
+    offset (an adapter plate): ``[I, R_m^T t_m]`` (identity for a mount found from the axis).
+
+    Raises:
+        ToolMountError: the mount cannot be worked out (names ``cell.tool.T_flange_tool``).
+    """
+    from planner.builtins import is_builtin, robot_urdf
+    from planner.cell.tool import tool_mount
+    from planner.robot.kinematics.chain import KinematicChain
+
+    refs = resolved_refs(plan, plan_dir)
+    ref = plan.cell.robot.urdf
+    urdf = robot_urdf(ref) if is_builtin(ref) else refs["robot"]
+    chain = KinematicChain.from_urdf(urdf, plan.cell.robot.base_link, plan.cell.robot.tip_link)
+    given = plan.cell.tool.mount
+    mount = tool_mount(chain, None if given is None else given.matrix())
+    offset = np.eye(4)
+    offset[:3, 3] = mount[:3, :3].T @ mount[:3, 3]
+    return offset
+
+
 def tool_data(plan: Plan, plan_dir: Path) -> tuple[Any, str]:
-    """The sensor tool for exports: TCP from the tool, mass and centre of gravity from its URDF.
+    """The sensor tool for exports: TCP, mass and centre of gravity (from the tool's URDF) in
+    the controller's flange frame (:func:`controller_T_flange_tool`).
 
     Returns:
         A :class:`planner.export.job.ToolData` and a note (``""``, or what was estimated).
@@ -95,12 +124,14 @@ def tool_data(plan: Plan, plan_dir: Path) -> tuple[Any, str]:
     from planner.robot.urdf import load_urdf
 
     tool = load_tool(str(resolved_refs(plan, plan_dir)["tool"]))
-    T_flange_tcp = tool.T_flange_tcp(plan.cell.tool.tcp)
+    offset = controller_T_flange_tool(plan, plan_dir)
+    T_flange_tcp = offset @ tool.T_flange_tcp(plan.cell.tool.tcp)
     mass, cog = 0.0, (0.0, 0.0, 0.1)  # a mesh tool, or a URDF without masses: placeholders
     if tool.urdf_path is not None:
         kg, com = load_urdf(tool.urdf_path, check_meshes=False).mass_and_com()
         if kg > 0.0:
-            mass, cog = kg, (float(com[0]), float(com[1]), float(com[2]))
+            c = np.asarray(com, dtype=np.float64) + offset[:3, 3]
+            mass, cog = kg, (float(c[0]), float(c[1]), float(c[2]))
     note = ""
     if mass < 1.0:
         note = (

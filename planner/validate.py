@@ -57,6 +57,7 @@ __all__ = [
     "check_simulatable",
     "preflight",
     "sensitivity_plan",
+    "simulation_setup",
     "validate_plan",
     "validation_models",
     "work_object_mesh",
@@ -105,7 +106,7 @@ def validate_plan(
     folder = plan_dir or Path.cwd()
     part = work_object_mesh(plan, folder, models) if mesh is None else mesh
     preflight(plan, models, part)
-    setup = _setup(plan, models, part)
+    setup = simulation_setup(plan, models, part)
     rows = report_rows(plan.validation.report, part, models.geometry, setup.xoffset)
     paper = PAPER_TABLE1 if models.geometry is not None and models.method == "hultman2013" else None
     n = plan.validation.trials if trials is None else int(trials)
@@ -143,7 +144,7 @@ def sensitivity_plan(
     models = check_simulatable(plan)
     part = work_object_mesh(plan, plan_dir or Path.cwd(), models) if mesh is None else mesh
     preflight(plan, models, part)
-    setup = _setup(plan, models, part)
+    setup = simulation_setup(plan, models, part)
     rows = report_rows(plan.validation.report, part, models.geometry, setup.xoffset)
     n = plan.validation.trials if trials is None else int(trials)
     return sensitivity(
@@ -157,7 +158,11 @@ def sensitivity_plan(
     )
 
 
-def _setup(plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh) -> SimulationSetup:
+def simulation_setup(
+    plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh
+) -> SimulationSetup:
+    """What every trial of ``plan`` shares (the part ``mesh`` in wobj, metres), with the
+    x-offset run's targets on the stator's bulged slot holes when the plan has one."""
     xo = getattr(models.settings, "xoffset", None)
     xs = None
     if xo is not None and models.geometry is not None:

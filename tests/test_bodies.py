@@ -49,3 +49,30 @@ def test_link_frame_not_inertial_frame(rng) -> None:
         np.testing.assert_allclose(T1[:3, 3], T[:3, 3] + 0.1575 * T[:3, 2], atol=1e-6)
     finally:
         pb.disconnect(client)
+
+
+def test_pybullet_chatter_goes_to_the_log_not_the_terminal(
+    tmp_path, capfd: pytest.CaptureFixture[str], caplog: pytest.LogCaptureFixture
+) -> None:
+    """Item 10: PyBullet's "No inertial data" lines flooded stderr (two per link)."""
+    import logging
+
+    from planner.cell.bodies import load_urdf_body
+    from planner.cell.pybullet_client import connect_direct, pb
+
+    urdf = tmp_path / "bare.urdf"
+    urdf.write_text(
+        '<robot name="bare"><link name="base"/><link name="arm"/>'
+        '<joint name="j" type="revolute"><parent link="base"/><child link="arm"/>'
+        '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>'
+    )
+    client = connect_direct()
+    try:
+        capfd.readouterr()
+        with caplog.at_level(logging.DEBUG, logger="planner.cell.pybullet_client"):
+            load_urdf_body(client, urdf, np.eye(4), "robot")
+    finally:
+        pb.disconnect(client)
+    out, err = capfd.readouterr()
+    assert "No inertial data" not in out + err and "b3Warning" not in out + err
+    assert "no inertial data (mass 1 assumed) for links ['base', 'arm']" in caplog.text

@@ -156,6 +156,44 @@ def test_calibrate_text_has_paste_lines(
     assert f"x {T_true[0, 3] * 1e3:.3f}" in out
 
 
+def test_calibrate_gross_error_exits_1_without_paste_lines(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Item 1: D 10 mm off printed a 17 deg frame ready to paste, exit 0. Now exit 1, D named on
+    stderr, no wobjdata/BASE_DATA lines and no frame in --json unless --force."""
+    plan = load_plan(STATOR)
+    T = nominal_T_base_wobj(plan)
+    pts = {
+        p.id: transform_points(T, np.add(p.position_m, (0.01, 0, 0) if p.id == "D" else 0))
+        for p in plan.points
+    }
+    meas = save_measurements(Measurements.from_points_m(pts, units="mm"), tmp_path / "m.json")
+    code, out, err = run(capsys, "calibrate", str(STATOR), str(meas))
+    assert code == 1
+    assert "re-measure D" in err and "max_angle_rad" in err
+    assert "PERS wobjdata" not in out and "BASE_DATA" not in out
+    code, out, err = run(capsys, "calibrate", str(STATOR), str(meas), "--json")
+    res = json.loads(out)
+    assert code == 1 and res["trusted"] is False and "T_base_wobj" not in res
+    assert res["screen"]["remeasure"] == ["D"]
+    code, out, err = run(capsys, "calibrate", str(STATOR), str(meas), "--force")
+    assert code == 0 and "PERS wobjdata" in out and "NOT TRUSTED" in out
+
+
+def test_calibrate_json_has_covariance_and_sigma(
+    tmp_path: Path, rng: np.random.Generator, capsys: pytest.CaptureFixture[str]
+) -> None:
+    meas, _ = _synthetic(tmp_path, rng)
+    code, out, _ = run(capsys, "calibrate", str(STATOR), str(meas), "--json")
+    res = json.loads(out)
+    assert code == 0 and res["trusted"] is True
+    cov = np.array(res["covariance"]["matrix"])
+    assert cov.shape == (6, 6) and np.allclose(cov, cov.T)
+    assert np.all(np.linalg.eigvalsh(cov) > 0)
+    assert res["sigma"]["x_m"] == pytest.approx(np.sqrt(cov[0, 0]))
+    assert res["sigma"]["ry_deg"] == pytest.approx(np.degrees(np.sqrt(cov[4, 4])))
+
+
 def test_calibrate_missing_point_exits_2(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -176,14 +214,25 @@ def test_calibrate_missing_point_exits_2(
 def test_ui_passes_flags_to_webui(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    import webui.app
+    from types import SimpleNamespace
+
+    import webui.server
 
     calls = []
-    monkeypatch.setattr(webui.app, "run", lambda *a, **k: calls.append((a, k)))
+
+    def fake_run(*a, **k):  # type: ignore[no-untyped-def]
+        calls.append((a, k))
+        server = SimpleNamespace(get_port=lambda: k["port"])
+        state = SimpleNamespace(autosave_path=None)
+        return SimpleNamespace(server=server, state=state, autosave_note="")
+
+    monkeypatch.setattr(webui.server, "run", fake_run)
+    monkeypatch.setattr(webui.server, "serve", lambda app: None)
     assert main(["ui", str(STATOR), "--host", "0.0.0.0", "--port", "8123"]) == 0
     assert main(["demo"]) == 0
-    assert calls[0] == ((str(STATOR),), {"host": "0.0.0.0", "port": 8123, "block": True})
-    assert calls[1] == ((None,), {"host": "127.0.0.1", "port": 8080, "block": True})
+    flags = {"block": False, "fresh": False}
+    assert calls[0] == ((str(STATOR),), {"host": "0.0.0.0", "port": 8123, **flags})
+    assert calls[1] == ((None,), {"host": "127.0.0.1", "port": 8080, **flags})
     code, _, err = run(capsys, "ui", "no_such_plan.json")
     assert code == 2 and "no_such_plan.json: No such file or directory" in err
     code, _, err = run(capsys, "ui", str(DATA / "bad_nan.json"))

@@ -26,7 +26,14 @@ from calib.probing import SearchCommand
 from planner.cli.main import main
 from planner.export import FORMATS, export_files
 from planner.export import fanuc as F
-from planner.export.job import ExportJob, ToolData, build_job, default_sensor_rotation
+from planner.export.job import (
+    TARGET_KINDS,
+    ArmPose,
+    ExportJob,
+    ToolData,
+    build_job,
+    default_sensor_rotation,
+)
 from planner.export_plan import export_job_for
 from tests.box_part import BoxProbe, distance_to_box
 from tests.test_export_rapid_adaptive import full_misplacement
@@ -314,8 +321,21 @@ def random_job(plan: Plan, rng: np.random.Generator) -> ExportJob:
     return build_job(plan, T_base_wobj, tool, rotations)
 
 
+#: A configuration for jobs built without a check (these tests are about poses and registers;
+#: the configuration has its own tests below).
+ANY_ARM = ArmPose((0.1, 0.2, 0.3, 0.4, 0.5, 0.6), True, True, False)
+
+
+def with_arms(job: ExportJob) -> ExportJob:
+    """``job`` with :data:`ANY_ARM` at every target that has no configuration."""
+    ts = tuple(
+        t if t.arm else replace(t, arm=dict.fromkeys(TARGET_KINDS, ANY_ARM)) for t in job.targets
+    )
+    return replace(job, targets=ts)
+
+
 def ls_of(job: ExportJob) -> str:
-    files = export_files(job, "fanuc")
+    files = export_files(with_arms(job), "fanuc")
     assert list(files) == [".ls"]
     return files[".ls"]
 
@@ -366,7 +386,7 @@ def test_poses_and_frames_parse_back(path: Path, rng: np.random.Generator) -> No
     # every P[n]: in the user frame / tool frame of the program, the job's targets
     assert sorted(prog.positions) == list(range(1, len(prog.positions) + 1))
     for pos in prog.positions.values():
-        assert (pos.uf, pos.ut, pos.config) == (F.UFRAME_NO, F.UTOOL_NO, F.CONFIG)
+        assert (pos.uf, pos.ut, pos.config) == (F.UFRAME_NO, F.UTOOL_NO, "N U T, 0, 0, 0")
     blocks = point_blocks(prog.lines)
     assert len(blocks) == len(job.targets)
     P = {n: pose_matrix(pos.values) for n, pos in prog.positions.items()}
@@ -581,3 +601,95 @@ def test_cli_export_and_help(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     for b, t in zip(point_blocks(prog.lines), job.targets, strict=True):
         got = prog.positions[b["safe"]].values[:3] / 1000.0
         assert np.abs(got - t.safe_start[:3, 3]).max() < 1e-8  # orientations come from check
+
+
+# ------------------------------------------------------------------ configuration (issue 10)
+#: ROS-Industrial's FANUC M-10iA joints (fanuc_m10ia_support): FANUC's joint directions, with
+#: J3, J5 about -y and J4, J6 about -x; boxes instead of meshes.
+_M10IA_JOINTS = [  # name, origin xyz, axis xyz, lower, upper
+    ("joint_1", "0 0 0", "0 0 1", -3.14, 3.14),
+    ("joint_2", "0.15 -0.04 0.45", "0 1 0", -1.57, 2.79),
+    ("joint_3", "0 -0.0225 0.6", "0 -1 0", -3.14, 4.61),
+    ("joint_4", "0.1805 0.0625 0.2", "-1 0 0", -3.31, 3.31),
+    ("joint_5", "0.4595 -0.0565 0", "0 -1 0", -3.31, 3.31),
+    ("joint_6", "0.1 0.0565 0", "-1 0 0", -6.28, 6.28),
+]
+_LINKS = ["base_link", "link_1", "link_2", "link_3", "link_4", "link_5", "link_6"]
+M10IA = (
+    '<robot name="m10ia">'
+    + "".join(f'<link name="{n}"/>' for n in [*_LINKS, "tool0"])
+    + "".join(
+        f'<joint name="{n}" type="revolute"><origin xyz="{o}"/><parent link="{_LINKS[k]}"/>'
+        f'<child link="{_LINKS[k + 1]}"/><axis xyz="{a}"/>'
+        f'<limit lower="{lo}" upper="{hi}" effort="0" velocity="1"/></joint>'
+        for k, (n, o, a, lo, hi) in enumerate(_M10IA_JOINTS)
+    )
+    + '<joint name="joint_6-tool0" type="fixed"><parent link="link_6"/><child link="tool0"/>'
+    "</joint></robot>"
+)
+
+
+def _config(robot, q) -> str:  # type: ignore[no-untyped-def]
+    from planner.robot.kinematics.branches import posture
+
+    f = posture(robot, np.asarray(q, dtype=float))
+    return F.config_text(ArmPose(tuple(q), f.front, f.elbow_up, f.wrist_flipped))
+
+
+def test_fanuc_config_of_a_fanuc_arm_in_fanuc_joint_directions(tmp_path: Path) -> None:
+    """The M-10iA's tool-down home (J5 = -90, FANUC's) is 'N U T'; J5 = +90 is the flipped
+    wrist; the elbow bent back is 'D'; the wrist behind axis 1 is 'B'; turn numbers follow
+    J4, J6, J1."""
+    from planner.robot.kinematics.chain import KinematicChain
+    from planner.robot.kinematics.opw_from_urdf import opw_from_chain
+
+    path = tmp_path / "m10ia.urdf"
+    path.write_text(M10IA)
+    robot = opw_from_chain(KinematicChain.from_urdf(path))
+    deg = np.radians
+    assert _config(robot, deg([0, 0, 0, 0, -90, 0])) == "N U T, 0, 0, 0"
+    T_down = robot.fk(deg([0, 0, 0, 0, -90, 0]))
+    assert np.allclose(T_down[:3, 0], [0, 0, -1], atol=1e-9)  # tool0 x (out of the flange) down
+    assert _config(robot, deg([0, 0, 0, 0, 90, 0])) == "F U T, 0, 0, 0"
+    assert _config(robot, deg([0, 0, 0, 200, -90, 270])) == "N U T, 1, 1, 0"
+    assert _config(robot, deg([-170, 0, 0, -200, -30, -300])) == "N U T, -1, -1, 0"
+    # the same flange pose on other branches: each flag read from the pose, not the branch index
+    sols, ok = robot.ik_branches(robot.fk(deg([20, 10, -20, 30, -60, 40]))[None])
+    got = {_config(robot, q)[:5] for q in sols[0][ok[0]]}
+    assert {g[0] for g in got} == {"N", "F"} and {g[2] for g in got} == {"U", "D"}
+    assert {g[4] for g in got} == {"T", "B"} and len(got) == 8  # eight branches, eight configs
+
+
+def test_fanuc_config_comes_from_the_checked_pose(tmp_path: Path) -> None:
+    """The shipped plan: every position's CONFIG is its own IK solution's next to the checked
+    pose, the same flags as the check's ABB confdata on this ABB-like arm (cfx bits)."""
+    from planner.check import check_plan
+    from planner.export_plan import export_program
+
+    plan = load_plan(STATOR)
+    result = export_program(plan, STATOR.parent, "fanuc")
+    check = check_plan(plan, STATOR.parent)
+    prog = parse_ls(result.files[".ls"])
+    for b, c in zip(point_blocks(prog.lines), check.points, strict=True):
+        assert c.confdata is not None
+        cfx = c.confdata[3]
+        flags = f"{'F' if cfx & 1 else 'N'} {'D' if cfx & 2 else 'U'} {'B' if cfx & 4 else 'T'}"
+        want = f"{flags}, 0, 0, 0"
+        for kind in ("safe", "end", "face", "start"):
+            if kind in b:
+                assert prog.positions[b[kind]].config == want, (c.point_id, kind)
+
+
+def test_fanuc_refuses_a_configuration_it_cannot_derive(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Before: 'N U T, 0, 0, 0' on every position whatever the pose. Without a checked pose
+    there is nothing to derive it from: refused, naming the point."""
+    plan = load_plan(STATOR)
+    job = build_job(plan, np.eye(4), ToolData(T_flange_tcp=np.eye(4)))
+    with pytest.raises(InputError, match=r"FANUC export: point A: no checked robot pose"):
+        export_files(job, "fanuc")
+    out = tmp_path / "x.ls"
+    code = main(["export", str(STATOR), "--format", "fanuc", "--no-check", "-o", str(out)])
+    assert code == 2 and "CONFIG cannot be derived" in capsys.readouterr().err
+    assert not out.exists()

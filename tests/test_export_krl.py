@@ -19,6 +19,7 @@ from planner.export.job import ToolData, build_job, default_sensor_rotation
 from tests.export_helpers import expected_ends_wobj
 
 VALID = Path(__file__).resolve().parent / "data" / "plans" / "valid_three_two_one.json"
+STATOR = Path(__file__).resolve().parent.parent / "assets" / "plans" / "stator_section_ah.json"
 
 
 def parse_frame(text: str) -> np.ndarray:
@@ -80,3 +81,41 @@ def test_program_structure() -> None:
     assert "INTERRUPT DECL 21 WHEN diSensor==FALSE" in src
     assert "xHit=$POS_INT" in src and "RESUME" in src
     assert "SIGNAL diSensor $IN[1]" in dat
+
+
+# ---- status and turn from the checked pose (issue 10) ----------------------------------------
+def test_status_and_turn_bits() -> None:
+    from planner.export.job import ArmPose
+    from planner.export.krl import e6pos_text, status_turn
+
+    q = (0.1, -0.2, 0.3, -0.4, 0.5, -0.6)
+    assert status_turn(ArmPose(q, True, True, False)) == (2, 0b101010)
+    assert status_turn(ArmPose(q, False, False, True)) == (5, 0b101010)
+    assert e6pos_text(np.eye(4), ArmPose(q, True, True, True)).endswith(",S 6,T 42}")
+    assert ",S " not in e6pos_text(np.eye(4), None)
+
+
+def test_krl_targets_carry_the_status_and_turn_of_the_checked_pose() -> None:
+    """Before: E6POS without S and T. Now each target has them, from its own IK solution next
+    to the checked pose: S matches the check's ABB cfx bits on this ABB-like arm, T the signs of
+    the checked joint values (away from zero)."""
+    import re
+
+    from calib.plan.file import load_plan
+    from planner.check import check_plan
+    from planner.export_plan import export_program
+
+    plan = load_plan(STATOR)
+    dat = export_program(plan, STATOR.parent, "krl").files[".dat"]
+    check = check_plan(plan, STATOR.parent)
+    for c in check.points:
+        assert c.confdata is not None and c.q is not None
+        cfx = c.confdata[3]
+        want_s = bool(cfx & 4) | ((not cfx & 2) << 1) | ((cfx & 1) << 2)
+        m = re.search(rf"DECL E6POS x{c.point_id}_safe=\{{[^}}]*,S (\d+),T (\d+)\}}", dat)
+        assert m is not None, c.point_id
+        assert int(m.group(1)) == want_s
+        t = int(m.group(2))
+        for i, v in enumerate(c.q):
+            if abs(v) > np.radians(5):
+                assert bool(t >> i & 1) == (v < 0), (c.point_id, i)

@@ -67,7 +67,9 @@ def test_short_plan_starts_are_moved_out_in_every_format() -> None:
     assert "NOMINAL FRAME" in src and "SAFE FOR: part misplaced up to 20.0 mm" in src
     ur = export_files(job, "urscript")[".script"]
     assert "NOMINAL FRAME" in ur and ur.count('probe("') == len(job.targets)
-    ls = export_files(job, "fanuc")[".ls"]  # poses checked in test_export_fanuc.py
+    from tests.test_export_fanuc import with_arms  # FANUC's CONFIG needs a configuration
+
+    ls = export_files(with_arms(job), "fanuc")[".ls"]  # poses checked in test_export_fanuc.py
     assert "NOMINAL FRAME" in ls and ls.count("SKIP CONDITION DI[1]=ON") == len(job.targets)
     assert "NOMINAL FRAME" in rapid
 

@@ -167,7 +167,10 @@ def test_vendor_robots_answer_through_numeric_ik(which, reference_dir) -> None:
         if which == "ur5"
         else f"{pybullet_data.getDataPath()}/kuka_iiwa/model.urdf"
     )
-    with Cell(path, use_acl_cache=False, acl_samples=300) as c:
+    # the iiwa's tip link_7 has its frame at joint 7, its flange face 45 mm further out: the
+    # tool goes there (a tool at the joint would sit inside link_6, which is now never allowed)
+    mount = None if which == "ur5" else make_transform(p=[0, 0, 0.045])
+    with Cell(path, use_acl_cache=False, acl_samples=300, T_flange_tool=mount) as c:
         c.set_work_object(trimesh.creation.box([0.2] * 3), "m", make_transform(p=[0.5, 0, 0.1]))
         near, far = c.check_probes([[0, 0, 0.1], [5, 0, 0]], [[0, 0, 1], [0, 0, 1]])
         assert c.solver.kind == "numeric"

@@ -172,3 +172,18 @@ def test_small_or_narrow_faces_cannot_hold_the_sensor(extents: tuple[float, ...]
     with pytest.raises(NoPlanarFaceError, match=r"^block: no planar face: largest flat") as err:
         pf.require_any()
     assert why in str(err.value)
+
+
+def test_a_flat_face_too_small_for_the_sensor_says_so() -> None:
+    """Item 4: a 10 x 10 mm flat top was reported as "curved, noisy or too small"."""
+    base = trimesh.creation.box([0.2, 0.2, 0.05])
+    boss = trimesh.creation.box([0.01, 0.01, 0.01])
+    boss.apply_translation([0.0, 0.0, 0.03])
+    mesh = trimesh.util.concatenate([base, boss])
+    (on_boss, on_base) = check_probe_faces(
+        mesh, [[0.0, 0.0, 0.035], [0.06, 0.06, 0.025]], [[0, 0, 1.0], [0, 0, 1.0]]
+    )
+    assert on_base.ok
+    assert on_boss.reason == (
+        "on a flat face of 100.0 mm^2, too small for the 18 mm sensor (its face covers 254 mm^2)"
+    )

@@ -1,4 +1,4 @@
-"""Tests of planner.cell.probe_clearance: staged candidate queries against the whole query."""
+"""Tests of planner.cell.probe_clearance: the query part by part against the whole query."""
 
 from __future__ import annotations
 
@@ -74,17 +74,22 @@ def assert_same(a: Clearance, b: Clearance) -> None:
     assert a.slack_m == pytest.approx(b.slack_m, abs=1e-6)
 
 
-def test_an_unbounded_check_is_the_whole_query(cell: Cell) -> None:
+def all_parts(cell: Cell, stages: ProbeClearance, rotation: int, q: np.ndarray) -> Clearance:
+    """Every part of the query evaluated by ``stages`` and merged."""
+    results = {p.index: stages.evaluate(rotation, q, p) for p in stages.plan.parts}
+    return stages.merge(results)
+
+
+def test_the_parts_merged_are_the_whole_query(cell: Cell) -> None:
     qs = configurations(cell, 40, seed=1)
     stages = ProbeClearance(cell, MARGIN)
     stages.start_point(cell.chain.fk(qs))
     with cell.saved_state():
-        got = [stages.check(r, q, -np.inf) for r, q in enumerate(qs)]
+        got = [all_parts(cell, stages, r, q) for r, q in enumerate(qs)]
     expected = [whole(cell, q) for q in qs]
     assert sum(not e.ok for e in expected) >= 5  # the sample holds real collisions
     assert {e.pair[1] for e in expected if e.pair and not e.ok} >= {"plate", "work object"}
     for g, e, q in zip(got, expected, qs):
-        assert g is not None
         assert_same(g, e)
         assert_same(whole_query(cell, q), e)  # the query made of parts, too
 
@@ -95,17 +100,29 @@ def whole_query(cell: Cell, q: np.ndarray) -> Clearance:
         return cell.clearance(MARGIN, sensor_wobj_allowed=True)
 
 
-def test_a_bound_drops_exactly_the_candidates_at_or_below_it(cell: Cell) -> None:
-    qs = configurations(cell, 30, seed=2)
-    expected = [whole(cell, q) for q in qs]
-    stages = ProbeClearance(cell, MARGIN)
-    stages.start_point(cell.chain.fk(qs))
+def test_a_subset_of_self_pairs_reports_the_nearest_of_them(cell: Cell) -> None:
+    """The self part over a mask of pairs: all pairs give the whole self part, none give
+    nothing, and the limiting pair alone gives the whole part's answer."""
+    rng = np.random.default_rng(2)
+    lo, hi = cell.chain.lower, cell.chain.upper
+    part = cell.checker.plan(MARGIN, cell.self_margin_m).parts[-1]
+    bodies, links, pa, pb_ = cell.checker._self_pair_table()
+    names = [
+        {cell.checker.names(bodies[a], links[a]), cell.checker.names(bodies[b], links[b])}
+        for a, b in zip(pa.tolist(), pb_.tolist())
+    ]
+    near_seen = 0
     with cell.saved_state():
-        for r, (q, e) in enumerate(zip(qs, expected)):
-            assert stages.check(r, q, e.slack_m + 1e-3) is None
-            above = stages.check(r, q, e.slack_m - 1e-3)
-            assert above is not None
-            assert_same(above, e)
+        for q in rng.uniform(lo, hi, size=(400, lo.size)):
+            cell.set_joint_positions(q)
+            full = cell.checker.evaluate(part)
+            assert cell.checker.evaluate(part, np.ones(pa.size, bool)) == full
+            assert cell.checker.evaluate(part, np.zeros(pa.size, bool)) is None
+            if full is not None:
+                near_seen += 1
+                mask = np.array([n == set(full.pair) for n in names])
+                assert cell.checker.evaluate(part, mask) == full
+    assert near_seen >= 10
 
 
 def test_certificates_never_claim_a_deeper_collision_than_the_full_part(cell: Cell) -> None:
@@ -128,7 +145,8 @@ def test_certificates_never_claim_a_deeper_collision_than_the_full_part(cell: Ce
 
 
 def test_the_tool_is_checked_once_per_rotation(cell: Cell, monkeypatch) -> None:
-    """Two IK branches of the same flange pose share the tool parts' results."""
+    """Two IK branches of the same flange pose share the tool parts' results, and a 2 pi
+    variant of the last joint shares every robot link before it."""
     T = cell.chain.fk(np.array([[0.2, 0.3, 0.1, 0.4, 0.8, 0.3]]))
     sol = cell.solver.solve(T)
     qs = sol.q[0][sol.valid[0]]
@@ -137,13 +155,20 @@ def test_the_tool_is_checked_once_per_rotation(cell: Cell, monkeypatch) -> None:
     assert np.abs(q_b[:4] - q_a[:4]).max() > 0.1
     kinds: list[str] = []
     evaluate = cell.checker.evaluate
-    monkeypatch.setattr(cell.checker, "evaluate", lambda p: kinds.append(p.kind) or evaluate(p))
+    monkeypatch.setattr(
+        cell.checker, "evaluate", lambda p, pairs=None: kinds.append(p.kind) or evaluate(p, pairs)
+    )
     stages = ProbeClearance(cell, MARGIN)
     stages.start_point(T)
     with cell.saved_state():
-        stages.check(0, q_a, -np.inf)
+        all_parts(cell, stages, 0, q_a)
         first = list(kinds)
-        stages.check(0, q_b, -np.inf)
-    second = kinds[len(first) :]
+        all_parts(cell, stages, 0, q_b)
+        second = kinds[len(first) :]
+        q_c = q_a.copy()
+        q_c[5] += 2 * np.pi if q_c[5] < 0 else -2 * np.pi
+        all_parts(cell, stages, 0, q_c)
+        third = kinds[len(first) + len(second) :]
     assert first.count("tool") == 2 * len(cell.checker._tool_links())  # work object, plate
     assert "tool" not in second and "robot" in second and "self" in second
+    assert third == ["self"]  # every robot link and the tool as before

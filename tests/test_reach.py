@@ -53,3 +53,28 @@ def test_wrist_centre_reasons(chain: KinematicChain) -> None:
     # close in front of the shoulder, inside the arm's dead zone |c2 - k|
     near = make_transform(p=[A1, 0.0, C1 + C4])
     assert opw_wrist_reason(opw, near[None]).startswith("too close (wrist centre 0.00 m")
+
+
+def test_batched_reasons_are_the_per_point_ones(chain: KinematicChain) -> None:
+    """``no_ik_reasons`` of many points equals ``no_ik_reason`` point by point: out of reach,
+    too close, joints at their limits (seeded poses all around the arm)."""
+    from planner.robot.reach import no_ik_reason, no_ik_reasons
+
+    rng = np.random.default_rng(11)
+    solver = make_ik_solver(chain)
+    model = reach_model(chain, np.random.default_rng(0))
+    p = rng.uniform([-3, -3, -1], [3, 3, 3], size=(1500, 3))
+    p[:1000] *= rng.uniform(0.05, 0.6, size=(1000, 1))  # many within reach
+    T = np.tile(np.eye(4), (1500, 8, 1, 1))
+    rot = rng.normal(size=(1500, 8, 3))
+    from scipy.spatial.transform import Rotation
+
+    T[..., :3, :3] = Rotation.from_rotvec(rot.reshape(-1, 3)).as_matrix().reshape(1500, 8, 3, 3)
+    T[..., :3, 3] = p[:, None]
+    none = ~solver.solve(T.reshape(-1, 4, 4)).valid.reshape(1500, -1).any(axis=1)
+    T = T[none]
+    expected = [no_ik_reason(model, solver, chain, t) for t in T]
+    assert no_ik_reasons(model, solver, chain, T) == expected
+    kinds = {e.split(" (")[0] for e in expected}
+    assert {"out of reach", "joint 2 at limit", "joint 3 at limit"} <= kinds
+    assert no_ik_reasons(model, solver, chain, T[:0]) == []

@@ -85,3 +85,22 @@ def test_points_are_relabelled_with_their_role() -> None:
 def test_bad_layouts_raise(points, error, match) -> None:
     with pytest.raises(error, match=match):
         check_stator_points(points)
+
+
+def test_a_normal_clicked_on_a_triangle_is_accepted() -> None:
+    """Item 3: `validate` refused B clicked in the UI on the right face (normal off by 3e-6)."""
+    pts = _with("B", normal=(0.9999999999956295, -2.6e-06, -1.4e-06))
+    check_stator_points(pts)
+    tilted = (float(np.cos(0.01)), float(np.sin(0.01)), 0.0)  # 0.57 deg
+    with pytest.raises(
+        DegenerateGeometryError, match=r"point B must have normal .* 0\.573 deg off"
+    ):
+        check_stator_points(_with("B", normal=tilted))
+
+
+def test_side_face_points_share_x_within_the_face_tolerance() -> None:
+    a = example_stator_points()["A"].position_m
+    layout = check_stator_points(_with("A", position_m=(a[0] + 4e-4, a[1], a[2])))
+    assert layout.face_coords_wobj[0] == pytest.approx(4e-4 / 7)  # the mean of A, B, D-H
+    with pytest.raises(DegenerateGeometryError, match=r"share x within 0\.5 mm .* 0\.600 mm"):
+        check_stator_points(_with("A", position_m=(a[0] + 6e-4, a[1], a[2])))

@@ -206,7 +206,7 @@ def test_box_layout_is_accepted_and_exact() -> None:
         (
             lambda p: (p[:3], [p[3], _p("e", (-0.1, -0.6, 0), (0, 0.6, 0.8))], p[5]),
             DegenerateGeometryError,
-            "different normals",
+            "normals 36.9 deg apart",
         ),
         (
             lambda p: (p[:3], p[3:5], p[0]),
@@ -275,3 +275,77 @@ def test_edge_search_spec_is_kept(rng: np.random.Generator) -> None:
     layout, _ = _layout(rng, n_edge=1)
     assert isinstance(layout.secondary[1].search, SearchSpec)
     assert layout.secondary[1].search.kind == "edge"
+
+
+# ---- tolerances that fit real meshes (issue 10, item 3) -------------------------------------
+def _float32_box_points() -> tuple[list[ProbePoint], np.ndarray]:
+    """3-2-1 points on a turned box 2 m from the origin, each at the centroid of a small (2 mm)
+    mesh triangle whose vertices were stored as float32 (an STL/PLY), with that triangle's own
+    normal: the normals of one face differ by ~1e-4 rad, as clicked in the UI."""
+    from calib.frames import matrix_from_rotvec
+
+    R = matrix_from_rotvec([0.3, -0.2, 0.5])
+    corner = np.array([1.6, -0.9, 0.8])
+    search = SearchSpec(start_offset_m=0.03, overtravel_m=0.02)
+    rng = np.random.default_rng(7)
+
+    def point(name: str, face: int, u: float, v: float) -> ProbePoint:
+        n, a, b = R[:, face], R[:, (face + 1) % 3], R[:, (face + 2) % 3]
+        centre = corner + u * a + v * b
+        tri = centre + 0.002 * (rng.uniform(-1, 1, (3, 1)) * a + rng.uniform(-1, 1, (3, 1)) * b)
+        tri = tri.astype(np.float32).astype(np.float64)
+        m = np.cross(tri[1] - tri[0], tri[2] - tri[0])
+        m *= np.sign(m @ n) / np.linalg.norm(m)
+        return ProbePoint(name, tuple(tri.mean(axis=0)), tuple(m), search)
+
+    pts = [
+        point("P1", 0, 0.1, 0.1),
+        point("P2", 0, 0.5, 0.1),
+        point("P3", 0, 0.3, 0.4),
+        point("S1", 1, 0.05, 0.1),
+        point("S2", 1, 0.6, 0.1),
+        point("T1", 2, 0.2, 0.2),
+    ]
+    return pts, R
+
+
+def test_points_on_two_triangles_of_a_float32_face_are_one_face() -> None:
+    """Item 3: normals that agree to float32 precision only were refused (1e-9)."""
+    pts, _ = _float32_box_points()
+    n0, n1 = np.asarray(pts[0].normal), np.asarray(pts[2].normal)
+    assert 1.0 - n0 @ n1 > 1e-9  # beyond the old tolerance: the normals really differ
+    layout = ThreeTwoOneLayout.from_points(pts[:3], pts[3:5], pts[5])
+    T_true = random_transform(np.random.default_rng(3), 0.02, 0.05)
+    q = transform_points(T_true, layout.nominal_m)
+    res = three_two_one(layout, q)
+    # the role faces are the mean triangle normals: exact to their float32 error (~1e-4 rad)
+    assert np.abs(motion_between(T_true, res.T_base_wobj)).max() < 2e-4
+
+
+def test_a_normal_tilted_1e_4_rad_is_accepted_and_1_deg_refused(rng: np.random.Generator) -> None:
+    from calib.frames import matrix_from_rotvec
+
+    layout, _ = _layout(rng)
+    p = list(layout.points)
+
+    def tilted(angle: float) -> ProbePoint:
+        axis = np.cross(p[1].normal, [0.3, 0.5, 0.8])
+        n = matrix_from_rotvec(axis / np.linalg.norm(axis) * angle) @ np.asarray(p[1].normal)
+        return ProbePoint(p[1].id, p[1].position_m, tuple(n), p[1].search)
+
+    ThreeTwoOneLayout.from_points([p[0], tilted(1e-4), p[2]], p[3:5], p[5])
+    with pytest.raises(DegenerateGeometryError, match=r"normals 1 deg apart \(one face allows"):
+        ThreeTwoOneLayout.from_points([p[0], tilted(np.radians(1.0)), p[2]], p[3:5], p[5])
+
+
+def test_coplanarity_within_the_planar_face_tolerance() -> None:
+    pts, _ = _float32_box_points()
+    n = np.asarray(pts[1].normal)
+
+    def off(d: float) -> ProbePoint:
+        return ProbePoint("P2", tuple(np.asarray(pts[1].position_m) + d * n), pts[1].normal,
+                          pts[1].search)  # fmt: skip
+
+    ThreeTwoOneLayout.from_points([pts[0], off(3e-4), pts[2]], pts[3:5], pts[5])
+    with pytest.raises(DegenerateGeometryError, match=r"differ by 1\.\d+ mm \(one face allows"):
+        ThreeTwoOneLayout.from_points([pts[0], off(1e-3), pts[2]], pts[3:5], pts[5])

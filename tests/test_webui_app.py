@@ -11,7 +11,8 @@ import pytest
 
 from calib.frames import transform_points
 from calib.plan.file import plan_from_json
-from webui.app import WobjcalApp, run
+from webui.app import WobjcalApp
+from webui.server import run
 from webui.testing import T_WORLD_WOBJ_BOX, box_plan, free_port
 
 
@@ -201,3 +202,20 @@ def test_gizmo_drag_previews_then_projects_onto_surface(app: WobjcalApp) -> None
     np.testing.assert_allclose(moved, [0.08, -0.03, 0.0], atol=1e-12)
     assert app.server.scene.get_handle_by_name("/wobj/drag_preview") is None
     app.points_panel.drag.value = False
+
+
+def test_the_points_table_says_when_the_layout_would_be_refused(app: WobjcalApp) -> None:
+    """Issue 10, item 3: the UI shows what `wobjcal check` (and `calibrate`) would refuse, the
+    same words as the check's ``layout``."""
+    from planner.check import layout_problem
+    from webui import plan_doc
+    from webui.plan_adapter import plan_from_ui
+
+    before = app.points_panel.status_md.content
+    app.state.apply(plan_doc.delete_point(app.state.doc, "T1"), "delete T1")
+    try:
+        want = layout_problem(plan_from_ui(app.state.doc))
+        assert want and f"**Layout:** {want}" in app.points_panel.status_md.content
+    finally:
+        app.state.undo()
+    assert app.points_panel.status_md.content == before

@@ -12,7 +12,7 @@ import trimesh
 
 from calib.frames import make_transform
 from planner import builtins
-from planner.cell.workobject import AUTO_MM_EXTENT, load_work_object
+from planner.cell.workobject import load_work_object
 from planner.errors import MeshError, UnknownFrameError
 
 
@@ -26,7 +26,7 @@ def test_plate_in_mm_is_detected_with_a_warning(reference_dir, caplog) -> None:
     np.testing.assert_allclose(sorted(wobj.mesh.extents), [0.0127, 0.2032, 0.3048], atol=1e-6)
     assert r.watertight and r.boundary_edges == 0
     assert r.merged_vertices > 0  # binary STL stores every triangle's corners separately
-    assert "millimetres" in caplog.text and "plate_holes.STL" in caplog.text
+    assert "read as 'mm'" in caplog.text and "plate_holes.STL" in caplog.text
     assert wobj.name == "plate_holes"
     # the plate has 5 through-holes: genus 5, so Euler characteristic 2 - 2 * 5
     assert wobj.mesh.euler_number == 2 - 2 * 5
@@ -42,9 +42,50 @@ def test_explicit_units(reference_dir) -> None:
 
 
 def test_metre_mesh_is_kept_in_metres() -> None:
-    box = trimesh.creation.box([0.3, 0.2, AUTO_MM_EXTENT * 0.99])
+    box = trimesh.creation.box([0.3, 0.2, 1.5])
     wobj = load_work_object(box)
-    assert wobj.report.units == "m" and wobj.report.warnings == ()
+    assert wobj.report.units == "m" and wobj.report.units_detected
+    assert wobj.report.warnings == (wobj.report.units_note,)  # says what it assumed
+    assert "units 'auto' read as 'm'" in wobj.report.units_note
+    assert "the part is 0.3 x 0.2 x 1.5 m" in wobj.report.units_note
+
+
+# ---- units (issue 10, item 4) ----------------------------------------------------------------
+def test_auto_reads_the_plate_as_mm_and_says_so(reference_dir) -> None:
+    w = load_work_object(reference_dir / "parts" / "plate_holes.STL", units="auto", reach_m=1.89)
+    assert w.report.units == "mm"
+    assert "read as 'mm'" in w.report.units_note and "reach 1.89 m" in w.report.units_note
+    assert "0.203 x 0.305 x 0.0127 m" in w.report.units_note
+    assert w.report.size_text == "0.203 x 0.305 x 0.0127 m (file units 'mm', detected)"
+
+
+def test_auto_reads_a_part_drawn_in_inches(tmp_path) -> None:
+    """Item 4: a 5 x 2.5 x 1.4 in part was read as a 5 m block that swallows the robot."""
+    box = trimesh.creation.box([5.0, 2.5, 1.4])
+    box.export(tmp_path / "bracket.stl")
+    w = load_work_object(tmp_path / "bracket.stl", units="auto", reach_m=1.89)
+    assert w.report.units == "in"
+    np.testing.assert_allclose(sorted(w.mesh.extents), sorted([0.127, 0.0635, 0.03556]))
+    assert "the file names no unit" in w.report.units_note
+    # the file's own hint wins when it gives a plausible part: 50 numbers are mm without it
+    big = trimesh.creation.box([50.0, 25.0, 14.0])
+    big.export(tmp_path / "frame.stl")
+    assert load_work_object(tmp_path / "frame.stl", reach_m=1.89).report.units == "mm"
+    big.export(tmp_path / "frame_inch.stl")
+    w = load_work_object(tmp_path / "frame_inch.stl", units="auto", reach_m=1.89)
+    assert w.report.units == "in" and "the file names 'in'" in w.report.units_note
+    # a hint that gives no plausible part is overruled, and said
+    box.export(tmp_path / "bracket_mm.stl")
+    w = load_work_object(tmp_path / "bracket_mm.stl", units="auto", reach_m=1.89)
+    assert w.report.units == "in" and "names 'mm', but that gives 0.005 m" in w.report.units_note
+
+
+def test_explicit_units_that_make_no_sense_are_said(reference_dir) -> None:
+    w = load_work_object(reference_dir / "parts" / "plate_holes.STL", units="m", reach_m=1.89)
+    assert w.report.units == "m"
+    (warning,) = w.report.warnings
+    assert "read in 'm' the part is 304.8 m across" in warning
+    assert "'mm' would make it 0.305 m" in warning
 
 
 def test_raw_scan_loads_with_a_report(reference_dir) -> None:
@@ -164,3 +205,39 @@ def test_large_mesh_goes_through_a_file(monkeypatch) -> None:
     finally:
         pb.disconnect(client)
     assert d == pytest.approx(0.04, abs=1e-6)
+
+
+# ---- bad mesh files (issue 10, items 7 and 8) -------------------------------------------------
+def test_bad_mesh_files_say_what_is_wrong(tmp_path) -> None:
+    import os
+
+    rand = tmp_path / "random.stl"
+    rand.write_bytes(os.urandom(2000))
+    with pytest.raises(
+        MeshError, match=r"corrupt binary STL: its header says .* the file has 2,000"
+    ):
+        load_work_object(rand)
+    ascii_ = tmp_path / "garbage.stl"
+    ascii_.write_text("solid x\nfacet garbage\n")
+    with pytest.raises(MeshError, match=r"no triangle could be read from its 22 bytes"):
+        load_work_object(ascii_)
+    with pytest.raises(MeshError, match=r"is a directory, not a mesh file"):
+        load_work_object(tmp_path)
+    with pytest.raises(MeshError, match=r"/dev/zero: not a regular file"):
+        load_work_object("/dev/zero")
+
+
+def test_a_five_million_triangle_mesh_is_refused_before_parsing(tmp_path) -> None:
+    """Item 7: 5 million triangles took 145 s and 7.2 GB to say 'no planar face'. A binary STL's
+    header gives the count: refused at once, with the number (a sparse file, nothing parsed)."""
+    import time
+
+    n = 5_000_000
+    path = tmp_path / "scan.stl"
+    with path.open("wb") as handle:
+        handle.write(b"\0" * 80 + n.to_bytes(4, "little"))
+        handle.truncate(84 + 50 * n)
+    t0 = time.perf_counter()
+    with pytest.raises(MeshError, match=r"scan\.stl: 5,000,000 triangles; wobjcal takes at most"):
+        load_work_object(path)
+    assert time.perf_counter() - t0 < 5.0

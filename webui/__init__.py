@@ -1,6 +1,8 @@
 """The wobjcal web UI (viser): a thin layer that turns browser events into planner/calib calls.
 
-Owns the app (:mod:`webui.app`, ``run()``), the interface its panels see
+Owns the app (:mod:`webui.app`), starting it (:mod:`webui.server`, ``run()``, ``serve()``),
+the autosave files and their lock (:mod:`webui.autosave`), uploads refused by their declared
+size (:mod:`webui.upload_guard`), the interface its panels see
 (:mod:`webui.context`), the panels (points, files, validation, calibration, heat map), the
 scene and robot drawing, click-to-place (:mod:`webui.surface`), the edited plan with undo/redo
 and autosave (:mod:`webui.plan_doc`, :mod:`webui.state`, :mod:`webui.plan_adapter`), and the

@@ -1,9 +1,9 @@
 """The wobjcal web UI: a viser server over one plan, its cell and its checks.
 
-``run()`` starts the server (127.0.0.1:8080 by default), loads a plan or the built-in demo and
-returns the :class:`WobjcalApp`. The app is thin: browser events become edits of the session
-plan (:mod:`webui.state`), and every edit is checked in the cell on the one worker thread
-(:mod:`webui.worker`) and drawn back (:mod:`webui.scene`).
+:func:`webui.server.run` starts the server (127.0.0.1:8080 by default), loads a plan or the
+built-in demo and returns the :class:`WobjcalApp`. The app is thin: browser events become edits
+of the session plan (:mod:`webui.state`), and every edit is checked in the cell on the one
+worker thread (:mod:`webui.worker`) and drawn back (:mod:`webui.scene`).
 """
 
 from __future__ import annotations
@@ -20,15 +20,17 @@ from calib.errors import InputError
 from calib.plan.file import CellSpec, Plan, WorkObjectSpec
 from calib.probing import ProbePoint
 from planner.check import PointCheck
-from webui import clients, demo, plan_doc
+from webui import clients, plan_doc
+from webui.autosave import AutosaveLock
 from webui.backend import CellSession, CellView
 from webui.heatmap import HeatMap
-from webui.plan_adapter import autosave_bytes, plan_point, ui_plan_from_file
+from webui.plan_adapter import autosave_bytes, plan_point
 from webui.plan_doc import UiPlan
-from webui.robot_view import RobotView
+from webui.robot_view import RobotView, robot_view_or_reason
 from webui.scene import PlanScene
-from webui.state import DEFAULT_AUTOSAVE, Change, SessionState, default_autosave_path
+from webui.state import DEFAULT_AUTOSAVE, Change, SessionState
 from webui.surface import SurfacePicker
+from webui.upload_guard import guard_uploads
 from webui.worker import CellWorker
 
 logger = logging.getLogger(__name__)
@@ -72,7 +74,11 @@ class WobjcalApp:
         self.validate_panel = validate_panel.ValidatePanel(self)
         self.files_panel = files_panel.FilesPanel(self)
         self.calibrate_panel = calibrate_panel.CalibratePanel(self)
+        guard_uploads(server, files_panel.MAX_UPLOAD_BYTES, self._upload_refused)
         self.state.subscribe(self._on_change)
+        #: What the app said about the autosave at start (restored, set aside), for new tabs.
+        self.autosave_note = ""
+        self.autosave_lock: AutosaveLock | None = None
         server.on_client_connect(self._on_connect)
         if isinstance(plan.source, Plan):
             self.load_cell(plan.source, self.plan_dir)
@@ -100,7 +106,10 @@ class WobjcalApp:
             self.robot.remove()
             self.robot = None
         if view.robot_urdf is not None:
-            self.robot = RobotView(self.server, view)
+            self.robot, why = robot_view_or_reason(self.server, view)
+            if why:
+                logger.warning("%s", why)
+                self.notify("Robot not drawn", why, error=True)
         self.recheck(self.state.doc.ids)
 
     # ---- checks ---------------------------------------------------------------------------
@@ -161,7 +170,7 @@ class WobjcalApp:
         elif self.selected in changed:
             self._show_selected()
 
-    def show_reachability(self, n_samples: int = 120) -> None:
+    def show_reachability(self, n_samples: int = 1000) -> None:
         """Start the reachability heat map (computed in chunks on the cell worker)."""
         self.heatmap.stop()
         self.heatmap.start(n_samples)
@@ -229,9 +238,15 @@ class WobjcalApp:
             self.notify("Point not placed", f"{type(exc).__name__}: {exc}", client=event.client)
 
     # ---- clients ---------------------------------------------------------------------------
+    def _upload_refused(self, client_id: int, name: str, message: str) -> None:
+        client = self.server.get_clients().get(client_id)
+        self.notify("Upload refused", message, client=client, error=True)
+
     def _on_connect(self, client: viser.ClientHandle) -> None:
         if self.view is not None:
             clients.set_default_camera(client, self.view)
+        if self.autosave_note:
+            self.notify("Autosave", self.autosave_note, client=client, error=False)
 
     def notify(
         self, title: str, body: str, client: viser.ClientHandle | None = None, error: bool = True
@@ -246,57 +261,11 @@ class WobjcalApp:
         self.validate_panel.close()
         self.server.stop()
         self.worker.close()
+        if self.autosave_lock is not None:
+            self.autosave_lock.release()
+            self.autosave_lock = None
 
 
 def _cell_key(plan: Plan) -> tuple[CellSpec, WorkObjectSpec]:
     """What decides the cell: when it changes, the cell is rebuilt."""
     return (plan.cell, plan.work_object)
-
-
-def run(
-    plan_path: str | Path | None = None,
-    host: str = "127.0.0.1",
-    port: int = 8080,
-    block: bool = True,
-    autosave_path: str | Path | None = "auto",
-) -> WobjcalApp:
-    """Start the wobjcal UI on ``http://host:port`` with a plan file or the built-in demo.
-
-    Args:
-        plan_path: a ``wobjcal.plan/1`` file; ``None`` opens the built-in stator-section demo.
-        host: interface to bind; 127.0.0.1 (this machine only) unless told otherwise.
-        port: TCP port.
-        block: serve until interrupted (Ctrl-C), then stop; ``False`` returns at once.
-        autosave_path: where the session plan autosaves; ``"auto"`` (default): one file per
-            plan and port under ``~/.cache/wobjcal/autosave/`` (see
-            :func:`webui.state.default_autosave_path`); ``None`` disables autosave.
-
-    Returns:
-        The running app (``app.server`` is the viser server; ``app.stop()`` ends it).
-    """
-    if plan_path is not None:
-        ui_plan, plan_dir = ui_plan_from_file(Path(plan_path)), Path(plan_path).parent
-    else:
-        ui_plan, plan_dir = demo.demo_ui_plan()
-    if autosave_path == "auto":
-        autosave_path = default_autosave_path(plan_path, port)
-    server = viser.ViserServer(host=host, port=port, label="wobjcal", verbose=block)
-    server.gui.configure_theme(control_width="large", show_share_button=False)
-    logger.info("wobjcal UI at http://%s:%d", host, server.get_port())
-    if autosave_path is not None:
-        logger.info("the session plan autosaves to %s", autosave_path)
-    app = WobjcalApp(
-        server,
-        ui_plan,
-        plan_dir,
-        autosave_path=None if autosave_path is None else Path(autosave_path),
-    )
-    if not block:
-        return app
-    try:
-        threading.Event().wait()
-    except KeyboardInterrupt:
-        logger.info("stopping the wobjcal UI")
-    finally:
-        app.stop()
-    return app

@@ -39,6 +39,7 @@ class CellView:
         tool_urdf: the tool URDF (root = flange frame), or ``None``.
         tool_mesh: the tool mesh in the flange frame (mesh tools), or ``None``.
         chain: the robot's kinematic chain (pure numpy ``fk``), or ``None`` without a cell.
+        T_flange_tool: ``(4, 4)`` the tool's mount on the flange (the cell's).
     """
 
     robot_urdf: Path | None
@@ -49,6 +50,7 @@ class CellView:
     tool_urdf: Path | None = None
     tool_mesh: trimesh.Trimesh | None = None
     chain: KinematicChain | None = None
+    T_flange_tool: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
 
     def T_world_flange(self, q: ArrayLike) -> NDArray[np.float64] | None:
         """``(4, 4)`` flange pose in the world at joint values ``q`` (``None``: no chain)."""
@@ -105,6 +107,7 @@ class CellSession:
             tool_urdf=None if cell.tool is None else cell.tool.urdf_path,
             tool_mesh=None if cell.tool is None else cell.tool.mesh,
             chain=cell.chain,
+            T_flange_tool=cell.T_flange_tool,
         )
 
     def _fixture_meshes(self) -> dict[str, tuple[trimesh.Trimesh, NDArray[np.float64]]]:
@@ -130,4 +133,3 @@ class CellSession:
         if self.cell is not None:
             self.cell.close()
         self.cell = None
-

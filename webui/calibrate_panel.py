@@ -1,7 +1,10 @@
 """The "Calibrate" panel: upload points measured on the robot, see the calibrated WOCS frame.
 
 Thin over ``planner.calibrate.calibrate_plan`` (what ``wobjcal calibrate`` runs): the
-calibrated frame is drawn beside the nominal one, with the shift and the residual per point.
+calibrated frame is drawn beside the nominal one, with the shift, 1 sigma per degree of freedom
+and the residual per point. A result the gross-error screen does not trust (a point off its
+face beyond the plan's noise, a frame beyond the misplacement bound) is not drawn: the panel
+lists the problems and names the point to re-measure, as ``wobjcal calibrate`` does on stderr.
 """
 
 from __future__ import annotations
@@ -63,20 +66,34 @@ class CalibratePanel:
         plan = plan_from_ui(self._app.state.doc)
         out = calibrate_plan(plan, measurements)
         self.last_output = out
-        T_world_base = plan.cell.robot.T_world_base.matrix()
-        self._app.scene.draw_calibrated_frame(T_world_base @ out.T_base_wobj)
         delta = motion_between(out.T_base_wobj_nominal, out.T_base_wobj)
-        rows = [
-            f"**{out.method}** with {len(out.used_ids)} points",
-            "",
+        rows = [f"**{out.method}** with {len(out.used_ids)} points", ""]
+        if not out.trusted:
+            rows += ["**NOT TRUSTED, frame not drawn:**", ""]
+            rows += [f"- {problem}" for problem in out.problems]
+            rows.append("")
+        rows += [f"- note: {note}" for note in out.notes]
+        rows += [
             f"shift from nominal: {np.round(delta[:3] * 1000.0, 3).tolist()} mm, "
             f"{np.round(np.degrees(delta[3:]), 4).tolist()} deg (wobj axes)",
             "",
-            "| point | residual (mm) |",
-            "|---|---|",
         ]
+        sd = out.sigma_dof
+        if sd is not None:
+            rows += [
+                f"1 sigma: {np.round(sd[:3] * 1000.0, 3).tolist()} mm, "
+                f"{np.round(np.degrees(sd[3:]), 4).tolist()} deg",
+                "",
+            ]
+        rows += ["| point | residual (mm) |", "|---|---|"]
         for pid, r in out.residuals_m.items():
             rows.append(f"| {pid} | {r * 1000.0:+.3f} |")
         self.result_md.content = "\n".join(rows)
+        if not out.trusted:
+            self._app.scene.draw_calibrated_frame(None)
+            self._app.notify("Calibration not trusted", " ".join(out.problems), error=True)
+            return out
+        T_world_base = plan.cell.robot.T_world_base.matrix()
+        self._app.scene.draw_calibrated_frame(T_world_base @ out.T_base_wobj)
         self._app.notify("Calibrated", f"{name}: calibrated frame drawn", error=False)
         return out

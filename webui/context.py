@@ -76,7 +76,7 @@ class AppContext(Protocol):
     def move_point_to(self, point_id: str, point_wobj: ArrayLike) -> PointCheck | None:
         """Move a point to the surface point nearest ``point_wobj`` (wobj frame, m)."""
 
-    def show_reachability(self, n_samples: int = 120) -> None:
+    def show_reachability(self, n_samples: int = 1000) -> None:
         """Start the reachability heat map."""
 
     def check_of(self, point_id: str) -> PointCheck | None:

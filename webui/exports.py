@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 from calib.errors import InputError
 from calib.plan.file import Plan
 from planner.export import FORMATS as EXPORT_FORMATS
-from planner.export.job import module_name
+from planner.export.text import module_name
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
@@ -36,9 +36,7 @@ class ExportResult:
     note: str = ""
 
 
-def export_program(
-    plan: Plan, fmt: str, plan_dir: Path, cell: Cell | None = None
-) -> ExportResult:
+def export_program(plan: Plan, fmt: str, plan_dir: Path, cell: Cell | None = None) -> ExportResult:
     """The robot program(s) of ``plan`` in ``fmt`` (a key of :data:`FORMATS`).
 
     Args:

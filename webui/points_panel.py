@@ -117,6 +117,9 @@ class PointsPanel:
             rows.append(f"| {p.id} | {p.role} | {status} | {reason} |")
         if not doc.points:
             rows.append("| - | - | no points yet | |")
+        layout = _layout_problem(doc)
+        if layout:  # what `wobjcal check` and `calibrate` would refuse, said while editing
+            rows += ["", f"**Layout:** {layout.replace('|', '/')}"]
         content = "\n".join(rows)
         if self.status_md.content != content:
             self.status_md.content = content
@@ -236,3 +239,15 @@ class PointsPanel:
             error=False,
         )
         self._guard(event, self._app.show_reachability)
+
+
+def _layout_problem(doc: plan_doc.UiPlan) -> str:
+    """Why the plan's procedure would refuse the edited points (:func:`planner.check.
+    layout_problem`, the check ``wobjcal check`` runs), ``""`` when it would not."""
+    from planner.check import layout_problem
+    from webui.plan_adapter import plan_from_ui
+
+    try:
+        return layout_problem(plan_from_ui(doc))
+    except InputError as exc:
+        return str(exc)

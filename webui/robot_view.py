@@ -18,6 +18,29 @@ from webui.scene import pose_kwargs
 logger = logging.getLogger(__name__)
 
 
+def robot_view_or_reason(server: viser.ViserServer, view: CellView) -> tuple[RobotView | None, str]:
+    """The robot drawn in the scene, or ``None`` and why it could not be drawn.
+
+    The robot's visual meshes are only for the eye: a URDF whose visuals cannot be read (e.g.
+    COLLADA ``.dae`` files without ``pycollada``) still checks, validates and exports; the
+    reason names the file and the fix instead of an "internal error: ImportError".
+    """
+    try:
+        return RobotView(server, view), ""
+    except ImportError as exc:
+        text = str(exc).lower()
+        hint = " (pip install pycollada)" if "collada" in text and "pip" not in text else ""
+        why = f"{exc}{hint}"
+    except Exception as exc:  # a visual mesh trimesh cannot read: draw no robot, say why
+        why = f"{type(exc).__name__}: {exc}"
+    server.scene.remove_by_name("/robot")
+    server.scene.remove_by_name("/tool")
+    return None, (
+        f"robot not drawn: the visual meshes of {view.robot_urdf} cannot be read: {why}; the "
+        "checks, validation and exports are not affected"
+    )
+
+
 class RobotView:
     """The robot model drawn under ``/robot`` (posed at ``T_world_base``).
 
@@ -81,7 +104,7 @@ class RobotView:
             self._urdf.update_cfg(q_arr[self._to_urdf])
             T = self._view.T_world_flange(q_arr)
             if T is not None and self._tool_frame is not None:
-                pose = pose_kwargs(T)
+                pose = pose_kwargs(T @ self._view.T_flange_tool)
                 self._tool_frame.wxyz = pose["wxyz"]
                 self._tool_frame.position = pose["position"]
 

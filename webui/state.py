@@ -8,7 +8,6 @@ immutable, undo and redo are just swaps, and every browser tab sees the same pla
 
 from __future__ import annotations
 
-import hashlib
 import logging
 import threading
 from collections.abc import Callable
@@ -17,29 +16,16 @@ from pathlib import Path
 from typing import Generic, TypeVar
 
 from calib.atomic_io import write_bytes_atomic
+from webui.autosave import AUTOSAVE_DIR, default_autosave_path
+
+__all__ = ["AUTOSAVE_DIR", "DEFAULT_AUTOSAVE", "Change", "SessionState", "default_autosave_path"]
 
 logger = logging.getLogger(__name__)
 
 D = TypeVar("D")
 
-#: Folder of the default autosave files (one per plan and port, see :func:`default_autosave_path`).
-AUTOSAVE_DIR = Path.home() / ".cache" / "wobjcal" / "autosave"
 #: Default location of the demo session's autosave on port 8080.
 DEFAULT_AUTOSAVE = AUTOSAVE_DIR / "demo-8080.json"
-
-
-def default_autosave_path(plan_path: str | Path | None, port: int) -> Path:
-    """Where a session autosaves by default: one file per plan and port, so two servers
-    (or two plans) never overwrite each other's work.
-
-    ``~/.cache/wobjcal/autosave/<plan stem>-<8 hex of its absolute path>-<port>.json``, or
-    ``demo-<port>.json`` for the built-in demo.
-    """
-    if plan_path is None:
-        return AUTOSAVE_DIR / f"demo-{port}.json"
-    resolved = Path(plan_path).resolve()
-    digest = hashlib.sha256(str(resolved).encode()).hexdigest()[:8]
-    return AUTOSAVE_DIR / f"{resolved.stem}-{digest}-{port}.json"
 
 
 def atomic_write_bytes(path: Path, data: bytes) -> None:

@@ -16,6 +16,11 @@ between them must be large enough to define a frame.
 An edge point can fill any role. Its role face is its ``normal``, except when that face is
 parallel to an earlier role's face (e.g. an edge search up the primary face to the top edge used
 as a secondary point): then the face whose end the search finds, ``edge_normal``, is used.
+
+Tolerances fit real meshes (:mod:`calib.tolerances`): the normals of one role's points may
+differ by :data:`~calib.tolerances.ROLE_NORMAL_TOL_RAD` (0.5 deg; the role face's normal is
+their mean) and the points may lie :data:`~calib.tolerances.FACE_MAX_DEVIATION_M` (0.5 mm)
+off one plane, as points clicked on two triangles of one face of a float32 mesh do.
 """
 
 from __future__ import annotations
@@ -30,6 +35,7 @@ from calib.errors import DegenerateGeometryError, ShapeError
 from calib.estimators.layout import axis_name, check_coincident
 from calib.frames import check_transform, invert_transform, make_transform, transform_points
 from calib.probing import ProbePoint
+from calib.tolerances import FACE_MAX_DEVIATION_M, ROLE_NORMAL_TOL_RAD, same_direction
 from calib.validation import check_points
 
 FloatArray = NDArray[np.float64]
@@ -93,18 +99,26 @@ class ThreeTwoOneLayout:
         normals = np.zeros((3, 3))
         offsets = np.zeros(3)
         for r, (role, pts) in enumerate(zip(ROLES, groups)):
-            n = _role_normal(pts[0], normals[:r])
+            first = _role_normal(pts[0], normals[:r])
+            role_normals = [first]
             for p in pts[1:]:
-                if float(_role_normal(p, normals[:r]) @ n) < 1.0 - 1e-9:
+                m = _role_normal(p, normals[:r])
+                cos = float(np.clip(m @ first, -1.0, 1.0))
+                if not same_direction(cos):
                     raise DegenerateGeometryError(
                         f"3-2-1 {role} points {pts[0].id!r} and {p.id!r} lie on faces with "
-                        "different normals; all points of a role must be on one face"
+                        f"normals {np.degrees(np.arccos(cos)):.3g} deg apart (one face allows "
+                        f"{np.degrees(ROLE_NORMAL_TOL_RAD):.2g} deg); all points of a role must "
+                        "be on one face"
                     )
+                role_normals.append(m)
+            n = _unit(np.mean(role_normals, axis=0))
             d = np.array([n @ np.asarray(p.position_m) for p in pts])
-            if np.ptp(d) > 1e-6:
+            if np.ptp(d) > FACE_MAX_DEVIATION_M:
                 raise DegenerateGeometryError(
                     f"3-2-1 {role} points are not on one plane: offsets along the normal differ "
-                    f"by {np.ptp(d) * 1e3:.3f} mm"
+                    f"by {np.ptp(d) * 1e3:.3f} mm (one face allows "
+                    f"{FACE_MAX_DEVIATION_M * 1e3:g} mm)"
                 )
             normals[r], offsets[r] = n, d.mean()
         nominal = np.array([p.position_m for p in all_pts], dtype=np.float64)
@@ -236,7 +250,7 @@ def check_role_geometry(
 
 def _role_normal(p: ProbePoint, earlier: FloatArray) -> FloatArray:
     n = np.asarray(p.normal, dtype=np.float64)
-    if p.edge_normal is not None and any(abs(abs(float(n @ e)) - 1.0) < 1e-9 for e in earlier):
+    if p.edge_normal is not None and any(same_direction(abs(float(n @ e))) for e in earlier):
         n = np.asarray(p.edge_normal, dtype=np.float64)
     return n / np.linalg.norm(n)
 

@@ -39,6 +39,8 @@ from calib.structs import Strict, check_count, check_positive
 FloatArray = NDArray[np.float64]
 
 _GOLDEN_ANGLE = math.pi * (3.0 - math.sqrt(5.0))
+#: Most rays over the sensor face (the default 256 resolves coverage to 0.4 %).
+MAX_RAYS = 65_536
 
 
 @lru_cache(maxsize=32)
@@ -94,8 +96,8 @@ class ProximitySensor(Strict, frozen=True, kw_only=True, tag="proximity", tag_fi
         check_positive(self.decay_length_m, "decay_length_m")
         check_positive(self.hysteresis_fraction, "hysteresis_fraction", allow_zero=True)
         check_positive(self.repeatability_sigma_m, "repeatability_sigma_m", allow_zero=True)
-        check_count(self.n_rays, "n_rays")
-        check_count(self.n_scan_rays, "n_scan_rays")
+        check_count(self.n_rays, "n_rays", maximum=MAX_RAYS)
+        check_count(self.n_scan_rays, "n_scan_rays", maximum=MAX_RAYS)
 
     @classmethod
     def ideal(cls) -> ProximitySensor:

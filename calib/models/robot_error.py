@@ -69,7 +69,7 @@ class RobotErrorModel(Strict, frozen=True, kw_only=True):
         check_positive(self.repeatability_sigma_m, "repeatability_sigma_m", allow_zero=True)
         check_positive(self.accuracy_amplitude_m, "accuracy_amplitude_m", allow_zero=True)
         check_positive(self.accuracy_wavelength_m, "accuracy_wavelength_m")
-        check_count(self.accuracy_terms, "accuracy_terms")
+        check_count(self.accuracy_terms, "accuracy_terms", maximum=1000)
         check_positive(self.tcp_sigma_m, "tcp_sigma_m", allow_zero=True)
 
     @classmethod

@@ -15,10 +15,14 @@ import numpy as np
 
 from calib.errors import DegenerateGeometryError, ShapeError
 from calib.probing import ProbePoint, SearchSpec
+from calib.tolerances import FACE_MAX_DEVIATION_M, ROLE_NORMAL_TOL_RAD, same_direction
 
 STATOR_POINT_IDS = ("A", "B", "C", "D", "E", "F", "G", "H")
-#: Nominal layout tolerance (metres, and unit-vector components).
+#: Smallest separation of points that must lie in an order (metres): A before B, E below D...
 LAYOUT_TOL = 1e-6
+#: Points that must share a coordinate (lie on one face, or on one line along an axis) may
+#: differ by this much, metres: the planar-face tolerance (:mod:`calib.tolerances`).
+SHARE_TOL_M = FACE_MAX_DEVIATION_M
 
 _X, _Y, _Z = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
 
@@ -38,7 +42,19 @@ class StatorLayout:
 
 
 def _same(a: Sequence[float] | None, b: Sequence[float]) -> bool:
-    return a is not None and bool(np.allclose(a, b, atol=LAYOUT_TOL, rtol=0.0))
+    """``a`` is the unit direction ``b`` within :data:`calib.tolerances.ROLE_NORMAL_TOL_RAD`
+    (a normal clicked on a mesh triangle is the face normal only to float precision)."""
+    if a is None:
+        return False
+    v = np.asarray(a, dtype=np.float64)
+    n = float(np.linalg.norm(v))
+    return n > 0 and same_direction(float(v @ np.asarray(b, dtype=np.float64)) / n)
+
+
+def _angle_deg(a: Sequence[float], b: Sequence[float]) -> float:
+    v, w = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    c = float(v @ w) / max(float(np.linalg.norm(v) * np.linalg.norm(w)), 1e-300)
+    return float(np.degrees(np.arccos(np.clip(c, -1.0, 1.0))))
 
 
 def relabel_point(point: ProbePoint, new_id: str) -> ProbePoint:
@@ -57,6 +73,11 @@ def check_stator_points(
     up (+z) that face to the top side; C is an approach point on the short side (normal +y).
     All side-face points share one x, F and H one z; A and B share z with A at smaller y;
     E lies below D, D below F, and H at smaller y than F. Extra points are ignored.
+
+    Tolerances fit real meshes (:mod:`calib.tolerances`): a normal or direction within
+    :data:`~calib.tolerances.ROLE_NORMAL_TOL_RAD` (0.5 deg) of its axis, shared coordinates
+    within :data:`SHARE_TOL_M` (the planar-face tolerance, 0.5 mm). The face coordinates
+    of the layout are the means over the points that share them.
 
     A mapping is keyed by role (``"A"`` ... ``"H"``); a point whose own id differs (a plan id
     such as ``"yoke_left"``) is re-labelled with its role, so search commands, measurements
@@ -81,8 +102,11 @@ def check_stator_points(
             raise ShapeError(f"point {pid} must be {kind}, got {p.search.kind!r}")
         want_normal = _Y if pid == "C" else _X
         if not _same(p.normal, want_normal):
+            got = ", ".join(f"{v:.4g}" for v in p.normal)
             raise DegenerateGeometryError(
-                f"point {pid} must have normal {want_normal} (wobj frame), got {p.normal}"
+                f"point {pid} must have normal {want_normal} (wobj frame) within "
+                f"{np.degrees(ROLE_NORMAL_TOL_RAD):.2g} deg, got ({got}), "
+                f"{_angle_deg(p.normal, want_normal):.3g} deg off"
             )
         if want_edge and not (
             _same(p.search.edge_direction, _Z) and _same(p.edge_normal or (0, 0, 0), _Z)
@@ -92,11 +116,25 @@ def check_stator_points(
                 f"(0, 0, 1), got {p.search.edge_direction} and {p.edge_normal}"
             )
     pos = {i: np.asarray(p.position_m, dtype=np.float64) for i, p in pts.items()}
-    x_face, y_face, z_top = float(pos["A"][0]), float(pos["C"][1]), float(pos["F"][2])
+    side_x = [float(pos[i][0]) for i in "ABDEFGH"]
+    x_face, y_face = float(np.mean(side_x)), float(pos["C"][1])
+    z_top = 0.5 * float(pos["F"][2] + pos["H"][2])
+    mm = f"within {SHARE_TOL_M * 1e3:g} mm"
     conditions = [
-        (all(abs(pos[i][0] - x_face) <= LAYOUT_TOL for i in "ABDEFGH"), "A, B, D-H share x"),
-        (abs(pos["H"][2] - z_top) <= LAYOUT_TOL, "F and H share z (the top edge)"),
-        (abs(pos["A"][2] - pos["B"][2]) <= LAYOUT_TOL, "A and B share z (A -> B along +y)"),
+        (
+            float(np.ptp(side_x)) <= SHARE_TOL_M,
+            f"A, B, D-H share x {mm} (they differ by {np.ptp(side_x) * 1e3:.3f} mm)",
+        ),
+        (
+            abs(pos["H"][2] - pos["F"][2]) <= SHARE_TOL_M,
+            f"F and H share z {mm} (the top edge; they differ by "
+            f"{abs(pos['H'][2] - pos['F'][2]) * 1e3:.3f} mm)",
+        ),
+        (
+            abs(pos["A"][2] - pos["B"][2]) <= SHARE_TOL_M,
+            f"A and B share z {mm} (A -> B along +y; they differ by "
+            f"{abs(pos['A'][2] - pos['B'][2]) * 1e3:.3f} mm)",
+        ),
         (pos["B"][1] > pos["A"][1] + LAYOUT_TOL, "A lies at smaller y than B"),
         (pos["D"][2] > pos["E"][2] + LAYOUT_TOL, "E lies below D (D - E along +z)"),
         (pos["F"][2] > pos["D"][2] + LAYOUT_TOL, "D lies below the edge point F"),

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 
+import msgspec
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -19,7 +20,8 @@ from calib.frames import (
     quat_wxyz_from_matrix,
 )
 from calib.plan.base import MeshUnits, check_sha256
-from calib.structs import Strict, Vec3, check_finite, check_unit
+from calib.structs import Strict, Vec3, check_coordinates, check_unit
+from calib.tolerances import COORDINATE_LIMIT_M
 
 
 class Pose(Strict, frozen=True, kw_only=True):
@@ -34,7 +36,7 @@ class Pose(Strict, frozen=True, kw_only=True):
     quat_wxyz: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
 
     def __post_init__(self) -> None:
-        check_finite(self.position_m, "position_m")
+        check_coordinates(self.position_m, "position_m")
         check_unit(self.quat_wxyz, "quat_wxyz")
 
     def matrix(self) -> NDArray[np.float64]:
@@ -70,11 +72,26 @@ class RobotSpec(Strict, frozen=True, kw_only=True):
 
 
 class ToolSpec(Strict, frozen=True, kw_only=True):
-    """The robot-held tool: ``name`` is a URDF path or ``builtin:cable_feeder``; ``tcp`` is the
-    probing TCP (the proximity sensor at its sensing distance)."""
+    """The robot-held tool.
+
+    Attributes:
+        name: a tool URDF or description path, or ``builtin:cable_feeder``.
+        tcp: the probing TCP (the proximity sensor at its sensing distance).
+        T_flange_tool: the tool's mount: its root frame (+z out of the flange) in the robot's
+            tip-link frame (``tool0``). Left out (default): along the last joint's axis,
+            whichever axis of the tip frame that is (some vendor URDFs have x out of the
+            flange); give it when the cell cannot tell (it says so, naming this field), or to
+            add an adapter plate. Read it through :attr:`mount`.
+    """
 
     name: str = "builtin:cable_feeder"
     tcp: str = "sensor"
+    T_flange_tool: Pose | msgspec.UnsetType = msgspec.UNSET
+
+    @property
+    def mount(self) -> Pose | None:
+        """``T_flange_tool`` when the plan sets it, else ``None`` (found from the robot)."""
+        return self.T_flange_tool if isinstance(self.T_flange_tool, Pose) else None
 
 
 class FixtureSpec(Strict, frozen=True, kw_only=True):
@@ -100,8 +117,11 @@ class FixtureSpec(Strict, frozen=True, kw_only=True):
         if (self.mesh is None) == (self.box_size_m is None):
             raise PlanError("mesh: give exactly one of mesh and box_size_m")
         if self.box_size_m is not None:
-            if not all(math.isfinite(v) and v > 0 for v in self.box_size_m):
-                raise PlanError(f"box_size_m: must be 3 lengths > 0, got {list(self.box_size_m)}")
+            if not all(math.isfinite(v) and 0 < v <= COORDINATE_LIMIT_M for v in self.box_size_m):
+                raise PlanError(
+                    f"box_size_m: must be 3 lengths > 0 and <= {COORDINATE_LIMIT_M:g} m, "
+                    f"got {list(self.box_size_m)}"
+                )
             if self.sha256 is not None:
                 raise PlanError("sha256: must be null for a box")
         else:

@@ -14,7 +14,6 @@ msgspec and numpy only, no simulator.
 
 from __future__ import annotations
 
-import hashlib
 from pathlib import Path
 from typing import Any, Final, Literal, get_args
 
@@ -24,7 +23,17 @@ from numpy.typing import ArrayLike
 from calib.atomic_io import write_text_atomic
 from calib.errors import PlanError
 from calib.models import SENSOR_KINDS, ProximitySensor
-from calib.plan.base import BUILTIN_PREFIX, MeshUnits
+from calib.plan.base import (
+    BUILTIN_PREFIX,
+    PLAN_NAME_PATTERN,
+    POINT_ID_PATTERN,
+    MeshUnits,
+    PlanName,
+    PointId,
+    check_pattern,
+    file_sha256,
+    resolve_ref,
+)
 from calib.plan.cell import (
     CellSpec,
     FixtureSpec,
@@ -45,7 +54,15 @@ from calib.plan.report_spec import COMPONENTS
 from calib.probing import ProbePoint, SearchSpec
 from calib.procedures import METHODS, ProcedureSettings, method_of, procedure_kind
 from calib.procedures.base import RolePoint
-from calib.structs import UNIT_TOL, Strict, Vec3, check_finite, check_positive, check_unit
+from calib.reading import MAX_MESH_BYTES, check_regular_file
+from calib.structs import (
+    UNIT_TOL,
+    Strict,
+    Vec3,
+    check_coordinates,
+    check_positive,
+    check_unit,
+)
 
 __all__ = [
     "BUILTIN_PREFIX",
@@ -115,7 +132,7 @@ class PlanPoint(Strict, frozen=True, kw_only=True):
         edge_normal: ``(3,)`` unit normal of the face whose end an edge search finds, or ``None``.
     """
 
-    id: str
+    id: PointId
     role: str
     position_m: Vec3
     normal: Vec3
@@ -123,9 +140,8 @@ class PlanPoint(Strict, frozen=True, kw_only=True):
     edge_normal: Vec3 | None = None
 
     def __post_init__(self) -> None:
-        if not self.id or not self.id.strip():
-            raise PlanError("id: must be a non-empty string")
-        check_finite(self.position_m, "position_m")
+        check_pattern(self.id, POINT_ID_PATTERN, "id", "a point id")
+        check_coordinates(self.position_m, "position_m")
         check_unit(self.normal, "normal")
         check_unit(self.edge_normal, "edge_normal")
         if self.search.edge_direction is not None:
@@ -182,7 +198,7 @@ class Plan(Strict, frozen=True, kw_only=True):
     """A complete measurement plan (file format ``wobjcal.plan/1``)."""
 
     schema: Literal["wobjcal.plan/1"] = PLAN_SCHEMA
-    name: str = ""
+    name: PlanName = ""
     description: str = ""
     cell: CellSpec = CellSpec()
     work_object: WorkObjectSpec = WorkObjectSpec()
@@ -191,6 +207,7 @@ class Plan(Strict, frozen=True, kw_only=True):
     validation: ValidationSpec = ValidationSpec()
 
     def __post_init__(self) -> None:
+        check_pattern(self.name, PLAN_NAME_PATTERN, "name", "a plan name")
         seen: dict[str, int] = {}
         for i, p in enumerate(self.points):
             if p.id in seen:
@@ -234,23 +251,6 @@ class Plan(Strict, frozen=True, kw_only=True):
     def role_points(self) -> list[RolePoint]:
         """Every point with its role, in plan order (what the procedures take)."""
         return [RolePoint(p.role, p.to_probe_point()) for p in self.points]
-
-
-def file_sha256(path: str | Path) -> str:
-    """Hex SHA-256 digest of a file's bytes."""
-    digest = hashlib.sha256()
-    with Path(path).open("rb") as handle:
-        for block in iter(lambda: handle.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
-
-
-def resolve_ref(ref: str, plan_dir: str | Path) -> str | Path:
-    """A file reference of the plan: ``builtin:NAME`` unchanged, else a path under ``plan_dir``."""
-    if ref.startswith(BUILTIN_PREFIX):
-        return ref
-    path = Path(ref)
-    return path if path.is_absolute() else Path(plan_dir) / path
 
 
 _CHOICES = {
@@ -305,8 +305,14 @@ def check_plan_files(plan: Plan, plan_dir: str | Path, source: str = "plan") -> 
         path = resolve_ref(ref, plan_dir)
         if isinstance(path, str):
             continue
-        if not path.is_file():
+        if path.is_dir():
+            raise PlanError(f"{source}: {where}.mesh: {path} is a directory, not a mesh file")
+        if not path.exists():
             raise PlanError(f"{source}: {where}.mesh: file not found: {path}")
+        try:
+            check_regular_file(path, MAX_MESH_BYTES, "mesh file", PlanError)
+        except PlanError as exc:
+            raise PlanError(f"{source}: {where}.mesh: {exc}") from None
         if sha is not None and file_sha256(path) != sha:
             raise PlanError(
                 f"{source}: {where}.sha256: {path} has digest {file_sha256(path)}, "
@@ -327,7 +333,7 @@ def load_plan(path: str | Path, check_files: bool = True) -> Plan:
         OSError: the file cannot be read.
     """
     p = Path(path)
-    text = read_text_file(p, PlanError)
+    text = read_text_file(p, PlanError, "plan file")
     plan = plan_from_json(text, source=str(p))
     if check_files:
         check_plan_files(plan, p.parent, source=str(p))

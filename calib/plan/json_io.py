@@ -25,6 +25,7 @@ from typing import Any, TypeVar
 import msgspec
 
 from calib.errors import InputError
+from calib.reading import MAX_JSON_BYTES, read_bytes_capped
 
 T = TypeVar("T")
 
@@ -39,6 +40,11 @@ _REWORDS: tuple[tuple[re.Pattern[str], str], ...] = (
     (re.compile(r"^Expected `array`, got `(\w+)`$"), r"must be a list, got \1"),
     (re.compile(r"^Expected `object`, got `(\w+)`$"), r"must be an object, got \1"),
     (re.compile(r"^Expected `(.+)`, got `(\w+)`$"), r"must be \1, got \2"),
+    (
+        re.compile(r"^Expected `str` matching regex '(.+)'$"),
+        r"must be a name matching \1 (no quotes, line breaks or other punctuation)",
+    ),
+    (re.compile(r"^Expected `str` of length <= (\d+)$"), r"must be at most \1 characters"),
 )
 
 
@@ -89,13 +95,19 @@ def _find_non_finite(value: Any, path: str) -> tuple[str, str] | None:
     return None
 
 
-def read_text_file(path: Path, error: type[InputError]) -> str:
+def read_text_file(
+    path: Path, error: type[InputError], what: str = "JSON file", limit: int = MAX_JSON_BYTES
+) -> str:
     """Read a UTF-8 text file, or raise ``error`` naming it when it is binary or not UTF-8.
+
+    The file must be a regular file of at most ``limit`` bytes (:mod:`calib.reading`): a path
+    to a directory, ``/dev/zero`` or a pipe is refused before anything is read.
 
     Raises:
         OSError: the file cannot be read (missing, permissions).
+        error: not a regular file, too large, or not UTF-8.
     """
-    data = path.read_bytes()
+    data = read_bytes_capped(path, limit, what, error)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -120,6 +132,11 @@ def parse_json_text(text: str, error: type[InputError], source: str) -> Any:
     except json.JSONDecodeError as exc:
         raise error(
             f"{source}: not valid JSON (line {exc.lineno}, column {exc.colno}): {exc.msg}"
+        ) from None
+    except RecursionError:
+        raise error(
+            f"{source}: JSON nested too deeply (arrays or objects within each other more than "
+            "about a thousand levels): not a plan or measurements file"
         ) from None
     found = _find_non_finite(raw, "")
     if found:

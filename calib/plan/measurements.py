@@ -14,6 +14,7 @@ whose search failed on the robot, with the reason. Inside the code everything is
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Final, Literal
 
@@ -31,6 +32,7 @@ from calib.plan.json_io import (
     parse_json_text,
     read_text_file,
 )
+from calib.tolerances import COORDINATE_LIMIT_M
 
 MEASUREMENTS_SCHEMA: Final = "wobjcal.measurements/1"
 SUPPORTED_MEASUREMENTS_SCHEMAS = (MEASUREMENTS_SCHEMA,)
@@ -121,31 +123,41 @@ class Measurements(msgspec.Struct, frozen=True, forbid_unknown_fields=True, kw_o
 _CHOICES = {"frame": ("base", "world"), "units": ("m", "mm")}
 
 
-def _check_xyz(value: object, where: str, source: str) -> None:
-    """msgspec does not name dict keys in its paths, so check ``{id: [x, y, z]}`` here."""
+def _check_xyz(value: object, where: str, source: str, unit: str) -> None:
+    """msgspec does not name dict keys in its paths, so check ``{id: [x, y, z]}`` here; a
+    coordinate beyond :data:`calib.tolerances.COORDINATE_LIMIT_M` (1e308, a typo) is refused
+    naming the point, before any arithmetic."""
     if not isinstance(value, list):
         raise MeasurementsError(f"{source}: {where}: must be a list [x, y, z]")
     if len(value) != 3:
         raise MeasurementsError(f"{source}: {where}: must have length 3, got {len(value)}")
+    limit = COORDINATE_LIMIT_M / _SCALE.get(unit, 1.0)
     for i, v in enumerate(value):
         if isinstance(v, bool) or not isinstance(v, int | float):
             raise MeasurementsError(
                 f"{source}: {where}[{i}]: must be a number, got {type(v).__name__}"
             )
+        if not math.isfinite(v) or abs(v) > limit:
+            raise MeasurementsError(
+                f"{source}: {where}[{i}]: {v:g} {unit} is not a plausible coordinate "
+                f"(limit +-{limit:g} {unit})"
+            )
 
 
 def _check_point_maps(raw: dict[str, object], source: str) -> None:
+    unit = raw.get("units", "m")
+    unit = unit if isinstance(unit, str) and unit in _SCALE else "m"
     points = raw.get("points")
     if isinstance(points, dict):
         for pid, xyz in points.items():
-            _check_xyz(xyz, f"points.{pid}", source)
+            _check_xyz(xyz, f"points.{pid}", source, unit)
     retakes = raw.get("retakes")
     if isinstance(retakes, dict):
         for pid, rows in retakes.items():
             if not isinstance(rows, list):
                 raise MeasurementsError(f"{source}: retakes.{pid}: must be a list of [x, y, z]")
             for k, xyz in enumerate(rows):
-                _check_xyz(xyz, f"retakes.{pid}[{k}]", source)
+                _check_xyz(xyz, f"retakes.{pid}[{k}]", source, unit)
 
 
 def measurements_from_json(text: str, source: str = "measurements") -> Measurements:
@@ -159,7 +171,9 @@ def measurements_from_json(text: str, source: str = "measurements") -> Measureme
 def load_measurements(path: str | Path) -> Measurements:
     """Read a measurements file strictly (see :func:`measurements_from_json`)."""
     p = Path(path)
-    return measurements_from_json(read_text_file(p, MeasurementsError), source=str(p))
+    return measurements_from_json(
+        read_text_file(p, MeasurementsError, "measurements file"), source=str(p)
+    )
 
 
 def save_measurements(measurements: Measurements, path: str | Path) -> Path:

@@ -6,13 +6,18 @@ Defaults and their sources are in ``docs/simulation.md``.
 
 from __future__ import annotations
 
-from calib.errors import PlanError
 from calib.models import SensorSettings
 from calib.models.misplacement import Misplacement
 from calib.models.proximity import ProximitySensor
 from calib.models.robot_error import RobotErrorModel
 from calib.plan.report_spec import ReportSpec
-from calib.structs import Strict
+from calib.structs import Strict, check_count
+
+#: Most trials a validation runs (about a minute per 10,000 on two cores; the results are
+#: kept in memory for the confidence intervals).
+MAX_TRIALS = 100_000
+#: Seeds are integers 0 .. 2**63 - 1.
+MAX_SEED = 2**63 - 1
 
 
 class ValidationSpec(Strict, frozen=True, kw_only=True):
@@ -24,8 +29,8 @@ class ValidationSpec(Strict, frozen=True, kw_only=True):
         robot_error: the robot error model.
         misplacement: misplacement tolerance of the part.
         report: points of interest, regions and confidence levels of the report.
-        trials: number of simulated calibrations.
-        seed: seed of the ``numpy.random.Generator``.
+        trials: number of simulated calibrations, 2 .. :data:`MAX_TRIALS`.
+        seed: seed of the ``numpy.random.Generator``, 0 .. :data:`MAX_SEED`.
     """
 
     sensor: SensorSettings = ProximitySensor()
@@ -36,5 +41,5 @@ class ValidationSpec(Strict, frozen=True, kw_only=True):
     seed: int = 20131023
 
     def __post_init__(self) -> None:
-        if self.trials < 2:
-            raise PlanError(f"trials: must be >= 2, got {self.trials}")
+        check_count(self.trials, "trials", minimum=2, maximum=MAX_TRIALS)
+        check_count(self.seed, "seed", minimum=0, maximum=MAX_SEED)

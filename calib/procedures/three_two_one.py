@@ -30,6 +30,7 @@ from calib.procedures.base import (
     edge_offset_of,
     unknown_role_problem,
 )
+from calib.tolerances import FACE_MAX_DEVIATION_M, same_direction
 
 #: The roles and how many points each takes.
 ROLE_COUNTS = {"primary": 3, "secondary": 2, "tertiary": 1}
@@ -58,11 +59,17 @@ class ThreeTwoOne(
 
 
 def _faces(p: ProbePoint) -> list[tuple[float, ...]]:
-    """The faces a point can stand for: ``(nx, ny, nz, offset)`` rounded, own face first."""
+    """The faces a point can stand for: ``(nx, ny, nz, offset)``, own face first."""
     faces = [(*p.normal, float(np.dot(p.normal, p.position_m)))]
     if p.edge_normal is not None:
         faces.append((*p.edge_normal, float(np.dot(p.edge_normal, p.position_m))))
-    return [tuple(round(float(v), 6) for v in f) for f in faces]
+    return [tuple(float(v) for v in f) for f in faces]
+
+
+def _same_face(a: tuple[float, ...], b: tuple[float, ...]) -> bool:
+    """Two ``(n, offset)`` faces are one within the tolerances of :mod:`calib.tolerances`."""
+    cos = float(np.dot(a[:3], b[:3]))
+    return same_direction(cos) and abs(a[3] - b[3]) <= FACE_MAX_DEVIATION_M
 
 
 def _spread(a: ProbePoint, b: ProbePoint, c: ProbePoint) -> float:
@@ -88,7 +95,8 @@ def pick_roles(points: Sequence[RolePoint]) -> dict[str, list[RolePoint]]:
     groups: dict[tuple[float, ...], list[RolePoint]] = {}
     for rp in points:
         for f in _faces(rp.point):
-            groups.setdefault(f, []).append(rp)
+            key = next((g for g in groups if _same_face(g, f)), f)
+            groups.setdefault(key, []).append(rp)
     ranked = sorted(groups.items(), key=lambda kv: -len(kv[1]))
     if not ranked or len(ranked[0][1]) < 3:
         raise PlanError("three_two_one: no face with 3 points for the primary role")

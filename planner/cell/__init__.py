@@ -10,9 +10,18 @@ Owns:
     - collisions: :mod:`~planner.cell.acl` (allowed-collision list, sampled once, cached),
       :mod:`~planner.cell.collision` and :mod:`~planner.cell.clearance` (the clearance query
       and its result, the default margins);
-    - queries: :mod:`~planner.cell.feasibility` (probe poses, ``check_probes``),
-      :mod:`~planner.cell.probe_clearance` (its staged collision checks),
-      :mod:`~planner.cell.search_paths` (``check_search``), :mod:`~planner.cell.reachability_map`.
+    - the broad phase of the clearance query, for batches of candidates:
+      :mod:`~planner.cell.broad_phase` (with :mod:`~planner.cell.broad_arrays`,
+      :mod:`~planner.cell.broad_parts`), its compiled kernels (:mod:`~planner.cell.broad_kernels`,
+      :mod:`~planner.cell.mesh_kernels`, :mod:`~planner.cell.field_kernels`,
+      :mod:`~planner.cell.gjk_kernels`), :mod:`~planner.cell.sphere_tree`,
+      :mod:`~planner.cell.link_geometry`, :mod:`~planner.cell.distance_field` (cached on disk by
+      :mod:`~planner.cell.disk_cache`);
+    - queries: :mod:`~planner.cell.feasibility` (probe poses, ``check_probes``) with
+      :mod:`~planner.cell.probe_candidates`, :mod:`~planner.cell.probe_rule`,
+      :mod:`~planner.cell.probe_search` and :mod:`~planner.cell.probe_clearance` (Bullet for the
+      parts the broad phase leaves open), :mod:`~planner.cell.search_paths` (``check_search``),
+      :mod:`~planner.cell.reachability_map`.
 
 One client per cell, ``physicsClientId`` on every call, no global state; not thread-safe (the UI
 serializes access through one worker). ``docs/cell.md`` has the details.

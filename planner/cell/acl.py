@@ -5,6 +5,9 @@ The list is worked out once per robot + tool by sampling random in-limit configu
 of robot/tool links is *allowed* (never reported) when it is adjacent (parent and child, or the
 tool's root on the flange link) or when it is closer than the self margin in at least
 :data:`ALWAYS_FRACTION` of the samples (e.g. vendor wrist meshes that overlap in every pose).
+A tool link is never allowed against a robot link other than those it is mounted on (the flange
+link and the links fixed to it): a tool that sticks through the wrist in every sample is a
+wrongly mounted tool, not a pair to ignore.
 Pairs that never came near are recorded as ``never`` but are still checked: Bullet's broadphase
 skips far pairs for free, so skipping them would save nothing and could hide a rare real
 collision. The list is cached in memory and on disk (JSON, ``$WOBJCAL_CACHE_DIR/acl`` or
@@ -32,7 +35,7 @@ log = logging.getLogger(__name__)
 #: A pair closer than the self margin in at least this fraction of the samples is allowed.
 ALWAYS_FRACTION = 0.95
 #: Bump when the ACL rule changes, so cached lists are recomputed.
-ACL_VERSION = 1
+ACL_VERSION = 2
 
 Pair = tuple[str, str]
 _MEMORY_CACHE: dict[str, AllowedCollisions] = {}
@@ -123,6 +126,7 @@ def compute_acl(
     self_margin_m: float,
     key: str,
     use_cache: bool = True,
+    mount_links: Iterable[str] = (),
 ) -> AllowedCollisions:
     """Sample configurations and classify robot/tool link pairs (see the module docstring).
 
@@ -136,6 +140,8 @@ def compute_acl(
         self_margin_m: a pair closer than this counts as near, m.
         key: cache key (see :func:`acl_key`).
         use_cache: read and write the memory and disk caches.
+        mount_links: robot links the tool is mounted on: the only robot links a tool link may
+            be allowed against (besides ``adjacent`` pairs).
     """
     if use_cache and key in _MEMORY_CACHE:
         return _MEMORY_CACHE[key]
@@ -164,7 +170,26 @@ def compute_acl(
     all_pairs = _all_pairs(robot, tool, names)
     n = max(len(samples), 1)
     frac = {p: counts.get(p, 0) / n for p in all_pairs}
-    allowed = {pair(*p) for p in adjacent} | {p for p, f in frac.items() if f >= ALWAYS_FRACTION}
+    tool_names = {names(tool.body_id, i) for i in tool.names} if tool is not None else set()
+    mount = set(mount_links)
+
+    def may_allow(p: Pair) -> bool:
+        a, b = p
+        if a in tool_names or b in tool_names:  # tool-robot: only against the mount links
+            return (b if a in tool_names else a) in mount
+        return True
+
+    sampled = {p for p, f in frac.items() if f >= ALWAYS_FRACTION and may_allow(p)}
+    for a, b in sorted(p for p, f in frac.items() if f >= ALWAYS_FRACTION and not may_allow(p)):
+        log.warning(
+            "%s and %s are within %.1f mm in %.0f %% of the sampled poses: the tool is mounted "
+            "through the robot (check the plan's cell.tool.T_flange_tool); checked, not allowed",
+            a,
+            b,
+            self_margin_m * 1e3,
+            100 * frac[(a, b)],
+        )
+    allowed = {pair(*p) for p in adjacent} | sampled
     never = {p for p, f in frac.items() if f == 0.0 and p not in allowed}
     acl = AllowedCollisions(frozenset(allowed), frozenset(never), frac, len(samples), key)
     if use_cache:

@@ -19,7 +19,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from calib.frames import invert_transform
-from planner.cell.pybullet_client import pb
+from planner.cell.pybullet_client import native_chatter_filtered, pb
 from planner.errors import MeshError, URDFError
 
 FloatArray = NDArray[np.float64]
@@ -110,14 +110,15 @@ def load_urdf_body(client: int, path: Path, T_world_root: FloatArray, what: str)
         raise URDFError(f"{what} URDF not found: {path}")
     pos, quat = pb_pose(T_world_root)
     try:
-        body = pb.loadURDF(
-            str(path),
-            pos,
-            quat,
-            useFixedBase=True,
-            flags=pb.URDF_USE_IMPLICIT_CYLINDER,
-            physicsClientId=client,
-        )
+        with native_chatter_filtered():
+            body = pb.loadURDF(
+                str(path),
+                pos,
+                quat,
+                useFixedBase=True,
+                flags=pb.URDF_USE_IMPLICIT_CYLINDER,
+                physicsClientId=client,
+            )
     except pb.error as exc:
         raise URDFError(f"cannot load {what} URDF {path}: {exc} (malformed XML?)") from None
     return _body_links(client, body)

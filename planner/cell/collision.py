@@ -228,12 +228,15 @@ class CollisionChecker:
         parts.append(QueryPart(len(parts), "self", -1, -1, -1, "", self_look, self_margin_m))
         return QueryPlan(tuple(parts), look, margin_m)
 
-    def evaluate(self, part: QueryPart) -> Clearance | None:
+    def evaluate(self, part: QueryPart, pairs: np.ndarray | None = None) -> Clearance | None:
         """The limiting point of one part in the current state (``None``: nothing within its
-        distance). Link pairs whose axis-aligned boxes lie farther apart are not queried."""
+        distance). Link pairs whose axis-aligned boxes lie farther apart are not queried.
+
+        ``pairs``: for the self part, a mask over :meth:`_self_pair_table`'s pairs to query
+        (the others are known to report nothing); default all."""
         self.last_points = 0
         if part.kind == "self":
-            return self._self_part(part)
+            return self._self_part(part, pairs)
         c = self.client
         lo, hi = pb.getAABB(part.body, part.link, physicsClientId=c)
         elo, ehi = pb.getAABB(part.env, -1, physicsClientId=c)  # cheap; bodies get replaced
@@ -281,19 +284,30 @@ class CollisionChecker:
         self.last_points = len(points)
         return any(pt[8] - part.need_m <= slack_m for pt in points)
 
-    def _self_part(self, part: QueryPart) -> Clearance | None:
-        """Robot-robot and robot-tool pairs not in the ACL, pair by pair, skipped by their
-        axis-aligned boxes first (a whole-body self query would also compute every allowed,
-        touching neighbour pair, ~10x slower)."""
+    def _self_part(self, part: QueryPart, pairs: np.ndarray | None = None) -> Clearance | None:
+        """Robot-robot and robot-tool pairs not in the ACL (or those of ``pairs``), pair by
+        pair, skipped by their axis-aligned boxes first (a whole-body self query would also
+        compute every allowed, touching neighbour pair, ~10x slower)."""
         c, look = self.client, part.dist_m
         bodies, links, pa, pb_ = self._self_pair_table()
-        boxes = np.array(
-            [pb.getAABB(b, i, physicsClientId=c) for b, i in zip(bodies, links)]
-        )  # (L, 2, 3): lower and upper corners
+        if pairs is not None:
+            keep = np.flatnonzero(pairs)
+            if keep.size == 0:
+                return None
+            used = np.unique(np.concatenate([pa[keep], pb_[keep]]))
+            boxes = np.zeros((len(bodies), 2, 3))
+            for i in used.tolist():
+                boxes[i] = pb.getAABB(bodies[i], links[i], physicsClientId=c)
+        else:
+            keep = np.arange(pa.size)
+            boxes = np.array(
+                [pb.getAABB(b, i, physicsClientId=c) for b, i in zip(bodies, links)]
+            )  # (L, 2, 3): lower and upper corners
         lo, hi = boxes[:, 0], boxes[:, 1]
-        apart = np.any((lo[pa] > hi[pb_] + look) | (lo[pb_] > hi[pa] + look), axis=1)
+        a_, b_ = pa[keep], pb_[keep]
+        apart = np.any((lo[a_] > hi[b_] + look) | (lo[b_] > hi[a_] + look), axis=1)
         best: Clearance | None = None
-        for k in np.flatnonzero(~apart).tolist():
+        for k in keep[~apart].tolist():
             a, b = int(pa[k]), int(pb_[k])
             for pt in pb.getClosestPoints(
                 bodies[a],

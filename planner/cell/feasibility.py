@@ -2,17 +2,18 @@
 
 A probe pose puts the TCP (``sensor`` by default) on the surface point with its +z axis along
 ``-normal`` (into the surface); the rotation about that axis is free and searched every
-``rotation_step_deg``. All ``N x R`` flange poses go to the IK solver in one call; candidates
-(pose, branch) within limits and away from wrist singularity are then collision-checked in
-order of least joint motion from ``q_ref`` (candidates near a joint limit last) until one
-passes with margin. A feasible pose whose clearance slack or joint-limit margin is small is
-``"marginal"``. Infeasible poses say why: out of reach, a joint at its limit, singular wrist, or
-the limiting collision pair and its clearance.
+``rotation_step_deg``. All ``N x R`` flange poses go to the IK solver in one call
+(:mod:`planner.cell.probe_candidates`); candidates (pose, branch) within limits and away from
+wrist singularity are then collision-checked in order of least joint motion from ``q_ref``
+(candidates near a joint limit last): the first that passes with margin is chosen, else the
+least-bad one (:mod:`planner.cell.probe_search`). A feasible pose whose clearance slack or
+joint-limit margin is small is ``"marginal"``. Infeasible poses say why: out of reach, a joint
+at its limit, singular wrist, or the limiting collision pair and its clearance.
 
-Candidates are checked staged (:mod:`planner.cell.probe_clearance`): the tool once per rotation
-before any robot link, and a candidate is dropped as soon as it can neither pass nor beat the
-least-bad one so far, so a point that collides in every pose costs a fraction of the whole
-queries; the answers are those of one whole clearance query per candidate (``staged=False``).
+The clearance of a candidate is the exact Bullet query's; a broad phase
+(:mod:`planner.cell.broad_phase`) shows for whole batches which parts of it report nothing, so
+Bullet sees only the rest (``staged=True``, the default). ``staged=False`` runs one whole query
+per candidate: the plain reference, with the same answers.
 """
 
 from __future__ import annotations
@@ -25,11 +26,21 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import DegenerateGeometryError, ShapeError
-from calib.frames import invert_transform
 from calib.validation import check_positive, check_shape
-from planner.cell.collision import DEFAULT_MARGIN_M, Clearance
-from planner.cell.probe_clearance import ProbeClearance
-from planner.robot.reach import no_ik_reason
+from planner.cell.clearance import Clearance
+from planner.cell.collision import DEFAULT_MARGIN_M
+from planner.cell.probe_candidates import (
+    MARGINAL_LIMIT_RAD,
+    MIN_SINGULAR_VALUE,
+    WRIST_SINGULAR_RAD,
+    ProbeCandidates,
+    limit_margin,
+    probe_candidates,
+    singular,
+    tcp_frames,
+)
+from planner.cell.probe_rule import CLEARANCE_TIE_M, Decision, select
+from planner.cell.probe_search import ProbeSearch
 
 if TYPE_CHECKING:
     from planner.cell.scene import CellScene
@@ -38,15 +49,17 @@ if TYPE_CHECKING:
 FloatArray = NDArray[np.float64]
 Status = Literal["feasible", "marginal", "infeasible"]
 
-#: Wrist singularity of OPW arms: ``|sin q5|`` below ``sin`` of this angle, rad.
-WRIST_SINGULAR_RAD = math.radians(5.0)
-#: Other arms: smallest singular value of the Jacobian (translation rows / reach) below this.
-MIN_SINGULAR_VALUE = 0.05
-#: Clearances closer than this are a tie (Bullet's GJK answers vary by micrometres with the
-#: scene's pose); among ties the earlier candidate (less joint motion) wins, m.
-CLEARANCE_TIE_M = 1e-4
-#: A joint closer than this to a limit makes a feasible pose marginal, rad.
-MARGINAL_LIMIT_RAD = math.radians(5.0)
+__all__ = [
+    "CLEARANCE_TIE_M",
+    "MARGINAL_LIMIT_RAD",
+    "MIN_SINGULAR_VALUE",
+    "WRIST_SINGULAR_RAD",
+    "ProbeFeasibility",
+    "check_probes",
+    "limit_margin",
+    "singular",
+    "tcp_frames",
+]
 
 
 @dataclass(frozen=True)
@@ -84,34 +97,6 @@ class ProbeFeasibility:
     clearance_pair: tuple[str, str] | None = None
 
 
-def tcp_frames(points: FloatArray, normals: FloatArray, angles: FloatArray) -> FloatArray:
-    """``T_wobj_tcp (N, R, 4, 4)``: origin on each point, +z = ``-normal``, rotated by angles.
-
-    At angle 0 the TCP x axis is the unit vector perpendicular to z closest to the wobj axis
-    least aligned with z (a fixed, deterministic choice); angle ``a`` turns x about z by ``a``.
-    """
-    z = -normals
-    ref = np.eye(3)[np.argmin(np.abs(z), axis=1)]
-    x0 = ref - np.einsum("ij,ij->i", ref, z)[:, None] * z
-    x0 /= np.linalg.norm(x0, axis=1, keepdims=True)
-    y0 = np.cross(z, x0)
-    c, s = np.cos(angles)[None, :, None], np.sin(angles)[None, :, None]
-    x = c * x0[:, None] + s * y0[:, None]
-    y = np.cross(z[:, None], x)
-    T = np.zeros((points.shape[0], angles.size, 4, 4))
-    T[..., :3, 0], T[..., :3, 1] = x, y
-    T[..., :3, 2] = z[:, None]
-    T[..., :3, 3] = points[:, None]
-    T[..., 3, 3] = 1.0
-    return T
-
-
-def limit_margin(chain: KinematicChain, q: FloatArray) -> FloatArray:
-    """Smallest distance of each ``q (..., n)`` to a joint limit, rad (inf for no limits)."""
-    with np.errstate(invalid="ignore"):
-        return np.min(np.minimum(q - chain.lower, chain.upper - q), axis=-1)
-
-
 def _near_limit_reason(chain: KinematicChain, q: FloatArray) -> str:
     """E.g. ``joint 3 near its upper limit (joint_3, 4.3 deg to go)`` for one ``q (n,)``."""
     to_lower, to_upper = q - chain.lower, chain.upper - q
@@ -121,17 +106,6 @@ def _near_limit_reason(chain: KinematicChain, q: FloatArray) -> str:
         f"joint {j + 1} near its {side} limit ({chain.joint_names[j]}, "
         f"{math.degrees(float(left)):.1f} deg to go)"
     )
-
-
-def singular(cell: CellScene, q: FloatArray) -> tuple[NDArray[np.bool_], str]:
-    """Mask ``(M,)`` of configurations ``q (M, n)`` too near a singularity, and the reason."""
-    if cell.solver.kind == "opw" and q.shape[1] == 6:
-        return np.abs(np.sin(q[:, 4])) < math.sin(WRIST_SINGULAR_RAD), "singular wrist"
-    _, J = cell.chain.fk_jacobian(q)
-    Js = J.copy()
-    Js[:, :3] /= max(cell.reach_model.reach_m, 1e-9)
-    sv = np.linalg.svd(Js, compute_uv=False)[:, -1]
-    return sv < MIN_SINGULAR_VALUE, "near a singularity"
 
 
 def check_probes(
@@ -155,11 +129,11 @@ def check_probes(
         rotation_step_deg: step of the free rotation about the sensor axis, degrees.
         margin_m: clearance to work object and fixtures, m (default the cell's 5 mm).
         q_ref: ``(n,)`` reference configuration for "least joint motion" (default home).
-        max_checks: largest number of candidates collision-checked per point.
-        staged: check candidates through :class:`planner.cell.probe_clearance.ProbeClearance`
-            (tool once per rotation, a candidate dropped as soon as it can change nothing);
-            ``False``: one whole clearance query per candidate, the plain reference. Both
-            give the same answers.
+        max_checks: largest number of candidates collision-checked per point (>= 1).
+        staged: decide candidates with :class:`planner.cell.probe_search.ProbeSearch` (a
+            broad phase for the whole batch, Bullet only for the parts it leaves open);
+            ``False``: one whole clearance query per candidate, the exact check. Both give
+            the same answers.
 
     Returns:
         One :class:`ProbeFeasibility` per point, in the order given. The cell's joint state is
@@ -183,104 +157,74 @@ def check_probes(
     margin = DEFAULT_MARGIN_M if margin_m is None else check_positive(margin_m, "margin_m", True)
     T_flange_tcp = cell.T_flange_tcp(tcp)
     ref = cell.home_q if q_ref is None else check_shape(q_ref, (cell.chain.n_joints,), "q_ref")
+    max_checks = int(max_checks)
+    if max_checks < 1:
+        raise ShapeError(f"max_checks must be >= 1, got {max_checks}")
     angles = np.arange(0.0, 2 * np.pi - 1e-9, step)
-    N, R = pts.shape[0], angles.size
-    if N == 0:
+    if pts.shape[0] == 0:
         return []
-    T_base_tcp = cell.T_base_wobj @ tcp_frames(pts, nrm, angles)
-    T_bf = (T_base_tcp @ invert_transform(T_flange_tcp)).reshape(N * R, 4, 4)
-    sol = cell.solver.solve(T_bf)
-    K = sol.q.shape[1]
-    valid = sol.valid.reshape(N, R * K)
-    q_all = sol.q.reshape(N, R * K, -1)
-    sing = np.zeros_like(valid)
-    sing_reason = "singular wrist"
-    if valid.any():
-        m, sing_reason = singular(cell, q_all[valid])
-        sing[valid] = m
-    usable = valid & ~sing
-    margin_all = np.where(valid, limit_margin(cell.chain, q_all), -np.inf)
-    motion = np.where(usable, np.linalg.norm(np.nan_to_num(q_all - ref), axis=-1), np.inf)
-    out: list[ProbeFeasibility] = []
-    stages = ProbeClearance(cell, margin)
+    cands = probe_candidates(cell, pts, nrm, T_flange_tcp, angles, ref)
     with cell.saved_state():
-        for i in range(N):
-            if not valid[i].any():
-                reason = no_ik_reason(
-                    cell.reach_model, cell.solver, cell.chain, T_bf[i * R : (i + 1) * R]
-                )
-                out.append(_none(reason))
-                continue
-            if not usable[i].any():
-                out.append(_none(sing_reason))
-                continue
-            near_limit = margin_all[i] < MARGINAL_LIMIT_RAD
-            keys = (motion[i], near_limit, ~usable[i])  # usable first, then by limit
-            order = np.lexsort(keys)[: int(usable[i].sum())][:max_checks]
-            best: tuple[Clearance, int] | None = None
-            chosen: tuple[Clearance, int] | None = None
-            stages.start_point(T_bf[i * R : (i + 1) * R])
-            for c in order:
-                if staged:
-                    limit_ok = margin_all[i, c] >= MARGINAL_LIMIT_RAD
-                    bound = _settled_at(best, margin, limit_ok)
-                    got = stages.check(int(c) // K, q_all[i, c], bound)
-                    if got is None:  # can neither pass nor beat the least-bad one
-                        continue
-                    cl = got
-                else:
-                    cell.set_joint_positions(q_all[i, c])
-                    cl = cell.clearance(margin, sensor_wobj_allowed=True)
-                if best is None or cl.slack_m > best[0].slack_m + CLEARANCE_TIE_M:
-                    best = (cl, c)
-                if cl.ok and cl.slack_m >= margin and margin_all[i, c] >= MARGINAL_LIMIT_RAD:
-                    chosen = (cl, c)
-                    break
-            if chosen is None and best is not None and best[0].ok:
-                chosen = best
-            pick = chosen or best
-            if pick is None:  # unreachable: order is non-empty when usable[i].any()
-                out.append(_none("no candidate checked"))
-                continue
-            cl, c = pick
-            r, k = divmod(int(c), K)
-            fine = cl.slack_m >= margin and margin_all[i, c] >= MARGINAL_LIMIT_RAD
-            status: Status = "infeasible" if chosen is None else "feasible" if fine else "marginal"
-            if status == "feasible":
-                reason = ""
-            elif status == "marginal":
-                reason = (
-                    f"small clearance: {cl.describe()}"
-                    if cl.slack_m < margin
-                    else _near_limit_reason(cell.chain, q_all[i, c])
-                )
-            else:
-                reason = cl.describe()
-            out.append(
-                ProbeFeasibility(
-                    feasible=chosen is not None,
-                    status=status,
-                    reason=reason,
-                    q=q_all[i, c].copy(),
-                    branch=int(sol.branch[i * R + r, k]),
-                    rotation_rad=float(angles[r]),
-                    clearance_m=float(cl.clearance_m),
-                    joint_margin_rad=float(margin_all[i, c]),
-                    T_base_flange=T_bf[i * R + r].copy(),
-                    clearance_pair=cl.pair,
-                )
-            )
+        if staged:
+            decisions = ProbeSearch(cell, margin, max_checks).run(cands)
+        else:
+            decisions = _reference(cell, cands, margin, max_checks)
+    return [
+        _feasibility(cell.chain, cands, i, d, margin) if d is not None else _none(why or "")
+        for i, (d, why) in enumerate(zip(decisions, cands.reasons))
+    ]
+
+
+def _reference(
+    cell: CellScene, cands: ProbeCandidates, margin: float, max_checks: int
+) -> list[Decision | None]:
+    """One whole clearance query per candidate, in order (the plain reference)."""
+    out: list[Decision | None] = []
+    for i, why in enumerate(cands.reasons):
+        if why is not None:
+            out.append(None)
+            continue
+
+        def clearance(c: int, i: int = i) -> Clearance:
+            cell.set_joint_positions(cands.q[i, c])
+            return cell.clearance(margin, sensor_wobj_allowed=True)
+
+        out.append(select(cands.order(i, max_checks), cands.near_limit[i], margin, clearance))
     return out
 
 
-def _settled_at(best: tuple[Clearance, int] | None, margin: float, limit_ok: bool) -> float:
-    """Slack at or below which a candidate changes nothing: it does not beat the least-bad
-    one so far by more than the tie, and it cannot pass (slack below ``margin``, or a joint
-    near its limit). ``-inf`` while nothing has been checked."""
-    if best is None:
-        return -math.inf
-    bound = best[0].slack_m + CLEARANCE_TIE_M
-    return min(bound, math.nextafter(margin, -math.inf)) if limit_ok else bound
+def _feasibility(
+    chain: KinematicChain, cands: ProbeCandidates, i: int, d: Decision, margin: float
+) -> ProbeFeasibility:
+    """The :class:`ProbeFeasibility` of point ``i``'s decision."""
+    c, cl = d.candidate, d.clearance
+    K = cands.per_rotation
+    r = c // K
+    joint_margin = float(cands.limit_margin[i, c])
+    fine = cl.slack_m >= margin and joint_margin >= MARGINAL_LIMIT_RAD
+    status: Status = "infeasible" if not d.chosen else "feasible" if fine else "marginal"
+    if status == "feasible":
+        reason = ""
+    elif status == "marginal":
+        reason = (
+            f"small clearance: {cl.describe()}"
+            if cl.slack_m < margin
+            else _near_limit_reason(chain, cands.q[i, c])
+        )
+    else:
+        reason = cl.describe()
+    return ProbeFeasibility(
+        feasible=d.chosen,
+        status=status,
+        reason=reason,
+        q=cands.q[i, c].copy(),
+        branch=int(cands.branch[i, c]),
+        rotation_rad=float(cands.angles[r]),
+        clearance_m=float(cl.clearance_m),
+        joint_margin_rad=joint_margin,
+        T_base_flange=cands.T_base_flange[i, r].copy(),
+        clearance_pair=cl.pair,
+    )
 
 
 def _none(reason: str) -> ProbeFeasibility:

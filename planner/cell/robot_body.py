@@ -54,6 +54,18 @@ class RobotBody:
         for j, v in zip(self.joint_index, q.tolist()):
             pb.resetJointState(self.links.body_id, j, v, physicsClientId=client)
 
+    def mount_links(self) -> tuple[str, ...]:
+        """The links the tool is mounted on: the flange link and the links it is fixed to,
+        up to the first moving joint (e.g. ``tool0`` and ``link_6``)."""
+        names = self.links.names
+        out, link = [], self.flange_index
+        while link >= 0:
+            out.append(names[link])
+            if link not in self.fixed:
+                break
+            link = self.parent[link]
+        return tuple(out)
+
     def adjacent_pairs(self, tool_root: str | None = None) -> list[Pair]:
         """Parent-child link pairs, plus the tool's root link with the flange link and the
         links the flange is fixed to (up to the first moving joint)."""

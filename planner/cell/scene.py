@@ -8,7 +8,9 @@ modules; :class:`planner.cell.cell.Cell` is the scene with those queries as meth
 A scene owns its client (``physicsClientId`` on every call, no global client); ``close()`` or
 ``with`` releases it. It is not thread-safe: serialize access (one lock or one worker). The
 robot stands with its chain base link at ``T_world_base``; the tool's root link sits on the
-chain's tip link (the flange, ``tool0``). Poses follow :mod:`calib.frames`.
+chain's tip link (the flange, ``tool0``) at the mount ``T_flange_tool``
+(:func:`planner.cell.tool.tool_mount`: along the last joint's axis, whichever axis of the tip
+frame that is, or as the plan sets it). Poses follow :mod:`calib.frames`.
 """
 
 from __future__ import annotations
@@ -38,7 +40,7 @@ from planner.cell.collision import (
 from planner.cell.fixtures import Fixture, fixture_from_spec
 from planner.cell.pybullet_client import connect_direct, pb
 from planner.cell.robot_body import load_robot_body
-from planner.cell.tool import Tool, load_tool
+from planner.cell.tool import FLANGE, Tool, load_tool, tool_mount
 from planner.cell.workobject import WorkObject, load_work_object
 from planner.errors import UnknownFrameError
 from planner.robot.kinematics.chain import KinematicChain
@@ -60,6 +62,8 @@ class CellScene:
         T_world_base: ``(4, 4)`` pose of the robot base link in the world; default identity.
         base_link: chain base link (default the URDF root); tip_link: the flange (default
             ``tool0`` or the end of the longest chain).
+        T_flange_tool: ``(4, 4)`` the tool's root in the flange frame (the plan's
+            ``cell.tool.T_flange_tool``); ``None`` mounts it along the last joint's axis.
         self_margin_m: clearance between robot/tool links not in the ACL, m.
         acl_samples: random configurations sampled for the allowed-collision list.
         acl_rng: generator of those samples (default seeded, so the ACL is reproducible).
@@ -68,6 +72,7 @@ class CellScene:
     Raises:
         URDFError: missing or malformed robot/tool URDF (the message names the file).
         UnknownFrameError: unknown built-in name, base or tip link.
+        ToolMountError: the tool cannot be mounted without ``T_flange_tool`` (named).
     """
 
     def __init__(
@@ -78,6 +83,7 @@ class CellScene:
         *,
         base_link: str | None = None,
         tip_link: str | None = None,
+        T_flange_tool: ArrayLike | None = None,
         self_margin_m: float = DEFAULT_SELF_MARGIN_M,
         acl_samples: int = 1000,
         acl_rng: np.random.Generator | None = None,
@@ -90,6 +96,12 @@ class CellScene:
         self.chain: KinematicChain = KinematicChain.from_model(model, base_link, tip_link)
         self.solver: IKSolver = make_ik_solver(self.chain)
         self.tool: Tool | None = None if tool is None else load_tool(tool)
+        #: ``(4, 4)`` the tool's root frame in the flange (tip-link) frame.
+        self.T_flange_tool: FloatArray = (
+            np.eye(4) if self.tool is None else tool_mount(self.chain, T_flange_tool)
+        )
+        if not np.allclose(self.T_flange_tool, np.eye(4)):
+            log.info("tool mounted on %s at\n%s", self.chain.tip_link, self.T_flange_tool)
         self.self_margin_m = float(self_margin_m)
         self._T_world_base = (
             np.eye(4) if T_world_base is None else check_transform(T_world_base, "T_world_base")
@@ -98,6 +110,9 @@ class CellScene:
         self._reach: ReachModel | None = None
         self.work_object: WorkObject | None = None
         self._wobj_links: BodyLinks | None = None
+        #: structures the query modules build once per scene and keep here (e.g. the broad
+        #: phase of :mod:`planner.cell.broad_phase`); they read the environment afresh.
+        self.query_cache: dict[str, object] = {}
         self.fixtures: dict[str, Fixture] = {}
         self._client: int | None = connect_direct()
         try:
@@ -136,7 +151,10 @@ class CellScene:
                 i for i, name in self.tool_body.names.items() if name in self.tool.sensor_links
             )
             texts.append(self.tool.fingerprint())
-        settings = f"{self.chain.base_link}>{self.chain.tip_link}:{n}:{self.self_margin_m:.6f}"
+        mount = ",".join(f"{v:.9f}" for v in self.T_flange_tool[:3].ravel())
+        settings = (
+            f"{self.chain.base_link}>{self.chain.tip_link}:{n}:{self.self_margin_m:.6f}:{mount}"
+        )
         with self.saved_state():
             acl = compute_acl(
                 self.client,
@@ -149,6 +167,7 @@ class CellScene:
                 self.self_margin_m,
                 acl_key(texts, settings),
                 use_cache,
+                mount_links=self.robot_body.mount_links(),
             )
         self.checker = CollisionChecker(
             self.client,
@@ -256,7 +275,7 @@ class CellScene:
         self.robot_body.set_q(c, qa)
         if self.tool_body is not None:
             flange = world_link_pose(c, self.robot, self.robot_body.flange_index)
-            set_link_pose(c, self.tool_body, flange)
+            set_link_pose(c, self.tool_body, flange @ self.T_flange_tool)
 
     def link_poses(self) -> dict[str, FloatArray]:
         """``T_world_link (4, 4)`` of every robot and tool link in the current state."""
@@ -268,7 +287,8 @@ class CellScene:
         return out
 
     def T_flange_tcp(self, tcp: str) -> FloatArray:
-        """``(4, 4)`` TCP ``tcp`` in the flange frame (``"flange"`` is always valid).
+        """``(4, 4)`` TCP ``tcp`` in the flange frame, through the tool's mount
+        (``"flange"`` is always valid: identity).
 
         Raises:
             UnknownFrameError: unknown TCP (the message lists the valid names).
@@ -277,7 +297,9 @@ class CellScene:
             if tcp != "flange":
                 raise UnknownFrameError(f"tcp {tcp!r}: the cell has no tool; valid: ['flange']")
             return np.eye(4)
-        return self.tool.T_flange_tcp(tcp)
+        if tcp == FLANGE:
+            return np.eye(4)
+        return self.T_flange_tool @ self.tool.T_flange_tcp(tcp)
 
     # ----------------------------------------------------------------- scene
     def set_work_object(
@@ -292,7 +314,11 @@ class CellScene:
         Raises:
             MeshError: missing, unreadable or empty mesh (the message names the file).
         """
-        wobj = mesh if isinstance(mesh, WorkObject) else load_work_object(mesh, units, name)
+        wobj = (
+            mesh
+            if isinstance(mesh, WorkObject)
+            else load_work_object(mesh, units, name, reach_m=self.reach_model.reach_m)
+        )
         T = np.eye(4) if T_world_wobj is None else check_transform(T_world_wobj, "T_world_wobj")
         if self.checker.wobj_body is not None:
             pb.removeBody(self.checker.wobj_body, physicsClientId=self.client)

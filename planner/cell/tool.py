@@ -8,6 +8,15 @@ a body on the flange with two cable guiding tubes and an 18 mm cylindrical proxi
 
 The ``sensor`` TCP lies at the sensing distance in front of the sensor face; its +z axis is
 the sensor axis, pointing from the sensor into the surface (``calib.frames`` conventions).
+
+Mounting (:func:`tool_mount`): a tool's root frame has +z out of the flange, along the last
+joint's axis. Most URDFs put the tip link (``tool0``) that way, but some vendor descriptions
+(ROS-Industrial's ABB arms) have its **x** axis out of the flange. The mount ``T_flange_tool``
+(the tool's root in the tip-link frame) is therefore worked out from the chain: the last joint's
+axis in the tip frame, signed to point away from the wrist, must lie along one of the tip
+frame's axes, and the tool is turned from z onto it by the smallest rotation. When it does not
+(a tilted flange, a tip on the axis of every joint), the cell refuses with a message naming the
+plan field that sets the mount, ``cell.tool.T_flange_tool``.
 """
 
 from __future__ import annotations
@@ -22,16 +31,83 @@ import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
-from calib.frames import check_transform
+from calib.frames import check_transform, make_transform, matrix_from_rotvec
+from calib.reading import MAX_JSON_BYTES, read_bytes_capped
+from calib.tolerances import ROLE_NORMAL_TOL_RAD
 from planner.builtins import is_builtin, tool_description
 from planner.cell.bodies import BodyLinks, load_urdf_body, mesh_collision_shape, static_body
-from planner.errors import MeshError, UnknownFrameError, URDFError
+from planner.errors import MeshError, ToolMountError, UnknownFrameError, URDFError
+from planner.robot.kinematics.chain import KinematicChain
 from planner.robot.urdf import load_urdf
 
 FloatArray = NDArray[np.float64]
 
 #: Name of the flange frame; always a valid TCP (identity).
 FLANGE = "flange"
+#: The plan field that sets the tool's mount on the flange (named in mount errors).
+MOUNT_FIELD = "cell.tool.T_flange_tool"
+#: A wrist point nearer than this to the flange axis cannot tell which way is out, m.
+_AXIS_SIGN_MIN_M = 1e-3
+
+
+def flange_axis(chain: KinematicChain) -> FloatArray | None:
+    """``(3,)`` the last joint's unit axis in the tip-link frame, pointing out of the flange
+    (away from the wrist), or ``None`` when no joint origin lies off the axis to tell the sign.
+
+    The sign comes from the joints before the last (at the chain's reference pose, zero clipped
+    into the limits): the tip lies on the far side of the last joint from them.
+    """
+    q0 = np.clip(np.zeros(chain.n_joints), chain.lower, chain.upper)
+    frames = chain.joint_frames(q0)[0]
+    T_base_tip = frames[-1] @ chain.T_last_tip
+    axis_base = frames[-1][:3, :3] @ chain.axes[-1]
+    axis_base = axis_base / np.linalg.norm(axis_base)
+    for k in range(chain.n_joints - 1, -1, -1):
+        along = float(axis_base @ (T_base_tip[:3, 3] - frames[k][:3, 3]))
+        if abs(along) > _AXIS_SIGN_MIN_M:
+            return np.asarray(T_base_tip[:3, :3].T @ (np.sign(along) * axis_base))
+    return None
+
+
+def tool_mount(chain: KinematicChain, T_flange_tool: ArrayLike | None = None) -> FloatArray:
+    """``(4, 4)`` the tool's root frame in the tip-link (flange) frame (see the module docstring).
+
+    Args:
+        chain: the robot chain; its tip link is the flange.
+        T_flange_tool: the mount the plan gives (``cell.tool.T_flange_tool``), used as is;
+            ``None`` works it out from the last joint's axis.
+
+    Raises:
+        ToolMountError: no mount given and the axis is not along an axis of the tip frame,
+            or its direction out of the flange cannot be told; the message names the plan field.
+    """
+    if T_flange_tool is not None:
+        return check_transform(T_flange_tool, MOUNT_FIELD)
+    joint = chain.joint_names[-1]
+    u = flange_axis(chain)
+    if u is None:
+        raise ToolMountError(
+            f"cannot tell which way the last joint {joint!r} points out of the flange "
+            f"{chain.tip_link!r} (every joint origin lies on its axis); set {MOUNT_FIELD} "
+            "(the tool's mount pose in the flange frame, +z out of the flange)"
+        )
+    k = int(np.argmax(np.abs(u)))
+    if abs(u[k]) < np.cos(ROLE_NORMAL_TOL_RAD):
+        shown = ", ".join(f"{v:.3f}" for v in u)
+        raise ToolMountError(
+            f"the last joint {joint!r} turns about ({shown}) in the tip frame "
+            f"{chain.tip_link!r}, not along one of its axes, so the tool's mount cannot be "
+            f"guessed; set {MOUNT_FIELD} (the tool's mount pose in the flange frame, +z out of "
+            "the flange)"
+        )
+    out = np.zeros(3)
+    out[k] = np.sign(u[k])
+    if out[2] > 0.5:
+        return np.eye(4)
+    if out[2] < -0.5:  # half a turn about x
+        return make_transform(np.diag([1.0, -1.0, -1.0]), np.zeros(3))
+    axis = np.cross([0.0, 0.0, 1.0], out)  # the smallest rotation taking z onto the axis
+    return make_transform(matrix_from_rotvec(axis * (np.pi / 2)), np.zeros(3))
 
 
 @dataclass(frozen=True)
@@ -173,10 +249,10 @@ def load_tool(spec: str | Path | Tool) -> Tool:
     path = tool_description(str(spec)) if is_builtin(spec) else Path(spec)
     if path.suffix.lower() == ".urdf":
         return Tool.from_urdf(path)
-    if not path.is_file():
+    if not path.exists():
         raise URDFError(f"tool description not found: {path}")
     try:
-        desc = json.loads(path.read_text())
+        desc = json.loads(read_bytes_capped(path, MAX_JSON_BYTES, "tool description", URDFError))
         tool = Tool.from_urdf(
             path.parent / desc["urdf"],
             tcps=list(desc["tcps"]),

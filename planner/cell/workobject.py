@@ -2,9 +2,20 @@
 
 Units: a name of :data:`calib.units.MESH_UNITS` (``"m"``, ``"mm"``, ``"cm"``, ``"in"``, ``"auto"``)
 or an alias of :data:`calib.units.ALIASES` (e.g. ``"inch"``), the same table the plan uses.
-The ``auto`` rule: a mesh whose largest bounding-box extent exceeds :data:`AUTO_MM_EXTENT` (20)
-is taken as millimetres, with a warning; otherwise as metres. A 20 m work object is implausible
-for a robot cell, and a part drawn in mm is rarely smaller than 20 mm.
+The ``auto`` rule (:func:`auto_units`) weighs the file's own unit hints and the cell's scale:
+
+1. a unit the file names (the loader's ``units``, a token of the STL header or the file name
+   such as ``_mm`` or ``inch``) is taken when it gives a plausible part;
+2. otherwise each unit is tried in the order m, mm, in, cm and the first that gives a plausible
+   part is taken: largest extent at least :data:`MIN_PART_M` (10 mm, about the sensor face)
+   and at most twice the robot's reach (a part the robot can work on from one side to the
+   other; the reach is the cell's :class:`planner.robot.reach.ReachModel`, or
+   :data:`DEFAULT_REACH_M` without a cell);
+3. when no unit does, metres, with a warning.
+
+Loading always says, in :attr:`RepairReport.units_note` and the log, the unit it used (and why,
+for ``auto``) and the part's resulting size; a part given in explicit units that comes out
+larger than twice the reach or smaller than 10 mm gets a warning naming the unit that would fit.
 
 Repair is light and reported: merge duplicate vertices, drop degenerate faces (zero area, or
 smaller than (1e-6 x the largest extent)^2) and duplicate faces
@@ -26,16 +37,23 @@ import trimesh
 from numpy.typing import NDArray
 
 from calib.errors import InputError
+from calib.reading import MAX_MESH_BYTES, check_regular_file
 from calib.units import AUTO, METRES_PER_UNIT, canonical_unit
 from planner.builtins import builtin_mesh, is_builtin
 from planner.cell.bodies import BodyLinks, mesh_collision_shape, static_body
+from planner.cell.mesh_units import (
+    DEFAULT_REACH_M,
+    auto_units,
+    implausible_units_warning,
+    unit_hint,
+)
 from planner.errors import MeshError
 
 FloatArray = NDArray[np.float64]
 log = logging.getLogger(__name__)
 
-#: ``units="auto"``: a larger extent than this (in file units) means millimetres.
-AUTO_MM_EXTENT = 20.0
+#: Most triangles a work object may have (face detection: ~6 s and ~1 GB per million).
+MAX_MESH_TRIANGLES = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -47,6 +65,8 @@ class RepairReport:
         units: the canonical unit used (``"m"``, ``"mm"``, ``"cm"``, ``"in"``).
         units_detected: True when ``units`` came from the ``auto`` rule.
         scale: metres per file unit applied.
+        extents_m: ``(3,)`` the part's bounding-box size after scaling, metres.
+        units_note: the unit used, why (for ``auto``) and the part's size, in words.
         merged_vertices: vertices removed by merging duplicates.
         removed_degenerate_faces: zero-area faces removed.
         removed_duplicate_faces: duplicate faces removed.
@@ -71,6 +91,15 @@ class RepairReport:
     n_vertices: int
     n_faces: int
     warnings: tuple[str, ...] = ()
+    extents_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    units_note: str = ""
+
+    @property
+    def size_text(self) -> str:
+        """The part's size and units in words, e.g. ``"0.203 x 0.305 x 0.013 m (file in mm)"``."""
+        dims = " x ".join(f"{v:.3g}" for v in self.extents_m)
+        how = "detected" if self.units_detected else "given"
+        return f"{dims} m (file units {self.units!r}, {how})"
 
 
 @dataclass(frozen=True)
@@ -93,26 +122,75 @@ class WorkObject:
         return static_body(client, shape, T_world_wobj, self.name)
 
 
+def _too_many(path: object, n: int) -> MeshError:
+    return MeshError(
+        f"{path}: {n:,} triangles; wobjcal takes at most {MAX_MESH_TRIANGLES:,} (planar-face "
+        "detection needs about 6 s and 1 GB per million): decimate it first (e.g. MeshLab's "
+        "quadric edge collapse)"
+    )
+
+
+def stl_triangle_count(path: Path, size: int) -> int | None:
+    """The triangle count of a binary STL from its header, ``None`` for an ASCII STL.
+
+    Raises:
+        MeshError: a binary STL whose size does not match its header (truncated, corrupt).
+    """
+    with path.open("rb") as handle:
+        head = handle.read(84)
+    if len(head) < 84:
+        if head.lstrip().lower().startswith(b"solid"):
+            return None
+        raise MeshError(f"{path}: {size} bytes is too short for an STL file (corrupt?)")
+    n = int.from_bytes(head[80:84], "little")
+    if size == 84 + 50 * n:
+        return n
+    if head.lstrip().lower().startswith(b"solid"):
+        return None  # ASCII (a binary STL may also start with "solid": then the size matches)
+    raise MeshError(
+        f"{path}: corrupt binary STL: its header says {n:,} triangles ({84 + 50 * n:,} bytes), "
+        f"the file has {size:,} bytes"
+    )
+
+
 def _read(source: str | Path | trimesh.Trimesh) -> tuple[trimesh.Trimesh, str]:
     if isinstance(source, trimesh.Trimesh):
         meta = source.metadata or {}
+        if len(source.faces) > MAX_MESH_TRIANGLES:
+            raise _too_many(meta.get("name") or "work object", len(source.faces))
         return source.copy(), str(meta.get("name") or "work object")
     if is_builtin(source):
         return builtin_mesh(str(source)), str(source)
     path = Path(source)
-    if not path.is_file():
-        raise MeshError(f"mesh file not found: {path}")
+    try:
+        size = check_regular_file(path, MAX_MESH_BYTES, "mesh file", MeshError)
+    except FileNotFoundError:
+        raise MeshError(f"mesh file not found: {path}") from None
+    if path.suffix.lower() == ".stl":
+        n = stl_triangle_count(path, size)
+        if n is not None and n > MAX_MESH_TRIANGLES:
+            raise _too_many(path, n)  # before a byte of geometry is parsed
     try:
         mesh = trimesh.load(str(path), force="mesh", process=False)
     except Exception as exc:  # trimesh raises many types for unreadable files
         raise MeshError(f"cannot read mesh file {path}: {exc}") from None
     if not isinstance(mesh, trimesh.Trimesh):
         raise MeshError(f"mesh file {path} holds no triangle mesh (got {type(mesh).__name__})")
+    if len(mesh.faces) == 0 and size > 0:
+        raise MeshError(
+            f"mesh file {path}: no triangle could be read from its {size:,} bytes (corrupt, or "
+            f"not a {path.suffix.lstrip('.').upper() or 'mesh'} file)"
+        )
+    if len(mesh.faces) > MAX_MESH_TRIANGLES:
+        raise _too_many(path, len(mesh.faces))
     return mesh, str(path)
 
 
 def load_work_object(
-    source: str | Path | trimesh.Trimesh, units: str = "auto", name: str | None = None
+    source: str | Path | trimesh.Trimesh,
+    units: str = "auto",
+    name: str | None = None,
+    reach_m: float | None = None,
 ) -> WorkObject:
     """Load, scale and lightly repair a work-object mesh.
 
@@ -122,6 +200,8 @@ def load_work_object(
         units: a unit of :mod:`calib.units` (``"m"``, ``"mm"``, ``"cm"``, ``"in"``, an alias
             such as ``"inch"``) or ``"auto"`` (see the module docstring).
         name: a short name; default the file stem.
+        reach_m: the robot's reach, m, for ``auto`` and the size warning; default
+            :data:`DEFAULT_REACH_M`.
 
     Raises:
         MeshError: missing or unreadable file, empty mesh, NaN/infinite vertices, bad units;
@@ -137,15 +217,17 @@ def load_work_object(
     if not np.all(np.isfinite(mesh.vertices)):
         raise MeshError(f"mesh {src} holds NaN or infinite vertex coordinates")
     warnings: list[str] = []
+    reach = DEFAULT_REACH_M if reach_m is None else float(reach_m)
+    extent = float(np.max(mesh.extents))
     detected = units == AUTO
     if detected:
-        extent = float(np.max(mesh.extents))
-        units = "mm" if extent > AUTO_MM_EXTENT else "m"
-        if units == "mm":
-            warnings.append(
-                f"{src}: largest extent {extent:.4g} > {AUTO_MM_EXTENT:g}, taken as millimetres "
-                f"(pass units='m' or 'in' if wrong)"
-            )
+        units, why = auto_units(extent, unit_hint(mesh, src), reach)
+        note = f"units 'auto' read as {units!r}: {why}"
+    else:
+        note = f"units {units!r} as given"
+        warning = implausible_units_warning(src, extent, units, reach)
+        if warning:
+            warnings.append(warning)
     n_v, n_f = len(mesh.vertices), len(mesh.faces)
     mesh.merge_vertices()
     merged = n_v - len(mesh.vertices)
@@ -170,6 +252,13 @@ def load_work_object(
         warnings.append(f"{src}: open mesh with {boundary} boundary edges; normals kept as given")
     scale = METRES_PER_UNIT[units]
     mesh.apply_scale(scale)
+    ext = tuple(float(v) for v in mesh.extents)
+    dims = " x ".join(f"{v:.3g}" for v in ext)
+    note = f"{src}: {note}; the part is {dims} m"
+    if detected:
+        warnings.insert(0, note)
+    else:
+        log.info(note)
     for w in warnings:
         log.warning(w)
     report = RepairReport(
@@ -186,6 +275,8 @@ def load_work_object(
         n_vertices=len(mesh.vertices),
         n_faces=len(mesh.faces),
         warnings=tuple(warnings),
+        extents_m=(ext[0], ext[1], ext[2]),
+        units_note=note,
     )
     stem = src.split(":", 1)[1] if is_builtin(src) else Path(src).stem or src
     return WorkObject(name=name or stem, mesh=mesh, report=report)

@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import argparse
+import math
+import sys
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 from rich.table import Table
 
+from calib.estimators.gross_errors import K_SIGMA
 from calib.frames import motion_between, quat_wxyz_from_matrix, tait_bryan_zyx_from_matrix
 from calib.plan.measurements import load_measurements
 from calib.procedures import METHODS
@@ -32,10 +35,16 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "hultman2013 replays the paper's A-H procedure with the recorded points; three_two_one\n"
         "uses the plan's 3-2-1 roles (or picks them from the faces); best_fit fits all points.\n"
         "Text output: origin (mm), Tait-Bryan z-y'-x'' angles (deg, paper eq. 7-9 = KUKA A, B,\n"
-        "C), quaternion (w, x, y, z), residuals (mm) and the ABB wobjdata and KUKA BASE_DATA\n"
-        "lines to paste. --json prints T_base_wobj (4x4), origin_m, tait_bryan_zyx_deg,\n"
-        "quat_wxyz and residuals_m.\n\n"
-        "exit codes: 0 ok, 2 bad input (file, missing point, layout the method cannot use)",
+        "C), quaternion (w, x, y, z), 1 sigma per degree of freedom, residuals (mm) and the ABB\n"
+        "wobjdata and KUKA BASE_DATA lines to paste. --json prints T_base_wobj (4x4),\n"
+        "origin_m, tait_bryan_zyx_deg, quat_wxyz, residuals_m, covariance (6x6) and sigma.\n\n"
+        "Every result is screened first: all points are fitted by least squares and a point off\n"
+        "its face by more than K sigma of the noise the plan expects (its sensor and robot\n"
+        "error models and the planar-face flatness) is flagged, the point to re-measure named\n"
+        "by leave-one-out; a frame beyond the plan's misplacement bound is flagged too. Then\n"
+        "nothing is printed to paste (and --json leaves out the frame) unless --force.\n\n"
+        "exit codes: 0 ok, 1 gross error or frame beyond the misplacement bound (named on\n"
+        "stderr), 2 bad input (file, missing point, layout the method cannot use)",
         "wobjcal calibrate plan.json measured.json\n"
         "wobjcal calibrate plan.json measured.json --method best_fit --json",
     )
@@ -43,19 +52,47 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
     p.add_argument("measured", metavar="MEASURED", help="measurements (wobjcal.measurements/1)")
     p.add_argument("--method", choices=METHODS, help="method (default: the plan's procedure)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument(
+        "--k-sigma",
+        type=positive_float,
+        default=K_SIGMA,
+        metavar="K",
+        help=f"flag points off their face by more than K sigma (default {K_SIGMA:g})",
+    )
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="print the frame to paste even when the screen flags it (exit 0)",
+    )
     p.set_defaults(handler=cmd_calibrate)
 
 
-def result_json(out: CalibrationOutput) -> dict[str, Any]:
-    """The JSON of a calibration (metres, degrees)."""
+def positive_float(text: str) -> float:
+    """An argparse ``type`` for a finite number > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text!r}")
+    return value
+
+
+def result_json(out: CalibrationOutput, with_frame: bool = True) -> dict[str, Any]:
+    """The JSON of a calibration (metres, degrees).
+
+    Args:
+        out: the calibration.
+        with_frame: include the frame (``T_base_wobj``, ``origin_m``, angles, quaternion);
+            ``False`` for an untrusted result printed without ``--force``.
+    """
     T = out.T_base_wobj
     delta = motion_between(out.T_base_wobj_nominal, T)
-    return {
+    data: dict[str, Any] = {
         "method": out.method,
-        "T_base_wobj": T.tolist(),
-        "origin_m": T[:3, 3].tolist(),
-        "tait_bryan_zyx_deg": np.degrees(tait_bryan_zyx_from_matrix(T[:3, :3])).tolist(),
-        "quat_wxyz": quat_wxyz_from_matrix(T[:3, :3]).tolist(),
+        "trusted": out.trusted,
+        "problems": list(out.problems),
+        "notes": list(out.notes),
         "residuals_m": out.residuals_m,
         "edge_residuals_m": out.edge_residuals_m,
         "used_points": list(out.used_ids),
@@ -65,9 +102,41 @@ def result_json(out: CalibrationOutput) -> dict[str, Any]:
             "rotation_deg": float(np.degrees(np.linalg.norm(delta[3:]))),
         },
     }
+    if out.screen is not None:
+        s = out.screen
+        data["screen"] = {
+            "sigma_m": s.sigma_m,
+            "k_sigma": s.k_sigma,
+            "limit_m": s.limit_m,
+            "redundancy": s.redundancy,
+            "fit_residuals_m": {k: list(v) for k, v in s.residuals_m.items()},
+            "flagged": list(s.flagged),
+            "remeasure": list(s.remeasure),
+        }
+    if out.covariance is not None and out.sigma_dof is not None:
+        sd = out.sigma_dof
+        data["covariance"] = {
+            "order": ["dx_m", "dy_m", "dz_m", "rx_rad", "ry_rad", "rz_rad"],
+            "frame": "calibrated wobj axes",
+            "matrix": out.covariance.tolist(),
+        }
+        data["sigma"] = {
+            "x_m": sd[0],
+            "y_m": sd[1],
+            "z_m": sd[2],
+            "rx_deg": float(np.degrees(sd[3])),
+            "ry_deg": float(np.degrees(sd[4])),
+            "rz_deg": float(np.degrees(sd[5])),
+        }
+    if with_frame:
+        data["T_base_wobj"] = T.tolist()
+        data["origin_m"] = T[:3, 3].tolist()
+        data["tait_bryan_zyx_deg"] = np.degrees(tait_bryan_zyx_from_matrix(T[:3, :3])).tolist()
+        data["quat_wxyz"] = quat_wxyz_from_matrix(T[:3, :3]).tolist()
+    return data
 
 
-def _print_text(out: CalibrationOutput) -> None:
+def _print_text(out: CalibrationOutput, paste: bool) -> None:
     con = stdout()
     T = out.T_base_wobj
     o = T[:3, 3] * 1e3
@@ -84,6 +153,13 @@ def _print_text(out: CalibrationOutput) -> None:
         f"  vs nominal   {np.linalg.norm(delta[:3]) * 1e3:.3f} mm, "
         f"{np.degrees(np.linalg.norm(delta[3:])):.4f} deg"
     )
+    sd = out.sigma_dof
+    if sd is not None:
+        con.print(
+            f"  1 sigma      x {sd[0] * 1e3:.3f}  y {sd[1] * 1e3:.3f}  z {sd[2] * 1e3:.3f} mm, "
+            f"rx {np.degrees(sd[3]):.4f}  ry {np.degrees(sd[4]):.4f}  rz {np.degrees(sd[5]):.4f} "
+            "deg (noise the plan expects)"
+        )
     table = Table(title="residuals (distance from the face of the calibrated part)")
     table.add_column("point")
     table.add_column("face [mm]", justify="right")
@@ -92,6 +168,11 @@ def _print_text(out: CalibrationOutput) -> None:
         e = out.edge_residuals_m.get(pid)
         table.add_row(pid, f"{r * 1e3:+.3f}", "" if e is None else f"{e * 1e3:+.3f}")
     con.print(table)
+    if not paste:
+        con.print("[red]not trusted: nothing to paste (see stderr; --force prints it anyway)[/]")
+        return
+    if not out.trusted:
+        con.print("[red]NOT TRUSTED (printed because of --force):[/]")
     con.print("ABB RAPID (world frame = robot base):")
     con.print(
         f'  PERS wobjdata wobjCalibrated:=[FALSE,TRUE,"",{pose_text(T)},[[0,0,0],[1,0,0,0]]];',
@@ -105,9 +186,14 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     """Compute and print the calibrated frame."""
     plan, _ = read_plan(args.plan)
     measurements = load_measurements(args.measured)
-    out = calibrate_plan(plan, measurements, args.method)
+    out = calibrate_plan(plan, measurements, args.method, k_sigma=args.k_sigma)
+    paste = out.trusted or args.force
+    for note in out.notes:
+        print(f"wobjcal calibrate: note: {note}", file=sys.stderr)
+    for problem in out.problems:
+        print(f"wobjcal calibrate: {problem}", file=sys.stderr)
     if args.json:
-        print_json(result_json(out))
+        print_json(result_json(out, with_frame=paste))
     else:
-        _print_text(out)
-    return 0
+        _print_text(out, paste)
+    return 0 if paste else 1

@@ -30,8 +30,11 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "Check every probe point of the plan (IK, joint limits, collisions, clearance), its\n"
         "search path from start to end of travel, and that it lies on a planar face with the\n"
         "sensor footprint on it, in the plan's cell. Prints a table, or JSON with --json.\n\n"
+        "The procedure's own preconditions are checked too: every role it needs, and a dry\n"
+        "run of 'wobjcal calibrate' on exact measurements of the nominal points (so a plan the\n"
+        "calibration would refuse fails here, before the robot measures).\n\n"
         "exit codes: 0 all feasible (marginal points are reported but pass), 1 any point or\n"
-        "path infeasible (each named with the reason), 2 bad input",
+        "path infeasible or the layout refused (each named with the reason), 2 bad input",
         "wobjcal check assets/plans/stator_section_ah.json\n"
         "wobjcal check plan.json --json > check.json",
     )
@@ -78,6 +81,8 @@ def cmd_check(args: argparse.Namespace) -> int:
     check = check_plan(plan, plan_dir)
     if check.error:
         print(f"wobjcal check: {check.error}", file=sys.stderr)
+    if check.layout:
+        print(f"wobjcal check: layout: {check.layout}", file=sys.stderr)
     bad = check.infeasible
     if args.json:
         print_json({"plan": args.plan, **check.to_json()})
@@ -88,9 +93,12 @@ def cmd_check(args: argparse.Namespace) -> int:
     out.print(_table(check, f"wobjcal check {args.plan}"))
     for p in bad:
         out.print(f"[red]point {p.point_id}: {p.status}: {p.reason or 'not feasible'}[/]")
+    if check.layout:
+        out.print(f"layout: {check.layout}", style="red", markup=False)
     n = len(check.points)
     out.print(
         f"{n - len(bad)} of {n} points feasible"
         + ("" if not bad else f"; not feasible: {', '.join(p.point_id for p in bad)}")
+        + ("; the layout is refused (see above)" if check.layout else "")
     )
     return 0 if check.feasible else 1

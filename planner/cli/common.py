@@ -16,8 +16,8 @@ from rich.console import Console
 from calib.plan.file import Plan, load_plan
 
 
-def count_arg(minimum: int) -> Callable[[str], int]:
-    """An argparse ``type`` for whole numbers ``>= minimum`` (clear message otherwise)."""
+def count_arg(minimum: int, maximum: int | None = None) -> Callable[[str], int]:
+    """An argparse ``type`` for whole numbers ``>= minimum`` (and ``<= maximum``)."""
 
     def parse(text: str) -> int:
         try:
@@ -26,6 +26,9 @@ def count_arg(minimum: int) -> Callable[[str], int]:
             raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
         if value < minimum:
             raise argparse.ArgumentTypeError(f"must be >= {minimum}, got {value}")
+        if maximum is not None and value > maximum:
+            shown = f"{value:,}" if value < 10**15 else f"{value:.3g}"
+            raise argparse.ArgumentTypeError(f"must be at most {maximum:,}, got {shown}")
         return value
 
     return parse
@@ -72,7 +75,7 @@ def stdout() -> Console:
 
 def stderr() -> Console:
     """A console on the current ``sys.stderr`` for progress and notes."""
-    return Console(file=sys.stderr, highlight=False)
+    return Console(file=sys.stderr, highlight=False, soft_wrap=True)
 
 
 def read_plan(path: str) -> tuple[Plan, Path]:

@@ -26,8 +26,11 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "confdata, noted in the program). FILE gets the format's first file; further files\n"
         "(KRL's .dat) go beside it: "
         + "; ".join(f"{f.name}: {' + '.join(f.suffixes)}" for f in FORMATS.values())
-        + ".\nExit 1 (nothing written) when the check finds an infeasible point, naming it;\n"
-        "--force writes the program anyway.",
+        + ".\nExit 1 (nothing written) when the check finds an infeasible point, or the plan's\n"
+        "procedure refuses its points (e.g. an A-H plan without a role, which would run as a\n"
+        "plain non-adaptive program), naming it; --force writes the program anyway. A file\n"
+        "is written like cp writes it: through a symbolic link, never over a read-only file,\n"
+        "never half (atomic, no temporary file left behind).",
         "wobjcal export plan.json --format rapid -o WobjcalStator.mod\n"
         "wobjcal export plan.json --format krl -o wobjcal_stator.src",
     )
@@ -65,15 +68,23 @@ def cmd_export(args: argparse.Namespace) -> int:
     from planner.export_plan import export_program  # PyBullet: not for ``wobjcal --help``
 
     result = export_program(plan, plan_dir, args.format, run_check=not args.no_check)
-    if result.check is not None and not result.check.feasible and not args.force:
-        if result.check.error:
-            stderr().print(f"error: {result.check.error}")
-        for p in result.check.infeasible:
-            stderr().print(f"error: point {p.point_id} is not feasible: {p.reason or p.status}")
-        stderr().print("nothing written; fix the plan, or export anyway with --force")
+    refused = result.layout or (result.check is not None and not result.check.feasible)
+    if refused and not args.force:
+        err = stderr()
+        if result.layout:
+            err.print(f"error: layout: {result.layout}", markup=False)
+        if result.check is not None:
+            if result.check.error:
+                err.print(f"error: {result.check.error}", markup=False)
+            for p in result.check.infeasible:
+                err.print(
+                    f"error: point {p.point_id} is not feasible: {p.reason or p.status}",
+                    markup=False,
+                )
+        err.print("nothing written; fix the plan, or export anyway with --force")
         return 1
     if result.notes:
-        stderr().print("note: " + "; ".join(result.notes))
+        stderr().print("note: " + "; ".join(result.notes), markup=False)
     files = result.files
     written = []
     for i, (suffix, text) in enumerate(files.items()):

@@ -12,14 +12,39 @@ import argparse
 import contextlib
 import logging
 import os
+import signal
 import sys
+import threading
 from collections.abc import Callable, Sequence
+from typing import NoReturn
 
 from calib._version import __version__
 from calib.errors import WobjcalError
 from planner.cli.common import native_output_to_stderr
 
 EXIT_OK, EXIT_FAIL, EXIT_INPUT = 0, 1, 2
+#: Exit code after SIGTERM (128 + 15, as a shell reports it).
+EXIT_TERMINATED = 143
+
+
+class Terminated(BaseException):
+    """Raised in the main thread when the process gets SIGTERM: ``finally`` blocks run (worker
+    processes stopped, temporary files removed) before the command exits 143."""
+
+
+def _raise_terminated(signum: int, frame: object) -> None:
+    raise Terminated()
+
+
+def _exit_now(code: int) -> NoReturn:
+    """Leave at once after SIGTERM, once the main thread has cleaned up (``finally`` blocks ran
+    while :class:`Terminated` propagated): the interpreter's normal exit would wait for helper
+    threads (a process pool's manager, a progress bar) that a terminated command must not."""
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    os._exit(code)
+
 
 _FORMATTER = argparse.RawDescriptionHelpFormatter
 
@@ -84,9 +109,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command is None:
         parser.print_help(sys.stdout)
         return EXIT_OK
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _raise_terminated)
     try:
         with native_output_to_stderr():
             return _run(args)
+    except Terminated:
+        print(f"wobjcal {args.command}: terminated", file=sys.stderr)
+        _exit_now(EXIT_TERMINATED)
     except BrokenPipeError:  # e.g. `wobjcal check --json plan.json | head`: the reader left
         with contextlib.suppress(OSError):
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
@@ -111,3 +142,6 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return EXIT_INPUT
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)

@@ -56,8 +56,31 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
                 help="write the built-in A-H plan to FILE instead of starting the UI",
             )
         p.add_argument("--host", default="127.0.0.1", help="interface to bind (default 127.0.0.1)")
-        p.add_argument("--port", type=int, default=8080, help="TCP port (default 8080)")
+        p.add_argument(
+            "--port",
+            type=port_arg,
+            default=8080,
+            help="TCP port 0-65535 (default 8080; 0: any free port); when it is busy the next "
+            "free one is used and printed",
+        )
+        p.add_argument(
+            "--fresh",
+            action="store_true",
+            help="start from the plan even when a newer autosave of the last session exists "
+            "(it is kept as .bak); by default it is restored, and said so",
+        )
         p.set_defaults(handler=cmd_ui)
+
+
+def port_arg(text: str) -> int:
+    """An argparse ``type`` for a TCP port 0-65535."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"must be 0-65535 (0: any free port), got {value}")
+    return value
 
 
 def cmd_schema(args: argparse.Namespace) -> int:
@@ -74,7 +97,7 @@ def cmd_schema(args: argparse.Namespace) -> int:
 
 
 def cmd_ui(args: argparse.Namespace) -> int:
-    """Start the web UI (``webui.app.run``), imported only here."""
+    """Start the web UI (``webui.server.run``), imported only here."""
     write_plan = getattr(args, "write_plan", None)
     if write_plan:
         from planner.demo import stator_plan_text
@@ -86,13 +109,21 @@ def cmd_ui(args: argparse.Namespace) -> int:
     if plan is not None:
         load_plan(plan)  # a clear error now, before a server starts
 
-    from webui.app import run  # the one place planner imports webui (viser), lazily
-    from webui.state import default_autosave_path
+    from webui.server import run, serve  # the one place planner imports webui (viser), lazily
 
-    stderr().print(
-        f"wobjcal UI on http://{args.host}:{args.port} "
-        f"({plan or 'built-in demo ' + DEMO_PLAN.name}); Ctrl-C stops it\n"
-        f"the session plan autosaves to {default_autosave_path(plan, args.port)}"
+    app = run(plan, host=args.host, port=args.port, block=False, fresh=args.fresh)
+    bound = app.server.get_port()
+    err = stderr()
+    if args.port not in (0, bound):
+        err.print(f"port {args.port} is busy: serving on {bound}", markup=False)
+    err.print(
+        f"wobjcal UI on http://{args.host}:{bound} "
+        f"({plan or 'built-in demo ' + DEMO_PLAN.name}); Ctrl-C stops it",
+        markup=False,
     )
-    run(plan, host=args.host, port=args.port, block=True)
+    if app.state.autosave_path is not None:
+        err.print(f"the session plan autosaves to {app.state.autosave_path}", markup=False)
+    if app.autosave_note:
+        err.print(app.autosave_note, markup=False)
+    serve(app)
     return 0

@@ -13,7 +13,11 @@ from typing import TYPE_CHECKING, Any
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from calib.atomic_io import write_text_atomic
+from calib.plan.models import MAX_SEED, MAX_TRIALS
 from planner.cli.common import count_arg, read_plan, stderr, stdout
+
+#: Most worker processes a validation may start.
+MAX_WORKERS = 64
 
 if TYPE_CHECKING:
     from planner.sim.report import ValidationReport
@@ -50,9 +54,19 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "wobjcal validate plan.json --protocol 20x20 --sensitivity",
     )
     p.add_argument("plan", metavar="PLAN", help="plan file (wobjcal.plan/1)")
-    p.add_argument("--trials", type=count_arg(1), help="number of trials (default: the plan's)")
-    p.add_argument("--seed", type=count_arg(0), help="random seed >= 0 (default: the plan's)")
-    p.add_argument("--workers", type=count_arg(1), help="worker processes (default: up to 2)")
+    p.add_argument(
+        "--trials",
+        type=count_arg(2, MAX_TRIALS),
+        help=f"number of trials, 2 to {MAX_TRIALS:,} (default: the plan's)",
+    )
+    p.add_argument(
+        "--seed", type=count_arg(0, MAX_SEED), help="random seed >= 0 (default: the plan's)"
+    )
+    p.add_argument(
+        "--workers",
+        type=count_arg(1, MAX_WORKERS),
+        help=f"worker processes, at most {MAX_WORKERS} (default: up to 2)",
+    )
     p.add_argument(
         "--reach-trials",
         type=count_arg(0),

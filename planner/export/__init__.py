@@ -5,7 +5,8 @@ Owns:
       formats: the nominal work object, the sensor tool, one :class:`TargetPair` per point,
       the safe starts and the adaptive A-H spec) and :func:`~planner.export.job.build_job`;
     - :mod:`planner.export.safety`: safe search starts under the plan's misplacement;
-    - :mod:`planner.export.text`: identifiers, numbers and header comments shared by writers;
+    - :mod:`planner.export.text`: identifiers, numbers, and names made safe for comments and
+      string literals, shared by writers;
     - one module per language: ``rapid`` (+ ``rapid_probe``, ``rapid_adaptive``,
       ``rapid_write``), ``krl``, ``urscript``, ``fanuc`` (FANUC TP ``.ls``);
     - the registry :data:`FORMATS` and :func:`export_files`.

@@ -8,7 +8,10 @@ z-y'-x'' angles with (alpha, beta, gamma) = (R, P, W)
 into ``PR[PR_UFRAME]`` and sets ``UFRAME[UFRAME_NO]`` from it (relative to WORLD, taken to be the
 robot base of the plan, as KRL takes ``$WORLD``), and the sensor TCP into ``PR[PR_UTOOL]`` ->
 ``UTOOL[UTOOL_NO]``; every ``P[]`` is a sensor-TCP pose in that user frame with that tool, with
-``CONFIG 'N U T, 0, 0, 0'`` (the check's ABB confdata does not carry over: verify in T1).
+the ``CONFIG`` of the robot's configuration there (:func:`config_text`: flip, up, top and the
+turn numbers of :data:`TURN_AXES`, from the IK solution at that target next to the pose
+``wobjcal check`` chose). Without a checked pose the configuration cannot be derived and the
+export is refused (:class:`calib.errors.InputError`), never written as a guess.
 
 Every search runs in the nominal user frame (not adaptive; the frame comes from ``wobjcal
 calibrate``) and starts at the safe start of :mod:`planner.export.safety`. A search is
@@ -30,15 +33,43 @@ counts), user frames 1-9 and tool frames 1-10.
 
 from __future__ import annotations
 
-import re
-import textwrap
-
 import numpy as np
 
 from calib._version import __version__
 from calib.errors import InputError
-from calib.frames import tait_bryan_zyx_from_matrix
-from planner.export.job import ExportJob, TargetPair, fmt, identifier, safety_header
+from planner.export.fanuc_text import (
+    COMMENT_MAX,
+    JOINT_PCT,
+    LINEAR_MM_S,
+    NAME_MAX,
+    POS_COMMENT_MAX,
+    TURN_AXES,
+    _ascii_ident,
+    _const,
+    _pos_num,
+    comment_lines,
+    config_text,
+    program_name,
+    turn_number,
+    wpr_deg,
+    xyzwpr,
+)
+from planner.export.job import ExportJob, TargetPair, safety_header
+from planner.export.text import fmt
+
+__all__ = [
+    "COMMENT_MAX",
+    "NAME_MAX",
+    "POS_COMMENT_MAX",
+    "TURN_AXES",
+    "comment_lines",
+    "config_text",
+    "export_fanuc",
+    "program_name",
+    "turn_number",
+    "wpr_deg",
+    "xyzwpr",
+]
 
 #: User frame of the nominal work object (``UFRAME[9]``).
 UFRAME_NO = 9
@@ -67,58 +98,6 @@ PR_COUNT = 100
 R_COUNT = 200
 #: Most points one program can probe (PR[11..100]).
 MAX_POINTS = min(PR_COUNT - PR_MEAS_BASE, R_COUNT - R_CODE_BASE)
-#: Program name, comment and position-comment lengths relied on.
-NAME_MAX = 36
-COMMENT_MAX = 32
-POS_COMMENT_MAX = 16
-#: Joint speed to the safe starts (%), linear speed of the moves that are no search (mm/sec).
-JOINT_PCT = 20
-LINEAR_MM_S = 100
-#: Configuration written on every position (flip, up, top; turns of J4, J5, J6).
-CONFIG = "N U T, 0, 0, 0"
-
-_NOT_IN_COMMENT = re.compile(r"[^A-Za-z0-9 _+*/=.,:()<>\[\]#%&?@-]")
-
-
-def program_name(name: str) -> str:
-    """A TP program name made of ``name``: upper case, ``[A-Z][A-Z0-9_]*``, at most 36 chars."""
-    ident = re.sub(r"[^A-Z0-9_]", "_", name.upper())
-    if not ident[:1].isalpha():
-        ident = "W" + ident
-    return ident[:NAME_MAX]
-
-
-def comment_lines(text: str) -> list[str]:
-    """``text`` as TP comment texts: printable ASCII without ``;``, quotes or ``!``, wrapped to
-    :data:`COMMENT_MAX` characters (the ``!`` and `` ;`` around them not counted)."""
-    text = re.sub(r"\s+", " ", text.replace(";", ",").replace("'s ", " "))
-    clean = _NOT_IN_COMMENT.sub("", text)
-    return textwrap.wrap(clean, COMMENT_MAX, break_on_hyphens=False)
-
-
-def wpr_deg(R: np.ndarray) -> tuple[float, float, float]:
-    """FANUC ``(W, P, R)`` in degrees of a rotation matrix: ``R = Rz(R) @ Ry(P) @ Rx(W)``."""
-    alpha, beta, gamma = np.degrees(tait_bryan_zyx_from_matrix(R))
-    return float(gamma), float(beta), float(alpha)
-
-
-def xyzwpr(T: np.ndarray) -> list[float]:
-    """``[X, Y, Z, W, P, R]`` of a transform in metres: mm and degrees."""
-    return [*(float(v) * 1000.0 for v in T[:3, 3]), *wpr_deg(T[:3, :3])]
-
-
-def _const(x: float) -> str:
-    """A TP numeric constant (6 decimals; a negative one in parentheses, ``(-1.5)``)."""
-    s = fmt(x, 6)
-    return f"({s})" if s.startswith("-") else s
-
-
-def _pos_num(x: float) -> str:
-    return f"{0.0 if abs(x) < 5e-7 else x:.6f}"
-
-
-def _ascii_ident(text: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_]", "_", identifier(text))
 
 
 class _Program:
@@ -134,14 +113,26 @@ class _Program:
     def comment(self, text: str) -> None:
         self.lines += ["!" + c for c in comment_lines(text)]
 
-    def position(self, T: np.ndarray, label: str) -> int:
-        """Add the sensor-TCP pose ``T`` (user frame, m) as the next ``P[n]``; return ``n``."""
+    def position(self, t: TargetPair, kind: str, label: str) -> int:
+        """Add the sensor-TCP pose of target ``kind`` of ``t`` (user frame) as the next
+        ``P[n]`` with its configuration; return ``n``.
+
+        Raises:
+            InputError: the robot's configuration there is not known (no checked pose).
+        """
+        arm = t.arm_pose(kind)
+        if arm is None:
+            raise InputError(
+                f"FANUC export: point {_ascii_ident(t.point_id)}: no checked robot pose at its "
+                f"{kind} target, so its CONFIG cannot be derived (export with the check, on a "
+                "6-axis arm with a spherical wrist, and a feasible pose for every point)"
+            )
         n = len(self.positions) + 1
-        x, y, z, w, p, r = (_pos_num(v) for v in xyzwpr(T))
+        x, y, z, w, p, r = (_pos_num(v) for v in xyzwpr(t.target(kind)))
         self.positions.append(
             f'P[{n}:"{label[:POS_COMMENT_MAX]}"]{{\n'
             "   GP1:\n"
-            f"\tUF : {UFRAME_NO}, UT : {UTOOL_NO},\t\tCONFIG : '{CONFIG}',\n"
+            f"\tUF : {UFRAME_NO}, UT : {UTOOL_NO},\t\tCONFIG : '{config_text(arm)}',\n"
             f"\tX = {x}  mm,\tY = {y}  mm,\tZ = {z}  mm,\n"
             f"\tW = {w} deg,\tP = {p} deg,\tR = {r} deg\n"
             "};"
@@ -245,8 +236,10 @@ def _header(prog: _Program, job: ExportJob, name: str) -> None:
         "below, and write a wobjcal.measurements/1 file (frame base, units mm) for wobjcal "
         "calibrate.",
         f"Overwrites PR[{PR_UFRAME}]..PR[{PR_FACE}], PR[{first}]..PR[{last}], "
-        f"R[{R_TMP[0]}]..R[{R_TMP[1]}], R[{R_CODE_BASE + 1}]..R[{R_CODE_BASE + n}]. CONFIG "
-        f"{CONFIG} on every position, not from the check: run the first time in T1. Limits "
+        f"R[{R_TMP[0]}]..R[{R_TMP[1]}], R[{R_CODE_BASE + 1}]..R[{R_CODE_BASE + n}]. CONFIG of "
+        "every position from the pose wobjcal check chose (turn numbers of "
+        + ", ".join(f"J{a}" for a in TURN_AXES)
+        + ": check $SCR_GRP[1].$TURN_AXIS); run the first time in T1. Limits "
         f"assumed: name {NAME_MAX}, comment {COMMENT_MAX} chars, PR[1..{PR_COUNT}], "
         f"R[1..{R_COUNT}].",
     ):
@@ -260,7 +253,7 @@ def _point(prog: _Program, i: int, t: TargetPair) -> None:
     code, meas, label = R_CODE_BASE + i, PR_MEAS_BASE + i, i
     speed = max(1, round(t.speed_m_s * 1000.0))
     keep = POS_COMMENT_MAX - 6
-    safe = prog.position(t.safe_start, f"{ident[:keep]} safe")
+    safe = prog.position(t, "safe", f"{ident[:keep]} safe")
     prog.comment(f"--- point {i} {ident}: {t.kind} search")
     prog.add(f"J P[{safe}] {JOINT_PCT}% FINE")
     prog.add(f"R[{code}]=2")
@@ -268,12 +261,12 @@ def _point(prog: _Program, i: int, t: TargetPair) -> None:
     prog.add(f"R[{code}]=1")
     prog.add(f"SKIP CONDITION DI[{SENSOR_DI}]=ON")
     if t.kind == "approach":
-        end = prog.position(t.T_wobj_end, f"{ident[:keep]} end")
+        end = prog.position(t, "end", f"{ident[:keep]} end")
         prog.add(f"L P[{end}] {speed}mm/sec FINE Skip,LBL[{label}],PR[{meas}]=LPOS")
     else:
-        face = prog.position(t.face_end, f"{ident[:keep]} face")
-        start = prog.position(t.T_wobj_start, f"{ident[:keep]} start")
-        end = prog.position(t.T_wobj_end, f"{ident[:keep]} end")
+        face = prog.position(t, "face", f"{ident[:keep]} face")
+        start = prog.position(t, "start", f"{ident[:keep]} start")
+        end = prog.position(t, "end", f"{ident[:keep]} end")
         prog.add(f"L P[{face}] {speed}mm/sec FINE Skip,LBL[{label}],PR[{PR_FACE}]=LPOS")
         prog.comment("edge start: the measured face point, plan orientation")
         s, e = PR_EDGE_START, PR_EDGE_END

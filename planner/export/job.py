@@ -9,7 +9,6 @@ orientations and configurations chosen by ``wobjcal check``.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -22,10 +21,33 @@ from calib.plan.file import Plan
 from calib.probing import SearchCommand
 from calib.procedures import procedure_kind
 from planner.export.safety import SafetySpec
+from planner.export.text import module_name
 
 FloatArray = NDArray[np.float64]
 #: ABB ``confdata`` (cf1, cf4, cf6, cfx).
 ConfData = tuple[int, int, int, int]
+
+
+@dataclass(frozen=True)
+class ArmPose:
+    """The robot's joint values and configuration at one target (from the checked pose).
+
+    Attributes:
+        q_rad: ``(n,)`` joint values, rad, in the robot URDF's joint directions.
+        front: the wrist centre lies in front of axis 1 (FANUC ``T``, KUKA status bit 0 = 0).
+        elbow_up: the elbow bent forward (FANUC ``U``, KUKA status bit 1 = 1).
+        wrist_flipped: axis 5 bent against ABB's positive direction (FANUC ``F``, KUKA status
+            bit 2 = 1); see :func:`planner.robot.kinematics.branches.posture`.
+    """
+
+    q_rad: tuple[float, ...]
+    front: bool
+    elbow_up: bool
+    wrist_flipped: bool
+
+
+#: The targets of one search a writer may place, each with its :class:`ArmPose`.
+TARGET_KINDS = ("start", "end", "safe", "face")
 
 
 @dataclass(frozen=True)
@@ -47,6 +69,9 @@ class TargetPair:
             moved out along the normal (the approach to the face the edge search runs along).
         T_wobj_face: ``(4, 4)`` end of that approach search, wobj frame, m (for an approach
             point the plan's end, for an edge point past the face by the safe overtravel).
+        arm: ``{kind: ArmPose}`` the robot's joint values and configuration at each target of
+            :data:`TARGET_KINDS` (from IK next to the checked pose), or ``None`` without a
+            check (or for robots that are not 6-axis OPW arms).
     """
 
     point_id: str
@@ -59,6 +84,20 @@ class TargetPair:
     normal_wobj: tuple[float, float, float] = (0.0, 0.0, 1.0)
     T_wobj_safe: FloatArray | None = None
     T_wobj_face: FloatArray | None = None
+    arm: Mapping[str, ArmPose] | None = None
+
+    def target(self, kind: str) -> FloatArray:
+        """``(4, 4)`` the target of ``kind`` (one of :data:`TARGET_KINDS`), wobj frame."""
+        return {
+            "start": self.T_wobj_start,
+            "end": self.T_wobj_end,
+            "safe": self.safe_start,
+            "face": self.face_end,
+        }[kind]
+
+    def arm_pose(self, kind: str) -> ArmPose | None:
+        """The :class:`ArmPose` at the target of ``kind``, or ``None`` when not known."""
+        return None if self.arm is None else self.arm.get(kind)
 
     @property
     def safe_start(self) -> FloatArray:
@@ -139,20 +178,6 @@ class ExportJob:
     sensor_input: str = "diSensor"
     safety: SafetySpec = field(default_factory=SafetySpec)
     adaptive: AdaptiveSpec | None = None
-
-
-def identifier(text: str, prefix: str = "p") -> str:
-    """A robot-language identifier made of ``text``: letters, digits and ``_`` only."""
-    ident = re.sub(r"\W", "_", text)
-    if not ident or not ident[0].isalpha():
-        ident = prefix + ident
-    return ident
-
-
-def module_name(plan_name: str) -> str:
-    """``"stator_section_ah"`` -> ``"WobjcalStatorSectionAh"`` (max 32 characters)."""
-    words = re.split(r"[^A-Za-z0-9]+", plan_name)
-    return ("Wobjcal" + "".join(w[:1].upper() + w[1:] for w in words if w))[:32]
 
 
 def default_sensor_rotation(
@@ -290,9 +315,3 @@ def safety_header(job: ExportJob, prefix: str, width: int = 92) -> list[str]:
         "travel * sin(angle)."
     )
     return [prefix + line for line in textwrap.wrap(text, width - len(prefix))]
-
-
-def fmt(x: float, decimals: int = 4) -> str:
-    """A number for program text: fixed decimals, no ``-0``, trailing zeros trimmed."""
-    s = f"{x:.{decimals}f}".rstrip("0").rstrip(".")
-    return "0" if s in ("-0", "") else s

@@ -31,8 +31,9 @@ import math
 from calib.paper.settings import XOffsetRun
 from calib.paper.stator_layout import STATOR_POINT_IDS as ROLES
 from calib.paper.xoffset import xoffset_probe_points
-from planner.export.job import AdaptiveSpec, ExportJob, fmt
+from planner.export.job import AdaptiveSpec, ExportJob
 from planner.export.rapid_probe import WOBJ
+from planner.export.text import fmt
 
 
 def _adaptive(job: ExportJob) -> AdaptiveSpec:

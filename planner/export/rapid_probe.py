@@ -11,7 +11,8 @@ a measured point passed in (``startBase``, base frame). ``measured{i}`` is in th
 
 from __future__ import annotations
 
-from planner.export.job import TargetPair, fmt
+from planner.export.job import TargetPair
+from planner.export.text import fmt, literal_text
 
 #: The wobjdata every search is commanded in.
 WOBJ = "wobjCal"
@@ -52,7 +53,7 @@ def _handler(t: TargetPair, safe: str, edge_stage: bool) -> list[str]:
         "            RAISE;",
         "        ENDIF",
         "        measuredOk{i}:=FALSE;",
-        f'        TPWrite "wobjcal: point {t.point_id} failed: "+measuredErr{{i}};',
+        f'        TPWrite "wobjcal: point {literal_text(t.point_id)} failed: "+measuredErr{{i}};',
         f"        MoveL {safe},vApproach,fine,{wobj};",
         "        IF bStopOnFail Stop;",
         "        RETURN;",

@@ -164,7 +164,7 @@ def check_probe_faces(
         elif dist[i] > max_distance_m:
             reason = f"point is {dist[i] * 1e3:.2f} mm from the surface"
         elif f < 0:
-            reason = "not on a planar face (curved, noisy or too small a flat region there)"
+            reason = pf.why_not_at(int(tri[i]), footprint_radius_m)
         elif not footprint_ok[i]:
             reason = (
                 f"footprint over a hole/edge: {n_off[i]} of {n_samples} points of the "

@@ -41,6 +41,7 @@ import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
+from calib.tolerances import FACE_ANGLE_TOL_RAD, FACE_FLATNESS_RMS_M, FACE_MAX_DEVIATION_M
 from calib.validation import check_points
 from planner.errors import MeshError
 from planner.faces.footprint import DEFAULT_FOOTPRINT_RADIUS_M, holds_footprint
@@ -54,12 +55,13 @@ IntArray = NDArray[np.int64]
 
 #: Default smallest face area: the sensor footprint, m^2.
 MIN_AREA_M2 = math.pi * DEFAULT_FOOTPRINT_RADIUS_M**2
-#: Default largest angle between triangle normals (and to the fitted plane) in a face, rad.
-ANGLE_TOL_RAD = math.radians(3.0)
+#: Default largest angle between triangle normals (and to the fitted plane) in a face, rad
+#: (the one table of tolerances, :mod:`calib.tolerances`).
+ANGLE_TOL_RAD = FACE_ANGLE_TOL_RAD
 #: Default largest RMS distance of a face from its fitted plane, m.
-FLATNESS_TOL_M = 1.0e-4
+FLATNESS_TOL_M = FACE_FLATNESS_RMS_M
 #: Default largest distance of any vertex of a face from its fitted plane, m.
-MAX_DEVIATION_M = 5.0e-4
+MAX_DEVIATION_M = FACE_MAX_DEVIATION_M
 _CACHE_SIZE = 8
 
 
@@ -81,6 +83,11 @@ class PlanarFaces:
         min_area_m2: the area a planar face needed, m^2.
         flatness_tol_m: the largest RMS a planar face could have, metres.
         max_deviation_m: the largest vertex distance from the plane within a face, metres.
+        region_of: ``(F,)`` flat region of each triangle (planar face or not), ``-1`` for none.
+        region_area_m2: ``(R,)`` area of each flat region, m^2.
+        region_rms_m: ``(R,)`` RMS distance of each flat region from its plane, metres.
+        region_holds: ``(R,)`` the region holds the sensor footprint somewhere (tested only
+            for regions large and flat enough).
     """
 
     name: str
@@ -91,6 +98,36 @@ class PlanarFaces:
     min_area_m2: float
     flatness_tol_m: float
     max_deviation_m: float
+    region_of: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64), repr=False)
+    region_area_m2: FloatArray = field(default_factory=lambda: np.zeros(0), repr=False)
+    region_rms_m: FloatArray = field(default_factory=lambda: np.zeros(0), repr=False)
+    region_holds: NDArray[np.bool_] = field(
+        default_factory=lambda: np.zeros(0, dtype=bool), repr=False
+    )
+
+    def why_not_at(self, triangle: int, footprint_radius_m: float) -> str:
+        """Why the triangle ``triangle`` is on no planar face, in words with the numbers."""
+        r = int(self.region_of[triangle]) if len(self.region_of) else -1
+        if r < 0:
+            return "not on a planar face (curved or noisy there: no flat region)"
+        area, rms = float(self.region_area_m2[r]), float(self.region_rms_m[r])
+        d_mm = 2e3 * footprint_radius_m
+        if area < self.min_area_m2:
+            return (
+                f"on a flat face of {area * 1e6:.1f} mm^2, too small for the {d_mm:.0f} mm "
+                f"sensor (its face covers {self.min_area_m2 * 1e6:.0f} mm^2)"
+            )
+        if rms > self.flatness_tol_m:
+            return (
+                f"on a flat region too rough to be a planar face (RMS {rms * 1e3:.3f} mm, "
+                f"limit {self.flatness_tol_m * 1e3:.3f} mm)"
+            )
+        if not bool(self.region_holds[r]):
+            return (
+                f"on a flat face of {area * 1e6:.1f} mm^2 too narrow for the {d_mm:.0f} mm sensor "
+                "(no spot of it holds the sensor face)"
+            )
+        return "not on a planar face"
 
     @property
     def normals(self) -> FloatArray:
@@ -173,7 +210,18 @@ def _detect(
     faces = tuple(region_stats(n, d, area_r, rms, cnt, holds, int(i)) for i in good)
     largest = region_stats(n, d, area_r, rms, cnt, holds, int(np.argmax(area_r)))
     return PlanarFaces(
-        name, mesh, face_id, faces, largest, min_area_m2, flatness_tol_m, max_deviation_m
+        name,
+        mesh,
+        face_id,
+        faces,
+        largest,
+        min_area_m2,
+        flatness_tol_m,
+        max_deviation_m,
+        region_of=labels,
+        region_area_m2=np.asarray(area_r, dtype=np.float64),
+        region_rms_m=np.asarray(rms, dtype=np.float64),
+        region_holds=holds,
     )
 
 

@@ -115,3 +115,54 @@ def opw_wrist_reason(opw: Any, T_flange: FloatArray) -> str:
     if d[i] < abs(P.c2 - k):
         return f"too close (wrist centre {d[i]:.2f} m from the shoulder, min {abs(P.c2 - k):.2f} m)"
     return f"out of reach (wrist centre {d[i]:.2f} m from the shoulder, reach {P.c2 + k:.2f} m)"
+
+
+def no_ik_reasons(
+    model: ReachModel, solver: IKSolver, chain: KinematicChain, T_flange: FloatArray
+) -> list[str]:
+    """:func:`no_ik_reason` of ``P`` points at once: ``T_flange (P, R, 4, 4)``, base frame, m.
+
+    The same strings as one call per point (``tests/test_reach.py`` compares them), with one
+    batched IK call for all points instead of one per point.
+    """
+    T = np.asarray(T_flange, dtype=np.float64)
+    P, R = T.shape[:2]
+    if P == 0:
+        return []
+    p = T[..., :3, 3].reshape(P * R, 3)
+    dist = np.min(np.linalg.norm(p - model.shoulder_towards(p), axis=1).reshape(P, R), axis=1)
+    out: list[str | None] = [None] * P
+    rest = []
+    for i in range(P):
+        where = f"{float(dist[i]):.2f} m from the shoulder, reach {model.reach_m:.2f} m"
+        if dist[i] > model.reach_m:
+            out[i] = f"out of reach ({where})"
+        elif solver.opw is None:
+            out[i] = f"no IK solution within joint limits ({where})"
+        else:
+            rest.append(i)
+    opw = solver.opw
+    if rest and opw is not None:
+        idx = np.array(rest)
+        q8, ok8 = opw.ik_branches(T[idx].reshape(-1, 4, 4))
+        n_j = q8.shape[-1]
+        q8 = q8.reshape(len(idx), R * 8, n_j)
+        ok8 = ok8.reshape(len(idx), R * 8)
+        owner, row = np.nonzero(ok8)
+        q = q8[owner, row]  # (K, n): the branches that exist
+        lo, hi = chain.lower, chain.upper
+        with np.errstate(invalid="ignore"):
+            best = np.full(q.shape, np.inf)  # violation of each joint over its 2*pi variants
+            for k in (-2, -1, 0, 1, 2):
+                qk = q + k * (2 * np.pi)
+                best = np.minimum(best, np.maximum(lo - qk, 0) + np.maximum(qk - hi, 0))
+        worst = np.argmax(best, axis=1)  # each branch's worst joint
+        counts = np.bincount(owner * n_j + worst, minlength=len(idx) * n_j).reshape(-1, n_j)
+        any_ok = np.asarray(ok8.any(axis=1), dtype=bool)
+        for n, i in enumerate(rest):
+            if not any_ok[n]:
+                out[i] = opw_wrist_reason(opw, T[i])
+            else:
+                j = int(np.argmax(counts[n]))
+                out[i] = f"joint {j + 1} at limit ({chain.joint_names[j]})"
+    return [s for s in out if s is not None]

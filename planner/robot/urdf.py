@@ -52,6 +52,7 @@ from typing import Any
 
 import numpy as np
 
+from calib.reading import MAX_URDF_BYTES, read_bytes_capped
 from planner.errors import URDFError
 from planner.robot.urdf_meshes import resolve_mesh
 from planner.robot.urdf_model import (
@@ -134,10 +135,10 @@ def load_urdf(path: str | Path, check_meshes: bool = True) -> URDFModel:
             the element (and lists every missing mesh).
     """
     p = Path(path)
-    if not p.is_file():
+    if not p.exists():
         raise URDFError(f"URDF file not found: {p}")
     try:
-        data = p.read_bytes()
+        data = read_bytes_capped(p, MAX_URDF_BYTES, "URDF file", URDFError)
     except OSError as exc:
         raise URDFError(f"cannot read URDF file {p}: {exc}") from None
     model = parse_urdf(data, source=p)

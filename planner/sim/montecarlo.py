@@ -34,6 +34,7 @@ from calib.models import Misplacement, RobotErrorModel
 from calib.models.proximity import ProximitySensor
 from calib.paper.settings import Hultman2013
 from calib.paper.stator_procedure import check_stator_points
+from calib.plan.models import MAX_TRIALS
 from calib.probing import ProbePoint
 from calib.procedures import RolePoint
 from planner.parts.stator import StatorGeometry
@@ -114,8 +115,8 @@ def simulate(
         InputError: bad arguments (named in the message), or a plan that cannot calibrate even
             on the ideal part (from the prediction, before any trial runs).
     """
-    if not isinstance(n_trials, int) or n_trials < 2:
-        raise ShapeError(f"n_trials must be an integer >= 2, got {n_trials!r}")
+    if not isinstance(n_trials, int) or not 2 <= n_trials <= MAX_TRIALS:
+        raise ShapeError(f"n_trials must be an integer 2 to {MAX_TRIALS:,}, got {n_trials!r}")
     if protocol is not None and (min(protocol) < 2 or len(protocol) != 2):
         raise ShapeError(f"protocol must be (positions, repeats), each >= 2, got {protocol!r}")
     prediction = predict(setup)  # before the run: a plan that cannot work fails here
@@ -260,8 +261,8 @@ def validate(
     """
     if procedure != "hultman2013":
         raise InputError(f"procedure must be 'hultman2013' here, got {procedure!r}")
-    if not isinstance(n_trials, int) or n_trials < 2:
-        raise ShapeError(f"n_trials must be an integer >= 2, got {n_trials!r}")
+    if not isinstance(n_trials, int) or not 2 <= n_trials <= MAX_TRIALS:
+        raise ShapeError(f"n_trials must be an integer 2 to {MAX_TRIALS:,}, got {n_trials!r}")
     setup, part = stator_setup(points, geometry, T_base_wobj_nominal, **kwargs)
     return simulate(
         setup,

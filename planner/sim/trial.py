@@ -13,9 +13,7 @@ the best fit of the same measurements fed as the procedure is fed
 from __future__ import annotations
 
 import math
-import multiprocessing as mp
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
@@ -27,6 +25,7 @@ from calib.errors import InputError, ProbeFailedError
 from calib.frames import motion_between
 from calib.procedures import procedure_kind
 from calib.procedures.comparison import FedFit
+from planner.sim.pool import kill_pool, open_pool
 from planner.sim.raycast import MeshRayCaster
 from planner.sim.search_events import ProbeEvent, ReachabilityHook, search_group
 from planner.sim.sensors import sensor_kind
@@ -200,10 +199,14 @@ def run_all(
             if progress is not None:
                 progress(len(out), total)
         return out
-    ctx = mp.get_context("fork") if "fork" in mp.get_all_start_methods() else None
-    with ProcessPoolExecutor(n_workers, ctx, init_worker, (setup, mesh)) as pool:
+    pool = open_pool(n_workers, init_worker, (setup, mesh))
+    try:
         for res in pool.map(run_chunk_in_worker, chunks):
             out.extend(res)
             if progress is not None:
                 progress(len(out), total)
+    except BaseException:  # Ctrl-C, SIGTERM, an error: no worker left running, no waiting
+        kill_pool(pool)
+        raise
+    pool.shutdown(wait=True)
     return out

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import os
 import shutil
-import time
+from pathlib import Path
 
 import numpy as np
 import pytest
-from ui_helpers import REPO, UiSession, wait_for
+from ui_helpers import REPO, UiSession, rendered, set_camera, wait_for
 
+from calib.atomic_io import write_bytes_atomic
 from webui.plan_doc import PAPER_IDS
 
 pytestmark = pytest.mark.browser
@@ -39,7 +40,7 @@ def test_validate_button_produces_table_and_histograms(demo: UiSession) -> None:
     demo.app.validate_panel.trials.value = 30
     demo.page.get_by_role("button", name="Validate plan").click()
     panel = demo.app.validate_panel
-    wait_for(lambda: not panel.running and panel.result_md.content, timeout=90, what="validation")
+    wait_for(lambda: not panel.running and panel.result_md.content, timeout=300, what="validation")
     md = panel.last_markdown
     assert md, f"validation gave no table: {panel.result_md.content}"
     assert "| WOCS origin x-axis |" in md
@@ -48,34 +49,34 @@ def test_validate_button_produces_table_and_histograms(demo: UiSession) -> None:
     assert demo.app.validate_panel.last_report.n_trials == 30
 
 
-def test_screenshot_of_demo_cell(demo: UiSession) -> None:
+def test_screenshot_of_demo_cell(demo: UiSession, tmp_path: Path) -> None:
     demo.page.set_viewport_size({"width": 1500, "height": 900})
     # hide transient notifications (e.g. SwiftShader's "software WebGL" warning)
     demo.page.add_style_tag(content=".mantine-Notification-root { display: none !important; }")
     client = demo.client()
-    client.camera.up_direction = (0.0, 0.0, 1.0)
     client.camera.fov = 0.8
-    client.camera.position = (0.3, -2.6, 2.1)
-    client.camera.look_at = (0.95, -0.15, 0.85)
-    client.flush()
+    set_camera(client, (0.3, -2.6, 2.1), (0.95, -0.15, 0.85))
     demo.app.select("F")  # the robot at F's probe pose, at the start of its edge search
-    time.sleep(3.0)  # let SwiftShader render the new view
+    wait_for(lambda: demo.app.robot is not None and demo.app.robot.q is not None, what="robot")
+    rendered(demo.page)  # SwiftShader has drawn the new view
+    shot = tmp_path / "demo_cell.png"  # this run's own file: two suites at once never mix
+    demo.page.screenshot(path=str(shot))  # the page's default timeout: generous
+    assert shot.stat().st_size > 20_000, "the screenshot looks empty"
     ARTIFACT.parent.mkdir(parents=True, exist_ok=True)
-    demo.page.screenshot(path=str(ARTIFACT))
-    assert ARTIFACT.stat().st_size > 20_000, "the screenshot looks empty"
+    write_bytes_atomic(ARTIFACT, shot.read_bytes())
     if UPDATE_SCREENSHOTS:
-        shutil.copyfile(ARTIFACT, SCREENSHOT)
+        shutil.copyfile(shot, SCREENSHOT)
     assert np.isfinite(client.camera.fov)
 
 
 def test_checks_run_while_validation_runs(demo: UiSession) -> None:
     panel = demo.app.validate_panel
-    wait_for(lambda: not panel.running, timeout=90, what="an earlier validation")
+    wait_for(lambda: not panel.running, timeout=300, what="an earlier validation")
     fut = panel.start(400)
     try:
         a = demo.app.state.doc.get("A")
         check = demo.app.move_point_to("A", a.probe.position_m)  # a no-op move, re-checked
         assert check is not None and panel.running, "the check waited for the validation"
     finally:
-        fut.result(120)
+        fut.result(300)
         demo.app.state.undo()

@@ -1,4 +1,9 @@
-"""Helpers of the end-to-end UI tests: waiting, starting the UI, opening a page."""
+"""Helpers of the end-to-end UI tests: waiting, starting the UI, opening a page.
+
+The tests must pass on a loaded machine (two test suites at once on two cores): they wait on
+conditions, never for a fixed time, with generous limits (:data:`TIMEOUT_S`; Playwright's own
+waits get the same through the page's default timeout).
+"""
 
 from __future__ import annotations
 
@@ -7,9 +12,11 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
-from webui.app import WobjcalApp, run
+from webui.app import WobjcalApp
+from webui.server import run
 from webui.testing import free_port
 
 CHROMIUM = "/usr/bin/chromium"
@@ -24,9 +31,11 @@ CHROMIUM_ARGS = [
 ]
 VIEWPORT = {"width": 1100, "height": 720}
 REPO = Path(__file__).resolve().parents[2]
+#: How long a test waits for a condition before it fails, s (generous: a loaded machine).
+TIMEOUT_S = 120.0
 
 
-def wait_for(pred: Callable[[], Any], timeout: float = 30.0, what: str = "condition") -> Any:
+def wait_for(pred: Callable[[], Any], timeout: float = TIMEOUT_S, what: str = "condition") -> Any:
     """Poll ``pred`` until it returns something truthy; fail the test after ``timeout`` s."""
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
@@ -64,9 +73,34 @@ def start_ui(plan: Path | None, tmp_path: Path) -> WobjcalApp:
 def open_page(browser: Any, app: WobjcalApp) -> UiSession:
     """Open a page on ``app`` and wait until its canvas is there and it is connected."""
     page = browser.new_page(viewport=VIEWPORT, accept_downloads=True)
+    page.set_default_timeout(TIMEOUT_S * 1000)  # every Playwright wait: generous under load
     url = f"http://127.0.0.1:{app.server.get_port()}/"
     page.goto(url)
-    page.locator("canvas").first.wait_for(timeout=20000)
+    page.locator("canvas").first.wait_for()
     session = UiSession(app, page, url)
     session.client()
     return session
+
+
+def set_camera(client: Any, position: Any, look_at: Any) -> None:
+    """Put the page's camera at ``position`` looking at ``look_at`` (z up) and wait until the
+    browser has applied it and reported it back (not for a fixed time)."""
+    client.camera.up_direction = (0.0, 0.0, 1.0)
+    client.camera.position = tuple(float(v) for v in position)
+    client.camera.look_at = tuple(float(v) for v in look_at)
+    client.flush()
+    sent = client.camera._state  # replaced by each camera report from the browser
+    want_p, want_l = np.asarray(position, float), np.asarray(look_at, float)
+    wait_for(
+        lambda: (
+            client.camera._state is not sent
+            and np.allclose(client.camera.position, want_p, atol=1e-3)
+            and np.allclose(client.camera.look_at, want_l, atol=1e-3)
+        ),
+        what="the browser to apply the camera",
+    )
+
+
+def rendered(page: Any) -> None:
+    """Wait until the page has drawn two more animation frames (the new view is on screen)."""
+    page.evaluate("new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))")

@@ -17,6 +17,12 @@ ABB ``confdata`` ``[cf1, cf4, cf6, cfx]`` (RAPID, serial 6-axis robots) is then:
 * ``cfx = 4 * shoulder_back + 2 * elbow_back + wrist_negative`` (0-7), ABB's table "wrist centre
   relative to axis 1: in front of / behind; relative to the lower arm: in front of / behind;
   axis 5: positive / negative".
+
+Other vendors name the same three flags their own way, in their own joint directions (FANUC's
+J5 turns the other way than ABB's axis 5). :func:`posture` gives them without any joint
+convention: ``wrist_flipped`` is the sign of the OPW model's canonical ``theta5`` (axis 5 bent
+the way ABB's positive axis 5 bends it, with axis 4 at its reference), and the exporters turn
+the flags into FANUC ``CONFIG`` (``N``/``F``, ``U``/``D``, ``T``/``B``) and KUKA ``S``.
 """
 
 from __future__ import annotations
@@ -65,6 +71,31 @@ def classify(robot: OPWRobot, q: ArrayLike) -> BranchFlags:
     """The :class:`BranchFlags` of one configuration ``q (6,)``, rad."""
     code = int(branch_codes(robot, check_shape(q, (6,), "q")))
     return BranchFlags(bool(code & 4), bool(code & 2), bool(code & 1))
+
+
+@dataclass(frozen=True)
+class Posture:
+    """The arm's configuration at one pose, free of any vendor's joint directions.
+
+    Attributes:
+        front: the wrist centre lies in front of axis 1 (on the side of the shoulder offset).
+        elbow_up: the wrist centre lies in front of the lower arm (the elbow bent forward: the
+            "elbow up" posture of an arm reaching forward).
+        wrist_flipped: the canonical ``theta5`` of the OPW model is negative.
+    """
+
+    front: bool
+    elbow_up: bool
+    wrist_flipped: bool
+
+
+def posture(robot: OPWRobot, q: ArrayLike) -> Posture:
+    """The :class:`Posture` of robot joint values ``q (6,)``, rad."""
+    qa = check_shape(q, (6,), "q")
+    code = int(branch_codes(robot, qa))
+    theta5 = float(robot.params.to_theta(qa)[4])
+    theta5 = np.pi - (np.pi - theta5) % (2 * np.pi)  # wrapped to (-pi, pi]
+    return Posture(front=not code & 4, elbow_up=not code & 2, wrist_flipped=theta5 < 0)
 
 
 @lru_cache(maxsize=1)

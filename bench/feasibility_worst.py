@@ -1,0 +1,91 @@
+"""The worst case of probe feasibility: demo-cell points that collide in every pose.
+
+In the demo cell (stator section on a table) ``n`` stator samples are checked one per call
+(a UI click); those whose answer is a collision (every candidate collides) are the worst
+case, the feasible ones the typical case. Each is checked by ``check_probes`` (the default
+path), by ``check_probes(staged=False)`` (one whole Bullet query per candidate: the exact
+check) and by the plain PyBullet loop; then all samples as one heat-map batch, both ways.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+from bench.feasibility_cell import run_plain_loop
+from planner.cell.cell import Cell
+from planner.cell.reachability_map import reachability_map, sample_surface
+
+
+def _timed_points(cell: Cell, pts: np.ndarray, nrm: np.ndarray, staged: bool) -> dict:
+    """Each point checked alone (one UI click each): per-point seconds and the answers."""
+    seconds, answers = [], []
+    for i in range(len(pts)):
+        t0 = time.perf_counter()
+        (r,) = cell.check_probes(pts[i : i + 1], nrm[i : i + 1], staged=staged)
+        seconds.append(time.perf_counter() - t0)
+        answers.append((r.status, r.reason, r.branch, round(r.clearance_m, 6)))
+    return {"seconds": seconds, "answers": answers}
+
+
+def _summary(seconds: list[float]) -> dict[str, float]:
+    s = np.asarray(seconds) * 1e3
+    return {"median_ms": float(np.median(s)), "max_ms": float(s.max()), "mean_ms": float(s.mean())}
+
+
+def run_worst_case(n_samples: int, seed: int) -> dict[str, object]:
+    """See the module docstring; per-point medians and maxima, ratios, same answers."""
+    from planner.demo import make_demo_cell
+
+    with make_demo_cell() as cell:
+        pts, nrm, _ = sample_surface(cell.work_object.mesh, n_samples, np.random.default_rng(seed))
+        cell.check_probes(pts[:2], nrm[:2])  # warm-up
+        first = _timed_points(cell, pts, nrm, staged=True)
+        worst = [i for i, a in enumerate(first["answers"]) if " hits " in a[1]]
+        typical = [i for i, a in enumerate(first["answers"]) if a[0] == "feasible"]
+        out: dict[str, object] = {"samples": n_samples, "worst_points": len(worst)}
+        for name, idx in (("worst", worst), ("typical", typical)):
+            if not idx:
+                continue
+            ours = _timed_points(cell, pts[idx], nrm[idx], staged=True)
+            exact = _timed_points(cell, pts[idx], nrm[idx], staged=False)
+            row: dict[str, object] = {"ours": _summary(ours["seconds"])}
+            row["exact_check"] = _summary(exact["seconds"])
+            row["same_answers"] = ours["answers"] == exact["answers"]
+            t0 = time.perf_counter()
+            run_plain_loop(cell, pts[idx], nrm[idx])
+            row["pybullet_loop_ms_per_point"] = 1e3 * (time.perf_counter() - t0) / len(idx)
+            out[name] = row
+        heat = {}
+        for label, staged in (("ours", True), ("exact_check", False)):
+            t0 = time.perf_counter()
+            reachability_map(cell, n_samples, np.random.default_rng(seed), staged=staged)
+            heat[label] = 1e3 * (time.perf_counter() - t0) / n_samples
+        out["heat_map_ms_per_sample"] = heat
+    return out
+
+
+def print_worst(w: dict) -> None:
+    """A table of :func:`run_worst_case`'s result."""
+    table = Table(title=f"demo cell, one point per call ({w['samples']} stator samples)")
+    for col in ("points", "n", "ours median / max ms", "exact check median / max ms", "same"):
+        table.add_column(col)
+    for name in ("worst", "typical"):
+        if name not in w:
+            continue
+        r = w[name]
+        table.add_row(
+            name,
+            str(w["worst_points"]) if name == "worst" else "",
+            f"{r['ours']['median_ms']:.1f} / {r['ours']['max_ms']:.0f}",
+            f"{r['exact_check']['median_ms']:.1f} / {r['exact_check']['max_ms']:.0f}",
+            str(r["same_answers"]),
+        )
+    Console().print(table)
+    h = w["heat_map_ms_per_sample"]
+    Console().print(
+        f"heat map: {h['ours']:.2f} ms/sample, exact check {h['exact_check']:.1f} ms/sample"
+    )

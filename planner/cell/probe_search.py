@@ -1,0 +1,315 @@
+"""Deciding probe points from their candidates: broad phase first, Bullet only where needed.
+
+The rule is :mod:`planner.cell.probe_rule`'s (the same as the exact check's,
+:func:`planner.cell.feasibility.check_probes` with ``staged=False``).
+
+The work is done in four passes; the answers do not depend on them:
+
+1. one broad-phase call for every point's first candidate (:mod:`planner.cell.broad_phase`):
+   when no part is left open, its clearance is the look distance and the point is decided;
+2. a lean loop over the others: the open parts of the first candidate with Bullet (often just
+   the sensor, which stands at the sensing distance from the surface);
+3. one broad-phase call for the first :data:`FIRST_BLOCK` candidates of the points still open
+   (more of a point's, up to ``max_checks``, in doubling blocks when it needs them);
+4. per point: candidates in order until one passes, each one's open parts cheapest first,
+   stopping as soon as its slack is shown below the margin; then the least-bad one, best
+   candidates first (by an upper bound from the parts already known), a candidate dropped as
+   soon as its slack is shown to be more than the tie below the best exact slack found.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planner.cell.broad_arrays import EnvArrays, PartMap
+from planner.cell.broad_kernels import FIELD
+from planner.cell.broad_phase import BroadPhase, broad_phase_of
+from planner.cell.clearance import Clearance, QueryPart
+from planner.cell.probe_clearance import ProbeClearance
+from planner.cell.probe_rule import CLEARANCE_TIE_M, Decision, least_bad, part_pair, passes
+
+if TYPE_CHECKING:
+    from planner.cell.probe_candidates import ProbeCandidates
+    from planner.cell.scene import CellScene
+
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+#: Candidates of an open point whose broad phase runs with the batch (most such points pass
+#: within them); a point that needs more gets the rest in one call.
+FIRST_BLOCK = 8
+
+
+class ProbeSearch:
+    """Decides probe points of one cell (see the module docstring).
+
+    Args:
+        cell: the cell (its joint state changes; restore it with ``cell.saved_state()``).
+        margin_m: required distance to the work object and fixtures, m.
+        max_checks: most candidates considered per point.
+    """
+
+    def __init__(self, cell: CellScene, margin_m: float, max_checks: int) -> None:
+        self._cell = cell
+        self.margin = margin_m
+        self.max_checks = max_checks
+        self.stages = ProbeClearance(cell, margin_m)
+        self.broad: BroadPhase = broad_phase_of(cell)
+        self.env: EnvArrays = self.broad.environment(cell)
+        self.parts: PartMap = self.broad.part_map(cell, self.stages.plan, self.env)
+        plan_parts = self.stages.plan.parts
+        self._env_parts: list[QueryPart] = [plan_parts[int(i)] for i in self.parts.part_index]
+        #: per env part: 0 against a box, cylinder or sphere (cheap in Bullet), 1 against a
+        #: mesh; and the size of its link (its tree's root radius): small links go first.
+        self._cost = [int(self.env.arrays[0][e] == FIELD) for e in self.parts.part_env]
+        self._size = [self.broad.link_radius(int(k)) for k in self.parts.part_link]
+        #: how many points each pass decided (for profiling and the bench).
+        self.decided_by = {"broad": 0, "first": 0, "search": 0}
+
+    def run(self, cands: ProbeCandidates) -> list[Decision | None]:
+        """One decision per point (``None`` for points without a usable candidate)."""
+        N = cands.q.shape[0]
+        out: list[Decision | None] = [None] * N
+        first = cands.first()
+        idx = np.flatnonzero(first >= 0)
+        if idx.size == 0:
+            return out
+        K = cands.per_rotation
+        c0 = first[idx]
+        pc, sc, _ = self._broad(cands, idx, c0)
+        near = cands.near_limit[idx, c0]
+        look = Clearance(True, self.stages.plan.look_m, self.stages.look_slack_m, None)
+        open_pts = []
+        for n, i in enumerate(idx.tolist()):
+            if (pc[n] == 1).all() and (sc[n] == 1).all():  # nothing within the look distance
+                out[i] = Decision(int(c0[n]), look, True)
+                self.decided_by["broad"] += 1
+            else:
+                open_pts.append(n)
+        rest = []
+        for n in open_pts:
+            i, c = int(idx[n]), int(c0[n])
+            if (pc[n] == -1).any() or (sc[n] == -1).any():
+                rest.append(i)  # it cannot pass
+                continue
+            self.stages.start_point(cands.T_base_flange[i])
+            cl, _ = self._exact(c // K, cands.q[i, c], pc[n] == 1, sc[n] == 1, {})
+            top = cl.slack_m >= self.stages.look_slack_m - CLEARANCE_TIE_M
+            if passes(cl, self.margin) and (not near[n] or top):
+                out[i] = Decision(c, cl, True)  # passes; or near a limit and none can beat it
+                self.decided_by["first"] += 1
+            else:
+                rest.append(i)
+        if rest:  # one broad-phase call for the first candidates of all these points
+            orders = [cands.order(i, self.max_checks) for i in rest]
+            heads = [o[:FIRST_BLOCK] for o in orders]
+            pts = np.repeat(np.array(rest), [len(h) for h in heads])
+            pc_all, sc_all, op_all = self._broad(cands, pts, np.concatenate(heads))
+            start = 0
+            for i, order, head in zip(rest, orders, heads):
+                flags = _Flags(self, cands, i, order)
+                sl = slice(start, start + len(head))
+                flags.put(pc_all[sl], sc_all[sl], op_all[sl])
+                start += len(head)
+                out[i] = self._search(cands, i, order, flags)
+                self.decided_by["search"] += 1
+        return out
+
+    # ------------------------------------------------------------------ passes
+    def _broad(
+        self, cands: ProbeCandidates, pts: NDArray[np.int_], cs: NDArray[np.int_]
+    ) -> tuple[NDArray[np.int8], NDArray[np.int8], NDArray[np.int64]]:
+        """Broad-phase states of candidates ``cs`` of points ``pts`` (see
+        :meth:`planner.cell.broad_phase.BroadPhase.states`)."""
+        K = cands.per_rotation
+        T_bf = cands.T_base_flange[pts, cs // K]
+        T_links = self.broad.link_poses(self._cell, cands.q[pts, cs], T_bf)
+        return self.broad.states(self.parts, self.env, T_links)
+
+    def _exact(
+        self,
+        rotation: int,
+        q: FloatArray,
+        clear: BoolArray,
+        pairs_clear: BoolArray,
+        results: dict[int, Clearance | None],
+        stop_below: float = -math.inf,
+        max_cost: int = 1,
+        max_parts: int = -1,
+        certify: bool = False,
+        tried: dict[int, float] | None = None,
+    ) -> tuple[Clearance, bool]:
+        """The candidate's open parts with Bullet, cheapest first (cached ones before all).
+
+        Stops once the slack is shown below ``stop_below``, before a part costing more than
+        ``max_cost``, or after ``max_parts`` parts not cached (-1: no limit). With
+        ``certify``, the work-object parts not cached are first asked only whether they go
+        below ``stop_below`` (:meth:`ProbeClearance.certify`, a fraction of a full query
+        when the collision is deep), smallest links first; one that does stops the candidate.
+        ``tried`` keeps, per part, the deepest bound a certificate failed to show (not asked
+        again). ``results`` collects the parts evaluated (plan index -> result, kept between
+        calls).
+
+        Returns:
+            The merge of the parts known so far (the exact clearance when complete, else an
+            upper bound of the slack) and whether every open part is known.
+        """
+        st = self.stages
+        running = min((r.slack_m for r in results.values() if r is not None), default=math.inf)
+        todo: list[tuple[int, int, float, int]] = []  # (not cached, cost, size, k)
+        for k in range(len(self._env_parts)):
+            part = self._env_parts[k]
+            if not clear[k] and part.index not in results:
+                cached = st.known(rotation, q, part)
+                todo.append((int(not cached), self._cost[k], self._size[k], k))
+        todo.sort()
+        self_open = not pairs_clear.all() and st.self_part.index not in results
+        fresh = 0
+        if running >= stop_below and self_open and max_parts != 0:
+            res = st.evaluate(rotation, q, st.self_part, ~pairs_clear)
+            results[st.self_part.index] = res
+            self_open = False
+            fresh += 1
+            if res is not None:
+                running = min(running, res.slack_m)
+        complete = not self_open
+        if certify and running >= stop_below and tried is not None:
+            # certificates first, smallest links first: any one shows the candidate below
+            below = math.nextafter(stop_below, -math.inf)
+            for new, cost, _, k in todo:
+                part = self._env_parts[k]
+                if not new or cost < 1 or tried.get(k, -math.inf) >= below:
+                    continue
+                if st.certify(rotation, q, part, below):
+                    return Clearance(False, below + part.need_m, below, part_pair(part)), False
+                tried[k] = below  # not that deep: no deeper bound can be shown either
+        for new, cost, _, k in todo:
+            if running < stop_below or cost > max_cost or (new and fresh == max_parts):
+                complete = False
+                break
+            part = self._env_parts[k]
+            res = st.evaluate(rotation, q, part)
+            results[part.index] = res
+            fresh += new
+            if res is not None:
+                running = min(running, res.slack_m)
+        return st.merge(results), complete
+
+    def _search(
+        self, cands: ProbeCandidates, i: int, order: NDArray[np.int_], flags: _Flags
+    ) -> Decision:
+        """Pass 4 for point ``i``: candidates ``order``, broad-phase flags from ``flags``."""
+        K = cands.per_rotation
+        near = cands.near_limit[i]
+        self.stages.start_point(cands.T_base_flange[i])
+        results: list[dict[int, Clearance | None]] = [{} for _ in order]
+        tried: list[dict[int, float]] = [{} for _ in order]
+        exact: dict[int, Clearance] = {}
+        bound: dict[int, float] = {}  # j -> upper bound of the slack
+        look = self.stages.look_slack_m
+
+        def run(
+            j: int, stop_below: float, max_cost: int = 1, max_parts: int = -1, certify: bool = False
+        ) -> None:
+            c = int(order[j])
+            clear, pairs_clear = flags.clear(j)
+            cl, complete = self._exact(
+                c // K, cands.q[i, c], clear, pairs_clear, results[j], stop_below, max_cost,
+                max_parts, certify, tried[j],
+            )  # fmt: skip
+            if complete:
+                exact[j] = cl
+                bound.pop(j, None)
+            else:
+                bound[j] = min(bound.get(j, math.inf), cl.slack_m)
+
+        below_margin = math.nextafter(self.margin, -math.inf)
+        for j, c in enumerate(order.tolist()):
+            if near[c]:
+                break  # the rest are near a limit too: none can be chosen outright
+            if flags.fails(j):
+                bound[j] = below_margin  # shown below the margin: it cannot pass
+                continue
+            run(j, self.margin)
+            if j in exact and passes(exact[j], self.margin):
+                return Decision(c, exact[j], True)
+        # the least-bad one: candidates the broad phase clears have the look distance
+        for j in range(len(order)):
+            if j not in exact and flags.all_clear(j):
+                run(j, -math.inf)
+        top = max((cl.slack_m for cl in exact.values()), default=-math.inf)
+        if top < look - CLEARANCE_TIE_M:  # bounds from the cheap parts order the rest
+            for j in range(len(order)):
+                if j not in exact:
+                    run(j, -math.inf, max_cost=0)
+            top = max((cl.slack_m for cl in exact.values()), default=-math.inf)
+        # best first: refine the candidate with the highest bound (no slack exceeds the look
+        # distance's), one part at a time, until no open candidate can reach the tie
+        heap = [
+            (-bound.get(j, look), flags.opened(j), j) for j in range(len(order)) if j not in exact
+        ]
+        heapq.heapify(heap)
+        while heap:
+            neg, opened, j = heapq.heappop(heap)
+            floor = top - CLEARANCE_TIE_M
+            if -neg < floor:
+                break  # nor can any other
+            lead = next((k for k in sorted(exact) if exact[k].slack_m >= floor), None)
+            if lead is not None and j > lead and -neg <= exact[lead].slack_m + CLEARANCE_TIE_M:
+                continue  # comes after a tie member it cannot push out of the tie
+            run(j, floor, max_parts=1, certify=floor < 0)
+            if j in exact:
+                top = max(top, exact[j].slack_m)
+            else:
+                heapq.heappush(heap, (-bound[j], opened, j))
+        seen = [(int(order[j]), exact[j]) for j in sorted(exact)]
+        return least_bad(seen)
+
+
+class _Flags:
+    """Broad-phase states of one point's candidates (the first with the batch; more on
+    demand, each block as large as all before it)."""
+
+    def __init__(
+        self, search: ProbeSearch, cands: ProbeCandidates, i: int, order: NDArray[np.int_]
+    ) -> None:
+        self._search, self._cands, self._i, self._order = search, cands, i, order
+        self._pc: list[NDArray[np.int8]] = []
+        self._sc: list[NDArray[np.int8]] = []
+        self._opened: list[int] = []
+
+    def put(self, pc: NDArray[np.int8], sc: NDArray[np.int8], opened: NDArray[np.int64]) -> None:
+        self._pc.extend(pc)
+        self._sc.extend(sc)
+        self._opened.extend(opened.tolist())
+
+    def _get(self, j: int) -> tuple[NDArray[np.int8], NDArray[np.int8]]:
+        while j >= len(self._pc):  # the next block, twice as many as computed so far
+            n = len(self._pc)
+            cs = self._order[n : max(j + 1, 2 * n)]
+            self.put(*self._search._broad(self._cands, np.full(cs.size, self._i), cs))
+        return self._pc[j], self._sc[j]
+
+    def opened(self, j: int) -> int:
+        """Sphere-tree leaves of candidate row ``j`` near the environment."""
+        self._get(j)
+        return self._opened[j]
+
+    def clear(self, j: int) -> tuple[BoolArray, BoolArray]:
+        """``(parts clear (P,), pairs clear (S,))`` of candidate row ``j``."""
+        pc, sc = self._get(j)
+        return pc == 1, sc == 1
+
+    def all_clear(self, j: int) -> bool:
+        pc, sc = self._get(j)
+        return bool((pc == 1).all() and (sc == 1).all())
+
+    def fails(self, j: int) -> bool:
+        """A part of candidate row ``j`` is shown below the margin."""
+        pc, sc = self._get(j)
+        return bool((pc == -1).any() or (sc == -1).any())

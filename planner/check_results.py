@@ -1,0 +1,162 @@
+"""The results of the one plan check (:mod:`planner.check`): a point's and a whole plan's.
+
+Frozen dataclasses that the command line prints (table and ``--json``), the web UI colours its
+markers and table with, and ``wobjcal export`` takes orientations and configurations from.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+Status = Literal["feasible", "marginal", "infeasible"]
+#: ABB ``confdata`` (cf1, cf4, cf6, cfx).
+ConfData = tuple[int, int, int, int]
+
+
+@dataclass(frozen=True)
+class PointCheck:
+    """The check of one probe point and its search.
+
+    Attributes:
+        point_id: the plan's point id.
+        role: its role in the procedure.
+        kind: ``"approach"`` or ``"edge"`` search.
+        status: ``feasible``, ``marginal`` or ``infeasible``: the pose, the path and the face
+            together (see the module docstring).
+        reason: why not feasible, all parts joined with ``"; "`` (``""`` when feasible).
+        pose_status: the probe pose alone.
+        pose_reason: why the pose is marginal or infeasible (``""`` when feasible).
+        path_feasible: the whole search path can be run.
+        path_reason: why not, with the distance along the path (``""`` when feasible).
+        path_fail_at_m: distance from the search start of the first failing sample, m (NaN
+            when the path is feasible).
+        face_reason: why the point is not on a planar face with the sensor footprint on it
+            (``""`` when it is).
+        clearance_m: clearance of the limiting pair at the chosen pose, m (NaN: no pose);
+            nothing nearer than the query's look-ahead when ``clearance_is_lower_bound``.
+        clearance_pair: ``(robot or tool link, obstacle)`` of that clearance, or ``None``.
+        clearance_is_lower_bound: the clearance is the look-ahead distance (nothing nearer).
+        confdata: ABB ``(cf1, cf4, cf6, cfx)`` of the chosen IK branch (OPW arms, feasible or
+            marginal pose), else ``None``.
+        ik_kind: the cell's IK: ``"opw"`` (analytic) or ``"numeric"``.
+        q: ``(n,)`` joint values of the chosen (or least-bad) pose, rad; ``None`` when no IK.
+        q_path: ``(M, n)`` joint values along the path samples that passed, rad, or ``None``.
+        T_base_flange: ``(4, 4)`` flange pose of ``q``, robot base frame, m, or ``None``.
+        elapsed_s: time this point's check took, s.
+        T_base_tcp: ``(4, 4)`` the probing TCP at ``q`` (through the tool's mount), robot base
+            frame, m, or ``None``.
+    """
+
+    point_id: str
+    role: str
+    kind: str
+    status: Status
+    reason: str
+    pose_status: Status
+    pose_reason: str
+    path_feasible: bool
+    path_reason: str
+    path_fail_at_m: float
+    face_reason: str
+    clearance_m: float
+    clearance_pair: tuple[str, str] | None
+    clearance_is_lower_bound: bool
+    confdata: ConfData | None
+    ik_kind: str
+    q: FloatArray | None
+    q_path: FloatArray | None
+    T_base_flange: FloatArray | None
+    elapsed_s: float = 0.0
+    T_base_tcp: FloatArray | None = None
+
+    @property
+    def feasible(self) -> bool:
+        """The point can be measured as planned (marginal counts as feasible)."""
+        return self.status != "infeasible"
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict (distances in metres; NaN as ``null``)."""
+        return {
+            "id": self.point_id,
+            "role": self.role,
+            "kind": self.kind,
+            "status": self.status,
+            "reason": self.reason,
+            "pose_status": self.pose_status,
+            "pose_reason": self.pose_reason,
+            "path_feasible": self.path_feasible,
+            "path_reason": self.path_reason,
+            "path_fail_at_m": _finite_or_none(self.path_fail_at_m),
+            "face_reason": self.face_reason,
+            "clearance_m": _finite_or_none(self.clearance_m),
+            "clearance_pair": list(self.clearance_pair) if self.clearance_pair else None,
+            "clearance_is_lower_bound": self.clearance_is_lower_bound,
+            "confdata": list(self.confdata) if self.confdata else None,
+            "ik_kind": self.ik_kind,
+            "feasible": self.feasible,
+        }
+
+
+@dataclass(frozen=True)
+class PlanCheck:
+    """The check of a whole plan.
+
+    Attributes:
+        points: one :class:`PointCheck` per plan point, in plan order.
+        ik_kind: the cell's IK: ``"opw"`` (analytic) or ``"numeric"``.
+        ik_note: why the analytic IK does not apply (``""`` for ``opw``).
+        error: a problem of the whole plan on this part (e.g. the part has no planar face),
+            ``""`` when none.
+        layout: why the plan's procedure would refuse its points (:func:`layout_problem`:
+            no points, a missing role, a layout that breaks the procedure's assumptions),
+            ``""`` when none.
+    """
+
+    points: tuple[PointCheck, ...]
+    ik_kind: str
+    ik_note: str = ""
+    error: str = ""
+    layout: str = ""
+
+    @property
+    def feasible(self) -> bool:
+        """Every point and path is feasible and the plan has no error or layout problem."""
+        return not self.error and not self.layout and all(p.feasible for p in self.points)
+
+    @property
+    def infeasible(self) -> tuple[PointCheck, ...]:
+        """The points that fail."""
+        return tuple(p for p in self.points if not p.feasible)
+
+    def point(self, point_id: str) -> PointCheck:
+        """The check of ``point_id``.
+
+        Raises:
+            KeyError: no such point (the message lists the ids).
+        """
+        for p in self.points:
+            if p.point_id == point_id:
+                return p
+        raise KeyError(f"no point {point_id!r}; points: {[p.point_id for p in self.points]}")
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict; ``ik_note``, ``error`` and ``layout`` appear only when set."""
+        out: dict[str, Any] = {
+            "feasible": self.feasible,
+            "ik_kind": self.ik_kind,
+            "points": [p.to_json() for p in self.points],
+        }
+        for key in ("ik_note", "error", "layout"):
+            if getattr(self, key):
+                out[key] = getattr(self, key)
+        return out
+
+
+def _finite_or_none(x: float) -> float | None:
+    return x if math.isfinite(x) else None

@@ -1,0 +1,162 @@
+"""Starting the wobjcal UI: the port, the autosave of earlier sessions, serving until stopped.
+
+``run()`` starts the server (127.0.0.1:8080 by default; viser moves on to the next free port
+when that one is busy, and ``app.server.get_port()`` is the one bound), restores the newest
+autosave of an earlier session of the plan or sets it aside (:mod:`webui.autosave`), and
+returns the :class:`webui.app.WobjcalApp`; :func:`serve` keeps it running until Ctrl-C or
+SIGTERM. ``wobjcal ui`` calls both.
+"""
+
+from __future__ import annotations
+
+import logging
+import signal
+import threading
+from pathlib import Path
+
+import viser
+
+from calib.errors import InputError
+from webui import demo
+from webui.app import WobjcalApp
+from webui.autosave import (
+    AutosaveLock,
+    AutosaveLockedError,
+    FoundAutosave,
+    default_autosave_path,
+    find_newer_autosave,
+    set_aside,
+)
+from webui.plan_adapter import autosave_bytes, ui_plan_from_file
+from webui.plan_doc import UiPlan
+
+logger = logging.getLogger(__name__)
+
+__all__ = ["check_port", "run", "serve"]
+
+
+def check_port(port: object) -> int:
+    """``port`` as a TCP port number 0-65535 (0: any free port).
+
+    Raises:
+        InputError: not an integer in that range (``--port 99999`` used to hang the server).
+    """
+    if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
+        raise InputError(f"port: must be a whole number 0-65535 (0: any free port), got {port!r}")
+    return port
+
+
+def _restore(found: FoundAutosave, plan_dir: Path) -> UiPlan:
+    """The session plan an autosave holds (its file references resolve from ``plan_dir``)."""
+    from calib.plan.file import check_plan_files, plan_from_json
+    from webui.plan_adapter import ui_plan_from_plan
+
+    plan = plan_from_json(found.path.read_text(encoding="utf-8"), source=str(found.path))
+    check_plan_files(plan, plan_dir, source=str(found.path))
+    return ui_plan_from_plan(plan, name=plan.name or found.path.stem)
+
+
+def run(
+    plan_path: str | Path | None = None,
+    host: str = "127.0.0.1",
+    port: int = 8080,
+    block: bool = True,
+    autosave_path: str | Path | None = "auto",
+    fresh: bool = False,
+) -> WobjcalApp:
+    """Start the wobjcal UI on ``http://host:port`` with a plan file or the built-in demo.
+
+    Args:
+        plan_path: a ``wobjcal.plan/1`` file; ``None`` opens the built-in stator-section demo.
+        host: interface to bind; 127.0.0.1 (this machine only) unless told otherwise.
+        port: TCP port (0-65535; 0 any free one); when it is busy viser binds the next free
+            one: ``app.server.get_port()`` is the one bound.
+        block: serve until interrupted (Ctrl-C or SIGTERM), then stop; ``False`` returns at
+            once.
+        autosave_path: where the session plan autosaves; ``"auto"`` (default): one file per
+            plan and bound port under ``~/.cache/wobjcal/autosave/`` (see
+            :func:`webui.autosave.default_autosave_path`); ``None`` disables autosave.
+        fresh: start from the plan file even when a newer autosave of an earlier session
+            exists (it is renamed ``<file>.<time>.bak``, not overwritten); by default it is
+            restored. Either way ``app.autosave_note`` says what happened (the CLI prints it,
+            each new tab shows it).
+
+    Returns:
+        The running app (``app.server`` is the viser server; ``app.stop()`` ends it).
+
+    Raises:
+        InputError: a bad port, a plan that cannot be loaded, or an autosave file held by
+            another running server.
+    """
+    check_port(port)
+    if plan_path is not None:
+        ui_plan, plan_dir = ui_plan_from_file(Path(plan_path)), Path(plan_path).parent
+    else:
+        ui_plan, plan_dir = demo.demo_ui_plan()
+    server = viser.ViserServer(host=host, port=port, label="wobjcal", verbose=block)
+    bound = server.get_port()
+    try:
+        auto = autosave_path == "auto"
+        path = (
+            default_autosave_path(plan_path, bound)
+            if auto
+            else (None if autosave_path is None else Path(autosave_path))
+        )
+        lock = None
+        note = ""
+        if path is not None:
+            found = find_newer_autosave(  # before taking our lock: it would hide our file
+                plan_path,
+                autosave_bytes(ui_plan),
+                folder=None if auto else path.parent / ".none",
+                also=path,
+            )
+            try:
+                lock = AutosaveLock(path)
+            except AutosaveLockedError as exc:
+                raise InputError(str(exc)) from None
+            if found is not None and not fresh:
+                try:
+                    ui_plan = _restore(found, plan_dir)
+                    note = f"restored the edits of the last session from {found.describe()}"
+                except (InputError, OSError) as exc:
+                    aside = set_aside(found.path)
+                    note = (
+                        f"not restored: {found.path} is unusable ({exc}); started from the plan, "
+                        f"the autosave is kept as {aside}"
+                    )
+            elif found is not None:
+                aside = set_aside(found.path)
+                note = f"started fresh; the last session's autosave is kept as {aside}"
+    except BaseException:
+        server.stop()
+        raise
+    server.gui.configure_theme(control_width="large", show_share_button=False)
+    logger.info("wobjcal UI at http://%s:%d", host, bound)
+    if path is not None:
+        logger.info("the session plan autosaves to %s", path)
+    app = WobjcalApp(server, ui_plan, plan_dir, autosave_path=path)
+    app.autosave_lock, app.autosave_note = lock, note
+    if note:
+        logger.warning("%s", note)
+    if not block:
+        return app
+    serve(app)
+    return app
+
+
+def serve(app: WobjcalApp) -> None:
+    """Serve until Ctrl-C or SIGTERM, then stop the app (server, worker, autosave lock)."""
+    stop = threading.Event()
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    try:
+        while not stop.wait(0.5):
+            pass
+    except KeyboardInterrupt:
+        logger.info("stopping the wobjcal UI")
+    finally:
+        app.stop()
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
