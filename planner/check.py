@@ -45,8 +45,11 @@ from planner.check_results import ConfData, PlanCheck, PointCheck, Status
 from planner.plan_cell import nominal_T_base_wobj, open_cell
 
 if TYPE_CHECKING:
+    import trimesh
+
     from planner.cell.cell import Cell
     from planner.cell.feasibility import ProbeFeasibility
+    from planner.sim.quality import LayoutQuality
 
 FloatArray = NDArray[np.float64]
 
@@ -58,6 +61,7 @@ __all__ = [
     "check_plan",
     "check_points",
     "layout_problem",
+    "plan_quality",
 ]
 
 
@@ -78,9 +82,58 @@ def check_plan(plan: Plan, plan_dir: Path | None = None, *, cell: Cell | None = 
         with open_cell(plan, plan_dir or Path.cwd()) as own:
             return check_plan(plan, cell=own)
     checks, error = _check(plan, list(plan.points), cell)
+    layout = layout_problem(plan)
+    quality, note = None, ""
+    if not layout and cell.work_object is not None:
+        quality, note = plan_quality(plan, cell.work_object.mesh)
+        if quality is not None and quality.rating == "unobservable":
+            layout = quality.problem
     return PlanCheck(
-        checks, cell.solver.kind, cell.solver.why_not_opw or "", error, layout_problem(plan)
+        checks, cell.solver.kind, cell.solver.why_not_opw or "", error, layout, quality, note
     )
+
+
+def plan_quality(plan: Plan, mesh: trimesh.Trimesh) -> tuple[LayoutQuality | None, str]:
+    """The predicted quality of ``plan``'s layout (:mod:`planner.sim.quality`), or why none.
+
+    The plan's procedure linearised with its noise figures, its points of interest on the
+    work object ``mesh`` (wobj, metres; the default point is the farthest surface point).
+    The check and the UI's live panel call this.
+
+    Returns:
+        ``(quality, "")``, or ``(None, reason)`` when the plan cannot be predicted (e.g. a
+        role missing, a touch probe asked for an edge search).
+    """
+    from calib.estimators.layout import search_constraint_set
+    from calib.estimators.observability import analyze_layout
+    from planner.sim.quality import layout_quality, unobservable_quality
+    from planner.sim.report_points import poi_rows
+    from planner.sim.setup import SimulationSetup
+    from planner.validate_checks import check_simulatable
+
+    try:
+        probes = [p.to_probe_point() for p in plan.points]
+        obs = analyze_layout(search_constraint_set(probes))
+        if not obs.observable:  # the quality names the free motions
+            return unobservable_quality(obs.messages), ""
+        models = check_simulatable(plan)
+    except InputError as exc:  # PlanError included
+        return None, str(exc)
+    setup = SimulationSetup(
+        points=models.points,
+        method=models.method,
+        settings=models.settings,
+        T_base_wobj_nominal=nominal_T_base_wobj(plan),
+        sensor=models.sensor,
+        robot_error=models.robot_error,
+        misplacement=models.misplacement,
+        pivot_wobj_m=np.zeros(3),
+        edge_inset_m=models.edge_inset_m,
+    )
+    try:
+        return layout_quality(setup, poi_rows(plan.validation.report, mesh)), ""
+    except (InputError, ProbeFailedError) as exc:
+        return None, f"{plan.method}: {exc}"
 
 
 def layout_problem(plan: Plan) -> str:

@@ -8,10 +8,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from planner.sim.quality import LayoutQuality
 
 FloatArray = NDArray[np.float64]
 Status = Literal["feasible", "marginal", "infeasible"]
@@ -116,6 +119,9 @@ class PlanCheck:
         layout: why the plan's procedure would refuse its points (:func:`layout_problem`:
             no points, a missing role, a layout that breaks the procedure's assumptions),
             ``""`` when none.
+        quality: the layout's predicted quality (:mod:`planner.sim.quality`), ``None`` when
+            it could not be predicted (``quality_note`` says why) or the layout is refused.
+        quality_note: why there is no quality, ``""`` otherwise.
     """
 
     points: tuple[PointCheck, ...]
@@ -123,6 +129,18 @@ class PlanCheck:
     ik_note: str = ""
     error: str = ""
     layout: str = ""
+    quality: LayoutQuality | None = None
+    quality_note: str = ""
+
+    @property
+    def layout_status(self) -> Status:
+        """``infeasible`` when the layout is refused (a degree of freedom free included),
+        ``marginal`` when it is weak, else ``feasible``."""
+        if self.layout:
+            return "infeasible"
+        if self.quality is not None and self.quality.rating == "weak":
+            return "marginal"
+        return "feasible"
 
     @property
     def feasible(self) -> bool:
@@ -146,15 +164,19 @@ class PlanCheck:
         raise KeyError(f"no point {point_id!r}; points: {[p.point_id for p in self.points]}")
 
     def to_json(self) -> dict[str, Any]:
-        """A JSON-ready dict; ``ik_note``, ``error`` and ``layout`` appear only when set."""
+        """A JSON-ready dict; ``ik_note``, ``error``, ``layout``, ``quality_note`` and
+        ``quality`` appear only when set; ``layout_status`` always."""
         out: dict[str, Any] = {
             "feasible": self.feasible,
             "ik_kind": self.ik_kind,
             "points": [p.to_json() for p in self.points],
         }
-        for key in ("ik_note", "error", "layout"):
+        for key in ("ik_note", "error", "layout", "quality_note"):
             if getattr(self, key):
                 out[key] = getattr(self, key)
+        out["layout_status"] = self.layout_status
+        if self.quality is not None:
+            out["quality"] = self.quality.to_json()
         return out
 
 

@@ -30,7 +30,16 @@ VOLATILE = {"elapsed_s", "workers", "plan"}
 #: Fields added on purpose since the recording, allowed in new output only: the one plan check
 #: (``planner.check``) also reports the IK kind, the pose and face parts of the status, where a
 #: path fails and the pair that limits the clearance. Every recorded field must still match.
-ADDED = {"ik_kind", "pose_status", "pose_reason", "path_fail_at_m", "face_reason", "clearance_pair"}
+ADDED = {
+    "ik_kind",
+    "pose_status",
+    "pose_reason",
+    "path_fail_at_m",
+    "face_reason",
+    "clearance_pair",
+    "layout_status",  # issue 13: the layout quality
+    "quality",
+}
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 

@@ -287,3 +287,41 @@ def _describe_general(v: FloatArray, cs: ConstraintSet) -> tuple[str, str]:
         f"screw motion about an axis along {where} through {_mm(c)} ({pitch * 1e3:.3g} mm per rad)",
         "the probe normal lines leave this combined rotation and translation free",
     )
+
+
+def name_motion(motion: FloatArray, centroid_m: FloatArray, scale_m: float) -> str:
+    """Name a (weak, not necessarily free) small motion of the wobj frame in words.
+
+    The motion's larger part in scaled centroid coordinates decides: a rotation-dominated
+    motion is ``"rotation about wobj y"`` (axis within about 10 degrees of a wobj axis, through
+    the origin within 5 % of the layout size) or ``"rotation about an axis along <axis>
+    through (x, y, z) mm"``; a translation-dominated one ``"translation along wobj z"``.
+
+    Args:
+        motion: ``(6,)`` small motion ``(dx, dy, dz, rx, ry, rz)`` about the wobj origin (m, rad).
+        centroid_m: ``(3,)`` the layout centroid, wobj frame, metres.
+        scale_m: the layout size, metres (rotations times this compare with translations).
+    """
+    t = np.asarray(motion[:3], dtype=np.float64)
+    w = np.asarray(motion[3:], dtype=np.float64)
+    c = np.asarray(centroid_m, dtype=np.float64)
+    t_c = t + np.cross(w, c)  # the translation at the centroid
+    if float(np.linalg.norm(w)) * scale_m <= float(np.linalg.norm(t_c)):
+        return f"translation along {axis_name(_snap(t))}"
+    axis = _snap(w)
+    point = np.cross(w, t) / float(w @ w)  # the screw axis' point nearest the origin
+    name = axis_name(axis)
+    if float(np.linalg.norm(point)) < 0.05 * scale_m:
+        return f"rotation about {name}"
+    return f"rotation about an axis along {name} through {_mm(point)}"
+
+
+def _snap(d: FloatArray, tol_rad: float = np.radians(10.0)) -> FloatArray:
+    """``d`` normalised, snapped to the nearest wobj axis when within ``tol_rad`` of it."""
+    u = d / np.linalg.norm(d)
+    k = int(np.argmax(np.abs(u)))
+    if abs(u[k]) >= np.cos(tol_rad):
+        out = np.zeros(3)
+        out[k] = np.sign(u[k])
+        return out
+    return u

@@ -17,6 +17,7 @@ from planner.cli.common import print_json, read_plan, stdout
 
 if TYPE_CHECKING:
     from planner.check import PlanCheck, PointCheck
+    from planner.sim.quality import LayoutQuality
 
 _COLOUR = {"feasible": "green", "marginal": "yellow", "infeasible": "red"}
 
@@ -33,8 +34,13 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "The procedure's own preconditions are checked too: every role it needs, and a dry\n"
         "run of 'wobjcal calibrate' on exact measurements of the nominal points (so a plan the\n"
         "calibration would refuse fails here, before the robot measures).\n\n"
-        "exit codes: 0 all feasible (marginal points are reported but pass), 1 any point or\n"
-        "path infeasible or the layout refused (each named with the reason), 2 bad input",
+        "The layout's predicted quality follows: 1 sigma of each degree of freedom, noise gain,\n"
+        "the weakest motion in words and the predicted error at the points of interest at the\n"
+        "plan's confidence levels; a weak layout is marginal, one that leaves a degree of\n"
+        "freedom free fails.\n\n"
+        "exit codes: 0 all feasible (marginal points and a weak layout are reported but pass),\n"
+        "1 any point or path infeasible or the layout refused (each named with the reason),\n"
+        "2 bad input",
         "wobjcal check assets/plans/stator_section_ah.json\n"
         "wobjcal check plan.json --json > check.json",
     )
@@ -73,6 +79,32 @@ def _table(check: PlanCheck, title: str) -> Table:
     return table
 
 
+def quality_table(q: LayoutQuality, status: str) -> Table:
+    """The layout quality as a table: 1 sigma per DOF, gains, weakest motion, points of
+    interest at their levels."""
+    from planner.sim.quality import DOF_NAMES
+
+    table = Table(
+        title="layout quality (predicted, the procedure linearised with the plan's noise)",
+        caption=f"layout: [{_COLOUR[status]}]{status}[/]" + (f": {q.problem}" if q.problem else ""),
+    )
+    table.add_column("quantity")
+    table.add_column("predicted", justify="right")
+    for i, name in enumerate(DOF_NAMES):
+        unit, scale = ("mm", 1e3) if i < 3 else ("deg", math.degrees(1.0))
+        table.add_row(f"1 sigma {name}", f"{q.sigma[i] * scale:.4f} {unit}")
+    table.add_row("noise per search (1 sigma)", f"{q.noise_sigma_m * 1e3:.4f} mm")
+    table.add_row("noise gain / condition", f"{q.noise_gain:.2f} / {q.condition:.1f}")
+    table.add_row("weakest motion", q.weakest_text)
+    for p in q.poi:
+        levels = ", ".join(
+            f"{h * 1e3:.3f} mm at {lv:g} %"
+            for lv, h in zip(p.levels_percent, p.half_width_m, strict=True)
+        )
+        table.add_row(p.label, levels)
+    return table
+
+
 def cmd_check(args: argparse.Namespace) -> int:
     """Run the check; exit 0 when all points and paths are feasible, else 1."""
     from planner.check import check_plan  # PyBullet: not for ``wobjcal --help``
@@ -95,10 +127,15 @@ def cmd_check(args: argparse.Namespace) -> int:
         out.print(f"[red]point {p.point_id}: {p.status}: {p.reason or 'not feasible'}[/]")
     if check.layout:
         out.print(f"layout: {check.layout}", style="red", markup=False)
+    if check.quality is not None and check.quality.rating != "unobservable":
+        out.print(quality_table(check.quality, check.layout_status))
+    elif check.quality_note:
+        out.print(f"layout quality: not predicted: {check.quality_note}", markup=False)
     n = len(check.points)
     out.print(
         f"{n - len(bad)} of {n} points feasible"
         + ("" if not bad else f"; not feasible: {', '.join(p.point_id for p in bad)}")
         + ("; the layout is refused (see above)" if check.layout else "")
+        + ("; the layout is weak (see above)" if check.layout_status == "marginal" else "")
     )
     return 0 if check.feasible else 1

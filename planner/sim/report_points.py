@@ -106,6 +106,27 @@ def region_points(
     return surface_samples(mesh, region.max_points)
 
 
+def poi_rows(spec: ReportSpec, mesh: trimesh.Trimesh) -> list[RowSpec]:
+    """The rows of the points of interest (default: the surface point farthest from the
+    origin), in the plan's order; the layout quality and the report share them."""
+    pois: Sequence[PointOfInterest] = (
+        spec.points_of_interest
+        if spec.points_of_interest is not None
+        else default_points_of_interest(mesh)
+    )
+    return [
+        RowSpec(
+            key=f"{poi.components}_{poi.name}",
+            label=poi.label or _label(poi.components, f"at {poi.name}"),
+            unit="mm",
+            levels_percent=poi.levels_percent or spec.levels_percent,
+            points_wobj=np.asarray([poi.position_m], dtype=np.float64),
+            components=poi.components,
+        )
+        for poi in pois
+    ]
+
+
 def report_rows(
     spec: ReportSpec,
     mesh: trimesh.Trimesh,
@@ -114,23 +135,7 @@ def report_rows(
 ) -> list[RowSpec]:
     """The rows of a plan's report, in order: frame, points of interest, regions, x-offset."""
     levels = spec.levels_percent
-    rows = frame_rows(levels)
-    pois: Sequence[PointOfInterest] = (
-        spec.points_of_interest
-        if spec.points_of_interest is not None
-        else default_points_of_interest(mesh)
-    )
-    for poi in pois:
-        rows.append(
-            RowSpec(
-                key=f"{poi.components}_{poi.name}",
-                label=poi.label or _label(poi.components, f"at {poi.name}"),
-                unit="mm",
-                levels_percent=poi.levels_percent or levels,
-                points_wobj=np.asarray([poi.position_m], dtype=np.float64),
-                components=poi.components,
-            )
-        )
+    rows = frame_rows(levels) + poi_rows(spec, mesh)
     regions = spec.regions if spec.regions is not None else [RegionSpec(name="part")]
     for region in regions:
         rows.append(

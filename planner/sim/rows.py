@@ -144,6 +144,14 @@ def predicted_sigma(spec: RowSpec, cov: FloatArray) -> float:
     return point_sigma(S, spec.components)
 
 
+def z_values(levels_percent: tuple[float, ...]) -> FloatArray:
+    """``z = Phi^-1(0.5 + P / 2)`` of each level ``P`` (percent): a row's half-width is
+    ``z * sigma``."""
+    from scipy.special import ndtri
+
+    return np.asarray(ndtri(0.5 + np.asarray(levels_percent) / 200.0), dtype=np.float64)
+
+
 def point_sigma(S: FloatArray, components: str) -> float:
     """Pooled standard deviation of the measure of Gaussian errors with covariances
     ``(M, 3, 3)`` (SI)."""

@@ -21,7 +21,7 @@ from calib.stats import confidence_intervals
 from planner.sim.predict import Prediction
 from planner.sim.report import IntervalRow, PointOutcome, ValidationReport
 from planner.sim.report_points import XOFFSET_KEYS
-from planner.sim.rows import SCALE, RowSpec, predicted_sigma, samples_and_bias
+from planner.sim.rows import SCALE, RowSpec, predicted_sigma, samples_and_bias, z_values
 from planner.sim.search_events import (
     LANDED_OFF_FACE,
     PARTLY_OFF_FACE,
@@ -82,12 +82,6 @@ def _half_widths(samples: FloatArray, unit: str, levels: tuple[float, ...]) -> l
     return [r.half_width for r in table.rows]
 
 
-def _z(levels: tuple[float, ...]) -> FloatArray:
-    from scipy.special import ndtri
-
-    return np.asarray(ndtri(0.5 + np.asarray(levels) / 200.0), dtype=np.float64)
-
-
 @dataclass(frozen=True)
 class RowInputs:
     """What one estimator contributes to a row.
@@ -119,7 +113,7 @@ def build_rows(
     nan = float("nan")
     for spec in specs:
         scale = SCALE[spec.unit]
-        z = _z(spec.levels_percent)
+        z = z_values(spec.levels_percent)
         per: list[tuple[list[float], list[float], float, list[float]]] = []
         for k, inp in enumerate((procedure, best_fit)):
             levels = spec.levels_percent
