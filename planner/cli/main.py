@@ -74,7 +74,7 @@ def _add(
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``wobjcal`` command."""
-    from planner.cli import calibrate, check, export, misc, validate
+    from planner.cli import calibrate, check, export, misc, suggest, validate
 
     parser = argparse.ArgumentParser(
         prog="wobjcal",
@@ -87,7 +87,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"wobjcal {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks and debug logs")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for module in (check, validate, calibrate, export, misc):
+    for module in (check, validate, calibrate, export, suggest, misc):
         module.register(sub, _add)
     return parser
 

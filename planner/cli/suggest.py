@@ -1,0 +1,160 @@
+"""``wobjcal suggest``: propose probe points that meet a target error at the points of interest.
+
+Calls :func:`planner.suggest.suggest_plan` (the same job the web UI's "Suggest" button runs)
+and writes the plan atomically.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from planner.cli.common import count_arg, read_plan, stdout
+
+
+def _points_mm(text: str) -> np.ndarray:
+    """``"X,Y,Z[;X,Y,Z...]"`` in millimetres, wobj frame -> ``(K, 3)`` metres."""
+    try:
+        rows = [[float(v) for v in part.split(",")] for part in text.split(";") if part.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"points are X,Y,Z[;X,Y,Z...] in mm, got {text!r}"
+        ) from None
+    if not rows or any(len(r) != 3 for r in rows) or not np.all(np.isfinite(rows)):
+        raise argparse.ArgumentTypeError(f"points are X,Y,Z[;X,Y,Z...] in mm, got {text!r}")
+    return np.asarray(rows, dtype=np.float64) * 1e-3
+
+
+def _positive_mm(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a distance in mm, got {text!r}") from None
+    if not (v > 0 and np.isfinite(v)):
+        raise argparse.ArgumentTypeError(f"a positive distance in mm, got {text!r}")
+    return v * 1e-3
+
+
+def _percent(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a percentage, got {text!r}") from None
+    if not 0 < v <= 99.9999:
+        raise argparse.ArgumentTypeError(f"a confidence in (0, 99.9999] percent, got {text!r}")
+    return v
+
+
+def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
+    """Add ``suggest`` to the subparsers ``sub``."""
+    p = add(
+        sub,
+        "suggest",
+        "propose probe points that meet a target error at the points of interest",
+        "Sample candidate approach searches on the part's planar faces (the sensor footprint,\n"
+        "grown by the misplacement's translation, on the face), keep those whose probe pose\n"
+        "and search path are feasible in the plan's cell, and choose the set that minimises\n"
+        "the predicted error at the points of interest (greedy plus exchange on the\n"
+        "information matrix), adding points until the target holds at the confidence or\n"
+        "--max-points is reached. Writes the plan (atomically) and prints its predicted\n"
+        "quality. With --add N the plan's points are kept and N are added (best fit).\n\n"
+        "exit codes: 0 target met (or none given), 1 target not reached (the best plan found\n"
+        "is still written), 2 bad input or no feasible layout (faces tried and why)",
+        "wobjcal suggest plan.json --target 0.3 -o suggested.json\n"
+        "wobjcal suggest plan.json --procedure three_two_one -o plan_321.json\n"
+        "wobjcal suggest plan.json --at 0,-600,-150 --confidence 99 --target 0.2 -o out.json\n"
+        "wobjcal suggest suggested.json --add 1 -o plus_one.json",
+    )
+    p.add_argument("plan", metavar="PLAN", help="plan file (wobjcal.plan/1): cell, part, models")
+    p.add_argument(
+        "--target",
+        type=_positive_mm,
+        metavar="MM",
+        help="largest predicted error at the points of interest, mm",
+    )
+    p.add_argument(
+        "--confidence",
+        type=_percent,
+        metavar="PCT",
+        help="confidence of the target, percent (default: the plan's first level)",
+    )
+    p.add_argument(
+        "--at",
+        type=_points_mm,
+        metavar="POINTS",
+        help="points of interest X,Y,Z[;X,Y,Z...] in mm, wobj frame (default: the plan's)",
+    )
+    p.add_argument(
+        "--max-points",
+        type=count_arg(6, 40),
+        default=8,
+        metavar="N",
+        help="most points to suggest (default 8; the number used without --target)",
+    )
+    p.add_argument(
+        "--procedure",
+        choices=("best_fit", "three_two_one"),
+        default="best_fit",
+        help="the procedure of the suggested plan (default best_fit)",
+    )
+    p.add_argument(
+        "--add",
+        type=count_arg(1, 40),
+        default=0,
+        metavar="N",
+        help="keep the plan's points and add the N best (best fit)",
+    )
+    p.add_argument("-o", "--output", metavar="OUT", required=True, help="plan file to write")
+    p.set_defaults(handler=cmd_suggest)
+
+
+def cmd_suggest(args: argparse.Namespace) -> int:
+    """Suggest, write the plan, print its quality; exit 0 when the target holds, else 1."""
+    from calib.plan.file import save_plan
+    from planner.cli.check import quality_table
+    from planner.suggest import suggest_plan
+
+    plan, plan_dir = read_plan(args.plan)
+    out = stdout()
+    res = suggest_plan(
+        plan,
+        plan_dir,
+        target_m=args.target,
+        confidence_percent=args.confidence,
+        at_m=args.at,
+        max_points=args.max_points,
+        procedure=args.procedure,
+        add=args.add,
+        progress=lambda stage, done, total: print(
+            f"wobjcal suggest: {stage} {done}/{total}", file=sys.stderr
+        ),
+    )
+    target = Path(args.output)
+    plan_out = res.plan
+    if target.resolve().parent != plan_dir.resolve():  # keep relative file references working
+        from planner.suggest import moved_plan
+
+        plan_out = moved_plan(plan_out, plan_dir, target.resolve().parent)
+    save_plan(plan_out, target)
+    for pt in res.plan.points[len(res.plan.points) - (args.add or len(res.plan.points)) :]:
+        pos = ", ".join(f"{c * 1e3:.1f}" for c in pt.position_m)
+        nrm = ", ".join(f"{c:.3f}" for c in pt.normal)
+        out.print(f"{pt.id} ({pt.role}): ({pos}) mm, normal ({nrm})", markup=False)
+    if res.quality is not None:
+        out.print(
+            quality_table(res.quality, "feasible" if res.quality.rating == "ok" else "marginal")
+        )
+    kept = ", ".join(f"{k} {v}" for k, v in sorted(res.rejected.items()))
+    out.print(
+        f"{res.n_feasible} of {res.n_candidates} candidates feasible"
+        + (f" (dropped: {kept})" if kept else "")
+        + f"; {res.elapsed_s:.1f} s",
+        markup=False,
+    )
+    out.print(f"{res.message}; wrote {target}", markup=False, style=None if res.met else "red")
+    return 0 if res.met else 1
