@@ -88,6 +88,8 @@ class SuggestResult:
         rejected: why the others were dropped: ``{"reach": n, "collision": n, ...}``.
         message: one line for humans: met, or the best reached and why not better.
         elapsed_s: wall time, s.
+        pool: the candidates with a feasible probe pose (search paths checked only for the
+            ones a design picked).
     """
 
     plan: Plan
@@ -103,6 +105,7 @@ class SuggestResult:
     rejected: dict[str, int]
     message: str
     elapsed_s: float
+    pool: Candidates | None = field(default=None, repr=False)
 
 
 def _why(reason: str) -> str:
@@ -279,6 +282,7 @@ def suggest_plan(
         rejected=rejected,
         message=msg,
         elapsed_s=time.perf_counter() - t0,
+        pool=pool,
     )
 
 

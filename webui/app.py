@@ -53,7 +53,7 @@ class WobjcalApp:
         plan_dir: Path,
         autosave_path: Path | None = DEFAULT_AUTOSAVE,
     ) -> None:
-        from webui import calibrate_panel, files_panel, points_panel, validate_panel
+        from webui import calibrate_panel, files_panel, layout_panel, points_panel, validate_panel
 
         self.server = server
         self.plan_dir = Path(plan_dir)
@@ -74,6 +74,7 @@ class WobjcalApp:
         self.validate_panel = validate_panel.ValidatePanel(self)
         self.files_panel = files_panel.FilesPanel(self)
         self.calibrate_panel = calibrate_panel.CalibratePanel(self)
+        self.layout_panel = layout_panel.LayoutPanel(self)  # issue 13: quality and suggest
         guard_uploads(server, files_panel.MAX_UPLOAD_BYTES, self._upload_refused)
         self.state.subscribe(self._on_change)
         #: What the app said about the autosave at start (restored, set aside), for new tabs.
@@ -111,6 +112,7 @@ class WobjcalApp:
                 logger.warning("%s", why)
                 self.notify("Robot not drawn", why, error=True)
         self.recheck(self.state.doc.ids)
+        self.layout_panel.refresh()
 
     # ---- checks ---------------------------------------------------------------------------
     def check_of(self, point_id: str) -> PointCheck | None:
@@ -259,6 +261,7 @@ class WobjcalApp:
         if self.robot is not None:
             self.robot.stop()
         self.validate_panel.close()
+        self.layout_panel.close()
         self.server.stop()
         self.worker.close()
         if self.autosave_lock is not None:

@@ -251,3 +251,29 @@ def quality_from_covariance(
         weakest_unit=unit,
         poi=tuple(poi),
     )
+
+
+def error_radius(points_wobj: FloatArray, cov: FloatArray, level_percent: float) -> FloatArray:
+    """``(M,)`` predicted radius within which ``level_percent`` of calibrations place each
+    point, metres: ``sqrt(chi2_3(level) * trace(S) / 3)`` for the point's Gaussian error of
+    covariance ``S = J cov J^T``: exact for an isotropic error, and for any other the radius of
+    the isotropic error with the same mean squared length (fast enough for the UI's colour map
+    on every edit: no eigenvalues). The UI paints it on the part.
+    """
+    from scipy.stats import chi2
+
+    P = np.asarray(points_wobj, dtype=np.float64).reshape(-1, 3)
+    C = np.asarray(cov, dtype=np.float64)
+    k = float(chi2.ppf(level_percent / 100.0, 3)) / 3.0
+    # e = t + w x p: E|e|^2 = tr Ctt + 2 E[t . (w x p)] + |p|^2 tr Cww - p^T Cww p, all
+    # quadratic in p (E[t . (w x p)] = p . E[t x w]), so no (M, 3, 6) Jacobian is built
+    Ctw = C[:3, 3:]
+    txw = np.array([Ctw[1, 2] - Ctw[2, 1], Ctw[2, 0] - Ctw[0, 2], Ctw[0, 1] - Ctw[1, 0]])
+    Cww = C[3:, 3:]
+    trace = (
+        np.trace(C[:3, :3])
+        + 2.0 * P @ txw
+        + np.einsum("mi,mi->m", P, P) * np.trace(Cww)
+        - np.einsum("mi,mi->m", P @ Cww, P)
+    )
+    return np.sqrt(k * np.maximum(trace, 0.0))

@@ -1,0 +1,69 @@
+"""The UI's layout panel on the server side: live quality after an edit, the predicted error
+on the part, and Suggest replacing the points (one undo step)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from webui.app import WobjcalApp
+from webui.server import run
+from webui.testing import free_port
+
+AH = Path(__file__).resolve().parent.parent / "assets" / "plans" / "stator_section_ah.json"
+
+
+@pytest.fixture(scope="module")
+def app(tmp_path_factory: pytest.TempPathFactory) -> Iterator[WobjcalApp]:
+    folder = tmp_path_factory.mktemp("layout")
+    a = run(AH, port=free_port(), block=False, autosave_path=folder / "auto.json", fresh=True)
+    yield a
+    a.stop()
+
+
+def test_quality_is_live_and_follows_an_edit(app: WobjcalApp) -> None:
+    panel = app.layout_panel
+    q = panel.refresh().result(60)
+    assert q is not None and q.rating == "ok"
+    before = q.worst_poi_m(95.5)
+    assert "Layout: ok" in panel.quality_md.content
+    assert "WOCS yz-plane at epsilon" in panel.quality_md.content
+    # B (rotation about z with A: 500 mm apart) moved to 40 mm from A: weaker, seen live
+    a = app.state.doc.get("A").probe.position_m
+    app.move_point_to("B", [a[0], a[1] + 0.04, a[2]])
+    q2 = panel.refresh().result(60)
+    assert q2 is not None and q2.worst_poi_m(95.5) > 1.5 * before
+    app.state.undo()
+    q3 = panel.refresh().result(60)
+    assert q3 is not None and q3.worst_poi_m(95.5) == pytest.approx(before, rel=1e-9)
+
+
+def test_error_map_paints_every_vertex(app: WobjcalApp, monkeypatch: pytest.MonkeyPatch) -> None:
+    painted: list[Any] = []
+    monkeypatch.setattr(app.scene, "color_work_object", lambda rgb: painted.append(rgb))
+    panel = app.layout_panel
+    panel.refresh().result(60)
+    panel.show_map.value = True
+    panel._paint()
+    assert painted and painted[-1] is not None
+    assert np.asarray(painted[-1]).shape == (len(app.view.wobj_mesh.vertices), 3)  # type: ignore[union-attr]
+    panel.show_map.value = False
+    panel._paint()
+    assert painted[-1] is None
+
+
+def test_suggest_replaces_the_points_in_one_undo_step(app: WobjcalApp) -> None:
+    panel = app.layout_panel
+    before = app.state.doc.ids
+    panel.target.value = 0.3
+    res = panel.suggest().result(300)
+    assert res.met
+    doc = app.state.doc
+    assert len(doc.points) >= 6 and all(p.role == "fit" for p in doc.points)
+    assert panel.refresh().result(60) is not None
+    app.state.undo()
+    assert app.state.doc.ids == before

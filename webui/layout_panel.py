@@ -1,0 +1,224 @@
+"""The "Layout" panel: the layout's predicted quality, live, and the Suggest buttons.
+
+After every edit of the points the plan's quality is predicted again
+(:func:`planner.check.plan_quality`, what ``wobjcal check`` prints) on this panel's own thread,
+the latest edit only (edits that arrive meanwhile are skipped): 1 sigma per degree of freedom,
+noise gain, the weakest motion in words, the error at the points of interest. Ticked, the
+predicted error is painted on the part (:func:`planner.sim.quality.error_radius`, green small
+to red large) and each point of interest carries a sphere of its predicted error (drawn 100
+times larger). "Suggest layout" and "Add best point" run :func:`planner.suggest.suggest_plan`
+in the cell's worker (it needs the cell) with a progress bar, and replace the points (one undo
+step).
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from concurrent.futures import Future
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from calib.errors import InputError, PlanError
+from planner.check import plan_quality
+from planner.sim.quality import DOF_NAMES, LayoutQuality, error_radius
+from webui.plan_adapter import plan_from_ui, ui_plan_from_plan
+from webui.scene import heat_rgb
+from webui.worker import CellWorker
+
+if TYPE_CHECKING:
+    from planner.suggest import SuggestResult
+    from webui.backend import CellSession
+    from webui.context import AppContext
+    from webui.plan_doc import UiPlan
+
+logger = logging.getLogger(__name__)
+
+#: The spheres at the points of interest are drawn this many times their predicted error.
+SPHERE_SCALE = 100.0
+
+
+def quality_markdown(q: LayoutQuality | None, note: str = "") -> str:
+    """The quality as Markdown (mm, deg)."""
+    if q is None:
+        return f"*Layout quality not predicted:* {note}" if note else ""
+    if q.rating == "unobservable":
+        return f"**Layout fails:** {q.problem}"
+    head = {"ok": "**Layout: ok**", "weak": "**Layout: marginal**"}[q.rating]
+    lines = [head + (f" ({q.problem})" if q.problem else ""), ""]
+    sig = ", ".join(
+        f"{n} {v * (1e3 if i < 3 else 57.29577951308232):.3f} {'mm' if i < 3 else 'deg'}"
+        for i, (n, v) in enumerate(zip(DOF_NAMES, q.sigma, strict=True))
+    )
+    lines.append(f"1 sigma: {sig}  ")
+    lines.append(f"noise gain {q.noise_gain:.2f}, condition {q.condition:.1f}  ")
+    lines.append(f"weakest: {q.weakest_text}  ")
+    for p in q.poi:
+        hw = ", ".join(
+            f"{h * 1e3:.3f} mm at {lv:g} %"
+            for lv, h in zip(p.levels_percent, p.half_width_m, strict=True)
+        )
+        lines.append(f"{p.label}: {hw}  ")
+    return "\n".join(lines)
+
+
+class LayoutPanel:
+    """Live layout quality and the Suggest buttons, shared by all tabs.
+
+    Args:
+        app: the app whose plan is rated.
+    """
+
+    def __init__(self, app: AppContext) -> None:
+        self._app = app
+        self._worker: CellWorker[None] = CellWorker(None, name="wobjcal-layout")
+        self._generation = 0
+        self._lock = threading.Lock()
+        self._suggesting = threading.Event()
+        self.last: LayoutQuality | None = None
+        self.last_note = ""
+        self.last_seconds = 0.0
+        self._painted = False
+        gui = app.server.gui
+        with gui.add_folder("Layout", expand_by_default=True):
+            self.quality_md = gui.add_markdown("")
+            self.show_map = gui.add_checkbox("Show predicted error on part", False)
+            self.target = gui.add_number("Target (mm)", 0.3, min=0.001, max=100.0, step=0.01)
+            self.max_points = gui.add_number("Max points", 8, min=6, max=40, step=1)
+            self.suggest_button = gui.add_button("Suggest layout", color="blue")
+            self.add_button = gui.add_button("Add best point")
+            self.progress = gui.add_progress_bar(0.0, visible=False, animated=True)
+        self.suggest_button.on_click(lambda e: self._on_suggest(e, add=0))
+        self.add_button.on_click(lambda e: self._on_suggest(e, add=1))
+        self.show_map.on_update(lambda _e: self._paint())
+        app.state.subscribe(self._on_change)
+
+    # ---- live quality ----------------------------------------------------------------------
+    def _on_change(self, _change: object) -> None:
+        self.refresh()
+
+    def refresh(self) -> Future[LayoutQuality | None]:
+        """Predict the quality of the current points on the panel's thread (the latest edit
+        wins: a job whose edit was overtaken returns at once)."""
+        with self._lock:
+            self._generation += 1
+            gen = self._generation
+        return self._worker.submit(self._job, gen)
+
+    def _job(self, _res: None, gen: int) -> LayoutQuality | None:
+        if gen != self._generation:
+            return self.last
+        t0 = time.perf_counter()
+        q, note = self.compute(self._app.state.doc)
+        self.last, self.last_note = q, note
+        self.last_seconds = time.perf_counter() - t0
+        self.quality_md.content = quality_markdown(q, note)
+        self._paint()
+        return q
+
+    def compute(self, doc: UiPlan) -> tuple[LayoutQuality | None, str]:
+        """The quality of ``doc``'s points, or why there is none."""
+        view = self._app.view
+        if view is None:
+            return None, "no work object loaded"
+        try:
+            plan = plan_from_ui(doc)
+        except PlanError as exc:
+            return None, str(exc)
+        return plan_quality(plan, view.wobj_mesh)
+
+    def _paint(self) -> None:
+        """The predicted error on the part and the spheres at the points of interest, or
+        neither when the box is not ticked."""
+        scene = self._app.server.scene
+        view, q = self._app.view, self.last
+        if not self.show_map.value or view is None or q is None or q.rating == "unobservable":
+            if self._painted:  # leave another panel's colours alone
+                self._app.scene.color_work_object(None)
+                scene.remove_by_name("/wobj/poi")
+                self._painted = False
+            return
+        self._painted = True
+        level = q.poi[0].levels_percent[0] if q.poi else 95.5
+        r = error_radius(np.asarray(view.wobj_mesh.vertices), q.covariance, level)
+        lo, hi = float(r.min()), float(r.max())
+        self._app.scene.color_work_object(heat_rgb(1.0 - (r - lo) / max(hi - lo, 1e-12)))
+        for i, p in enumerate(q.poi):
+            scene.add_icosphere(
+                f"/wobj/poi/{i}",
+                radius=float(max(p.at(level) * SPHERE_SCALE, 1e-3)),
+                color=(60, 110, 220),
+                position=np.asarray(p.position_m, dtype=np.float64),
+                opacity=0.5,
+            )
+
+    # ---- suggest ---------------------------------------------------------------------------
+    def _on_suggest(self, event: Any, add: int) -> None:
+        client = getattr(event, "client", None)
+        try:
+            self.suggest(add=add)
+        except InputError as exc:
+            self._app.notify("Not suggested", str(exc), client=client)
+
+    def suggest(self, add: int = 0) -> Future[SuggestResult]:
+        """Suggest a layout (``add``: keep the points, add this many) in the cell's worker;
+        the points are replaced when it is done.
+
+        Raises:
+            InputError: a suggestion is already running, or there is no plan.
+        """
+        from planner.suggest import suggest_plan
+
+        plan = plan_from_ui(self._app.state.doc)
+        if self._suggesting.is_set():
+            raise InputError("a suggestion is already running")
+        self._suggesting.set()
+        self.suggest_button.disabled = self.add_button.disabled = True
+        self.progress.value, self.progress.visible = 0.0, True
+        target = float(self.target.value) * 1e-3
+        n_max = int(self.max_points.value)
+        plan_dir = self._app.plan_dir
+        stages = ("planar faces", "candidates", "feasibility", "design", "prediction")
+
+        def progress(stage: str, done: int, total: int) -> None:
+            k = stages.index(stage) if stage in stages else 0
+            self.progress.value = 100.0 * (k + done / max(total, 1)) / len(stages)
+
+        def job(session: CellSession | None) -> SuggestResult:
+            if session is None or session.cell is None:
+                raise InputError("no cell is loaded")
+            return suggest_plan(
+                plan,
+                plan_dir,
+                target_m=None if add else target,
+                max_points=n_max,
+                add=add,
+                progress=progress,
+                cell=session.cell,
+            )
+
+        fut = self._app.worker.submit(job)
+        fut.add_done_callback(self._suggested)
+        return fut
+
+    def _suggested(self, fut: Future[SuggestResult]) -> None:
+        try:
+            res = fut.result()
+        except Exception as exc:  # the message names the faces tried and why
+            if not isinstance(exc, InputError):
+                logger.exception("suggest failed")
+            self._app.notify("No layout suggested", str(exc))
+        else:
+            doc = ui_plan_from_plan(res.plan, name=self._app.state.doc.name)
+            self._app.state.apply(doc, "suggest layout")
+            self._app.notify("Layout suggested", res.message, error=not res.met)
+        finally:
+            self.progress.visible = False
+            self.suggest_button.disabled = self.add_button.disabled = False
+            self._suggesting.clear()
+
+    def close(self) -> None:
+        """Stop the panel's thread."""
+        self._worker.close(timeout=1.0)
