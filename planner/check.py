@@ -108,7 +108,7 @@ def plan_quality(plan: Plan, mesh: trimesh.Trimesh) -> tuple[LayoutQuality | Non
     from calib.estimators.observability import analyze_layout
     from planner.sim.quality import layout_quality, unobservable_quality
     from planner.sim.report_points import poi_rows
-    from planner.sim.setup import SimulationSetup
+    from planner.validate import prediction_setup
     from planner.validate_checks import check_simulatable
 
     try:
@@ -119,17 +119,7 @@ def plan_quality(plan: Plan, mesh: trimesh.Trimesh) -> tuple[LayoutQuality | Non
         models = check_simulatable(plan)
     except InputError as exc:  # PlanError included
         return None, str(exc)
-    setup = SimulationSetup(
-        points=models.points,
-        method=models.method,
-        settings=models.settings,
-        T_base_wobj_nominal=nominal_T_base_wobj(plan),
-        sensor=models.sensor,
-        robot_error=models.robot_error,
-        misplacement=models.misplacement,
-        pivot_wobj_m=np.zeros(3),
-        edge_inset_m=models.edge_inset_m,
-    )
+    setup = prediction_setup(plan, models)
     try:
         return layout_quality(setup, poi_rows(plan.validation.report, mesh)), ""
     except (InputError, ProbeFailedError) as exc:

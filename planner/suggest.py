@@ -369,25 +369,25 @@ def _feasible(
     first = np.concatenate([np.flatnonzero(cands.face == f)[:PROBE_FIRST] for f in face_ids])
     rest = []
     say("feasibility", 0, len(face_ids))
-    res = cell.check_probes(cands.positions_m[first], cands.normals[first], tcp=tcp)
-    for i, x in zip(first, res, strict=True):
-        ok[i] = x.feasible
-        if not x.feasible:
-            key = _why(x.reason)
-            rejected[key] = rejected.get(key, 0) + 1
+
+    def run(idx: list[int]) -> None:
+        res = cell.check_probes(cands.positions_m[idx], cands.normals[idx], tcp=tcp)
+        for i, x in zip(idx, res, strict=True):
+            ok[i] = x.feasible
+            if not x.feasible:
+                key = _why(x.reason)
+                rejected[key] = rejected.get(key, 0) + 1
+
+    run(first.tolist())
     for f in face_ids:
         idx = np.flatnonzero(cands.face == f)
         if ok[idx[:PROBE_FIRST]].any():
             rest.extend(idx[PROBE_FIRST:].tolist())
         else:
-            rejected["face dropped"] = rejected.get("face dropped", 0) + len(idx) - PROBE_FIRST
+            dropped = max(0, len(idx) - PROBE_FIRST)
+            rejected["face dropped"] = rejected.get("face dropped", 0) + dropped
     if rest:
-        res = cell.check_probes(cands.positions_m[rest], cands.normals[rest], tcp=tcp)
-        for i, x in zip(rest, res, strict=True):
-            ok[i] = x.feasible
-            if not x.feasible:
-                key = _why(x.reason)
-                rejected[key] = rejected.get(key, 0) + 1
+        run(rest)
     say("feasibility", len(face_ids), len(face_ids))
     return ok, {k: v for k, v in rejected.items() if v > 0}
 

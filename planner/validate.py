@@ -26,6 +26,7 @@ Example::
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import Any
 
@@ -55,6 +56,7 @@ __all__ = [
     "SIMULATED_PARTS",
     "ValidationModels",
     "check_simulatable",
+    "prediction_setup",
     "preflight",
     "sensitivity_plan",
     "simulation_setup",
@@ -176,6 +178,16 @@ def simulation_setup(
         # the true hole of each target: at its y and z, pushed out by the bolts' bulge
         xs = xoffset_setup(xo, np.stack([g.side_face_offset_m(y, z), y, z], axis=-1))
     px = tuple(RolePoint("xoffset", p) for row in (xs.points if xs else ()) for p in row)
+    return dataclasses.replace(
+        prediction_setup(plan, models),
+        faces=face_lookup(mesh, models.points + px, models.sensor.footprint_radius_m),
+        xoffset=xs,
+    )
+
+
+def prediction_setup(plan: Plan, models: ValidationModels) -> SimulationSetup:
+    """What the prediction of ``plan`` needs (:func:`planner.sim.predict.predict`, the layout
+    quality): its points, procedure, nominal pose and models; no part faces, no x-offset run."""
     return SimulationSetup(
         points=models.points,
         method=models.method,
@@ -185,7 +197,5 @@ def simulation_setup(
         robot_error=models.robot_error,
         misplacement=models.misplacement,
         pivot_wobj_m=default_pivot(list(models.points)),
-        faces=face_lookup(mesh, models.points + px, models.sensor.footprint_radius_m),
-        xoffset=xs,
         edge_inset_m=models.edge_inset_m,
     )

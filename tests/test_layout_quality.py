@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
+from typing import Any
 
 import msgspec
 import numpy as np
@@ -33,19 +34,44 @@ def _moved(plan: Plan, index: int, position_m: tuple[float, float, float]) -> Pl
     return msgspec.structs.replace(plan, points=pts)
 
 
-def test_best_fit_sigma_is_the_least_squares_covariance(plate: tuple) -> None:
-    """For a best fit of approach searches the linearised procedure is the least-squares fit:
-    its covariance is ``var (J^T J)^-1`` (J the point-to-plane rows), TCP error aside."""
+def test_least_squares_closed_form_is_the_linearised_procedure(plate: tuple) -> None:
+    """The quality's fast path for the best fit (``(A^T W A)^-1``) equals the procedure
+    linearised by :func:`planner.sim.predict.predict`, run by run (the one definition)."""
+    from planner.sim.predict import predict
+    from planner.sim.quality import least_squares_covariance
+
     _, best, mesh = plate
     q, note = plan_quality(best, mesh)
     assert q is not None, note
+    setup = _setup(best)
+    closed = least_squares_covariance(setup)
+    assert closed is not None
+    np.testing.assert_allclose(q.covariance, closed, rtol=0, atol=0)  # the fast path ran
+    linearised = predict(setup).cov_procedure
+    np.testing.assert_allclose(closed, linearised, rtol=1e-4, atol=1e-16)
     P = np.array([p.position_m for p in best.points])
     N = np.array([p.normal for p in best.points])
-    J = constraint_jacobian(N, P)
-    var = q.noise_sigma_m**2
-    expected = var * np.linalg.inv(J.T @ J)
-    np.testing.assert_allclose(q.covariance, expected, rtol=1e-4, atol=1e-16)
+    J = constraint_jacobian(N, P)  # and it is var (J^T J)^-1
+    np.testing.assert_allclose(
+        closed, q.noise_sigma_m**2 * np.linalg.inv(J.T @ J), rtol=1e-9, atol=1e-18
+    )
     assert q.rating == "ok" and q.problem == ""
+    # no fast path for a shared TCP error, nor for another procedure
+    import dataclasses
+
+    tcp = msgspec.structs.replace(setup.robot_error, tcp_sigma_m=1e-5)
+    assert least_squares_covariance(dataclasses.replace(setup, robot_error=tcp)) is None
+    # 3-2-1: six constraints solved exactly, the same closed form
+    s321 = _setup(plate[0])
+    closed = least_squares_covariance(s321)
+    assert closed is not None
+    np.testing.assert_allclose(closed, predict(s321).cov_procedure, rtol=1e-6, atol=1e-16)
+
+
+def _setup(plan: Plan) -> Any:
+    from planner.validate import prediction_setup
+
+    return prediction_setup(plan, check_simulatable(plan))
 
 
 def test_poi_half_width_is_the_validation_reports_prediction(plate: tuple) -> None:

@@ -164,7 +164,7 @@ class LayoutPanel:
 
     def suggest(self, add: int = 0) -> Future[SuggestResult]:
         """Suggest a layout (``add``: keep the points, add this many) in the cell's worker;
-        the points are replaced when it is done.
+        the returned future completes once the points are replaced.
 
         Raises:
             InputError: a suggestion is already running, or there is no plan.
@@ -199,21 +199,24 @@ class LayoutPanel:
                 cell=session.cell,
             )
 
+        done: Future[SuggestResult] = Future()  # set once the points are replaced
         fut = self._app.worker.submit(job)
-        fut.add_done_callback(self._suggested)
-        return fut
+        fut.add_done_callback(lambda f: self._suggested(f, done))
+        return done
 
-    def _suggested(self, fut: Future[SuggestResult]) -> None:
+    def _suggested(self, fut: Future[SuggestResult], done: Future[SuggestResult]) -> None:
         try:
             res = fut.result()
         except Exception as exc:  # the message names the faces tried and why
             if not isinstance(exc, InputError):
                 logger.exception("suggest failed")
             self._app.notify("No layout suggested", str(exc))
+            done.set_exception(exc)
         else:
             doc = ui_plan_from_plan(res.plan, name=self._app.state.doc.name)
             self._app.state.apply(doc, "suggest layout")
             self._app.notify("Layout suggested", res.message, error=not res.met)
+            done.set_result(res)
         finally:
             self.progress.visible = False
             self.suggest_button.disabled = self.add_button.disabled = False

@@ -65,6 +65,10 @@ class BestFitProcedure:
     settings_type: type = BestFit
     roles: tuple[str, ...] = (ROLE,)
     summary = "least-squares fit of every point to its face"
+    #: Its linearised covariance is the least-squares one of its searches, ``(A^T W A)^-1``,
+    #: for approach searches without a shared TCP error (a test checks it against the
+    #: linearisation): the UI's live layout quality takes that fast path.
+    least_squares = True
 
     def role_problem(self, roles: Sequence[str], complete: bool) -> str:
         """See :meth:`ProcedureKind.role_problem`."""

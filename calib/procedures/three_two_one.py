@@ -151,6 +151,9 @@ class ThreeTwoOneProcedure:
     settings_type: type = ThreeTwoOne
     roles: tuple[str, ...] = tuple(ROLE_COUNTS)
     summary = "3 points on a primary face, 2 on a secondary, 1 on a tertiary"
+    #: Six face constraints, solved exactly: its linearised covariance is the least-squares
+    #: one of its searches (a test checks it against the linearisation to 1e-9).
+    least_squares = True
 
     def role_problem(self, roles: Sequence[str], complete: bool) -> str:
         """See :meth:`ProcedureKind.role_problem`."""
