@@ -245,7 +245,9 @@ def suggest_plan(
         design, history = _best_fit(ctx, target_m, max_points, add, fixed, say)
     if design is None:
         raise SuggestError(
-            "no layout fixes all 6 degrees of freedom with the feasible candidates: "
+            "no layout fixes all 6 degrees of freedom with the feasible candidates (the "
+            "footprint is grown by the misplacement's translation, "
+            f"{plan.validation.misplacement.max_translation_m * 1e3:.1f} mm): "
             + _faces_text(tried, pool, ctx)
         )
     new_plan = _plan(plan, ctx, design, procedure, add, at_m)
@@ -536,9 +538,27 @@ def _vec3(p: FloatArray | None) -> tuple[float, float, float]:
     return float(q[0]), float(q[1]), float(q[2])
 
 
+#: Faces named one by one in a refusal (the largest); the rest are counted.
+MAX_FACES_NAMED = 8
+
+
+def _largest(tried: tuple[FaceTried, ...]) -> tuple[list[FaceTried], str]:
+    faces = sorted(tried, key=lambda f: -f.area_m2)
+    rest = faces[MAX_FACES_NAMED:]
+    more = ""
+    if rest:
+        stopped = sum(f.kept == 0 for f in rest)
+        more = (
+            f"; and {len(rest)} smaller faces (up to {rest[0].area_m2 * 1e6:.0f} mm^2), "
+            f"{stopped} of them too small for the grown footprint"
+        )
+    return faces[:MAX_FACES_NAMED], more
+
+
 def _faces_text(tried: tuple[FaceTried, ...], pool: Candidates, ctx: _Context) -> str:
     parts = []
-    for f in tried:
+    named, more = _largest(tried)
+    for f in named:
         idx = np.flatnonzero(pool.face == f.face_id)
         n = len(idx)
         blocked = [ctx.path_why[int(i)] for i in idx if ctx.path_ok.get(int(i)) is False]
@@ -553,14 +573,18 @@ def _faces_text(tried: tuple[FaceTried, ...], pool: Candidates, ctx: _Context) -
             parts.append(f"{f.name}: footprint ({f.footprint_reason})")
         else:
             parts.append(f"{f.name}: no feasible pose (reach or collision)")
-    return "; ".join(parts)
+    return "; ".join(parts) + more
 
 
 def _nothing_message(tried: tuple[FaceTried, ...], rejected: dict[str, int], n: int) -> str:
-    faces = "; ".join(
-        f"{f.name}: {f.kept} of {f.sampled} samples hold the footprint"
-        + (f" ({f.footprint_reason})" if f.kept == 0 else "")
-        for f in tried
+    named, more = _largest(tried)
+    faces = (
+        "; ".join(
+            f"{f.name}: {f.kept} of {f.sampled} samples hold the footprint"
+            + (f" ({f.footprint_reason})" if f.kept == 0 else "")
+            for f in named
+        )
+        + more
     )
     why = ", ".join(f"{k} {v}" for k, v in sorted(rejected.items())) or "none checked"
     return (

@@ -83,3 +83,17 @@ def test_cli_writes_the_plan(ah: Plan, tmp_path: Path) -> None:
     assert len(plan.points) == 6 and plan.method == "best_fit"
     assert main(["suggest", str(out), "--add", "1", "-o", str(tmp_path / "t.json")]) == 0
     assert len(load_plan(tmp_path / "t.json").points) == 7
+
+
+def test_plate_sides_too_narrow_for_the_misplacement_are_named(reference_dir: Path) -> None:
+    """The plate's flat side band (6.35 mm) cannot hold the touch probe's footprint grown by
+    the plan's 3 mm misplacement: only the top remains, which cannot fix all six degrees of
+    freedom. The refusal names the faces and what stopped them."""
+    plan = load_plan(ASSETS / "plate_holes_best_fit.json")
+    with pytest.raises(SuggestError) as err:
+        suggest_plan(plan, ASSETS, target_m=0.2e-3)
+    msg = str(err.value)
+    assert "6 degrees of freedom" in msg
+    assert "grown by the misplacement's translation, 3.0 mm" in msg
+    assert "face 0 (normal +z" in msg and "feasible poses" in msg
+    assert "(normal -x" in msg and "footprint over a hole/edge" in msg
