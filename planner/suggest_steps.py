@@ -1,0 +1,356 @@
+"""The steps of :func:`planner.suggest.suggest_plan`: feasibility of the candidates in the
+cell, the designs (best fit growing to the target, 3-2-1 over every triple of faces), the
+suggested plan, and the refusals' words.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import msgspec
+import numpy as np
+from numpy.typing import NDArray
+
+from calib.estimators.design import Design, poi_jacobians, select
+from calib.estimators.layout import constraint_jacobian, search_constraint_set
+from calib.plan.file import Plan, PlanPoint
+from calib.plan.report_spec import PointOfInterest, ReportSpec
+from calib.probing import ProbePoint, SearchCommand, SearchSpec
+from calib.procedures import BestFit, ThreeTwoOne
+from planner.export.safety import SafetySpec
+from planner.faces.candidates import Candidates, FaceTried
+from planner.plan_cell import nominal_T_base_wobj
+from planner.sim.rows import RowSpec, predicted_sigma
+
+if TYPE_CHECKING:
+    from planner.cell.cell import Cell
+
+FloatArray = NDArray[np.float64]
+#: progress(stage, done, total)
+SuggestProgress = Callable[[str, int, int], None]
+#: Samples tried first on each face (a face whose samples all fail is dropped).
+PROBE_FIRST = 6
+
+
+def _why(reason: str) -> str:
+    r = reason.lower()
+    if "reach" in r or "no ik" in r:
+        return "reach"
+    if "limit" in r:
+        return "joint limits"
+    if "singular" in r:
+        return "singularity"
+    if "hit" in r or "clearance" in r or "collision" in r:
+        return "collision"
+    return "other"
+
+
+@dataclass
+class Context:
+    cell: Cell
+    plan: Plan
+    pool: Candidates
+    safety: SafetySpec
+    rows_poi: list[RowSpec]
+    z: float
+    radius_m: float
+    corners: FloatArray | None = None
+    path_ok: dict[int, bool] = field(default_factory=dict)
+    path_why: dict[int, str] = field(default_factory=dict)
+
+    @property
+    def poi(self) -> list[FloatArray]:
+        pts = np.concatenate([r.points_wobj for r in self.rows_poi if r.points_wobj is not None])
+        return poi_jacobians(pts, [r.components for r in self.rows_poi])
+
+    def rows(self) -> tuple[FloatArray, FloatArray]:
+        A = constraint_jacobian(self.pool.normals, self.pool.positions_m)
+        sensor = self.plan.validation.sensor
+        s = sensor.search_noise("approach", 0.003).sensor_sigma_m
+        var = s**2 + self.plan.validation.robot_error.repeatability_sigma_m**2
+        return A, np.full(len(A), var)
+
+    def probe(self, i: int, pid: str) -> ProbePoint:
+        p = self.pool.positions_m[i]
+        search = SearchSpec(
+            "approach",
+            start_offset_m=max(0.015, self.safety.start_clearance_m(p)),
+            overtravel_m=max(0.010, self.safety.overtravel_m(p)),
+        )
+        return ProbePoint(pid, tuple(float(c) for c in p), tuple(self.pool.normals[i]), search)  # type: ignore[arg-type]
+
+    def size_searches(self, chosen: tuple[int, ...]) -> bool:
+        """Size the searches for the misplacement about the chosen points' centroid (the
+        validation's pivot); re-check the paths whose start moved. False: one is blocked."""
+        c = self.pool.positions_m[list(chosen)].mean(axis=0)
+        pivot = (float(c[0]), float(c[1]), float(c[2]))
+        if pivot == self.safety.pivot_wobj_m:
+            return True
+        old = {i: self.probe(i, "c").search for i in chosen}
+        self.safety = dataclasses.replace(self.safety, pivot_wobj_m=pivot)
+        for i in chosen:
+            if self.probe(i, "c").search != old[i]:
+                self.path_ok.pop(i, None)
+        return self.paths_ok(chosen)
+
+    def worst(self, cov: FloatArray) -> float:
+        if not np.all(np.isfinite(cov)):
+            return math.inf
+        return max(self.z * predicted_sigma(r, cov) for r in self.rows_poi)
+
+    def paths_ok(self, chosen: tuple[int, ...]) -> bool:
+        """Check the search paths of the chosen candidates not yet checked."""
+        T = nominal_T_base_wobj(self.plan)
+        tcp = self.plan.cell.tool.tcp
+        for i in chosen:
+            if i in self.path_ok:
+                continue
+            pose = self.cell.check_probes(
+                self.pool.positions_m[i : i + 1], self.pool.normals[i : i + 1], tcp=tcp
+            )[0]
+            path = self.cell.check_search(
+                SearchCommand.from_point(self.probe(i, "c"), T), q_ref=pose.q
+            )
+            self.path_ok[i] = bool(pose.feasible and path.feasible)
+            self.path_why[i] = str(path.reason or pose.reason)
+        return all(self.path_ok[i] for i in chosen)
+
+
+def feasible_poses(
+    cell: Cell, plan: Plan, cands: Candidates, say: SuggestProgress
+) -> tuple[NDArray[np.bool_], dict[str, int]]:
+    """Feasible probe poses: a few spread samples per face first, the rest of the faces
+    where any of those passed."""
+    ok = np.zeros(len(cands), dtype=bool)
+    rejected: dict[str, int] = {}
+    tcp = plan.cell.tool.tcp
+    face_ids = sorted(set(cands.face.tolist()))
+    first = np.concatenate([np.flatnonzero(cands.face == f)[:PROBE_FIRST] for f in face_ids])
+    rest = []
+    say("feasibility", 0, len(face_ids))
+
+    def run(idx: list[int]) -> None:
+        res = cell.check_probes(cands.positions_m[idx], cands.normals[idx], tcp=tcp)
+        for i, x in zip(idx, res, strict=True):
+            ok[i] = x.feasible
+            if not x.feasible:
+                key = _why(x.reason)
+                rejected[key] = rejected.get(key, 0) + 1
+
+    run(first.tolist())
+    for f in face_ids:
+        idx = np.flatnonzero(cands.face == f)
+        if ok[idx[:PROBE_FIRST]].any():
+            rest.extend(idx[PROBE_FIRST:].tolist())
+        else:
+            dropped = max(0, len(idx) - PROBE_FIRST)
+            rejected["face dropped"] = rejected.get("face dropped", 0) + dropped
+    if rest:
+        run(rest)
+    say("feasibility", len(face_ids), len(face_ids))
+    return ok, {k: v for k, v in rejected.items() if v > 0}
+
+
+def fixed_rows(plan: Plan) -> tuple[FloatArray, FloatArray]:
+    cs = search_constraint_set([p.to_probe_point() for p in plan.points])
+    A = constraint_jacobian(cs.normals, cs.nominal_m)
+    s = plan.validation.sensor.search_noise("approach", 0.003).sensor_sigma_m
+    var = s**2 + plan.validation.robot_error.repeatability_sigma_m**2
+    return A, np.full(len(A), var)
+
+
+def _select_feasible(ctx: Context, n: int, **kw: object) -> Design | None:
+    """The design of ``n`` points whose search paths are all feasible (blocked ones dropped)."""
+    A, var = ctx.rows()
+    for _ in range(50):
+        blocked = np.array([ctx.path_ok.get(i, True) is False for i in range(len(A))])
+        d = select(
+            A,
+            var,
+            n,
+            ctx.poi,
+            positions_m=ctx.pool.positions_m,
+            available=~blocked,
+            min_separation_m=max(2 * ctx.radius_m, 0.01),
+            scale_m=1.0,
+            background_m=ctx.corners,
+            **kw,  # type: ignore[arg-type]
+        )
+        if len(d.chosen) < n or not np.isfinite(d.score):
+            return None
+        if ctx.paths_ok(d.chosen) and ctx.size_searches(d.chosen):
+            return d
+    return None
+
+
+def best_fit_design(
+    ctx: Context,
+    target_m: float | None,
+    max_points: int,
+    add: int,
+    fixed: tuple[FloatArray, FloatArray] | None,
+    say: SuggestProgress,
+) -> tuple[Design | None, list[tuple[int, float]]]:
+    history: list[tuple[int, float]] = []
+    best: Design | None = None
+    sizes = [add] if add else list(range(6, max_points + 1))
+    if target_m is None and not add:
+        sizes = [max_points]
+    start: tuple[int, ...] = ()
+    for k, n in enumerate(sizes):
+        say("design", k, len(sizes))
+        kw: dict[str, object] = {"start": start}
+        if fixed is not None:
+            kw.update(fixed_rows=fixed[0], fixed_var=fixed[1])
+        d = _select_feasible(ctx, n, **kw)
+        if d is None:
+            continue
+        worst = ctx.worst(d.covariance)
+        history.append((n + (len(fixed[0]) if fixed is not None else 0), worst))
+        best, start = d, d.chosen
+        if target_m is not None and worst <= target_m:
+            break
+    return best, history
+
+
+def three_two_one_design(
+    ctx: Context, say: SuggestProgress
+) -> tuple[Design | None, list[tuple[int, float]]]:
+    face = ctx.pool.face
+    count = {f: int(np.sum(face == f)) for f in set(face.tolist())}
+    normals = {f: ctx.pool.normals[np.flatnonzero(face == f)[0]] for f in count}
+    best: Design | None = None
+    best_worst = math.inf
+    triples = [
+        t
+        for t in itertools.permutations(sorted(count), 3)
+        if count[t[0]] >= 3
+        and count[t[1]] >= 2
+        and all(abs(float(normals[a] @ normals[b])) < 0.5 for a, b in itertools.combinations(t, 2))
+    ]
+    for k, (p, s, t) in enumerate(triples):
+        say("design", k, len(triples))
+        d = _select_feasible(ctx, 6, groups=face, quota={p: 3, s: 2, t: 1})
+        if d is None:
+            continue
+        worst = ctx.worst(d.covariance)
+        if worst < best_worst:
+            best, best_worst = d, worst
+    return best, ([(6, best_worst)] if best is not None else [])
+
+
+def suggested_plan(
+    plan: Plan, ctx: Context, d: Design, procedure: str, add: int, at_m: FloatArray | None
+) -> Plan:
+    roles = ["fit"] * len(d.chosen)
+    if procedure == "three_two_one":  # the face with three points is primary, two secondary
+        face = ctx.pool.face
+        counts = {
+            int(f): sum(int(face[i]) == int(f) for i in d.chosen) for f in face[list(d.chosen)]
+        }
+        name = {3: "primary", 2: "secondary", 1: "tertiary"}
+        chosen = sorted(d.chosen, key=lambda i: -counts[int(face[i])])
+        roles = [name[counts[int(face[i])]] for i in chosen]
+    else:
+        chosen = list(d.chosen)
+    taken = {p.id for p in plan.points} if add else set()
+    ids: list[str] = []
+    k = 1
+    while len(ids) < len(chosen):
+        if f"S{k}" not in taken:
+            ids.append(f"S{k}")
+        k += 1
+    new = [
+        PlanPoint.from_probe_point(ctx.probe(i, pid), role)
+        for i, pid, role in zip(chosen, ids, roles, strict=True)
+    ]
+    points = list(plan.points) + new if add else new
+    offset = getattr(plan.procedure, "edge_event_offset_m", None)
+    proc = (
+        plan.procedure
+        if add
+        else (
+            ThreeTwoOne(edge_event_offset_m=offset)
+            if procedure == "three_two_one"
+            else BestFit(edge_event_offset_m=offset)
+        )
+    )
+    report: ReportSpec = plan.validation.report
+    if at_m is not None:
+        pts = [
+            PointOfInterest(
+                name=r.key.split("_", 1)[1],
+                position_m=_vec3(r.points_wobj),
+                components=r.components,  # type: ignore[arg-type]
+            )
+            for r in ctx.rows_poi
+        ]
+        report = msgspec.structs.replace(report, points_of_interest=pts)
+    validation = msgspec.structs.replace(plan.validation, report=report)
+    return msgspec.structs.replace(plan, points=points, procedure=proc, validation=validation)
+
+
+def _vec3(p: FloatArray | None) -> tuple[float, float, float]:
+    q = np.asarray(p, dtype=np.float64).reshape(-1, 3)[0]
+    return float(q[0]), float(q[1]), float(q[2])
+
+
+#: Faces named one by one in a refusal (the largest); the rest are counted.
+MAX_FACES_NAMED = 8
+
+
+def _largest(tried: tuple[FaceTried, ...]) -> tuple[list[FaceTried], str]:
+    faces = sorted(tried, key=lambda f: -f.area_m2)
+    rest = faces[MAX_FACES_NAMED:]
+    more = ""
+    if rest:
+        stopped = sum(f.kept == 0 for f in rest)
+        more = (
+            f"; and {len(rest)} smaller faces (up to {rest[0].area_m2 * 1e6:.0f} mm^2), "
+            f"{stopped} of them too small for the grown footprint"
+        )
+    return faces[:MAX_FACES_NAMED], more
+
+
+def faces_text(tried: tuple[FaceTried, ...], pool: Candidates, ctx: Context) -> str:
+    parts = []
+    named, more = _largest(tried)
+    for f in named:
+        idx = np.flatnonzero(pool.face == f.face_id)
+        n = len(idx)
+        blocked = [ctx.path_why[int(i)] for i in idx if ctx.path_ok.get(int(i)) is False]
+        if n and len(blocked) == n:
+            parts.append(f"{f.name}: every search path blocked (e.g. {blocked[0]})")
+        elif n:
+            parts.append(
+                f"{f.name}: {n} feasible poses"
+                + (f", {len(blocked)} search paths blocked" if blocked else "")
+            )
+        elif f.kept == 0:
+            parts.append(f"{f.name}: footprint ({f.footprint_reason})")
+        else:
+            parts.append(f"{f.name}: no feasible pose (reach or collision)")
+    return "; ".join(parts) + more
+
+
+def nothing_message(tried: tuple[FaceTried, ...], rejected: dict[str, int], n: int) -> str:
+    named, more = _largest(tried)
+    faces = (
+        "; ".join(
+            f"{f.name}: {f.kept} of {f.sampled} samples hold the footprint"
+            + (f" ({f.footprint_reason})" if f.kept == 0 else "")
+            for f in named
+        )
+        + more
+    )
+    why = ", ".join(f"{k} {v}" for k, v in sorted(rejected.items())) or "none checked"
+    return (
+        f"no feasible candidate: {n} candidates on {len(tried)} planar faces, none with a "
+        f"feasible probe pose (dropped: {why}). Faces tried: {faces}. The footprint is grown "
+        "by the in-plane shift the plan's misplacement allows."
+    )
