@@ -33,7 +33,10 @@ import numpy as np
 
 from planner.cell import gjk_kernels as G
 from planner.cell.field_kernels import field_lb
+from planner.cell.kernel_cache import configure
 from planner.cell.mesh_kernels import shape_vs_mesh
+
+configure()  # before the first @njit: numba picks the cache directory then
 
 BOX, CYLINDER, SPHERE, FIELD = 0, 1, 2, 3
 #: Depth of the traversal stacks (a binary tree of a few hundred leaves is ~10 deep).

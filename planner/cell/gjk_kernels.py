@@ -26,6 +26,10 @@ import math
 import numba as nb
 import numpy as np
 
+from planner.cell.kernel_cache import configure
+
+configure()  # before the first @njit: numba picks the cache directory then
+
 BOX, CYLINDER, SPHERE, CAPSULE, HULL = 0, 1, 2, 3, 4
 _MAX_ITER = 40
 # Explicit signatures: every caller shares one compiled version (constant arguments would
