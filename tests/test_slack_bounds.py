@@ -5,7 +5,7 @@ configuration (a bound too low could drop the candidate the exact check chooses)
 configurations of ``tests/test_broad_phase.py``: random joints and probe poses from 12 mm
 inside to 2 mm outside a dense part, with a table, a post and a mesh fixture. And the bounds
 must be worth having: near the table and in self-contact most candidates get one within a few
-millimetres of Bullet's slack.
+millimetres of Bullet's slack, and most links deep in the table or the post one below -1 cm.
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ def test_bounds_are_never_below_bullets_slack(cell: Cell) -> None:  # noqa: F811
     T_links = broad.link_poses(cell, q, T_bf)
     ps, ss, _ = broad.states(parts, env, T_links)
     ub = SlackBounds(broad, parts, env, plan).upper(T_links, ps, ss)
-    bounded = apart = tight = 0
+    bounded = apart = tight = deep = deep_shown = 0
     links = {b.name for b in broad.links}
     with cell.saved_state():
         for m in range(len(q)):
@@ -47,8 +47,13 @@ def test_bounds_are_never_below_bullets_slack(cell: Cell) -> None:  # noqa: F811
             ):
                 apart += 1
                 tight += ub[m] - cl.slack_m <= 0.003
+            # and against a box or a cylinder, depths: points of the link deep inside it
+            if cl.pair is not None and cl.clearance_m < -0.01 and cl.pair[1] in {"table", "post"}:
+                deep += 1
+                deep_shown += ub[m] < -0.01
     assert bounded >= 200, bounded
     assert apart >= 30 and tight >= 0.9 * apart, (tight, apart)
+    assert deep >= 50 and deep_shown >= 0.7 * deep, (deep_shown, deep)
 
 
 def _T(p: tuple[float, float, float], rz: float = 0.0) -> np.ndarray:

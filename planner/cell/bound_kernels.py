@@ -5,7 +5,10 @@ margin; the search among a point's candidates (:mod:`planner.cell.probe_search`)
 to know that a candidate *cannot* beat another one without asking Bullet. An upper bound does
 that: GJK's simplex closest point ``v`` is a point of the Minkowski difference ``A - B``
 (a convex combination of support points), so ``dist(A, B) <= |v|`` whatever the iteration
-did; when the simplex holds the origin the shapes overlap and ``0`` bounds the signed distance.
+did; when the simplex holds the origin the shapes overlap and ``0`` bounds the signed distance,
+or, against a box, cylinder or sphere body, minus the depth of the deepest of a few points of
+the shape inside it (:func:`_depth_lower`: a translation that separates the shapes moves each
+of their points out of the body).
 :func:`slack_upper` turns these into an upper bound of each candidate's slack in Bullet's
 query with Bullet's rounding of boxes and cylinders and a safety added
 (:mod:`planner.cell.slack_bounds`).
@@ -92,7 +95,66 @@ def _link_upper(
             sh_kind[i], TA, sh_dims[i], verts, sh_vs[i], sh_vc[i], kind, T, dims, verts, vs, vc,
             1e-7,
         )  # fmt: skip
+        if d <= 0.0 and kind <= G.SPHERE:  # overlap with a primitive body: how deep, at least
+            d = -_depth_lower(sh_kind[i], TA, sh_dims[i], verts, sh_vs[i], sh_vc[i], kind, T, dims)
         best = min(best, d)
+    return best
+
+
+@nb.njit(cache=True)
+def _depth(kind, T, dims, x, y, z):  # fmt: skip
+    """How deep world point ``(x, y, z)`` lies inside a box, cylinder or sphere (pose ``T``),
+    m; negative outside."""
+    dx, dy, dz = x - T[0, 3], y - T[1, 3], z - T[2, 3]
+    lx = T[0, 0] * dx + T[1, 0] * dy + T[2, 0] * dz
+    ly = T[0, 1] * dx + T[1, 1] * dy + T[2, 1] * dz
+    lz = T[0, 2] * dx + T[1, 2] * dy + T[2, 2] * dz
+    if kind == G.BOX:
+        return min(dims[0] - abs(lx), dims[1] - abs(ly), dims[2] - abs(lz))
+    if kind == G.CYLINDER:
+        return min(dims[0] - math.sqrt(lx * lx + ly * ly), dims[1] - abs(lz))
+    return dims[0] - math.sqrt(lx * lx + ly * ly + lz * lz)
+
+
+@nb.njit(cache=True)
+def _depth_lower(kA, TA, dA, verts, sA, cA, kB, TB, dB):  # fmt: skip
+    """A lower bound of the penetration depth of shape A into the primitive B (0 when none is
+    shown): the deepest of some points of A (box corners, cylinder and capsule rims and tips,
+    sphere poles, hull vertices) inside B. Any translation that separates them moves each
+    point of A out of B, so it is at least that long."""
+    best = 0.0
+    if kA == G.HULL:
+        for r in range(sA, sA + cA):
+            px, py, pz = verts[r, 0], verts[r, 1], verts[r, 2]
+            x = TA[0, 0] * px + TA[0, 1] * py + TA[0, 2] * pz + TA[0, 3]
+            y = TA[1, 0] * px + TA[1, 1] * py + TA[1, 2] * pz + TA[1, 3]
+            z = TA[2, 0] * px + TA[2, 1] * py + TA[2, 2] * pz + TA[2, 3]
+            best = max(best, _depth(kB, TB, dB, x, y, z))
+        return best
+    n = 8 if kA == G.BOX else 16 if kA in (G.CYLINDER, G.CAPSULE) else 6
+    for r in range(n):
+        if kA == G.BOX:
+            px = dA[0] if r & 1 else -dA[0]
+            py = dA[1] if r & 2 else -dA[1]
+            pz = dA[2] if r & 4 else -dA[2]
+        elif kA == G.CYLINDER or kA == G.CAPSULE:
+            a = (r % 8) * (math.pi / 4.0)
+            # rim points (cylinder); for a capsule the sphere caps' equators
+            px, py = dA[0] * math.cos(a), dA[0] * math.sin(a)
+            pz = dA[1] if r < 8 else -dA[1]
+        else:  # sphere: its six poles
+            px = py = pz = 0.0
+            sgn = dA[0] if r % 2 == 0 else -dA[0]
+            if r < 2:
+                px = sgn
+            elif r < 4:
+                py = sgn
+            else:
+                pz = sgn
+        x = TA[0, 0] * px + TA[0, 1] * py + TA[0, 2] * pz + TA[0, 3]
+        y = TA[1, 0] * px + TA[1, 1] * py + TA[1, 2] * pz + TA[1, 3]
+        z = TA[2, 0] * px + TA[2, 1] * py + TA[2, 2] * pz + TA[2, 3]
+        best = max(best, _depth(kB, TB, dB, x, y, z))
     return best
 
 
