@@ -55,6 +55,8 @@ class CandidateFlags:
         self._sc: list[NDArray[np.int8]] = []
         self._opened: list[int] = []
         self._upper: list[float] = []
+        self._all_clear: list[bool] = []
+        self._fails: list[bool] = []
 
     def put(self, block: Block) -> None:
         """Append the next rows' states and bounds."""
@@ -63,6 +65,8 @@ class CandidateFlags:
         self._sc.extend(sc)
         self._opened.extend(opened.tolist())
         self._upper.extend(upper.tolist())
+        self._all_clear.extend(((pc == 1).all(axis=1) & (sc == 1).all(axis=1)).tolist())
+        self._fails.extend(((pc == -1).any(axis=1) | (sc == -1).any(axis=1)).tolist())
 
     def _get(self, j: int) -> tuple[NDArray[np.int8], NDArray[np.int8]]:
         while j >= len(self._pc):  # the next block, twice as many as computed so far
@@ -87,10 +91,10 @@ class CandidateFlags:
 
     def all_clear(self, j: int) -> bool:
         """Nothing of candidate row ``j`` is near: its clearance is the look distance."""
-        pc, sc = self._get(j)
-        return bool((pc == 1).all() and (sc == 1).all())
+        self._get(j)
+        return self._all_clear[j]
 
     def fails(self, j: int) -> bool:
         """A part of candidate row ``j`` is shown below the margin."""
-        pc, sc = self._get(j)
-        return bool((pc == -1).any() or (sc == -1).any())
+        self._get(j)
+        return self._fails[j]
