@@ -263,6 +263,8 @@ class ProbeSearch:
                 bound[j] = u
             if u < self.margin:
                 continue  # it cannot pass
+            if flags.all_clear(j):  # nothing near: the look distance, which passes
+                return Decision(c, self.stages.merge({}), True)
             run(j, self.margin)
             if j in exact and passes(exact[j], self.margin):
                 return Decision(c, exact[j], True)
