@@ -44,9 +44,7 @@ def gjk_upper(
     W = np.empty((4, 3))
     scratch = np.empty((6, 3))
     v = np.empty(3)
-    v[0], v[1], v[2] = TA[0, 3] - TB[0, 3], TA[1, 3] - TB[1, 3], TA[2, 3] - TB[2, 3]
-    if v[0] * v[0] + v[1] * v[1] + v[2] * v[2] < 1e-24:
-        v[0] = 1.0
+    G.start_direction(TA, TB, v)
     n = 0
     lb = -np.inf
     ub = np.inf
@@ -63,20 +61,9 @@ def gjk_upper(
             lb = max(lb, (v[0] * wx + v[1] * wy + v[2] * wz) / vn)
         if n > 0 and ub - lb <= tol:
             return ub
-        G._set(W, n, wx, wy, wz)
-        n += 1
-        if n == 1:
-            v[0], v[1], v[2] = wx, wy, wz
-        elif n == 2:
-            n = G._closest_segment(W, v)
-        elif n == 3:
-            n = G._closest_triangle(W, 0, 1, 2, scratch, v)
-            for r in range(n):
-                G._set(W, r, scratch[r, 0], scratch[r, 1], scratch[r, 2])
-        else:
-            n = G._closest_tetra(W, scratch, v)
-            if n == 0:
-                return 0.0  # the origin is inside the simplex: the shapes overlap
+        n = G.add_point(W, n, wx, wy, wz, scratch, v)
+        if n == 0:
+            return 0.0  # the origin is inside the simplex: the shapes overlap
     vn = math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
     return min(ub, vn)
 
