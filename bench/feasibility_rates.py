@@ -48,12 +48,19 @@ def timed_best(
     return res, best
 
 
-def one_per_call(cell: Cell, pts: np.ndarray, nrm: np.ndarray, **kw: Any) -> tuple[list, float]:
-    """The plain loop: one exact ``check_probes(staged=False)`` call per target."""
-    t0 = time.perf_counter()
-    res = [cell.check_probes(pts[i : i + 1], nrm[i : i + 1], staged=False, **kw)[0]
-           for i in range(len(pts))]  # fmt: skip
-    return res, time.perf_counter() - t0
+def one_per_call(
+    cell: Cell, pts: np.ndarray, nrm: np.ndarray, repeat: int, **kw: Any
+) -> tuple[list, float]:
+    """The plain loop: one exact ``check_probes(staged=False)`` call per target; the answers
+    and the fastest of ``repeat`` runs, seconds (timed like ours, so that load changes on
+    this shared machine touch both sides alike)."""
+    best, res = np.inf, []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        res = [cell.check_probes(pts[i : i + 1], nrm[i : i + 1], staged=False, **kw)[0]
+               for i in range(len(pts))]  # fmt: skip
+        best = min(best, time.perf_counter() - t0)
+    return res, best
 
 
 def answer_key(r: Any) -> tuple:
@@ -82,7 +89,7 @@ def _side(
     n = len(pts)
     ours, dt = timed_best(cell, pts, nrm, repeat, **kw)
     ours_k, dt_k = timed_best(cell, pts[:k], nrm[:k], repeat, **kw)
-    loop, dt_loop = one_per_call(cell, pts[:k], nrm[:k], **kw)
+    loop, dt_loop = one_per_call(cell, pts[:k], nrm[:k], repeat, **kw)
     status = [r.status for r in ours]
     return {
         "n": n,
@@ -104,9 +111,11 @@ def run_rates(
     poses = _side(cell, pts, nrm, k, repeat, rotation_step_deg=POSE_STEP_DEG)
     points = _side(cell, pts, nrm, max(k // 2, 1), repeat)
     kp = int(points["loop_n"])  # type: ignore[call-overload]
-    t0 = time.perf_counter()
-    pyb = run_plain_loop(cell, pts[:kp], nrm[:kp])
-    dt_pyb = time.perf_counter() - t0
+    dt_pyb = np.inf
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        pyb = run_plain_loop(cell, pts[:kp], nrm[:kp])
+        dt_pyb = min(dt_pyb, time.perf_counter() - t0)
     points["pybullet_ik_loop_per_s"] = kp / dt_pyb
     points["pybullet_ik_loop_feasible"] = pyb["feasible"]
     points["ratio_vs_pybullet_ik_loop"] = dt_pyb / (kp / points["ours_on_loop_targets_per_s"])  # type: ignore[operator]
