@@ -48,7 +48,7 @@ BoolArray = NDArray[np.bool_]
 
 #: Candidates of an open point whose broad phase runs with the batch (most such points pass
 #: within them); a point that needs more gets the rest in one call.
-FIRST_BLOCK = 8
+FIRST_BLOCK = 16
 
 
 class ProbeSearch:
