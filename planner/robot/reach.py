@@ -165,10 +165,16 @@ def no_ik_reasons(
         q = q8[owner, row]  # (K, n): the branches that exist
         lo, hi = chain.lower, chain.upper
         with np.errstate(invalid="ignore"):
-            best = np.full(q.shape, np.inf)  # violation of each joint over its 2*pi variants
-            for k in (-2, -1, 0, 1, 2):
-                qk = q + k * (2 * np.pi)
-                best = np.minimum(best, np.maximum(lo - qk, 0) + np.maximum(qk - hi, 0))
+            # violation of each joint over its 2*pi variants k = -2..2: the distance of
+            # q + 2 pi k to [lo, hi] falls, then rises with k, so its least is at the first
+            # variant at or above lo or at the one before it
+            two_pi = 2 * np.pi
+            k_up = np.clip(np.ceil((lo - q) / two_pi), -2, 2)
+            q_up, q_dn = q + k_up * two_pi, q + np.clip(k_up - 1, -2, 2) * two_pi
+            best = np.minimum(
+                np.maximum(lo - q_up, 0) + np.maximum(q_up - hi, 0),
+                np.maximum(lo - q_dn, 0) + np.maximum(q_dn - hi, 0),
+            )
         worst = np.argmax(best, axis=1)  # each branch's worst joint
         counts = np.bincount(owner * n_j + worst, minlength=len(idx) * n_j).reshape(-1, n_j)
         any_ok = np.asarray(ok8.any(axis=1), dtype=bool)
