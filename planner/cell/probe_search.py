@@ -36,7 +36,7 @@ from planner.cell.broad_phase import BroadPhase, broad_phase_of
 from planner.cell.clearance import Clearance, QueryPart
 from planner.cell.probe_clearance import ProbeClearance
 from planner.cell.probe_flags import Block, CandidateFlags, clear_ahead
-from planner.cell.probe_rule import CLEARANCE_TIE_M, Decision, least_bad, part_pair, passes
+from planner.cell.probe_rule import CLEARANCE_TIE_M, Decision, least_bad, passes
 from planner.cell.slack_bounds import SlackBounds
 
 if TYPE_CHECKING:
@@ -172,11 +172,12 @@ class ProbeSearch:
 
         Stops once the slack is shown below ``stop_below``, before a part costing more than
         ``max_cost``, or after ``max_parts`` parts not cached (-1: no limit). With
-        ``certify``, the work-object parts not cached are first asked only whether they go
-        below ``stop_below`` (:meth:`ProbeClearance.certify`, a fraction of a full query
-        when the collision is deep), smallest links first; one that does stops the candidate.
-        ``tried`` keeps, per part, the deepest bound a certificate failed to show (not asked
-        again). ``results`` collects the parts evaluated (plan index -> result, kept between
+        ``certify``, the work-object parts not cached are first asked with a query capped at
+        the tie above ``stop_below`` (:meth:`ProbeClearance.evaluate_capped`, a fraction of a
+        full query when the collision is deep), smallest links first: it gives the part's
+        exact result when it lies below the cap (one below ``stop_below`` stops the
+        candidate). ``tried`` keeps, per part, the deepest cap a query failed to reach (not
+        asked again). ``results`` collects the parts evaluated (plan index -> result, kept between
         calls).
 
         Returns:
@@ -202,21 +203,39 @@ class ProbeSearch:
             if res is not None:
                 running = min(running, res.slack_m)
         complete = not self_open
+        for new, _, _, k in todo:  # cached parts first: they cost nothing
+            if new:
+                break
+            part = self._env_parts[k]
+            res = st.evaluate(rotation, q, part)
+            results[part.index] = res
+            if res is not None:
+                running = min(running, res.slack_m)
         if certify and running >= stop_below and tried is not None:
-            # certificates first, smallest links first: any one shows the candidate below
-            below = math.nextafter(stop_below, -math.inf)
+            # capped queries first, smallest links first: each looks only as deep as can still
+            # matter (the tie above stop_below) and gives the part's exact result, or shows
+            # that it lies above that; one below stop_below shows the candidate below
+            cap = stop_below + 2 * CLEARANCE_TIE_M
             for new, cost, _, k in todo:
                 part = self._env_parts[k]
-                if not new or cost < 1 or tried.get(k, -math.inf) >= below:
+                if not new or cost < 1 or tried.get(k, -math.inf) >= cap:
                     continue
-                if st.certify(rotation, q, part, below):
-                    return Clearance(False, below + part.need_m, below, part_pair(part)), False
-                tried[k] = below  # not that deep: no deeper bound can be shown either
+                res = st.evaluate_capped(rotation, q, part, cap)
+                if res is None:
+                    tried[k] = cap  # not that deep: no deeper cap can show it either
+                    continue
+                results[part.index] = res
+                fresh += 1
+                running = min(running, res.slack_m)
+                if running < stop_below:
+                    return st.merge(results), False
         for new, cost, _, k in todo:
+            part = self._env_parts[k]
+            if part.index in results:
+                continue  # known from a capped query
             if running < stop_below or cost > max_cost or (new and fresh == max_parts):
                 complete = False
                 break
-            part = self._env_parts[k]
             res = st.evaluate(rotation, q, part)
             results[part.index] = res
             fresh += new
