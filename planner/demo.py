@@ -73,7 +73,6 @@ def make_demo_cell(geom: StatorGeometry | None = None, **cell_kwargs: Any) -> Ce
     is the world frame. Extra keyword arguments go to :class:`planner.cell.cell.Cell`.
     """
     from planner.cell.cell import Cell  # PyBullet: only when a cell is built
-
     g = geom or StatorGeometry.full_section()
     kwargs: dict[str, Any] = {"robot": "builtin:irb4400", "tool": "builtin:cable_feeder"}
     kwargs.update(cell_kwargs)
