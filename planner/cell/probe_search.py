@@ -36,6 +36,7 @@ from planner.cell.broad_phase import BroadPhase, broad_phase_of
 from planner.cell.clearance import Clearance, QueryPart
 from planner.cell.probe_clearance import ProbeClearance
 from planner.cell.probe_flags import Block, CandidateFlags, clear_ahead
+from planner.cell.probe_parts import OpenParts
 from planner.cell.probe_rule import CLEARANCE_TIE_M, Decision, least_bad, passes
 from planner.cell.slack_bounds import SlackBounds
 
@@ -75,6 +76,7 @@ class ProbeSearch:
         self._cost = [int(self.env.arrays[0][e] == FIELD) for e in self.parts.part_env]
         self._size = [self.broad.link_radius(int(k)) for k in self.parts.part_link]
         self.bounds = SlackBounds(self.broad, self.parts, self.env, self.stages.plan)
+        self.open_parts = OpenParts(self.stages, self._env_parts, self._cost, self._size)
         #: how many points each pass decided (for profiling and the bench).
         self.decided_by = {"broad": 0, "first": 0, "ahead": 0, "search": 0}
 
@@ -105,7 +107,7 @@ class ProbeSearch:
                 rest.append(i)  # it cannot pass
                 continue
             self.stages.start_point(cands.T_base_flange[i])
-            cl, _ = self._exact(c // K, cands.q[i, c], pc[n] == 1, sc[n] == 1, {})
+            cl, _ = self.open_parts.evaluate(c // K, cands.q[i, c], pc[n] == 1, sc[n] == 1, {})
             top = cl.slack_m >= self.stages.look_slack_m - CLEARANCE_TIE_M
             if passes(cl, self.margin) and (not near[n] or top):
                 out[i] = Decision(c, cl, True)  # passes; or near a limit and none can beat it
@@ -155,94 +157,6 @@ class ProbeSearch:
         pc, sc, opened = self.broad.states(self.parts, self.env, T_links)
         return pc, sc, opened, self.bounds.upper(T_links, pc, sc)
 
-    def _exact(
-        self,
-        rotation: int,
-        q: FloatArray,
-        clear: BoolArray,
-        pairs_clear: BoolArray,
-        results: dict[int, Clearance | None],
-        stop_below: float = -math.inf,
-        max_cost: int = 1,
-        max_parts: int = -1,
-        certify: bool = False,
-        tried: dict[int, float] | None = None,
-    ) -> tuple[Clearance, bool]:
-        """The candidate's open parts with Bullet, cheapest first (cached ones before all).
-
-        Stops once the slack is shown below ``stop_below``, before a part costing more than
-        ``max_cost``, or after ``max_parts`` parts not cached (-1: no limit). With
-        ``certify``, the work-object parts not cached are first asked with a query capped at
-        the tie above ``stop_below`` (:meth:`ProbeClearance.evaluate_capped`, a fraction of a
-        full query when the collision is deep), smallest links first: it gives the part's
-        exact result when it lies below the cap (one below ``stop_below`` stops the
-        candidate). ``tried`` keeps, per part, the deepest cap a query failed to reach (not
-        asked again). ``results`` collects the parts evaluated (plan index -> result, kept between
-        calls).
-
-        Returns:
-            The merge of the parts known so far (the exact clearance when complete, else an
-            upper bound of the slack) and whether every open part is known.
-        """
-        st = self.stages
-        running = min((r.slack_m for r in results.values() if r is not None), default=math.inf)
-        todo: list[tuple[int, int, float, int]] = []  # (not cached, cost, size, k)
-        for k in range(len(self._env_parts)):
-            part = self._env_parts[k]
-            if not clear[k] and part.index not in results:
-                cached = st.known(rotation, q, part)
-                todo.append((int(not cached), self._cost[k], self._size[k], k))
-        todo.sort()
-        self_open = not pairs_clear.all() and st.self_part.index not in results
-        fresh = 0
-        if running >= stop_below and self_open and max_parts != 0:
-            res = st.evaluate(rotation, q, st.self_part, ~pairs_clear)
-            results[st.self_part.index] = res
-            self_open = False
-            fresh += 1
-            if res is not None:
-                running = min(running, res.slack_m)
-        complete = not self_open
-        for new, _, _, k in todo:  # cached parts first: they cost nothing
-            if new:
-                break
-            part = self._env_parts[k]
-            res = st.evaluate(rotation, q, part)
-            results[part.index] = res
-            if res is not None:
-                running = min(running, res.slack_m)
-        if certify and running >= stop_below and tried is not None:
-            # capped queries first, smallest links first: each looks only as deep as can still
-            # matter (the tie above stop_below) and gives the part's exact result, or shows
-            # that it lies above that; one below stop_below shows the candidate below
-            cap = stop_below + 2 * CLEARANCE_TIE_M
-            for new, cost, _, k in todo:
-                part = self._env_parts[k]
-                if not new or cost < 1 or tried.get(k, -math.inf) >= cap:
-                    continue
-                res = st.evaluate_capped(rotation, q, part, cap)
-                if res is None:
-                    tried[k] = cap  # not that deep: no deeper cap can show it either
-                    continue
-                results[part.index] = res
-                fresh += 1
-                running = min(running, res.slack_m)
-                if running < stop_below:
-                    return st.merge(results), False
-        for new, cost, _, k in todo:
-            part = self._env_parts[k]
-            if part.index in results:
-                continue  # known from a capped query
-            if running < stop_below or cost > max_cost or (new and fresh == max_parts):
-                complete = False
-                break
-            res = st.evaluate(rotation, q, part)
-            results[part.index] = res
-            fresh += new
-            if res is not None:
-                running = min(running, res.slack_m)
-        return st.merge(results), complete
-
     def _search(
         self, cands: ProbeCandidates, i: int, order: NDArray[np.int_], flags: CandidateFlags
     ) -> Decision:
@@ -261,7 +175,7 @@ class ProbeSearch:
         ) -> None:
             c = int(order[j])
             clear, pairs_clear = flags.clear(j)
-            cl, complete = self._exact(
+            cl, complete = self.open_parts.evaluate(
                 c // K, cands.q[i, c], clear, pairs_clear, results[j], stop_below, max_cost,
                 max_parts, certify, tried[j],
             )  # fmt: skip
