@@ -137,10 +137,14 @@ def test_certificates_never_claim_a_deeper_collision_than_the_full_part(cell: Ce
                 slack = np.inf if full is None else full.slack_m
                 # just above the full result: a certificate must not go below it
                 assert not cell.checker.certify_below(part, slack - 1e-4)
+                assert cell.checker.evaluate_capped(part, slack - 1e-4) is None
                 if full is not None and part.kind != "self" and slack < -0.01:
                     hit = cell.checker.certify_below(part, slack + 1e-4)
                     assert hit == (part.env_name == "work object")  # only the concave mesh
                     certified += hit
+                    if hit:  # the capped query's deepest point is the full query's, bit for bit
+                        assert cell.checker.evaluate_capped(part, slack + 1e-4) == full
+                        assert cell.checker.evaluate_capped(part, slack) == full
     assert certified >= 3  # and deep collisions with the work object do get certified
 
 

@@ -126,3 +126,23 @@ def test_self_collision_near_misses_answer_as_the_exact_check() -> None:
     assert len(near) >= 5
     assert all(same(fast[i], e) for i, e in zip(idx, exact))
     assert all(fast[i].clearance_m == e.clearance_m for i, e in zip(idx, exact) if i in near)
+
+
+def test_points_near_the_table_answer_as_the_exact_check() -> None:
+    """600 points on the lowest 8 cm of the benchmark box's sides, half of them pushed up to
+    12 mm into the part: the tool meets the table at every depth, so the least-bad search runs
+    on penetration bounds (:mod:`planner.cell.slack_bounds`) for most of them."""
+    from bench.feasibility_cell import bench_cell
+
+    rng = np.random.default_rng(8)
+    with bench_cell(trimesh.creation.box([0.8, 0.6, 0.4]).subdivide_to_size(0.03)) as c:
+        pts, nrm, _ = sample_surface(c.work_object.mesh, 6_000, rng)
+        low = np.flatnonzero((pts[:, 2] < -0.12) & (np.abs(nrm[:, 2]) < 0.5))[:600]
+        pts, nrm = pts[low], nrm[low]
+        pts[::2] += nrm[::2] * rng.uniform(-0.012, 0.0, size=(len(pts[::2]), 1))
+        fast = c.check_probes(pts, nrm)
+        exact = c.check_probes(pts, nrm, staged=False)
+    assert len(pts) == 600
+    assert [i for i, (a, b) in enumerate(zip(fast, exact)) if not same(a, b)] == []
+    hits_table = sum("hits table" in r.reason for r in exact)
+    assert hits_table >= 40, hits_table

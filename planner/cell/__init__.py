@@ -14,13 +14,17 @@ Owns:
       :mod:`~planner.cell.broad_phase` (with :mod:`~planner.cell.broad_arrays`,
       :mod:`~planner.cell.broad_parts`), its compiled kernels (:mod:`~planner.cell.broad_kernels`,
       :mod:`~planner.cell.mesh_kernels`, :mod:`~planner.cell.field_kernels`,
-      :mod:`~planner.cell.gjk_kernels`), :mod:`~planner.cell.sphere_tree`,
+      :mod:`~planner.cell.gjk_kernels`, :mod:`~planner.cell.bound_kernels`; cached where
+      :mod:`~planner.cell.kernel_cache` says), :mod:`~planner.cell.sphere_tree`,
       :mod:`~planner.cell.link_geometry`, :mod:`~planner.cell.distance_field` (cached on disk by
       :mod:`~planner.cell.disk_cache`);
     - queries: :mod:`~planner.cell.feasibility` (probe poses, ``check_probes``) with
       :mod:`~planner.cell.probe_candidates`, :mod:`~planner.cell.probe_rule`,
-      :mod:`~planner.cell.probe_search` and :mod:`~planner.cell.probe_clearance` (Bullet for the
-      parts the broad phase leaves open), :mod:`~planner.cell.search_paths` (``check_search``),
+      :mod:`~planner.cell.probe_search`, :mod:`~planner.cell.probe_flags`,
+      :mod:`~planner.cell.probe_parts`,
+      :mod:`~planner.cell.slack_bounds` (bounds that spare Bullet queries) and
+      :mod:`~planner.cell.probe_clearance` (Bullet for the parts the broad phase leaves open),
+      :mod:`~planner.cell.search_paths` (``check_search``),
       :mod:`~planner.cell.reachability_map`.
 
 One client per cell, ``physicsClientId`` on every call, no global state; not thread-safe (the UI

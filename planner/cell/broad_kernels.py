@@ -4,9 +4,9 @@ each other, then the exact (GJK) step where they leave a part open.
 Everything here is a lower bound on a true (nominal-geometry) distance, m: the callers add
 Bullet's own shape margins and a safety before they call a part clear
 (:mod:`planner.cell.broad_phase`). Compiled with numba (``cache=True``: the machine code is
-kept next to this file after the first run). The kernels run on one core: on a shared machine
-numba's parallel loops waited for busy cores (up to 100x slower in a measured run), and the
-batches of a UI click are small.
+kept in the user's cache after the first run, :mod:`planner.cell.kernel_cache`). The kernels
+run on one core: on a shared machine numba's parallel loops waited for busy cores (up to 100x
+slower in a measured run), and the batches of a UI click are small.
 
 Array layouts (all float64 unless said):
 
@@ -33,7 +33,10 @@ import numpy as np
 
 from planner.cell import gjk_kernels as G
 from planner.cell.field_kernels import field_lb
+from planner.cell.kernel_cache import configure
 from planner.cell.mesh_kernels import shape_vs_mesh
+
+configure()  # before the first @njit: numba picks the cache directory then
 
 BOX, CYLINDER, SPHERE, FIELD = 0, 1, 2, 3
 #: Depth of the traversal stacks (a binary tree of a few hundred leaves is ~10 deep).

@@ -259,30 +259,45 @@ class CollisionChecker:
 
     def certify_below(self, part: QueryPart, slack_m: float) -> bool:
         """True when part ``part`` surely has a point with slack ``<= slack_m`` in the current
-        state; False when that is not shown (then evaluate it in full).
+        state; False when that is not shown (then evaluate it in full). See
+        :meth:`evaluate_capped`."""
+        return self.evaluate_capped(part, slack_m) is not None
 
-        A cheap certificate for a deep collision with the work object: ``getClosestPoints``
-        with the distance ``slack_m + need_m`` (negative for a penetration) looks only at the
-        triangles near enough to go that deep. Bullet computes each triangle's contact on its
-        own, so this returns a subset of the full query's points, bit for bit (checked in
-        ``tests/test_probe_clearance.py``). Only parts against the work object (a concave
-        triangle mesh) are certified: between convex shapes the contact depends on the query
-        distance (up to 0.4 mm deeper was seen between two boxes).
+    def evaluate_capped(self, part: QueryPart, slack_m: float) -> Clearance | None:
+        """The part's exact result (:meth:`evaluate`'s, bit for bit) when its slack is at most
+        ``slack_m``; ``None`` when that is not shown.
+
+        A cheap query for a deep collision with the work object: ``getClosestPoints`` with the
+        distance ``slack_m + need_m`` (negative for a penetration) looks only at the triangles
+        near enough to go that deep. Bullet computes each triangle's contact on its own, so
+        this returns a subset of the full query's points, bit for bit (checked in
+        ``tests/test_probe_clearance.py``); when its deepest point is within ``slack_m`` it is
+        the full query's deepest. Only parts against the work object (a concave triangle mesh)
+        are capped: between convex shapes the contact depends on the query distance (up to
+        0.4 mm deeper was seen between two boxes).
         """
         self.last_points = 0
         dist = slack_m + part.need_m
         if part.env != self.wobj_body or part.kind == "self" or not dist < part.dist_m:
-            return False
+            return None
         c = self.client
         lo, hi = pb.getAABB(part.body, part.link, physicsClientId=c)
         elo, ehi = pb.getAABB(part.env, -1, physicsClientId=c)
         if any(lo[k] > ehi[k] + dist or elo[k] > hi[k] + dist for k in range(3)):
-            return False
+            return None
         points = pb.getClosestPoints(
             part.body, part.env, dist, linkIndexA=part.link, physicsClientId=c
         )
         self.last_points = len(points)
-        return any(pt[8] - part.need_m <= slack_m for pt in points)
+        best: Clearance | None = None
+        for pt in points:
+            slack = pt[8] - part.need_m
+            if best is None or slack < best.slack_m:
+                best = Clearance(pt[8] >= part.need_m, pt[8], slack, None)
+        if best is None or not best.slack_m <= slack_m:
+            return None
+        pair_ = (self.names(part.body, part.link), part.env_name)
+        return Clearance(best.ok, best.clearance_m, best.slack_m, pair_)
 
     def _self_part(self, part: QueryPart, pairs: np.ndarray | None = None) -> Clearance | None:
         """Robot-robot and robot-tool pairs not in the ACL (or those of ``pairs``), pair by

@@ -11,6 +11,10 @@ import math
 import numba as nb
 import numpy as np
 
+from planner.cell.kernel_cache import configure
+
+configure()  # before the first @njit: numba picks the cache directory then
+
 
 @nb.njit(cache=True, fastmath=False)
 def point_triangle_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> float:

@@ -26,6 +26,10 @@ import math
 import numba as nb
 import numpy as np
 
+from planner.cell.kernel_cache import configure
+
+configure()  # before the first @njit: numba picks the cache directory then
+
 BOX, CYLINDER, SPHERE, CAPSULE, HULL = 0, 1, 2, 3, 4
 _MAX_ITER = 40
 # Explicit signatures: every caller shares one compiled version (constant arguments would
@@ -224,6 +228,36 @@ def _closest_tetra(W: np.ndarray, scratch: np.ndarray, v: np.ndarray) -> int:
     return nkeep
 
 
+@nb.njit(cache=True)
+def start_direction(TA: np.ndarray, TB: np.ndarray, v: np.ndarray) -> None:
+    """GJK's first direction ``v``: from B's origin to A's (x when they coincide)."""
+    v[0], v[1], v[2] = TA[0, 3] - TB[0, 3], TA[1, 3] - TB[1, 3], TA[2, 3] - TB[2, 3]
+    if v[0] * v[0] + v[1] * v[1] + v[2] * v[2] < 1e-24:
+        v[0] = 1.0
+
+
+@nb.njit(cache=True)
+def add_point(
+    W: np.ndarray, n: int, wx: float, wy: float, wz: float, scratch: np.ndarray, v: np.ndarray
+) -> int:
+    """Add the support point ``w`` to the simplex ``W[:n]``, reduce it to the feature nearest
+    the origin and put that feature's closest point in ``v``; returns the new size, 0 when the
+    tetrahedron holds the origin (the shapes overlap)."""
+    _set(W, n, wx, wy, wz)
+    n += 1
+    if n == 1:
+        v[0], v[1], v[2] = wx, wy, wz
+    elif n == 2:
+        n = _closest_segment(W, v)
+    elif n == 3:
+        n = _closest_triangle(W, 0, 1, 2, scratch, v)
+        for r in range(n):
+            _set(W, r, scratch[r, 0], scratch[r, 1], scratch[r, 2])
+    else:
+        n = _closest_tetra(W, scratch, v)
+    return n
+
+
 @nb.njit(_CLASSIFY, cache=True)
 def gjk_classify(
     kA: int, TA: np.ndarray, dA: np.ndarray, vA: np.ndarray, sA: int, cA: int,
@@ -235,9 +269,7 @@ def gjk_classify(
     W = np.empty((4, 3))
     scratch = np.empty((6, 3))
     v = np.empty(3)
-    v[0], v[1], v[2] = TA[0, 3] - TB[0, 3], TA[1, 3] - TB[1, 3], TA[2, 3] - TB[2, 3]
-    if v[0] * v[0] + v[1] * v[1] + v[2] * v[2] < 1e-24:
-        v[0] = 1.0
+    start_direction(TA, TB, v)
     n = 0
     lb = -np.inf
     for _ in range(_MAX_ITER):
@@ -257,20 +289,9 @@ def gjk_classify(
         # stalled: the new point does not get closer than the current one
         if n > 0 and vn - lb <= 1e-12 * max(vn, 1e-3):
             return 0
-        _set(W, n, wx, wy, wz)
-        n += 1
-        if n == 1:
-            v[0], v[1], v[2] = wx, wy, wz
-        elif n == 2:
-            n = _closest_segment(W, v)
-        elif n == 3:
-            n = _closest_triangle(W, 0, 1, 2, scratch, v)
-            for r in range(n):
-                _set(W, r, scratch[r, 0], scratch[r, 1], scratch[r, 2])
-        else:
-            n = _closest_tetra(W, scratch, v)
-            if n == 0:
-                return -1 if near_thr > 0.0 else 0  # the origin is inside: overlap
+        n = add_point(W, n, wx, wy, wz, scratch, v)
+        if n == 0:
+            return -1 if near_thr > 0.0 else 0  # the origin is inside: overlap
     return 0
 
 

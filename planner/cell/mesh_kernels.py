@@ -14,6 +14,9 @@ import numpy as np
 
 from planner.cell import gjk_kernels as G
 from planner.cell.gjk_kernels import support
+from planner.cell.kernel_cache import configure
+
+configure()  # before the first @njit: numba picks the cache directory then
 
 #: Most triangles examined for one shape; beyond, the part is left to Bullet.
 MAX_TRIANGLE_TESTS = 4000

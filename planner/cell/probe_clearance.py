@@ -15,8 +15,9 @@ evaluates the others with Bullet, one part at a time, in the state the part need
 Merged in the plan's order (:meth:`planner.cell.clearance.QueryPlan.merge`) with ``None`` for
 the cleared parts, the results are exactly the whole query's, except that the tool stands at
 the planned flange pose instead of PyBullet's single-precision forward kinematics of the branch
-(they differ by ~1e-7 m). :meth:`ProbeClearance.certify` is a cheap proof that a work-object part
-is at or below a slack (:meth:`~planner.cell.collision.CollisionChecker.certify_below`).
+(they differ by ~1e-7 m). :meth:`ProbeClearance.evaluate_capped` gives a work-object part's
+exact result from a cheap query when it is at or below a slack
+(:meth:`~planner.cell.collision.CollisionChecker.evaluate_capped`).
 """
 
 from __future__ import annotations
@@ -63,7 +64,7 @@ class ProbeClearance:
         self._tool_at: int | None = None
         self._q_at: FloatArray | None = None
         self._tool_on_flange = False
-        #: parts evaluated in full, and certificate queries made (for profiling and tests).
+        #: parts evaluated in full, and capped queries made (for profiling and tests).
         self.parts_evaluated = 0
         self.parts_certified = 0
 
@@ -111,18 +112,27 @@ class ProbeClearance:
         self.parts_evaluated += 1
         return checker.evaluate(part, pairs)
 
-    def certify(self, rotation: int, q: FloatArray, part: QueryPart, slack_m: float) -> bool:
-        """True when ``part`` surely has slack ``<= slack_m`` for the candidate (a cheap
-        Bullet query that looks only that deep; work-object parts only, else False)."""
+    def evaluate_capped(
+        self, rotation: int, q: FloatArray, part: QueryPart, slack_m: float
+    ) -> Clearance | None:
+        """The exact result of a work-object ``part`` when its slack is at most ``slack_m`` (a
+        cheap Bullet query that looks only that deep, kept as the part's result); ``None``
+        when that is not shown (and for other parts)."""
         checker = self._cell.checker
         if part.env != checker.wobj_body or part.kind == "self":
-            return False
+            return None
         if part.kind == "tool":
             self._place_tool(rotation)
         else:
             self._set_q(q)
         self.parts_certified += 1
-        return checker.certify_below(part, slack_m)
+        res = checker.evaluate_capped(part, slack_m)
+        if res is not None:
+            if part.kind == "tool":
+                self._tool[(rotation, part.index)] = res
+            else:
+                self._robot[self._robot_key(part, q)] = res
+        return res
 
     def merge(self, results: dict[int, Clearance | None]) -> Clearance:
         """The query's answer from the results of some parts (the others report nothing)."""

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from planner.cell.clearance import Clearance, QueryPart
+from planner.cell.clearance import Clearance
 
 BoolArray = NDArray[np.bool_]
 
@@ -60,11 +60,6 @@ def select(
             return Decision(c, cl, True)
         seen.append((c, cl))
     return least_bad(seen)
-
-
-def part_pair(part: QueryPart) -> tuple[str, str]:
-    """``(link, obstacle)`` of a part, for bounds that name no contact."""
-    return (str(part.link), part.env_name)
 
 
 def passes(cl: Clearance, margin_m: float) -> bool:

@@ -10,17 +10,21 @@ The work is done in four passes; the answers do not depend on them:
 2. a lean loop over the others: the open parts of the first candidate with Bullet (often just
    the sensor, which stands at the sensing distance from the surface);
 3. one broad-phase call for the first :data:`FIRST_BLOCK` candidates of the points still open
-   (more of a point's, up to ``max_checks``, in doubling blocks when it needs them);
-4. per point: candidates in order until one passes, each one's open parts cheapest first,
-   stopping as soon as its slack is shown below the margin; then the least-bad one, best
-   candidates first (by an upper bound from the parts already known), a candidate dropped as
-   soon as its slack is shown to be more than the tie below the best exact slack found.
+   (more of a point's, up to ``max_checks``, in doubling blocks when it needs them); a point
+   whose first candidate not shown below the margin is clear of everything is decided here;
+4. per point: candidates in order until one passes (a candidate whose slack is shown below the
+   margin, by the broad phase or by its GJK upper bound, :mod:`planner.cell.slack_bounds`, is
+   skipped), each one's open parts cheapest first, stopping as soon as its slack is shown
+   below the margin; then the least-bad one, best candidates first (by upper bounds: GJK's and
+   those of the parts already known), a candidate dropped as soon as its slack is shown to be
+   more than the tie below the best exact slack found.
 """
 
 from __future__ import annotations
 
 import heapq
 import math
+from functools import partial
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -31,7 +35,10 @@ from planner.cell.broad_kernels import FIELD
 from planner.cell.broad_phase import BroadPhase, broad_phase_of
 from planner.cell.clearance import Clearance, QueryPart
 from planner.cell.probe_clearance import ProbeClearance
-from planner.cell.probe_rule import CLEARANCE_TIE_M, Decision, least_bad, part_pair, passes
+from planner.cell.probe_flags import Block, CandidateFlags, clear_ahead
+from planner.cell.probe_parts import OpenParts
+from planner.cell.probe_rule import CLEARANCE_TIE_M, Decision, least_bad, passes
+from planner.cell.slack_bounds import SlackBounds
 
 if TYPE_CHECKING:
     from planner.cell.probe_candidates import ProbeCandidates
@@ -42,7 +49,7 @@ BoolArray = NDArray[np.bool_]
 
 #: Candidates of an open point whose broad phase runs with the batch (most such points pass
 #: within them); a point that needs more gets the rest in one call.
-FIRST_BLOCK = 8
+FIRST_BLOCK = 16
 
 
 class ProbeSearch:
@@ -68,8 +75,10 @@ class ProbeSearch:
         #: mesh; and the size of its link (its tree's root radius): small links go first.
         self._cost = [int(self.env.arrays[0][e] == FIELD) for e in self.parts.part_env]
         self._size = [self.broad.link_radius(int(k)) for k in self.parts.part_link]
+        self.bounds = SlackBounds(self.broad, self.parts, self.env, self.stages.plan)
+        self.open_parts = OpenParts(self.stages, self._env_parts, self._cost, self._size)
         #: how many points each pass decided (for profiling and the bench).
-        self.decided_by = {"broad": 0, "first": 0, "search": 0}
+        self.decided_by = {"broad": 0, "first": 0, "ahead": 0, "search": 0}
 
     def run(self, cands: ProbeCandidates) -> list[Decision | None]:
         """One decision per point (``None`` for points without a usable candidate)."""
@@ -98,7 +107,7 @@ class ProbeSearch:
                 rest.append(i)  # it cannot pass
                 continue
             self.stages.start_point(cands.T_base_flange[i])
-            cl, _ = self._exact(c // K, cands.q[i, c], pc[n] == 1, sc[n] == 1, {})
+            cl, _ = self.open_parts.evaluate(c // K, cands.q[i, c], pc[n] == 1, sc[n] == 1, {})
             top = cl.slack_m >= self.stages.look_slack_m - CLEARANCE_TIE_M
             if passes(cl, self.margin) and (not near[n] or top):
                 out[i] = Decision(c, cl, True)  # passes; or near a limit and none can beat it
@@ -109,13 +118,18 @@ class ProbeSearch:
             orders = [cands.order(i, self.max_checks) for i in rest]
             heads = [o[:FIRST_BLOCK] for o in orders]
             pts = np.repeat(np.array(rest), [len(h) for h in heads])
-            pc_all, sc_all, op_all = self._broad(cands, pts, np.concatenate(heads))
+            pc_all, sc_all, op_all, ub_all = self._block(cands, pts, np.concatenate(heads))
             start = 0
             for i, order, head in zip(rest, orders, heads):
-                flags = _Flags(self, cands, i, order)
                 sl = slice(start, start + len(head))
-                flags.put(pc_all[sl], sc_all[sl], op_all[sl])
                 start += len(head)
+                c = clear_ahead(cands.near_limit[i], head, pc_all[sl], sc_all[sl])
+                if c >= 0:  # what pass 4 would find first, without Bullet
+                    out[i] = Decision(c, look, True)
+                    self.decided_by["ahead"] += 1
+                    continue
+                flags = CandidateFlags(order, partial(self._point_block, cands, i))
+                flags.put((pc_all[sl], sc_all[sl], op_all[sl], ub_all[sl]))
                 out[i] = self._search(cands, i, order, flags)
                 self.decided_by["search"] += 1
         return out
@@ -131,77 +145,20 @@ class ProbeSearch:
         T_links = self.broad.link_poses(self._cell, cands.q[pts, cs], T_bf)
         return self.broad.states(self.parts, self.env, T_links)
 
-    def _exact(
-        self,
-        rotation: int,
-        q: FloatArray,
-        clear: BoolArray,
-        pairs_clear: BoolArray,
-        results: dict[int, Clearance | None],
-        stop_below: float = -math.inf,
-        max_cost: int = 1,
-        max_parts: int = -1,
-        certify: bool = False,
-        tried: dict[int, float] | None = None,
-    ) -> tuple[Clearance, bool]:
-        """The candidate's open parts with Bullet, cheapest first (cached ones before all).
+    def _point_block(self, cands: ProbeCandidates, i: int, cs: NDArray[np.int_]) -> Block:
+        """:meth:`_block` of candidates ``cs`` of point ``i``."""
+        return self._block(cands, np.full(cs.size, i), cs)
 
-        Stops once the slack is shown below ``stop_below``, before a part costing more than
-        ``max_cost``, or after ``max_parts`` parts not cached (-1: no limit). With
-        ``certify``, the work-object parts not cached are first asked only whether they go
-        below ``stop_below`` (:meth:`ProbeClearance.certify`, a fraction of a full query
-        when the collision is deep), smallest links first; one that does stops the candidate.
-        ``tried`` keeps, per part, the deepest bound a certificate failed to show (not asked
-        again). ``results`` collects the parts evaluated (plan index -> result, kept between
-        calls).
-
-        Returns:
-            The merge of the parts known so far (the exact clearance when complete, else an
-            upper bound of the slack) and whether every open part is known.
-        """
-        st = self.stages
-        running = min((r.slack_m for r in results.values() if r is not None), default=math.inf)
-        todo: list[tuple[int, int, float, int]] = []  # (not cached, cost, size, k)
-        for k in range(len(self._env_parts)):
-            part = self._env_parts[k]
-            if not clear[k] and part.index not in results:
-                cached = st.known(rotation, q, part)
-                todo.append((int(not cached), self._cost[k], self._size[k], k))
-        todo.sort()
-        self_open = not pairs_clear.all() and st.self_part.index not in results
-        fresh = 0
-        if running >= stop_below and self_open and max_parts != 0:
-            res = st.evaluate(rotation, q, st.self_part, ~pairs_clear)
-            results[st.self_part.index] = res
-            self_open = False
-            fresh += 1
-            if res is not None:
-                running = min(running, res.slack_m)
-        complete = not self_open
-        if certify and running >= stop_below and tried is not None:
-            # certificates first, smallest links first: any one shows the candidate below
-            below = math.nextafter(stop_below, -math.inf)
-            for new, cost, _, k in todo:
-                part = self._env_parts[k]
-                if not new or cost < 1 or tried.get(k, -math.inf) >= below:
-                    continue
-                if st.certify(rotation, q, part, below):
-                    return Clearance(False, below + part.need_m, below, part_pair(part)), False
-                tried[k] = below  # not that deep: no deeper bound can be shown either
-        for new, cost, _, k in todo:
-            if running < stop_below or cost > max_cost or (new and fresh == max_parts):
-                complete = False
-                break
-            part = self._env_parts[k]
-            res = st.evaluate(rotation, q, part)
-            results[part.index] = res
-            fresh += new
-            if res is not None:
-                running = min(running, res.slack_m)
-        return st.merge(results), complete
+    def _block(self, cands: ProbeCandidates, pts: NDArray[np.int_], cs: NDArray[np.int_]) -> Block:
+        """Broad-phase states and slack upper bounds of candidates ``cs`` of points ``pts``."""
+        K = cands.per_rotation
+        T_bf = cands.T_base_flange[pts, cs // K]
+        T_links = self.broad.link_poses(self._cell, cands.q[pts, cs], T_bf)
+        pc, sc, opened = self.broad.states(self.parts, self.env, T_links)
+        return pc, sc, opened, self.bounds.upper(T_links, pc, sc)
 
     def _search(
-        self, cands: ProbeCandidates, i: int, order: NDArray[np.int_], flags: _Flags
+        self, cands: ProbeCandidates, i: int, order: NDArray[np.int_], flags: CandidateFlags
     ) -> Decision:
         """Pass 4 for point ``i``: candidates ``order``, broad-phase flags from ``flags``."""
         K = cands.per_rotation
@@ -218,7 +175,7 @@ class ProbeSearch:
         ) -> None:
             c = int(order[j])
             clear, pairs_clear = flags.clear(j)
-            cl, complete = self._exact(
+            cl, complete = self.open_parts.evaluate(
                 c // K, cands.q[i, c], clear, pairs_clear, results[j], stop_below, max_cost,
                 max_parts, certify, tried[j],
             )  # fmt: skip
@@ -232,9 +189,15 @@ class ProbeSearch:
         for j, c in enumerate(order.tolist()):
             if near[c]:
                 break  # the rest are near a limit too: none can be chosen outright
+            u = flags.upper(j)
             if flags.fails(j):
-                bound[j] = below_margin  # shown below the margin: it cannot pass
-                continue
+                u = min(u, below_margin)  # shown below the margin
+            if u < math.inf:
+                bound[j] = u
+            if u < self.margin:
+                continue  # it cannot pass
+            if flags.all_clear(j):  # nothing near: the look distance, which passes
+                return Decision(c, self.stages.merge({}), True)
             run(j, self.margin)
             if j in exact and passes(exact[j], self.margin):
                 return Decision(c, exact[j], True)
@@ -242,12 +205,19 @@ class ProbeSearch:
         for j in range(len(order)):
             if j not in exact and flags.all_clear(j):
                 run(j, -math.inf)
+        for j in range(len(order)):  # the bounds without Bullet (GJK on the exact shapes)
+            if j not in exact and flags.upper(j) < bound.get(j, math.inf):
+                bound[j] = flags.upper(j)
         top = max((cl.slack_m for cl in exact.values()), default=-math.inf)
         if top < look - CLEARANCE_TIE_M:  # bounds from the cheap parts order the rest
-            for j in range(len(order)):
-                if j not in exact:
-                    run(j, -math.inf, max_cost=0)
-            top = max((cl.slack_m for cl in exact.values()), default=-math.inf)
+            rest = sorted((j for j in range(len(order)) if j not in exact),
+                          key=lambda j: -bound.get(j, look))  # fmt: skip
+            for j in rest:
+                if bound.get(j, look) < top - CLEARANCE_TIE_M:
+                    continue  # cannot reach the tie
+                run(j, -math.inf, max_cost=0)
+                if j in exact:
+                    top = max(top, exact[j].slack_m)
         # best first: refine the candidate with the highest bound (no slack exceeds the look
         # distance's), one part at a time, until no open candidate can reach the tie
         heap = [
@@ -269,47 +239,3 @@ class ProbeSearch:
                 heapq.heappush(heap, (-bound[j], opened, j))
         seen = [(int(order[j]), exact[j]) for j in sorted(exact)]
         return least_bad(seen)
-
-
-class _Flags:
-    """Broad-phase states of one point's candidates (the first with the batch; more on
-    demand, each block as large as all before it)."""
-
-    def __init__(
-        self, search: ProbeSearch, cands: ProbeCandidates, i: int, order: NDArray[np.int_]
-    ) -> None:
-        self._search, self._cands, self._i, self._order = search, cands, i, order
-        self._pc: list[NDArray[np.int8]] = []
-        self._sc: list[NDArray[np.int8]] = []
-        self._opened: list[int] = []
-
-    def put(self, pc: NDArray[np.int8], sc: NDArray[np.int8], opened: NDArray[np.int64]) -> None:
-        self._pc.extend(pc)
-        self._sc.extend(sc)
-        self._opened.extend(opened.tolist())
-
-    def _get(self, j: int) -> tuple[NDArray[np.int8], NDArray[np.int8]]:
-        while j >= len(self._pc):  # the next block, twice as many as computed so far
-            n = len(self._pc)
-            cs = self._order[n : max(j + 1, 2 * n)]
-            self.put(*self._search._broad(self._cands, np.full(cs.size, self._i), cs))
-        return self._pc[j], self._sc[j]
-
-    def opened(self, j: int) -> int:
-        """Sphere-tree leaves of candidate row ``j`` near the environment."""
-        self._get(j)
-        return self._opened[j]
-
-    def clear(self, j: int) -> tuple[BoolArray, BoolArray]:
-        """``(parts clear (P,), pairs clear (S,))`` of candidate row ``j``."""
-        pc, sc = self._get(j)
-        return pc == 1, sc == 1
-
-    def all_clear(self, j: int) -> bool:
-        pc, sc = self._get(j)
-        return bool((pc == 1).all() and (sc == 1).all())
-
-    def fails(self, j: int) -> bool:
-        """A part of candidate row ``j`` is shown below the margin."""
-        pc, sc = self._get(j)
-        return bool((pc == -1).any() or (sc == -1).any())

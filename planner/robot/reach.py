@@ -105,16 +105,30 @@ def no_ik_reason(
 def opw_wrist_reason(opw: Any, T_flange: FloatArray) -> str:
     """Why an OPW arm reaches none of the flange poses ``(R, 4, 4)``: the wrist centre's
     distance from the shoulder against the arm's range ``|c2 - k| .. c2 + k``."""
+    return opw_wrist_reasons(opw, T_flange[None])[0]
+
+
+def opw_wrist_reasons(opw: Any, T_flange: FloatArray) -> list[str]:
+    """:func:`opw_wrist_reason` of ``P`` points at once, ``T_flange (P, R, 4, 4)``."""
     P = opw.params
     T = invert_transform(opw.T_base_opw) @ T_flange @ invert_transform(opw.T_ee_tip)
-    c = T[:, :3, 3] - P.c4 * T[:, :3, 2]
-    radial = np.sqrt(np.maximum(c[:, 0] ** 2 + c[:, 1] ** 2 - P.b**2, 0.0))
+    c = T[..., :3, 3] - P.c4 * T[..., :3, 2]
+    radial = np.sqrt(np.maximum(c[..., 0] ** 2 + c[..., 1] ** 2 - P.b**2, 0.0))
     k = math.hypot(P.c3, P.a2)
-    d = np.minimum(np.hypot(radial - P.a1, c[:, 2] - P.c1), np.hypot(radial + P.a1, c[:, 2] - P.c1))
-    i = int(np.argmin(np.abs(d - np.clip(d, abs(P.c2 - k), P.c2 + k))))
-    if d[i] < abs(P.c2 - k):
-        return f"too close (wrist centre {d[i]:.2f} m from the shoulder, min {abs(P.c2 - k):.2f} m)"
-    return f"out of reach (wrist centre {d[i]:.2f} m from the shoulder, reach {P.c2 + k:.2f} m)"
+    d = np.minimum(
+        np.hypot(radial - P.a1, c[..., 2] - P.c1), np.hypot(radial + P.a1, c[..., 2] - P.c1)
+    )
+    lo, hi = abs(P.c2 - k), P.c2 + k
+    i = np.argmin(np.abs(d - np.clip(d, lo, hi)), axis=1)
+    out = []
+    for di in d[np.arange(d.shape[0]), i].tolist():
+        if di < lo:
+            out.append(f"too close (wrist centre {di:.2f} m from the shoulder, min {lo:.2f} m)")
+        else:
+            out.append(
+                f"out of reach (wrist centre {di:.2f} m from the shoulder, reach {hi:.2f} m)"
+            )
+    return out
 
 
 def no_ik_reasons(
@@ -133,12 +147,11 @@ def no_ik_reasons(
     dist = np.min(np.linalg.norm(p - model.shoulder_towards(p), axis=1).reshape(P, R), axis=1)
     out: list[str | None] = [None] * P
     rest = []
-    for i in range(P):
-        where = f"{float(dist[i]):.2f} m from the shoulder, reach {model.reach_m:.2f} m"
-        if dist[i] > model.reach_m:
-            out[i] = f"out of reach ({where})"
-        elif solver.opw is None:
-            out[i] = f"no IK solution within joint limits ({where})"
+    for i, di in enumerate(dist.tolist()):
+        if di > model.reach_m or solver.opw is None:
+            where = f"{di:.2f} m from the shoulder, reach {model.reach_m:.2f} m"
+            why = "out of reach" if di > model.reach_m else "no IK solution within joint limits"
+            out[i] = f"{why} ({where})"
         else:
             rest.append(i)
     opw = solver.opw
@@ -152,17 +165,24 @@ def no_ik_reasons(
         q = q8[owner, row]  # (K, n): the branches that exist
         lo, hi = chain.lower, chain.upper
         with np.errstate(invalid="ignore"):
-            best = np.full(q.shape, np.inf)  # violation of each joint over its 2*pi variants
-            for k in (-2, -1, 0, 1, 2):
-                qk = q + k * (2 * np.pi)
-                best = np.minimum(best, np.maximum(lo - qk, 0) + np.maximum(qk - hi, 0))
+            # violation of each joint over its 2*pi variants k = -2..2: the distance of
+            # q + 2 pi k to [lo, hi] falls, then rises with k, so its least is at the first
+            # variant at or above lo or at the one before it
+            two_pi = 2 * np.pi
+            k_up = np.clip(np.ceil((lo - q) / two_pi), -2, 2)
+            q_up, q_dn = q + k_up * two_pi, q + np.clip(k_up - 1, -2, 2) * two_pi
+            best = np.minimum(
+                np.maximum(lo - q_up, 0) + np.maximum(q_up - hi, 0),
+                np.maximum(lo - q_dn, 0) + np.maximum(q_dn - hi, 0),
+            )
         worst = np.argmax(best, axis=1)  # each branch's worst joint
         counts = np.bincount(owner * n_j + worst, minlength=len(idx) * n_j).reshape(-1, n_j)
         any_ok = np.asarray(ok8.any(axis=1), dtype=bool)
-        for n, i in enumerate(rest):
-            if not any_ok[n]:
-                out[i] = opw_wrist_reason(opw, T[i])
-            else:
-                j = int(np.argmax(counts[n]))
-                out[i] = f"joint {j + 1} at limit ({chain.joint_names[j]})"
+        none_ok = np.flatnonzero(~any_ok)
+        wrist = opw_wrist_reasons(opw, T[idx[none_ok]]) if none_ok.size else []
+        for n, why in zip(none_ok.tolist(), wrist):
+            out[rest[n]] = why
+        for n in np.flatnonzero(any_ok).tolist():
+            j = int(np.argmax(counts[n]))
+            out[rest[n]] = f"joint {j + 1} at limit ({chain.joint_names[j]})"
     return [s for s in out if s is not None]

@@ -150,8 +150,9 @@ class KinematicChain:
         N = qa.shape[0]
         T = np.broadcast_to(np.eye(4), (N, 4, 4))
         out = np.empty((N, self.n_joints, 4, 4))
+        motions = self._motions(qa)
         for k in range(self.n_joints):
-            T = T @ self.T_prev_joint[k] @ self._motion(k, qa[:, k])
+            T = T @ self.T_prev_joint[k] @ motions[:, k]
             out[:, k] = T
         return out
 
@@ -165,8 +166,9 @@ class KinematicChain:
         """
         qa = self.check_q(q)
         T = np.broadcast_to(np.eye(4), (qa.shape[0], 4, 4))
+        motions = self._motions(qa)
         for k in range(self.n_joints):
-            T = T @ self.T_prev_joint[k] @ self._motion(k, qa[:, k])
+            T = T @ self.T_prev_joint[k] @ motions[:, k]
         return T @ self.T_last_tip
 
     def fk_jacobian(self, q: ArrayLike) -> tuple[FloatArray, FloatArray]:
@@ -201,20 +203,33 @@ class KinematicChain:
             )
         return out
 
-    def _motion(self, k: int, qk: FloatArray) -> FloatArray:
-        """Joint ``k``'s motion transform ``(N, 4, 4)`` for values ``qk (N,)``."""
-        N = qk.shape[0]
-        M = np.zeros((N, 4, 4))
-        M[:, 3, 3] = 1.0
-        a = self.axes[k]
-        if self.joint_types[k] == "prismatic":
-            M[:, :3, :3] = np.eye(3)
-            M[:, :3, 3] = qk[:, None] * a
-            return M
-        K = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
-        s, c = np.sin(qk)[:, None, None], np.cos(qk)[:, None, None]
-        M[:, :3, :3] = np.eye(3) + s * K + (1.0 - c) * (K @ K)
+    def _motions(self, q: FloatArray) -> FloatArray:
+        """Every joint's motion transform ``(N, n, 4, 4)`` for configurations ``q (N, n)``:
+        Rodrigues' formula for revolute joints, a translation along the axis for prismatic
+        ones (all joints at once; the same arithmetic as one joint at a time)."""
+        N, n = q.shape
+        M = np.zeros((N, n, 4, 4))
+        M[..., 3, 3] = 1.0
+        K, KK, prismatic = self._axis_matrices()
+        s, c = np.sin(q)[..., None, None], np.cos(q)[..., None, None]
+        M[..., :3, :3] = np.eye(3) + s * K + (1.0 - c) * KK
+        if prismatic.any():
+            M[:, prismatic, :3, :3] = np.eye(3)
+            M[:, prismatic, :3, 3] = q[:, prismatic, None] * self.axes[prismatic]
         return M
+
+    def _axis_matrices(self) -> tuple[FloatArray, FloatArray, NDArray[np.bool_]]:
+        """``(K (n, 3, 3), K @ K, prismatic (n,))``: each axis's cross-product matrix."""
+        cached = self.__dict__.get("_axis_cache")
+        if cached is None:
+            a = np.asarray(self.axes, dtype=np.float64).reshape(-1, 3)
+            K = np.zeros((a.shape[0], 3, 3))
+            K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -a[:, 2], a[:, 1], -a[:, 0]
+            K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = a[:, 2], -a[:, 1], a[:, 0]
+            prismatic = np.array([t == "prismatic" for t in self.joint_types], dtype=bool)
+            cached = (K, np.stack([k @ k for k in K]), prismatic)  # as one joint at a time
+            object.__setattr__(self, "_axis_cache", cached)
+        return cached
 
 
 def _default_tip(model: URDFModel, base: str) -> str:
