@@ -61,7 +61,7 @@ class FilesPanel:
         self._app = app
         self.upload_dir = upload_dir
         gui = app.server.gui
-        with gui.add_folder("Files", expand_by_default=True):
+        with app.tab("Files"):
             self.plan_upload = gui.add_upload_button("Upload plan (.json)", mime_type=".json")
             self.units = gui.add_dropdown("Mesh units", MESH_UNITS, initial_value="mm")
             self.mesh_upload = gui.add_upload_button("Upload work-object mesh")
@@ -71,27 +71,32 @@ class FilesPanel:
         self.plan_upload.on_upload(lambda ev: self._guard(ev, self.upload_plan))
         self.mesh_upload.on_upload(lambda ev: self._guard(ev, self.upload_mesh))
         self.urdf_upload.on_upload(lambda ev: self._guard(ev, self.upload_urdf))
-        self.download.on_click(lambda ev: self._guard(ev, self.download_plan, ev.client))
+        self.download.on_click(
+            lambda ev: self._guard(ev, self.download_plan, ev.client, failure="Not downloaded")
+        )
         for fmt, button in self.export_buttons.items():
             button.on_click(self._export_callback(fmt))
 
     def _export_callback(self, fmt: str) -> Any:
         def callback(event: Any) -> None:
-            self._guard(event, self.download_export, event.client, fmt)
+            self._guard(event, self.download_export, event.client, fmt, failure="Not exported")
 
         return callback
 
-    def _guard(self, event: Any, fn: Any, *args: Any) -> None:
+    def _guard(self, event: Any, fn: Any, *args: Any, failure: str = "File not used") -> None:
+        """Run ``fn`` (an upload with the event's file when no ``args``); a refusal shows as an
+        error notification titled ``failure`` that stays until closed."""
         client = getattr(event, "client", None)
         if not args:
             args = (event.target.value.name, event.target.value.content)
         try:
-            title = fn(*args)
+            with self._app.busy(f"{fn.__name__.replace('_', ' ')}"):
+                title = fn(*args)
         except InputError as exc:
-            self._app.notify("File not used", str(exc), client=client)
+            self._app.notify(failure, str(exc), client=client)
         except Exception as exc:  # never a traceback in the browser
             logger.exception("file action failed")
-            self._app.notify("File not used", f"{type(exc).__name__}: {exc}", client=client)
+            self._app.notify(failure, f"{type(exc).__name__}: {exc}", client=client)
         else:
             if title:
                 self._app.notify(title, "", client=client, error=False)
@@ -113,8 +118,18 @@ class FilesPanel:
         atomic_write_bytes(path, content)
         return path, digest
 
-    def _apply_source(self, plan: Plan, label: str) -> None:
-        self._app.load_cell(plan, self._app.plan_dir)
+    def _apply_source(
+        self, plan: Plan, label: str, kept: Path | None = None, name: str = ""
+    ) -> None:
+        """Load the cell of ``plan`` and make it the session's (one undoable step); an error
+        names the user's file ``name``, not where the upload is ``kept``."""
+        try:
+            self._app.load_cell(plan, self._app.plan_dir)
+        except Exception as exc:
+            text = str(exc) if isinstance(exc, InputError) else f"{type(exc).__name__}: {exc}"
+            if kept is not None:
+                text = text.replace(str(kept), name).replace(str(kept.parent), "uploads")
+            raise UploadError(text if name in text else f"{name}: {text}") from None
         self._app.state.update(lambda d: with_source(d, plan), label)
 
     def upload_mesh(self, name: str, content: bytes) -> str:
@@ -125,7 +140,9 @@ class FilesPanel:
         work_object = msgspec.structs.replace(
             source.work_object, mesh=str(path), units=str(self.units.value), sha256=digest
         )
-        self._apply_source(msgspec.structs.replace(source, work_object=work_object), "new mesh")
+        self._apply_source(
+            msgspec.structs.replace(source, work_object=work_object), "new mesh", path, name
+        )
         return f"Work object {name} loaded"
 
     def upload_urdf(self, name: str, content: bytes) -> str:
@@ -135,7 +152,7 @@ class FilesPanel:
         path, _ = self._keep(name, content)
         robot = msgspec.structs.replace(source.cell.robot, urdf=str(path))
         cell = msgspec.structs.replace(source.cell, robot=robot)
-        self._apply_source(msgspec.structs.replace(source, cell=cell), "new robot")
+        self._apply_source(msgspec.structs.replace(source, cell=cell), "new robot", path, name)
         return f"Robot {name} loaded"
 
     def _current_plan(self) -> Plan:

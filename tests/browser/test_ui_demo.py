@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from ui_helpers import REPO, UiSession, rendered, set_camera, wait_for
+from ui_helpers import REPO, UiSession, open_tab, rendered, set_camera, wait_for
 
 from calib.atomic_io import write_bytes_atomic
 from webui.plan_doc import PAPER_IDS
@@ -38,6 +38,7 @@ def test_demo_loads_with_ah_points_and_statuses(demo: UiSession) -> None:
 
 def test_validate_button_produces_table_and_histograms(demo: UiSession) -> None:
     demo.app.validate_panel.trials.value = 30
+    open_tab(demo.page, "Validate")
     demo.page.get_by_role("button", name="Validate plan").click()
     panel = demo.app.validate_panel
     wait_for(lambda: not panel.running and panel.result_md.content, timeout=300, what="validation")
@@ -75,7 +76,8 @@ def test_checks_run_while_validation_runs(demo: UiSession) -> None:
     fut = panel.start(400)
     try:
         a = demo.app.state.doc.get("A")
-        check = demo.app.move_point_to("A", a.probe.position_m)  # a no-op move, re-checked
+        moved = np.add(a.probe.position_m, [0.0, 0.002, 0.0])  # 2 mm along the side face
+        check = demo.app.move_point_to("A", moved)
         assert check is not None and panel.running, "the check waited for the validation"
     finally:
         fut.result(300)
