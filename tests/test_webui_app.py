@@ -119,7 +119,11 @@ def test_heat_map_grows_in_chunks_and_colours_vertices(app: WobjcalApp) -> None:
     assert app.heatmap.done.wait(120)
     assert len(app.heatmap.scores) == 6
     assert set(app.heatmap.scores) <= {0.0, 0.5, 1.0}
+    from webui.heatmap import CATEGORY_RGB
+
+    assert len(app.heatmap.categories) == 6 and set(app.heatmap.categories) <= set(CATEGORY_RGB)
     assert app.server.scene.get_handle_by_name("/wobj/heat_mesh") is not None
+    assert "surface samples usable" in app.heatmap.summary
     app.place_at_ray(*_ray_to([0.0, 0.1, 0.0]), point_id="H1")  # clicks still work after
     app.heatmap.stop()
     assert app.server.scene.get_handle_by_name("/wobj/heat_mesh") is None

@@ -61,7 +61,14 @@ class WobjcalApp:
         plan_dir: Path,
         autosave_path: Path | None = DEFAULT_AUTOSAVE,
     ) -> None:
-        from webui import calibrate_panel, cell_panel, files_panel, points_panel, validate_panel
+        from webui import (
+            calibrate_panel,
+            cell_panel,
+            files_panel,
+            points_panel,
+            teach_panel,
+            validate_panel,
+        )
 
         self.server = server
         self.plan_dir = Path(plan_dir)
@@ -88,6 +95,7 @@ class WobjcalApp:
         self.heatmap = HeatMap(self)
         self.points_panel = points_panel.PointsPanel(self)
         self.cell_panel = cell_panel.CellPanel(self)
+        self.teach_panel = teach_panel.TeachPanel(self)
         self.validate_panel = validate_panel.ValidatePanel(self)
         self.files_panel = files_panel.FilesPanel(self)
         self.calibrate_panel = calibrate_panel.CalibratePanel(self)
@@ -129,6 +137,7 @@ class WobjcalApp:
             if why:
                 logger.warning("%s", why)
                 self.notify("Robot not drawn", why, error=True)
+        self.teach_panel.on_cell()
         if old_part is not None and old_part is not view.wobj_mesh:  # a new part: reframe
             for client in self.server.get_clients().values():
                 clients.set_default_camera(client, view)

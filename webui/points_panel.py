@@ -12,9 +12,10 @@ import numpy as np
 
 from calib.errors import InputError
 from calib.procedures import PROCEDURES
-from webui import plan_doc
+from webui import heatmap, plan_doc
 from webui.plan_adapter import with_procedure
 from webui.plan_doc import NO_ROLE, PAPER_IDS
+from webui.scene import legend_html
 
 if TYPE_CHECKING:
     from webui.context import AppContext
@@ -74,6 +75,9 @@ class PointsPanel:
             self.drag = gui.add_checkbox("Drag selected point", False)
             self.play = gui.add_button("Play search path")
             self.heat = gui.add_checkbox("Reachability heat map", False)
+            self.heat_legend = gui.add_html(
+                legend_html(heatmap.CATEGORY_MEANING, heatmap.CATEGORY_RGB), visible=False
+            )
             self.status_md = gui.add_markdown("")
         self.selected.on_update(self._on_selected)
         self.procedure.on_update(self._on_procedure)
@@ -303,6 +307,7 @@ class PointsPanel:
     def _on_heat(self, event: Any) -> None:
         if self._is_programmatic():
             return
+        self.heat_legend.visible = bool(self.heat.value)
         if not self.heat.value:
             self._app.heatmap.stop()
             return

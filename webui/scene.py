@@ -71,12 +71,18 @@ class PlanScene:
         self._heat: Any = None
         self._wobj_mesh: trimesh.Trimesh | None = None
 
-    def color_work_object(self, vertex_rgb: ArrayLike | None) -> None:
-        """Overlay the work object with per-vertex colours (``(V, 3)`` uint8), or remove it."""
+    def color_work_object(
+        self, vertex_rgb: ArrayLike | None, mesh: trimesh.Trimesh | None = None
+    ) -> None:
+        """Overlay the work object with per-vertex colours (``(V, 3)`` uint8), or remove it.
+
+        ``mesh``: a refined copy of the work object (wobj frame) the colours belong to;
+        default the work object itself.
+        """
         if vertex_rgb is None or self._wobj_mesh is None:
             self._scene.remove_by_name("/wobj/heat_mesh")
             return
-        colored = self._wobj_mesh.copy()
+        colored = (self._wobj_mesh if mesh is None else mesh).copy()
         rgb = np.asarray(vertex_rgb, dtype=np.uint8)
         colored.visual = trimesh.visual.ColorVisuals(
             colored, vertex_colors=np.hstack([rgb, np.full((len(rgb), 1), 255, np.uint8)])
@@ -229,11 +235,14 @@ class PlanScene:
         )
 
 
-def legend_html(entries: Mapping[str, str] = STATUS_MEANING) -> str:
-    """HTML of a colour legend: a swatch of :data:`STATUS_RGB` and the meaning per status."""
+def legend_html(
+    entries: Mapping[str, str] = STATUS_MEANING,
+    colours: Mapping[str, tuple[int, int, int]] = STATUS_RGB,
+) -> str:
+    """HTML of a colour legend: a swatch of ``colours`` and the meaning, per entry."""
     rows = []
     for status, meaning in entries.items():
-        r, g, b = STATUS_RGB.get(status, STATUS_RGB["unknown"])
+        r, g, b = colours.get(status, STATUS_RGB["unknown"])
         rows.append(
             f'<div style="display:flex;gap:6px;align-items:center;font-size:0.8em">'
             f'<span style="width:12px;height:12px;border-radius:6px;flex:none;'
