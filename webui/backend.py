@@ -102,6 +102,19 @@ class JogStatus:
         return "; ".join(parts)
 
 
+@dataclass(frozen=True)
+class MoveCheck:
+    """A joint move between two poses.
+
+    Attributes:
+        tcp_path_world: ``(steps, 3)`` the TCP along the move, world frame, m.
+        problem: where and what collides first (``""``: the move is clear).
+    """
+
+    tcp_path_world: NDArray[np.float64]
+    problem: str
+
+
 def resolve_robot_urdf(ref: str, plan_dir: Path) -> Path | None:
     """The URDF file of ``plan.cell.robot.urdf`` (``builtin:NAME`` from the bundled assets)."""
     resolved = resolve_ref(ref, plan_dir)
@@ -210,6 +223,26 @@ class CellSession:
         if len(q) == 0:
             return None
         return np.asarray(q[int(np.argmin(np.linalg.norm(q - q0, axis=1)))], dtype=np.float64)
+
+    def check_move(
+        self, q_from: ArrayLike, q_to: ArrayLike, tcp: str, steps: int = 20
+    ) -> MoveCheck:
+        """The joint move from ``q_from`` to ``q_to`` (linear in joint space, ``steps``
+        poses): the TCP's path (world) and the first pose that collides, if any."""
+        cell = self._cell()
+        a = np.asarray(q_from, dtype=np.float64).reshape(-1)
+        b = np.asarray(q_to, dtype=np.float64).reshape(-1)
+        qs = a + np.linspace(0.0, 1.0, steps)[:, None] * (b - a)
+        T = cell.T_world_base @ np.asarray(cell.chain.fk(qs)) @ cell.T_flange_tcp(tcp)
+        problem = ""
+        with cell.saved_state():
+            for k, q in enumerate(qs):
+                cell.set_joint_positions(q)
+                c = cell.clearance()
+                if not c.ok:
+                    problem = f"at {100 * k // (steps - 1)} %: {c.describe()}"
+                    break
+        return MoveCheck(T[:, :3, 3].copy(), problem)
 
     def _cell(self) -> Cell:
         if self.cell is None:

@@ -32,9 +32,10 @@ ISO_DIRECTION = (0.25, 0.9, -0.45)
 #: The part's share of the camera's focus: the view centres on the part, pulled this far
 #: towards the robot (0: the part's centre, 1: the middle of part and robot).
 ROBOT_PULL = 0.25
-#: Share of the view's width the cell may use, centred: the control panel floats over the
-#: right-hand side of the canvas.
-WIDTH_SHARE = 0.5
+#: Share of the view's width and height the cell may use, centred (a margin around it).
+WIDTH_SHARE = 0.85
+#: Robot points are spheres of this radius in the framing (the links' size), m.
+ROBOT_RADIUS_M = 0.25
 #: Default vertical field of view of a tab, rad (viser's default).
 DEFAULT_FOV = float(np.radians(75.0))
 #: Notifications of successes close after this long, s; errors stay until closed.
@@ -43,7 +44,7 @@ OK_SECONDS = 8.0
 
 def cell_points(view: CellView) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The points the view must hold (world, m): the part's bounding-box corners, and the
-    robot's base and flange at zero joint values."""
+    robot's base and joint origins at zero joint values (clipped into the limits)."""
     lo, hi = view.wobj_mesh.bounds
     corners = np.array(
         [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
@@ -51,9 +52,9 @@ def cell_points(view: CellView) -> tuple[NDArray[np.float64], NDArray[np.float64
     part = transform_points(view.T_world_wobj, corners)
     robot = [view.T_world_base[:3, 3]]
     if view.chain is not None:
-        T = view.T_world_flange(np.zeros(view.chain.n_joints))
-        if T is not None:
-            robot.append(T[:3, 3])
+        q0 = np.clip(np.zeros(view.chain.n_joints), view.chain.lower, view.chain.upper)
+        frames = np.asarray(view.chain.joint_frames(q0[None]))[0]
+        robot.extend(transform_points(view.T_world_base, frames[:, :3, 3]))
     return part, np.asarray(robot, dtype=np.float64)
 
 
@@ -64,9 +65,9 @@ def framed_camera(
     aspect: float = 1.5,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Camera ``(position, look_at)`` (world, m) looking along ``direction`` at the part, far
-    enough back that the part and the robot (base and flange) are all inside the view: within
-    85 % of its height and the middle :data:`WIDTH_SHARE` of its width. The camera orbits
-    about the part (pulled :data:`ROBOT_PULL` towards the robot).
+    enough back that the part and the robot (base and joint origins, each with
+    :data:`ROBOT_RADIUS_M` around it) are all inside the middle :data:`WIDTH_SHARE` of the
+    view. The camera orbits about the part (pulled :data:`ROBOT_PULL` towards the robot).
 
     Args:
         view: the cell's geometry.
@@ -85,14 +86,15 @@ def framed_camera(
         right = np.array([1.0, 0.0, 0.0])
     right /= np.linalg.norm(right)
     cam_up = np.cross(right, d)
-    tan_v = np.tan(0.5 * fov) * 0.85  # a margin around the cell
+    tan_v = np.tan(0.5 * fov) * WIDTH_SHARE
     tan_h = np.tan(0.5 * fov) * aspect * WIDTH_SHARE
     distance = 0.3
-    for p in np.vstack([part, robot]):
+    radius = np.r_[np.zeros(len(part)), np.full(len(robot), ROBOT_RADIUS_M)]
+    for p, r in zip(np.vstack([part, robot]), radius, strict=True):
         rel = p - look_at
         along = float(rel @ d)
-        need = max(abs(float(rel @ right)) / tan_h, abs(float(rel @ cam_up)) / tan_v)
-        distance = max(distance, need - along)
+        need = max((abs(float(rel @ right)) + r) / tan_h, (abs(float(rel @ cam_up)) + r) / tan_v)
+        distance = max(distance, need - along + r)
     return look_at - distance * d, look_at
 
 

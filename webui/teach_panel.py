@@ -14,6 +14,7 @@ check picks it), so a taught pose fixes the point and its start offset, not the 
 from __future__ import annotations
 
 import contextlib
+import itertools
 import logging
 import threading
 from collections.abc import Iterator
@@ -67,10 +68,15 @@ class TeachPanel:
             self.drag_tcp = gui.add_checkbox("Drag TCP (IK)", False)
             self.target = gui.add_dropdown("Teach as", (NEW_POINT,))
             self.teach_button = gui.add_button("Teach pose", color="blue")
+            self.show_moves = gui.add_checkbox("Show moves between points", False)
+            self.moves_md = gui.add_markdown("")
         self.from_point.on_click(lambda ev: self._guard(ev, self.jog_to_selected))
         self.drag_tcp.on_update(lambda ev: self._guard(ev, self._update_gizmo))
         self.teach_button.on_click(lambda ev: self._guard(ev, self.teach, str(self.target.value)))
+        self.show_moves.on_update(lambda ev: self._guard(ev, self.draw_moves))
         app.state.subscribe(lambda _c: self._refresh_targets())
+        #: ``{"A->B": problem}`` of the last drawn moves (``""``: clear).
+        self.moves: dict[str, str] = {}
 
     # ---- helpers ---------------------------------------------------------------------------
     @contextlib.contextmanager
@@ -206,6 +212,43 @@ class TeachPanel:
             )
             return None
         return self.jog(q)
+
+    # ---- moves between points --------------------------------------------------------------
+    def draw_moves(self) -> dict[str, str]:
+        """Draw and check the joint moves between consecutive points of the plan (from each
+        feasible point's probe pose to the next one's, linear in joint space), while the box is
+        ticked; say which collide. Recomputed when the box is ticked again."""
+        scene = self._app.server.scene
+        scene.remove_by_name("/moves")
+        self.moves = {}
+        if not self.show_moves.value:
+            self.moves_md.content = ""
+            return self.moves
+        doc, checks, tcp = self._app.state.doc, self._app.checks(), self._tcp()
+        posed = [
+            (p.id, c.q)
+            for p in doc.points
+            if (c := checks.get(p.id)) is not None and c.q is not None and c.status != "infeasible"
+        ]
+        lines = []
+        for (a, qa), (b, qb) in itertools.pairwise(posed):
+            move = self._app.worker.call(lambda s, qa=qa, qb=qb: s.check_move(qa, qb, tcp))
+            self.moves[f"{a}->{b}"] = move.problem
+            rgb = (215, 40, 40) if move.problem else (40, 170, 60)
+            path = move.tcp_path_world
+            scene.add_line_segments(
+                f"/moves/{a}_{b}",
+                points=np.stack([path[:-1], path[1:]], axis=1),
+                colors=rgb,
+                thickness=2.0,
+                thickness_units="screen",
+            )
+            lines.append(f"- {a} → {b}: {move.problem or 'clear'}")
+        skipped = [p.id for p in doc.points if p.id not in dict(posed)]
+        if skipped:
+            lines.append(f"- left out (no feasible pose): {', '.join(skipped)}")
+        self.moves_md.content = "\n".join(lines) or "no two points with a pose"
+        return self.moves
 
     # ---- teach -----------------------------------------------------------------------------
     def teach(self, target: str) -> str:

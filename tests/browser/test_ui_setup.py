@@ -12,6 +12,7 @@ from ui_helpers import UiSession, open_tab, save_screenshot, set_camera, wait_fo
 
 from calib.frames import transform_points
 from webui.cell_edits import WORK_OBJECT, pose_of
+from webui.plan_doc import PAPER_IDS
 
 pytestmark = pytest.mark.browser
 
@@ -93,3 +94,33 @@ def test_jog_slider_and_teach_in_the_page(demo: UiSession, tmp_path: Path) -> No
     set_camera(demo.client(), np.add(p, [-1.6, -1.9, 1.0]), np.add(p, [-0.4, 0.0, 0.1]))
     save_screenshot(page, "taught_pose.png", tmp_path)
     app.state.undo()
+
+
+def test_uploading_a_part_shows_its_size_then_reframes_and_lists_points_off_it(
+    demo: UiSession, reference_dir: Path
+) -> None:
+    from webui import clients
+
+    app, page = demo.app, demo.page
+    files = app.files_panel
+    before = app.state.doc
+    open_tab(page, "Files")
+    files.units.value = "mm"
+    with page.expect_file_chooser() as fc:
+        page.get_by_role("button", name="Upload work-object mesh").click()
+    fc.value.set_files(str(reference_dir / "parts" / "plate_holes.STL"))
+    wait_for(lambda: "203.2 x 304.8 x 12.7 mm" in page.inner_text("body"), what="the size")
+    assert app.state.doc is before, "not used before it is accepted"
+    page.get_by_role("button", name="Use this part").click()
+    wait_for(lambda: app.state.doc.source.work_object.units == "mm", what="the new part")
+    want = clients.framed_camera(app.view, clients.ISO_DIRECTION, demo.client().camera.fov)[1]
+    wait_for(lambda: np.allclose(demo.client().camera.look_at, want, atol=1e-3), what="reframed")
+    wait_for(lambda: "off the new part" in page.inner_text("body"), what="the list")
+    assert set(files.off) == set(PAPER_IDS)
+    page.get_by_role("button", name="Project them onto the part").click()
+    wait_for(lambda: not files.off, what="the points projected")
+    for p in app.state.doc.points:
+        assert app.picker.project(p.probe.position_m).distance_m < 1e-9
+    app.state.undo()
+    app.state.undo()
+    wait_for(lambda: app.state.doc.source is before.source, what="the demo back")
