@@ -197,9 +197,12 @@ def bench_demo_browser(clicks: int, rng: np.random.Generator) -> dict[str, objec
             page = browser.new_page(viewport={"width": 1400, "height": 900})
             page.goto(f"http://127.0.0.1:{app.server.get_port()}/")
             page.locator("canvas").first.wait_for(timeout=60000)
-            while len(app.checks()) < 8:
+            while len(app.checks()) < 8 or not app.server.get_clients():
                 time.sleep(0.05)
             client = next(iter(app.server.get_clients().values()))
+            while client.camera.image_width == 0:
+                time.sleep(0.05)
+            time.sleep(2.0)  # the framed first view applied and reported back
             ref = _dom_round_trip_ms(app, page)
             view = app.view
             cam = client.camera

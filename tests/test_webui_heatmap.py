@@ -31,7 +31,7 @@ def test_refined_surface_is_fine_and_keeps_the_shape() -> None:
     assert edges.max() <= 0.02 * max(box.extents) + 1e-12
 
 
-def test_colours_blend_between_samples_and_match_them_at_the_samples() -> None:
+def test_colours_are_voted_never_mixed_and_match_the_samples_near_them() -> None:
     plane = trimesh.creation.box(extents=(1.0, 1.0, 0.01))
     fine = refined(plane)
     pts = np.array([[-0.4, 0.0, 0.005], [0.4, 0.0, 0.005]])
@@ -41,6 +41,9 @@ def test_colours_blend_between_samples_and_match_them_at_the_samples() -> None:
     top = np.where(fine.vertices[:, 2] > 0.004)[0]
     v = fine.vertices[top]
     near_red = top[np.argmin(np.linalg.norm(v - pts[0], axis=1))]
-    middle = top[np.argmin(np.linalg.norm(v - [0.0, 0.0, 0.005], axis=1))]
-    assert col[near_red, 0] > 240 and col[near_red, 2] < 15
-    assert 100 < col[middle, 0] < 155 and 100 < col[middle, 2] < 155, col[middle]
+    near_blue = top[np.argmin(np.linalg.norm(v - pts[1], axis=1))]
+    assert tuple(col[near_red]) == (255, 0, 0) and tuple(col[near_blue]) == (0, 0, 255)
+    assert {tuple(c) for c in col[top]} == {(255, 0, 0), (0, 0, 255)}, "no mixed colours"
+    left = fine.vertices[top][:, 0] < -0.01
+    right = fine.vertices[top][:, 0] > 0.01
+    assert np.all(col[top][left, 0] == 255) and np.all(col[top][right, 2] == 255)

@@ -33,7 +33,7 @@ from webui.robot_view import RobotView, robot_view_or_reason
 from webui.role_check import RoleFlags, role_flags
 from webui.scene import MARKER_RADIUS_M, PlanScene, legend_html
 from webui.state import DEFAULT_AUTOSAVE, Change, SessionState
-from webui.surface import SurfacePicker
+from webui.surface import SurfacePicker, marker_on_ray
 from webui.tabs import AppTabs
 from webui.upload_guard import guard_uploads
 from webui.worker import CellWorker
@@ -296,31 +296,18 @@ class WobjcalApp:
     def marker_at_ray(
         self, origin_world: ArrayLike, direction_world: ArrayLike, hit: Any = None
     ) -> str | None:
-        """The point whose marker the ray passes through (nearest to the camera; not one
-        hidden behind the part where the ray hits it, ``hit``), or ``None``."""
+        """The point whose marker the ray passes through (see :func:`webui.surface.
+        marker_on_ray`), or ``None``."""
         view = self.view
         if view is None:
             return None
-        o = np.asarray(origin_world, dtype=np.float64)
-        d = np.asarray(direction_world, dtype=np.float64)
-        d = d / np.linalg.norm(d)
-        best: tuple[float, str] | None = None
-        t_part = np.inf
-        if hit is not None:
-            t_part = float((transform_points(view.T_world_wobj, hit.position_wobj) - o) @ d)
-        for p in self.state.doc.points:
-            c = transform_points(view.T_world_wobj, p.probe.position_m)
-            t = float((c - o) @ d)
-            miss = float(np.linalg.norm(o + t * d - c))
-            hidden = t > t_part + 2.0 * MARKER_RADIUS_M
-            if (
-                t > 0
-                and not hidden
-                and miss <= 1.6 * MARKER_RADIUS_M
-                and (best is None or t < best[0])
-            ):
-                best = (t, p.id)
-        return None if best is None else best[1]
+        doc = self.state.doc
+        positions = [transform_points(view.T_world_wobj, p.probe.position_m) for p in doc.points]
+        hit_world = None if hit is None else transform_points(view.T_world_wobj, hit.position_wobj)
+        k = marker_on_ray(
+            positions, origin_world, direction_world, 1.6 * MARKER_RADIUS_M, hit_world
+        )
+        return None if k is None else doc.points[k].id
 
     def _click_place(self, event: Any) -> None:
         """A click in place mode: on a marker selects it, on the part places a point, anywhere

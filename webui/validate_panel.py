@@ -1,9 +1,10 @@
 """The "Validate" panel: Monte Carlo validation of any plan with a progress bar, the report's
 rows (simulated beside predicted), histograms, and the simulated error painted on the part.
 
-The report opens in its own wide window ("Validation report", docked on the right, wide
-enough for the Table-1 rows), with one histogram per row on a value axis in the row's unit
-(mm or deg). When the plan changes after a validation, the report is marked stale at once.
+The report opens in its own wide window ("Validation report", floating over the 3D view,
+wide enough for the Table-1 rows; "Show report window" hides or shows it), with one
+histogram per row on a value axis in the row's unit (mm or deg). When the plan changes after
+a validation, the report is marked stale at once.
 
 Validation runs on its own thread (:class:`webui.worker.CellWorker` without a shared resource),
 not on the cell worker: point checks from any tab stay fast while it runs. Whatever simulator
@@ -33,9 +34,10 @@ if TYPE_CHECKING:
 
 logger = logging.getLogger(__name__)
 
-#: Width of the report window, px: the Table-1 rows (simulated, predicted, bias, the paper)
+#: Size of the report window, px: the Table-1 rows (simulated, predicted, bias, the paper)
 #: fit without cutting.
 REPORT_WIDTH_PX = 640
+REPORT_HEIGHT_PX = 560
 
 
 class ValidatePanel:
@@ -60,6 +62,7 @@ class ValidatePanel:
             self.button = gui.add_button("Validate plan", color="blue")
             self.progress = gui.add_progress_bar(0.0, visible=False, animated=True)
             self.status_md = gui.add_markdown("")
+            self.show_report = gui.add_checkbox("Show report window", False, disabled=True)
             self.show_error = gui.add_checkbox("Show error on part", False, disabled=True)
             self.error_md = gui.add_markdown("")
         self.report_window = gui.add_panel(visible=False)
@@ -67,11 +70,13 @@ class ValidatePanel:
             self.stale_md = gui.add_markdown("")
             self.result_md = gui.add_markdown("")
             self._plots_folder = gui.add_folder("Histograms", expand_by_default=True)
-        self.report_window.dock_right()
-        self.report_window.set_width(REPORT_WIDTH_PX)
+        # floating over the 3D view's top-left corner: wide enough for the whole table next to
+        # the control panel docked on the right, also in a 1100 px window
+        self.report_window.float(x=12, y=12, width=REPORT_WIDTH_PX, height=REPORT_HEIGHT_PX)
         self.plots: list[Any] = []
         self.button.on_click(self._on_click)
         self.show_error.on_update(self._on_show_error)
+        self.show_report.on_update(lambda _ev: self._show_window(bool(self.show_report.value)))
         app.state.subscribe(self._on_plan_change)
 
     def _on_click(self, event: Any) -> None:
@@ -150,7 +155,8 @@ class ValidatePanel:
         with self._plots_folder:
             for title, unit, edges, counts in summary.histograms:
                 self._add_plot(gui, title, unit, edges, counts)
-        self.report_window.visible = True
+        self.show_report.disabled = False
+        self._show_window(True)
         if summary.T_world_wobj_example is not None:
             self._app.scene.draw_calibrated_frame(summary.T_world_wobj_example)
         self._app.notify("Validation done", summary.headline, error=False)
@@ -172,6 +178,12 @@ class ValidatePanel:
                 aspect=2.2,
             )
         )
+
+    def _show_window(self, visible: bool) -> None:
+        """Show or hide the report window (the box in the tab follows)."""
+        self.report_window.visible = visible and self.last_report is not None
+        if bool(self.show_report.value) != self.report_window.visible:
+            self.show_report.value = self.report_window.visible
 
     def _on_plan_change(self, change: Any) -> None:
         """Mark the shown report stale when the plan changes after it was made."""
