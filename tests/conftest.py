@@ -60,3 +60,16 @@ def ur5(reference_dir: Path) -> Iterator[Any]:
 
     with Cell(reference_dir / "robots" / "ur5" / "ur5.urdf", use_acl_cache=False) as c:
         yield c
+
+
+@pytest.fixture(scope="module")
+def demo_app(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
+    """The web UI's app on the built-in demo, served on a free port, no browser (one per
+    module: its edits stay in the module)."""
+    from webui.server import run
+    from webui.testing import free_port
+
+    folder = tmp_path_factory.mktemp("demo_app")
+    app = run(None, port=free_port(), block=False, autosave_path=folder / "auto.json")
+    yield app
+    app.stop()

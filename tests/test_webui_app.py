@@ -66,6 +66,14 @@ def test_undo_redo_restore_points_and_checks(app: WobjcalApp) -> None:
 
 
 def test_plan_download_is_the_strict_plan(app: WobjcalApp) -> None:
+    from webui import plan_doc
+
+    extra = [p.id for p in app.state.doc.points if p.role == plan_doc.NO_ROLE]
+    if extra:  # points added with every 3-2-1 role full have none: refused, naming them
+        with pytest.raises(ValueError, match=f"points? {', '.join(extra)} ha"):
+            app.files_panel.plan_bytes()
+        for pid in extra:
+            app.state.update(lambda d, pid=pid: plan_doc.delete_point(d, pid), f"delete {pid}")
     name, data = app.files_panel.plan_bytes()
     plan = plan_from_json(data.decode(), source=name)
     assert [p.id for p in plan.points] == list(app.state.doc.ids)
@@ -111,7 +119,11 @@ def test_heat_map_grows_in_chunks_and_colours_vertices(app: WobjcalApp) -> None:
     assert app.heatmap.done.wait(120)
     assert len(app.heatmap.scores) == 6
     assert set(app.heatmap.scores) <= {0.0, 0.5, 1.0}
+    from webui.heatmap import CATEGORY_RGB
+
+    assert len(app.heatmap.categories) == 6 and set(app.heatmap.categories) <= set(CATEGORY_RGB)
     assert app.server.scene.get_handle_by_name("/wobj/heat_mesh") is not None
+    assert "surface samples usable" in app.heatmap.summary
     app.place_at_ray(*_ray_to([0.0, 0.1, 0.0]), point_id="H1")  # clicks still work after
     app.heatmap.stop()
     assert app.server.scene.get_handle_by_name("/wobj/heat_mesh") is None
@@ -128,6 +140,8 @@ def test_feasible_point_has_pose_and_search_path(app: WobjcalApp) -> None:
 
 
 def test_exports_are_robot_programs(app: WobjcalApp) -> None:
+    original = app.plan_dir / "box_plan.json"
+    app.files_panel.upload_plan(original.name, original.read_bytes())  # drop the extra points
     rapid = app.files_panel.export("RAPID")
     (name, data), *_ = rapid.files
     assert name.endswith(".mod") and b"MODULE" in data
@@ -204,6 +218,34 @@ def test_gizmo_drag_previews_then_projects_onto_surface(app: WobjcalApp) -> None
     app.points_panel.drag.value = False
 
 
+def test_gizmo_sits_outside_the_part_and_a_drag_back_to_the_start_records_nothing(
+    app: WobjcalApp,
+) -> None:
+    """Issue 14, item 10: the gizmo is sized for the part and held out along the normal; a
+    drag that ends where it started (or a move onto the point itself) records no undo step and
+    leaves every coordinate as it was."""
+    from types import SimpleNamespace
+
+    app.place_at_ray(*_ray_to([0.05, -0.02, 0.0]), point_id="G2")
+    app.select("G2")
+    panel = app.points_panel
+    panel.drag.value = True
+    gizmo = app.server.scene.get_handle_by_name("/wobj/gizmo")
+    scale, offset = panel.gizmo_geometry()
+    assert gizmo is not None and 0.05 <= scale <= 0.4 and offset > 0.01
+    point = app.state.doc.get("G2").probe
+    np.testing.assert_allclose(gizmo.position, np.add(point.position_m, [0, 0, offset]))
+    before, undo_depth = app.state.doc, len(app.state._undo)
+    start = SimpleNamespace(position=tuple(gizmo.position))
+    for phase in ("start", "update", "end"):
+        panel._on_gizmo(SimpleNamespace(phase=phase, target=start, client=None))
+    assert app.state.doc is before and len(app.state._undo) == undo_depth
+    app.move_point_to("G2", point.position_m)  # a move onto itself: nothing either
+    assert app.state.doc is before and len(app.state._undo) == undo_depth
+    assert app.state.doc.get("G2").probe.position_m == point.position_m
+    panel.drag.value = False
+
+
 def test_the_points_table_says_when_the_layout_would_be_refused(app: WobjcalApp) -> None:
     """Issue 10, item 3: the UI shows what `wobjcal check` (and `calibrate`) would refuse, the
     same words as the check's ``layout``."""
@@ -211,6 +253,8 @@ def test_the_points_table_says_when_the_layout_would_be_refused(app: WobjcalApp)
     from webui import plan_doc
     from webui.plan_adapter import plan_from_ui
 
+    original = app.plan_dir / "box_plan.json"
+    app.files_panel.upload_plan(original.name, original.read_bytes())  # drop the extra points
     before = app.points_panel.status_md.content
     app.state.apply(plan_doc.delete_point(app.state.doc, "T1"), "delete T1")
     try:

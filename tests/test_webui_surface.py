@@ -56,3 +56,16 @@ def test_zero_direction_is_a_clear_error(box: trimesh.Trimesh) -> None:
     picker = SurfacePicker(box, np.eye(4))
     with pytest.raises(ValueError, match="ray_direction"):
         picker.pick([0, 0, 1], [0, 0, 0])
+
+
+def test_marker_on_ray_takes_the_nearest_visible_marker() -> None:
+    from webui.surface import marker_on_ray
+
+    centres = [[0.0, 0.0, 1.0], [0.0, 0.0, 2.0], [0.05, 0.0, 0.5]]
+    down = [0.0, 0.0, -1.0]
+    assert marker_on_ray(centres, [0, 0, 5.0], down, 0.01) == 1, "nearest the camera first"
+    assert marker_on_ray(centres, [0.005, 0, 5.0], down, 0.01) == 1
+    assert marker_on_ray(centres, [0.02, 0, 5.0], down, 0.01) is None, "passes beside them"
+    # the surface hit at z = 2.5 hides markers behind it (z < 2.5 - 1.25 r)
+    assert marker_on_ray(centres, [0, 0, 5.0], down, 0.01, hit_world=[0, 0, 2.5]) is None
+    assert marker_on_ray(centres, [0, 0, 0.0], [0, 0, 1.0], 0.01) == 0, "looking up: z = 1 first"

@@ -13,27 +13,35 @@ import threading
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import viser
 from numpy.typing import ArrayLike
 
 from calib.errors import InputError
+from calib.frames import transform_points
 from calib.plan.file import CellSpec, Plan, WorkObjectSpec
 from calib.probing import ProbePoint
 from planner.check import PointCheck
 from webui import clients, plan_doc
 from webui.autosave import AutosaveLock
 from webui.backend import CellSession, CellView
+from webui.busy import BusyIndicator
 from webui.heatmap import HeatMap
-from webui.plan_adapter import autosave_bytes, plan_point
+from webui.plan_adapter import autosave_bytes, plan_point, with_source
 from webui.plan_doc import UiPlan
 from webui.robot_view import RobotView, robot_view_or_reason
-from webui.scene import PlanScene
+from webui.role_check import RoleFlags, role_flags
+from webui.scene import MARKER_RADIUS_M, PlanScene, legend_html
 from webui.state import DEFAULT_AUTOSAVE, Change, SessionState
-from webui.surface import SurfacePicker
+from webui.surface import SurfacePicker, marker_on_ray
+from webui.tabs import AppTabs
 from webui.upload_guard import guard_uploads
 from webui.worker import CellWorker
 
 logger = logging.getLogger(__name__)
+
+#: A move that lands within this of where the point is changes nothing, m.
+MOVE_TOL_M = 1e-6
 
 
 class WobjcalApp:
@@ -53,10 +61,21 @@ class WobjcalApp:
         plan_dir: Path,
         autosave_path: Path | None = DEFAULT_AUTOSAVE,
     ) -> None:
-        from webui import calibrate_panel, files_panel, layout_panel, points_panel, validate_panel
+        from webui import (
+            calibrate_panel,
+            cell_panel,
+            files_panel,
+            layout_panel,
+            points_panel,
+            teach_panel,
+            validate_panel,
+        )
 
         self.server = server
         self.plan_dir = Path(plan_dir)
+        self.busy = BusyIndicator(server.gui)
+        self._add_view_bar()
+        self.tabs = AppTabs(server.gui)
         self.scene = PlanScene(server)
         self.state: SessionState[UiPlan] = SessionState(
             plan, serialize=autosave_bytes, autosave_path=autosave_path
@@ -69,13 +88,21 @@ class WobjcalApp:
         self._checks: dict[str, tuple[ProbePoint, PointCheck]] = {}
         self._lock = threading.RLock()
         self._cell_key: tuple[CellSpec, WorkObjectSpec] | None = None
+        self.flags = RoleFlags()
+        #: Handlers of scene clicks by mode (``"place"``: click-to-place); a panel may set
+        #: :attr:`click_mode` to its own (e.g. picking the points of a 3-point frame).
+        self.click_handlers: dict[str, Any] = {"place": self._click_place}
+        self.click_mode = "place"
         self.heatmap = HeatMap(self)
         self.points_panel = points_panel.PointsPanel(self)
+        self.cell_panel = cell_panel.CellPanel(self)
+        self.teach_panel = teach_panel.TeachPanel(self)
         self.validate_panel = validate_panel.ValidatePanel(self)
         self.files_panel = files_panel.FilesPanel(self)
         self.calibrate_panel = calibrate_panel.CalibratePanel(self)
         self.layout_panel = layout_panel.LayoutPanel(self)  # issue 13: quality and suggest
         guard_uploads(server, files_panel.MAX_UPLOAD_BYTES, self._upload_refused)
+        server.scene.on_click()(self._on_scene_click)
         self.state.subscribe(self._on_change)
         #: What the app said about the autosave at start (restored, set aside), for new tabs.
         self.autosave_note = ""
@@ -91,17 +118,18 @@ class WobjcalApp:
         On failure the previous cell, scene and plan stay as they were.
         """
         self.heatmap.stop()
-        self.worker.replace_resource(lambda: CellSession(plan, plan_dir)).result(300)
+        with self.busy("loading the cell"):
+            self.worker.replace_resource(lambda: CellSession(plan, plan_dir)).result(300)
         session = self.worker.call(lambda s: s)
         view = session.view
         picker = SurfacePicker(view.wobj_mesh, view.T_world_wobj)
         with self._lock:
+            old_part = None if self.view is None else self.view.wobj_mesh
             self.plan_dir = Path(plan_dir)
             self.view, self.picker = view, picker
             self._cell_key = _cell_key(plan)
             self._checks.clear()
-        handle = self.scene.draw_work_object(view.wobj_mesh, view.T_world_wobj)
-        handle.on_click(self._on_mesh_click)
+        self.scene.draw_work_object(view.wobj_mesh, view.T_world_wobj)
         self.scene.draw_fixtures(view.fixtures)
         if self.robot is not None:
             self.robot.remove()
@@ -111,8 +139,18 @@ class WobjcalApp:
             if why:
                 logger.warning("%s", why)
                 self.notify("Robot not drawn", why, error=True)
+        self.teach_panel.on_cell()
+        if old_part is not None and old_part is not view.wobj_mesh:  # a new part: reframe
+            for client in self.server.get_clients().values():
+                clients.set_default_camera(client, view)
         self.recheck(self.state.doc.ids)
         self.layout_panel.refresh()
+
+    def replace_source(self, plan: Plan, label: str) -> None:
+        """Make ``plan`` (another cell: part, robot, fixtures or their poses) the session's, in
+        one undoable step; its cell is built first, and when that fails nothing changes."""
+        self.load_cell(plan, self.plan_dir)
+        self.state.update(lambda d: with_source(d, plan), label)
 
     # ---- checks ---------------------------------------------------------------------------
     def check_of(self, point_id: str) -> PointCheck | None:
@@ -133,7 +171,8 @@ class WobjcalApp:
         if not points:
             return []
         edited = [plan_point(p) for p in points]
-        results = self.worker.call(lambda s: [] if s is None else s.check_points(edited))
+        with self.busy(f"checking {', '.join(p.id for p in points[:6])}"):
+            results = self.worker.call(lambda s: [] if s is None else s.check_points(edited))
         current = self.state.doc
         with self._lock:
             for point, check in zip(points, results, strict=False):
@@ -146,7 +185,13 @@ class WobjcalApp:
     def _redraw(self, point_ids: list[str] | None = None) -> None:
         """Redraw the given points (all when ``None``), drop removed ones, refresh the panel."""
         doc = self.state.doc
-        self.scene.draw_points(doc, self.checks(), self.selected, only=point_ids)
+        before, self.flags = self.flags, role_flags(doc)
+        if point_ids is not None:  # a point whose flag came or went is redrawn too
+            moved = set(before.by_point) ^ set(self.flags.by_point)
+            point_ids = [*point_ids, *(i for i in moved if i not in point_ids and i in doc.ids)]
+        self.scene.draw_points(
+            doc, self.checks(), self.selected, only=point_ids, flags=self.flags.by_point
+        )
         self.points_panel.refresh()
         self.server.flush()
 
@@ -204,10 +249,19 @@ class WobjcalApp:
         return self.check_of(pid)
 
     def move_point_to(self, point_id: str, point_wobj: ArrayLike) -> PointCheck | None:
-        """Move a point to the surface point closest to ``point_wobj`` (e.g. after a drag)."""
+        """Move a point to the surface point closest to ``point_wobj`` (e.g. after a drag).
+
+        A move that lands where the point is (within :data:`MOVE_TOL_M`, same normal) records
+        nothing: no undo step, no coordinate drifted by the projection.
+        """
         if self.picker is None:
             raise InputError("no work object is loaded")
         hit = self.picker.project(point_wobj)
+        p = self.state.doc.get(point_id).probe
+        if np.allclose(hit.position_wobj, p.position_m, rtol=0.0, atol=MOVE_TOL_M) and np.allclose(
+            hit.normal_wobj, p.normal, rtol=0.0, atol=1e-9
+        ):  # lands where it is: no undo step, no drifted coordinate
+            return self.check_of(point_id)
         self.state.update(
             lambda d: plan_doc.place_point(d, point_id, hit.position_wobj, hit.normal_wobj),
             f"move {point_id}",
@@ -230,19 +284,75 @@ class WobjcalApp:
             self.robot.set_q(check.q)
         self.points_panel.on_select(point_id)
 
-    def _on_mesh_click(self, event: Any) -> None:
+    # ---- clicks ----------------------------------------------------------------------------
+    def _on_scene_click(self, event: Any) -> None:
+        """Every click on the 3D view: handled by the current mode, or told why it did nothing."""
+        handler = self.click_handlers.get(self.click_mode, self._click_place)
         try:
-            self.place_at_ray(event.ray_origin, event.ray_direction)
+            handler(event)
         except InputError as exc:
-            self.notify("Point not placed", str(exc), client=event.client, error=True)
+            self.notify("Click not used", str(exc), client=event.client, error=True)
         except Exception as exc:  # never a traceback in the browser
-            logger.exception("placing a point failed")
-            self.notify("Point not placed", f"{type(exc).__name__}: {exc}", client=event.client)
+            logger.exception("a click failed")
+            self.notify("Click not used", f"{type(exc).__name__}: {exc}", client=event.client)
+
+    def marker_at_ray(
+        self, origin_world: ArrayLike, direction_world: ArrayLike, hit: Any = None
+    ) -> str | None:
+        """The point whose marker the ray passes through (see :func:`webui.surface.
+        marker_on_ray`), or ``None``."""
+        view = self.view
+        if view is None:
+            return None
+        doc = self.state.doc
+        positions = [transform_points(view.T_world_wobj, p.probe.position_m) for p in doc.points]
+        hit_world = None if hit is None else transform_points(view.T_world_wobj, hit.position_wobj)
+        k = marker_on_ray(
+            positions, origin_world, direction_world, 1.6 * MARKER_RADIUS_M, hit_world
+        )
+        return None if k is None else doc.points[k].id
+
+    def _click_place(self, event: Any) -> None:
+        """A click in place mode: on a marker selects it, on the part places a point, anywhere
+        else says that nothing was placed and why."""
+        picker = self.picker
+        hit = None if picker is None else picker.pick(event.ray_origin, event.ray_direction)
+        marker = self.marker_at_ray(event.ray_origin, event.ray_direction, hit)
+        if marker is not None:
+            self.select(marker)
+            return
+        if picker is None:
+            raise InputError("no work object is loaded: load a plan first")
+        if hit is None:
+            raise InputError(
+                "nothing placed: the click did not hit the work object (points go on the part; "
+                "to select a point, click its marker or pick it under Selected)"
+            )
+        self.place_at_ray(event.ray_origin, event.ray_direction)
 
     # ---- clients ---------------------------------------------------------------------------
     def _upload_refused(self, client_id: int, name: str, message: str) -> None:
         client = self.server.get_clients().get(client_id)
         self.notify("Upload refused", message, client=client, error=True)
+
+    def tab(self, name: str) -> Any:
+        """The control panel's tab ``name`` (a context for a panel's widgets)."""
+        return self.tabs.tab(name)
+
+    def _add_view_bar(self) -> None:
+        """The view buttons (front, top, side, fit: each tab's own camera) and the legend."""
+        gui = self.server.gui
+        bar = gui.add_button_group("View", tuple(clients.VIEWS))
+        bar.on_click(self._on_view_button)
+        with gui.add_folder("Legend", expand_by_default=False):
+            gui.add_html(legend_html())
+
+    def _on_view_button(self, event: Any) -> None:
+        view = self.view
+        if view is None:
+            self.notify("View not changed", "no cell is loaded yet", client=event.client)
+            return
+        clients.frame_client(event.client, view, clients.VIEWS[str(event.target.value)])
 
     def _on_connect(self, client: viser.ClientHandle) -> None:
         if self.view is not None:

@@ -65,6 +65,56 @@ class CellView:
         return invert_transform(self.T_world_base) @ self.T_world_wobj
 
 
+@dataclass(frozen=True)
+class JogStatus:
+    """The robot at jogged joint values: limits and clearance.
+
+    Attributes:
+        q: ``(n,)`` the joint values, rad.
+        outside: joints beyond their limits (by URDF name).
+        near: joints within 0.05 rad of a limit.
+        clear: the robot (at ``q`` clipped into the limits) keeps its clearance everywhere.
+        clearance: the limiting pair in words, e.g. ``"link_4 hits table (clearance -3.0 mm)"``.
+    """
+
+    q: NDArray[np.float64]
+    outside: tuple[str, ...]
+    near: tuple[str, ...]
+    clear: bool
+    clearance: str
+
+    @property
+    def status(self) -> str:
+        """``infeasible`` (beyond a limit or colliding), ``marginal`` (near a limit) or
+        ``feasible``."""
+        if self.outside or not self.clear:
+            return "infeasible"
+        return "marginal" if self.near else "feasible"
+
+    def describe(self) -> str:
+        """One line for the panel."""
+        parts = []
+        if self.outside:
+            parts.append(f"beyond the limits: {', '.join(self.outside)}")
+        if self.near:
+            parts.append(f"near a limit: {', '.join(self.near)}")
+        parts.append(self.clearance)
+        return "; ".join(parts)
+
+
+@dataclass(frozen=True)
+class MoveCheck:
+    """A joint move between two poses.
+
+    Attributes:
+        tcp_path_world: ``(steps, 3)`` the TCP along the move, world frame, m.
+        problem: where and what collides first (``""``: the move is clear).
+    """
+
+    tcp_path_world: NDArray[np.float64]
+    problem: str
+
+
 def resolve_robot_urdf(ref: str, plan_dir: Path) -> Path | None:
     """The URDF file of ``plan.cell.robot.urdf`` (``builtin:NAME`` from the bundled assets)."""
     resolved = resolve_ref(ref, plan_dir)
@@ -127,6 +177,77 @@ class CellSession:
         if not points or self.cell is None:
             return []
         return list(check_points(self.cell, self.plan, points))
+
+    # ---- jogging ---------------------------------------------------------------------------
+    def T_world_tcp(self, q: ArrayLike, tcp: str) -> NDArray[np.float64]:
+        """``(4, 4)`` the TCP ``tcp`` in the world at joint values ``q`` (rad)."""
+        cell = self._cell()
+        qa = np.asarray(q, dtype=np.float64).reshape(1, -1)
+        T_base_flange = np.asarray(cell.chain.fk(qa), dtype=np.float64)[0]
+        return cell.T_world_base @ T_base_flange @ cell.T_flange_tcp(tcp)
+
+    def jog_status(self, q: ArrayLike, near_limit_rad: float = 0.05) -> JogStatus:
+        """Joint limits and clearance of the robot at ``q`` (the cell's own state is kept)."""
+        cell = self._cell()
+        qa = np.asarray(q, dtype=np.float64).reshape(-1)
+        names = cell.chain.joint_names
+        lo, hi = cell.chain.lower, cell.chain.upper
+        outside = [names[i] for i in range(len(qa)) if not lo[i] - 1e-9 <= qa[i] <= hi[i] + 1e-9]
+        near = [
+            names[i]
+            for i in range(len(qa))
+            if min(qa[i] - lo[i], hi[i] - qa[i]) < near_limit_rad and names[i] not in outside
+        ]
+        with cell.saved_state():
+            cell.set_joint_positions(np.clip(qa, lo, hi))
+            clearance = cell.clearance()
+        return JogStatus(
+            q=qa, outside=tuple(outside), near=tuple(near), clear=clearance.ok,
+            clearance=clearance.describe(),
+        )  # fmt: skip
+
+    def ik_near(
+        self, T_world_tcp: ArrayLike, q_now: ArrayLike, tcp: str
+    ) -> NDArray[np.float64] | None:
+        """The IK solution for the TCP pose ``T_world_tcp`` nearest ``q_now`` (so the arm keeps
+        its branch), or ``None`` when the pose cannot be reached within the joint limits."""
+        cell = self._cell()
+        T_base_flange = (
+            invert_transform(cell.T_world_base)
+            @ np.asarray(T_world_tcp, dtype=np.float64)
+            @ invert_transform(cell.T_flange_tcp(tcp))
+        )
+        q0 = np.asarray(q_now, dtype=np.float64).reshape(-1)
+        sols = cell.solver.solve(T_base_flange[None], seeds=q0[None])
+        q = sols.q[0][sols.valid[0]]
+        if len(q) == 0:
+            return None
+        return np.asarray(q[int(np.argmin(np.linalg.norm(q - q0, axis=1)))], dtype=np.float64)
+
+    def check_move(
+        self, q_from: ArrayLike, q_to: ArrayLike, tcp: str, steps: int = 20
+    ) -> MoveCheck:
+        """The joint move from ``q_from`` to ``q_to`` (linear in joint space, ``steps``
+        poses): the TCP's path (world) and the first pose that collides, if any."""
+        cell = self._cell()
+        a = np.asarray(q_from, dtype=np.float64).reshape(-1)
+        b = np.asarray(q_to, dtype=np.float64).reshape(-1)
+        qs = a + np.linspace(0.0, 1.0, steps)[:, None] * (b - a)
+        T = cell.T_world_base @ np.asarray(cell.chain.fk(qs)) @ cell.T_flange_tcp(tcp)
+        problem = ""
+        with cell.saved_state():
+            for k, q in enumerate(qs):
+                cell.set_joint_positions(q)
+                c = cell.clearance()
+                if not c.ok:
+                    problem = f"at {100 * k // (steps - 1)} %: {c.describe()}"
+                    break
+        return MoveCheck(T[:, :3, 3].copy(), problem)
+
+    def _cell(self) -> Cell:
+        if self.cell is None:
+            raise RuntimeError("the cell is closed")
+        return self.cell
 
     def close(self) -> None:
         """Release the PyBullet client."""

@@ -38,7 +38,7 @@ class CalibratePanel:
         self._app = app
         self.last_output: CalibrationOutput | None = None
         gui = app.server.gui
-        with gui.add_folder("Calibrate", expand_by_default=False):
+        with app.tab("Files"), gui.add_folder("Calibrate", expand_by_default=False):
             self.upload = gui.add_upload_button("Upload measurements (.json)", mime_type=".json")
             self.result_md = gui.add_markdown(
                 "Upload a `wobjcal.measurements/1` file to compute the calibrated frame."

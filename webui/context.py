@@ -8,7 +8,7 @@ app's class, so no panel imports :mod:`webui.app` (the app imports the panels).
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 from numpy.typing import ArrayLike
 
@@ -18,8 +18,10 @@ if TYPE_CHECKING:
     from calib.plan.file import Plan
     from planner.check import PointCheck
     from webui.backend import CellSession, CellView
+    from webui.busy import BusyIndicator
     from webui.plan_doc import UiPlan
     from webui.robot_view import RobotView
+    from webui.role_check import RoleFlags
     from webui.scene import PlanScene
     from webui.state import SessionState
     from webui.surface import SurfacePicker
@@ -46,6 +48,10 @@ class AppContext(Protocol):
         picker: click-to-place on the work object (``None`` before a cell is loaded).
         robot: the robot drawn in the scene, or ``None``.
         selected: the selected point's id, or ``None``.
+        busy: the busy indicator (``with app.busy("checking B"): ...``).
+        flags: the points the procedure cannot use where they are (role or face), and why.
+        click_mode: what a click on the 3D view does (a key of ``click_handlers``).
+        click_handlers: ``{mode: handler(event)}`` of scene clicks; ``"place"`` places points.
     """
 
     server: viser.ViserServer
@@ -57,6 +63,13 @@ class AppContext(Protocol):
     picker: SurfacePicker | None
     robot: RobotView | None
     selected: str | None
+    busy: BusyIndicator
+    flags: RoleFlags
+    click_mode: str
+    click_handlers: dict[str, Any]
+
+    def tab(self, name: str) -> Any:
+        """The control panel's tab ``name`` (a context for a panel's widgets)."""
 
     @property
     def heatmap(self) -> HeatMapControl:
@@ -69,6 +82,10 @@ class AppContext(Protocol):
 
     def load_cell(self, plan: Plan, plan_dir: Path) -> None:
         """Build the plan's cell and redraw; raise (keeping the old cell) when it fails."""
+
+    def replace_source(self, plan: Plan, label: str) -> None:
+        """Make ``plan`` (another cell) the session's in one undoable step; raise (changing
+        nothing) when its cell cannot be built."""
 
     def select(self, point_id: str | None) -> None:
         """Select a point (or none)."""

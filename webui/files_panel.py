@@ -18,8 +18,10 @@ from calib.errors import InputError
 from calib.plan.file import Plan, PlanError
 from calib.units import MESH_UNITS
 from webui.exports import FORMATS, ExportResult, export_program
+from webui.part_upload import PendingPart, drop_points, off_surface, project_points
 from webui.plan_adapter import plan_from_ui, plan_json_from_ui, ui_plan_from_bytes, with_source
 from webui.state import atomic_write_bytes
+from webui.urdf_zip import unpack_robot_zip
 
 if TYPE_CHECKING:
     from webui.context import AppContext
@@ -30,6 +32,18 @@ logger = logging.getLogger(__name__)
 MAX_UPLOAD_BYTES = 50 * 1024 * 1024
 MESH_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".glb", ".gltf")
 UPLOAD_DIR = Path.home() / ".cache" / "wobjcal" / "uploads"
+
+
+def _file(event: Any) -> tuple[str, bytes]:
+    """The uploaded file's name and bytes of an upload event."""
+    return event.target.value.name, event.target.value.content
+
+
+def _named(text: str, kept: Path | None, name: str) -> str:
+    """``text`` about an upload kept at ``kept``, naming the user's file ``name`` instead."""
+    if kept is not None:
+        text = text.replace(str(kept), name).replace(str(kept.parent), "uploads")
+    return text if name in text else f"{name}: {text}"
 
 
 class UploadError(InputError):
@@ -61,37 +75,56 @@ class FilesPanel:
         self._app = app
         self.upload_dir = upload_dir
         gui = app.server.gui
-        with gui.add_folder("Files", expand_by_default=True):
+        with app.tab("Files"):
             self.plan_upload = gui.add_upload_button("Upload plan (.json)", mime_type=".json")
-            self.units = gui.add_dropdown("Mesh units", MESH_UNITS, initial_value="mm")
             self.mesh_upload = gui.add_upload_button("Upload work-object mesh")
-            self.urdf_upload = gui.add_upload_button("Upload robot URDF", mime_type=".urdf")
+            self.units = gui.add_dropdown("Mesh units", MESH_UNITS, initial_value="mm")
+            self.pending_md = gui.add_markdown("")
+            self.accept = gui.add_button("Use this part", color="green", visible=False)
+            self.cancel = gui.add_button("Cancel upload", visible=False)
+            self.off_md = gui.add_markdown("")
+            self.project_off = gui.add_button("Project them onto the part", visible=False)
+            self.drop_off = gui.add_button("Drop them", color="red", visible=False)
+            self.urdf_upload = gui.add_upload_button(
+                "Upload robot URDF (.urdf, or .zip with meshes)", mime_type=".urdf,.zip"
+            )
             self.download = gui.add_button("Download plan JSON")
             self.export_buttons = {fmt: gui.add_button(f"Download {fmt}") for fmt in FORMATS}
-        self.plan_upload.on_upload(lambda ev: self._guard(ev, self.upload_plan))
-        self.mesh_upload.on_upload(lambda ev: self._guard(ev, self.upload_mesh))
-        self.urdf_upload.on_upload(lambda ev: self._guard(ev, self.upload_urdf))
-        self.download.on_click(lambda ev: self._guard(ev, self.download_plan, ev.client))
+        self.plan_upload.on_upload(lambda ev: self._guard(ev, self.upload_plan, *_file(ev)))
+        self.mesh_upload.on_upload(lambda ev: self._guard(ev, self.stage_mesh, *_file(ev)))
+        self.units.on_update(lambda ev: self._guard(ev, self._show_pending, failure="Units"))
+        self.accept.on_click(lambda ev: self._guard(ev, self.accept_mesh))
+        self.cancel.on_click(lambda ev: self._guard(ev, self.cancel_mesh, failure="Not done"))
+        self.project_off.on_click(lambda ev: self._guard(ev, self.fix_off_surface, "project"))
+        self.drop_off.on_click(lambda ev: self._guard(ev, self.fix_off_surface, "drop"))
+        self.pending: PendingPart | None = None
+        #: ``{point id: distance, m}`` of the points off the surface after the last new part.
+        self.off: dict[str, float] = {}
+        self.urdf_upload.on_upload(lambda ev: self._guard(ev, self.upload_urdf, *_file(ev)))
+        self.download.on_click(
+            lambda ev: self._guard(ev, self.download_plan, ev.client, failure="Not downloaded")
+        )
         for fmt, button in self.export_buttons.items():
             button.on_click(self._export_callback(fmt))
 
     def _export_callback(self, fmt: str) -> Any:
         def callback(event: Any) -> None:
-            self._guard(event, self.download_export, event.client, fmt)
+            self._guard(event, self.download_export, event.client, fmt, failure="Not exported")
 
         return callback
 
-    def _guard(self, event: Any, fn: Any, *args: Any) -> None:
+    def _guard(self, event: Any, fn: Any, *args: Any, failure: str = "File not used") -> None:
+        """Run ``fn(*args)``; a refusal shows as an error notification titled ``failure`` that
+        stays until closed."""
         client = getattr(event, "client", None)
-        if not args:
-            args = (event.target.value.name, event.target.value.content)
         try:
-            title = fn(*args)
+            with self._app.busy(f"{fn.__name__.replace('_', ' ')}"):
+                title = fn(*args)
         except InputError as exc:
-            self._app.notify("File not used", str(exc), client=client)
+            self._app.notify(failure, str(exc), client=client)
         except Exception as exc:  # never a traceback in the browser
             logger.exception("file action failed")
-            self._app.notify("File not used", f"{type(exc).__name__}: {exc}", client=client)
+            self._app.notify(failure, f"{type(exc).__name__}: {exc}", client=client)
         else:
             if title:
                 self._app.notify(title, "", client=client, error=False)
@@ -113,29 +146,111 @@ class FilesPanel:
         atomic_write_bytes(path, content)
         return path, digest
 
-    def _apply_source(self, plan: Plan, label: str) -> None:
-        self._app.load_cell(plan, self._app.plan_dir)
+    def _apply_source(
+        self, plan: Plan, label: str, kept: Path | None = None, name: str = ""
+    ) -> None:
+        """Load the cell of ``plan`` and make it the session's (one undoable step); an error
+        names the user's file ``name``, not where the upload is ``kept``."""
+        try:
+            self._app.load_cell(plan, self._app.plan_dir)
+        except Exception as exc:
+            text = str(exc) if isinstance(exc, InputError) else f"{type(exc).__name__}: {exc}"
+            raise UploadError(_named(text, kept, name)) from None
         self._app.state.update(lambda d: with_source(d, plan), label)
 
-    def upload_mesh(self, name: str, content: bytes) -> str:
-        """Use an uploaded mesh (in the chosen units) as the work object."""
+    def stage_mesh(self, name: str, content: bytes) -> str:
+        """Keep an uploaded mesh and show its size in the chosen units; nothing changes until
+        :meth:`accept_mesh` (the **Use this part** button)."""
         check_upload(name, content, MESH_SUFFIXES, "mesh")
-        source = self._current_plan()
+        self._current_plan()
         path, digest = self._keep(name, content)
+        try:
+            self.pending = PendingPart.read(name, path, digest)
+        except InputError as exc:
+            raise UploadError(_named(str(exc), path, name)) from None
+        self._show_pending()
+        return ""
+
+    def _show_pending(self) -> None:
+        pending = self.pending
+        if pending is None:
+            self.pending_md.content = ""
+            self.accept.visible = self.cancel.visible = False
+            return
+        text = pending.describe(str(self.units.value))
+        self.pending_md.content = f"**New part:** {text}. Check the size, then use it."
+        self.accept.visible = self.cancel.visible = True
+
+    def cancel_mesh(self) -> str:
+        """Forget the uploaded mesh waiting for its units."""
+        self.pending = None
+        self._show_pending()
+        return ""
+
+    def accept_mesh(self) -> str:
+        """Use the waiting mesh, in the chosen units, as the work object (one undoable step);
+        then list the points that are no longer on its surface."""
+        pending = self.pending
+        if pending is None:
+            raise InputError("upload a mesh first: no part is waiting")
+        source = self._current_plan()
         work_object = msgspec.structs.replace(
-            source.work_object, mesh=str(path), units=str(self.units.value), sha256=digest
+            source.work_object,
+            mesh=str(pending.path),
+            units=str(self.units.value),
+            sha256=pending.digest,
         )
-        self._apply_source(msgspec.structs.replace(source, work_object=work_object), "new mesh")
-        return f"Work object {name} loaded"
+        plan = msgspec.structs.replace(source, work_object=work_object)
+        self._apply_source(plan, "new mesh", pending.path, pending.name)
+        self.pending = None
+        self._show_pending()
+        self._list_off_surface()
+        return f"Work object {pending.name} loaded"
+
+    def upload_mesh(self, name: str, content: bytes) -> str:
+        """Use an uploaded mesh (in the chosen units) as the work object at once (scripts)."""
+        self.stage_mesh(name, content)
+        return self.accept_mesh()
+
+    def _list_off_surface(self) -> None:
+        view = self._app.view
+        self.off = {} if view is None else off_surface(self._app.state.doc, view.wobj_mesh)
+        if self.off:
+            items = ", ".join(f"{pid} ({d * 1e3:.1f} mm)" for pid, d in self.off.items())
+            self.off_md.content = f"**Points off the new part's surface:** {items}"
+        else:
+            self.off_md.content = ""
+        self.project_off.visible = self.drop_off.visible = bool(self.off)
+
+    def fix_off_surface(self, how: str) -> str:
+        """Project (``"project"``) or drop (``"drop"``) the points listed as off the surface,
+        in one undoable step."""
+        ids = [pid for pid in self.off if pid in self._app.state.doc.ids]
+        picker = self._app.picker
+        if not ids or picker is None:
+            raise InputError("no points are off the surface")
+        if how == "project":
+            self._app.state.update(lambda d: project_points(d, picker, ids), "project points")
+        else:
+            self._app.state.update(lambda d: drop_points(d, ids), "drop points")
+        self._list_off_surface()
+        return f"{len(ids)} point{'s' if len(ids) > 1 else ''} {how}ed"
 
     def upload_urdf(self, name: str, content: bytes) -> str:
-        """Use an uploaded URDF (primitive or absolute-path meshes) as the robot."""
-        check_upload(name, content, (".urdf",), "robot description")
+        """Use an uploaded robot as the robot: a URDF (primitive or absolute-path meshes) or a
+        zip of a URDF with its meshes (:func:`webui.urdf_zip.unpack_robot_zip`)."""
+        check_upload(name, content, (".urdf", ".zip"), "robot description")
         source = self._current_plan()
-        path, _ = self._keep(name, content)
+        if name.lower().endswith(".zip"):
+            digest = hashlib.sha256(content).hexdigest()
+            path = unpack_robot_zip(name, content, self.upload_dir / digest[:16] / "robot")
+            kept = path
+        else:
+            path, _ = self._keep(name, content)
+            kept = path
         robot = msgspec.structs.replace(source.cell.robot, urdf=str(path))
         cell = msgspec.structs.replace(source.cell, robot=robot)
-        self._apply_source(msgspec.structs.replace(source, cell=cell), "new robot")
+        self._apply_source(msgspec.structs.replace(source, cell=cell), "new robot", kept, name)
         return f"Robot {name} loaded"
 
     def _current_plan(self) -> Plan:

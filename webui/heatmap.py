@@ -1,12 +1,15 @@
 """The reachability heat map: surface samples checked as probe poses, drawn on the work object.
 
-The samples go through the same batched check as a click (:func:`planner.cell.feasibility.
-check_probes`: a broad phase decides most clearance parts, Bullet only the rest), in chunks
-queued on the cell worker: clicks from any tab slip in between chunks, the map grows on screen
-as chunks finish, and unticking the box stops it. A chunk's size adapts so that it takes about
-:data:`CHUNK_SECONDS` (most samples cost well under a millisecond; a sample that collides in
-every pose up to a few hundred). At the end the work object's vertices are coloured by their
-nearest sample (red: infeasible, amber: marginal, green: feasible).
+The samples go through the fast batched check of a click (:func:`planner.cell.feasibility.
+check_probes`: a broad phase decides most clearance parts, Bullet only the rest), with a
+coarser search over the sensor's rotation (:data:`ROTATION_STEP_DEG`, :data:`MAX_CHECKS`: a
+map, not a verdict; a click checks its point fully), in chunks queued on the cell worker:
+clicks from any tab slip in between chunks, the map grows on screen as chunks finish, and
+unticking the box stops it. A chunk's size adapts so that it takes about
+:data:`CHUNK_SECONDS`. Each sample is coloured by what fails (:data:`CATEGORY_RGB`: out of
+reach, joint limit or singular wrist, collision, sensor footprint off a planar face) or by its
+status; at the end the colours are spread smoothly over a refined copy of the surface
+(:func:`smooth_vertex_colours`).
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ from scipy.spatial import cKDTree
 
 from calib.errors import InputError
 from planner.cell.reachability_map import sample_surface
-from webui.scene import heat_rgb
+from planner.faces.checks import check_probe_faces
 
 if TYPE_CHECKING:
     from webui.backend import CellSession
@@ -32,23 +35,109 @@ if TYPE_CHECKING:
 
 logger = logging.getLogger(__name__)
 
-#: Status name -> score in [0, 1] for the colour ramp.
+#: Status name -> score in [0, 1] (1: feasible) of each sample.
 SCORE = {"infeasible": 0.0, "marginal": 0.5, "feasible": 1.0}
+#: What a sample's colour says, in legend order.
+CATEGORY_RGB: dict[str, tuple[int, int, int]] = {
+    "feasible": (40, 170, 60),
+    "marginal": (240, 165, 0),
+    "reach": (150, 20, 20),
+    "joint limit": (150, 70, 200),
+    "collision": (235, 80, 30),
+    "footprint": (60, 110, 220),
+}
+CATEGORY_MEANING: dict[str, str] = {
+    "feasible": "reachable and clear",
+    "marginal": "little clearance or near a joint limit",
+    "reach": "out of reach",
+    "joint limit": "only at a joint limit or singular wrist",
+    "collision": "robot or tool collides",
+    "footprint": "sensor footprint off a planar face",
+}
+#: The map's search over the sensor's rotation: coarser than a click's (15 deg, 48 checks).
+ROTATION_STEP_DEG = 45.0
+MAX_CHECKS = 4
+#: Samples of the map.
+N_SAMPLES = 500
 #: Wall time a chunk aims at, s: a click waits at most about this long for the cell.
 CHUNK_SECONDS = 0.15
 #: Bounds of the adaptive chunk size, samples.
 MAX_CHUNK = 512
+#: Edge length of the refined surface the colours are spread over, as a share of the
+#: part's largest extent.
+REFINE_SHARE = 0.02
+#: A mesh with at least this many triangles is dense enough as it is (not refined).
+DENSE_FACES = 20_000
+#: Samples blended per vertex.
+BLEND_K = 6
+
+
+def category_of(status: str, reason: str, on_face: bool) -> str:
+    """What a sample's colour says (a key of :data:`CATEGORY_RGB`)."""
+    if status == "feasible" and not on_face:
+        return "footprint"
+    if status in ("feasible", "marginal"):
+        return status if on_face else "footprint"
+    text = reason.lower()
+    if "reach" in text or "no ik" in text or "no solution" in text:
+        return "reach"
+    if "limit" in text or "singular" in text:
+        return "joint limit"
+    if "hit" in text or "near" in text or "clearance" in text:
+        return "collision"
+    return "reach"
+
+
+def _features(points: NDArray[np.float64], normals: NDArray[np.float64]) -> NDArray[np.float64]:
+    normal_weight = 0.05  # metres per unit of normal difference: keeps faces apart at edges
+    return np.hstack([points, normal_weight * normals])
 
 
 def vertex_scores(
     mesh: trimesh.Trimesh, points: NDArray[np.float64], normals: NDArray[np.float64], score: Any
 ) -> NDArray[np.float64]:
     """Score of each mesh vertex: that of the nearest sample on a similarly facing face."""
-    normal_weight = 0.05  # metres per unit of normal difference: keeps faces apart at edges
-    tree = cKDTree(np.hstack([points, normal_weight * normals]))
-    query = np.hstack([mesh.vertices, normal_weight * mesh.vertex_normals])
-    _, idx = tree.query(query)
+    tree = cKDTree(_features(points, normals))
+    _, idx = tree.query(_features(np.asarray(mesh.vertices), np.asarray(mesh.vertex_normals)))
     return np.asarray(score, dtype=np.float64)[idx]
+
+
+def refined(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """A copy of ``mesh`` with no edge longer than :data:`REFINE_SHARE` of its size (a mesh of
+    :data:`DENSE_FACES` triangles or more is kept as it is) and unshared vertices (each face
+    its own normal: colours do not bleed round edges)."""
+    v, f = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    if len(f) < DENSE_FACES:
+        size = float(np.max(mesh.extents)) * REFINE_SHARE
+        v, f = trimesh.remesh.subdivide_to_size(v, f, max_edge=size, max_iter=8)
+    out = trimesh.Trimesh(v, f, process=False)
+    out.unmerge_vertices()
+    return out
+
+
+def smooth_vertex_colours(
+    mesh: trimesh.Trimesh,
+    points: NDArray[np.float64],
+    normals: NDArray[np.float64],
+    rgb: NDArray[np.uint8],
+) -> NDArray[np.uint8]:
+    """``(V, 3)`` colours of ``mesh``'s vertices: the colour that wins a vote of the
+    :data:`BLEND_K` nearest similarly facing samples, each weighted by inverse squared
+    distance. Colours are never mixed (a mix of "reach" and "footprint" would read as another
+    category); on a refined surface the borders between them are smooth curves."""
+    vn = np.repeat(np.asarray(mesh.face_normals), 3, axis=0)
+    corner = np.asarray(mesh.faces).reshape(-1)
+    verts = np.asarray(mesh.vertices)[corner]
+    k = min(BLEND_K, len(points))
+    dist, idx = cKDTree(_features(points, normals)).query(_features(verts, vn), k=k)
+    dist, idx = dist.reshape(len(verts), k), idx.reshape(len(verts), k)
+    palette, label = np.unique(np.asarray(rgb, dtype=np.uint8), axis=0, return_inverse=True)
+    votes = np.zeros((len(verts), len(palette)))
+    w = 1.0 / np.maximum(dist, 1e-6) ** 2
+    np.add.at(votes, (np.arange(len(verts))[:, None], label.reshape(-1)[idx]), w)
+    out = np.zeros((len(mesh.vertices), 3), dtype=np.uint8)
+    out[corner] = palette[np.argmax(votes, axis=1)]
+    return out
 
 
 class HeatMap:
@@ -64,19 +153,33 @@ class HeatMap:
         self.points: NDArray[np.float64] = np.zeros((0, 3))
         self.normals: NDArray[np.float64] = np.zeros((0, 3))
         self.scores: list[float] = []
+        self.categories: list[str] = []
+        self.on_face: NDArray[np.bool_] = np.zeros(0, dtype=bool)
         self.done = threading.Event()
+        #: Wall time of the last complete map, s (``nan`` until one completes).
+        self.seconds = float("nan")
+        self._t0 = 0.0
         self._chunk = 3
         self._tcp = "sensor"
+        #: One line on the last complete map (usable share, what fails, time).
+        self.summary = ""
 
-    def start(self, n_samples: int = 1000, chunk: int = 16, seed: int = 0) -> None:
+    def start(self, n_samples: int = N_SAMPLES, chunk: int = 16, seed: int = 0) -> None:
         """Sample the surface and queue the checks in chunks on the cell worker (``chunk``:
         the first chunk's size; later ones adapt to :data:`CHUNK_SECONDS`)."""
         view = self._app.view
         if view is None:
             raise InputError("the reachability map needs a work object: load a plan first")
+        self._t0 = time.perf_counter()
         pts, nrm, _ = sample_surface(view.wobj_mesh, n_samples, np.random.default_rng(seed))
         self.points, self.normals = np.asarray(pts, float), np.asarray(nrm, float)
-        self.scores, self._stop = [], threading.Event()
+        source = self._app.state.doc.source
+        radius = 0.0 if source is None else float(source.validation.sensor.footprint_radius_m)
+        faces = check_probe_faces(
+            view.wobj_mesh, self.points, self.normals, footprint_radius_m=radius
+        )
+        self.on_face = np.array([f.ok for f in faces], dtype=bool)
+        self.scores, self.categories, self._stop = [], [], threading.Event()
         self.done = threading.Event()
         self._chunk = chunk
         source = self._app.state.doc.source
@@ -101,24 +204,35 @@ class HeatMap:
         nrm: NDArray[np.float64],
         tcp: str,
         stop: threading.Event,
-    ) -> tuple[list[float], float]:
+    ) -> tuple[list[tuple[str, str]], float]:
         if stop.is_set() or session is None or session.cell is None:
             return [], 0.0
         t0 = time.perf_counter()
-        res = session.cell.check_probes(pts, nrm, tcp=tcp)
-        return [SCORE.get(str(r.status), 0.0) for r in res], time.perf_counter() - t0
+        res = session.cell.check_probes(
+            pts, nrm, tcp=tcp, rotation_step_deg=ROTATION_STEP_DEG, max_checks=MAX_CHECKS
+        )
+        return [(str(r.status), r.reason) for r in res], time.perf_counter() - t0
 
-    def _chunk_done(self, fut: Future[tuple[list[float], float]], stop: threading.Event) -> None:
+    def rgb(self) -> NDArray[np.uint8]:
+        """``(n, 3)`` colours of the samples checked so far (by :data:`CATEGORY_RGB`)."""
+        return np.array([CATEGORY_RGB[c] for c in self.categories], dtype=np.uint8).reshape(-1, 3)
+
+    def _chunk_done(
+        self, fut: Future[tuple[list[tuple[str, str]], float]], stop: threading.Event
+    ) -> None:
         if stop is not self._stop:  # a chunk of an earlier, stopped map
             return
         if stop.is_set():
             self.done.set()
             return
         try:
-            scores, seconds = fut.result()
-            self.scores.extend(scores)
-            if scores:  # the next chunk takes about CHUNK_SECONDS
-                rate = len(scores) / max(seconds, 1e-3)
+            results, seconds = fut.result()
+            n0 = len(self.scores)
+            for i, (status, reason) in enumerate(results):
+                self.scores.append(SCORE.get(status, 0.0))
+                self.categories.append(category_of(status, reason, bool(self.on_face[n0 + i])))
+            if results:  # the next chunk takes about CHUNK_SECONDS
+                rate = len(results) / max(seconds, 1e-3)
                 self._chunk = int(min(MAX_CHUNK, max(1, CHUNK_SECONDS * rate)))
         except Exception as exc:
             logger.exception("reachability chunk failed")
@@ -127,7 +241,7 @@ class HeatMap:
             self._app.notify("Reachability map stopped", f"{type(exc).__name__}: {exc}")
             return
         n = len(self.scores)
-        self._app.scene.show_heat_map(self.points[:n], heat_rgb(np.asarray(self.scores)))
+        self._app.scene.show_heat_map(self.points[:n], self.rgb())
         if n == len(self.points):
             self._finish()
         self._submit_next()
@@ -136,14 +250,19 @@ class HeatMap:
         view = self._app.view
         if view is None:
             return
-        s = vertex_scores(view.wobj_mesh, self.points, self.normals, self.scores)
-        self._app.scene.color_work_object(heat_rgb(s))
-        feasible = float(np.mean(np.asarray(self.scores) > 0.25))
-        self._app.notify(
-            "Reachability map done",
-            f"{feasible:.0%} of {len(self.scores)} surface samples reachable",
-            error=False,
+        fine = refined(view.wobj_mesh)
+        colours = smooth_vertex_colours(fine, self.points, self.normals, self.rgb())
+        self._app.scene.color_work_object(colours, mesh=fine)
+        self._app.scene.show_heat_map(None)
+        self.seconds = time.perf_counter() - self._t0
+        counts = {c: self.categories.count(c) for c in CATEGORY_RGB}
+        usable = counts["feasible"] + counts["marginal"]
+        failing = ", ".join(f"{c} {n}" for c, n in counts.items() if n and c not in SCORE)
+        self.summary = (
+            f"{usable / max(len(self.categories), 1):.0%} of {len(self.categories)} surface "
+            f"samples usable ({failing or 'none fail'}); {self.seconds:.1f} s"
         )
+        self._app.notify("Reachability map done", self.summary, error=False)
 
     def stop(self) -> None:
         """Stop computing and hide the map."""

@@ -82,7 +82,7 @@ class LayoutPanel:
         self.last_seconds = 0.0
         self._painted = False
         gui = app.server.gui
-        with gui.add_folder("Layout", expand_by_default=True):
+        with app.tab("Layout"):
             self.quality_md = gui.add_markdown("")
             self.show_map = gui.add_checkbox("Show predicted error on part", False)
             self.target = gui.add_number("Target (mm)", 0.3, min=0.001, max=100.0, step=0.01)

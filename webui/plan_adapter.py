@@ -17,13 +17,30 @@ import msgspec
 
 from calib.plan.file import Plan, PlanError, PlanPoint, load_plan, plan_from_json, plan_to_json
 from calib.plan.json_io import canonical_json
-from calib.procedures import procedure_kind
-from webui.plan_doc import UiPlan, UiPoint
+from calib.procedures import PROCEDURES, RolePoint, method_of, procedure_kind
+from webui.plan_doc import (
+    NO_ROLE,
+    UiPlan,
+    UiPoint,
+    next_free_role,
+    replace_point,
+    role_refusal,
+)
 
 
 def roles_of(plan: Plan) -> tuple[str, ...]:
     """The point roles the plan's procedure allows."""
     return procedure_kind(plan.procedure).roles
+
+
+def _procedure_fields(plan: Plan) -> dict[str, Any]:
+    """The :class:`UiPlan` fields that come from the plan's procedure."""
+    kind = procedure_kind(plan.procedure)
+    return {
+        "roles": kind.roles,
+        "role_limits": tuple(kind.role_limits[r] for r in kind.roles),
+        "method": method_of(plan.procedure),
+    }
 
 
 def ui_plan_from_plan(plan: Plan, name: str | None = None) -> UiPlan:
@@ -33,7 +50,7 @@ def ui_plan_from_plan(plan: Plan, name: str | None = None) -> UiPlan:
         for p in plan.points
     )
     return UiPlan(
-        points=points, name=name or plan.name or "plan", roles=roles_of(plan), source=plan
+        points=points, name=name or plan.name or "plan", source=plan, **_procedure_fields(plan)
     )
 
 
@@ -50,11 +67,14 @@ def plan_from_ui(ui: UiPlan) -> Plan:
     """The strict plan: ``ui.source`` with the edited points.
 
     Raises:
-        PlanError: the points do not fit the procedure (the message says what is missing), or
-            there is no source plan to take the cell and procedure from.
+        PlanError: the points do not fit the procedure (the message names the points and says
+            what is missing), or there is no source plan to take the cell and procedure from.
     """
     if not isinstance(ui.source, Plan):
         raise PlanError("no plan is loaded: load a plan or the demo first")
+    refusal = role_refusal(ui)
+    if refusal:
+        raise PlanError(refusal)
     return msgspec.structs.replace(ui.source, points=_plan_points(ui))
 
 
@@ -89,4 +109,43 @@ def ui_plan_from_file(path: Path) -> UiPlan:
 
 def with_source(ui: UiPlan, plan: Plan) -> UiPlan:
     """``ui`` with another source plan (e.g. after a new work object was uploaded)."""
-    return dataclasses.replace(ui, source=plan, roles=roles_of(plan))
+    return dataclasses.replace(ui, source=plan, **_procedure_fields(plan))
+
+
+def with_procedure(ui: UiPlan, method: str) -> UiPlan:
+    """``ui`` under another procedure (:data:`calib.procedures.PROCEDURES`, default settings).
+
+    The points keep their roles when the new procedure has them and they fit its limits;
+    otherwise the procedure assigns roles from the points' geometry (``assign``, e.g. the
+    3-2-1's primary, secondary and tertiary faces), and when it cannot, each point takes the
+    next free role in order (:func:`webui.plan_doc.next_free_role`), or none.
+
+    Raises:
+        PlanError: ``method`` is not a known procedure, or no plan is loaded.
+    """
+    if not isinstance(ui.source, Plan):
+        raise PlanError("no plan is loaded: load a plan or the demo first")
+    if method not in PROCEDURES:
+        raise PlanError(f"procedure: must be one of {list(PROCEDURES)}, got {method!r}")
+    if method == ui.method:
+        return ui
+    kind = PROCEDURES[method]
+    source = msgspec.structs.replace(ui.source, points=[], procedure=kind.settings_type())
+    empty = with_source(dataclasses.replace(ui, points=()), source)
+    kept = dataclasses.replace(empty, points=ui.points)
+    if not role_refusal(kept):
+        return kept
+    roles: dict[str, str] = {}
+    try:
+        assigned = kind.assign([RolePoint(p.role, p.probe) for p in ui.points])
+        roles = {rp.point.id: rp.role for rp in assigned}
+    except (PlanError, ValueError):
+        roles = {}
+    out = dataclasses.replace(  # the assigned roles first, then the rest in order
+        empty,
+        points=tuple(dataclasses.replace(p, role=roles.get(p.id, NO_ROLE)) for p in ui.points),
+    )
+    for p in out.points:
+        if p.role == NO_ROLE:
+            out = replace_point(out, dataclasses.replace(p, role=next_free_role(out)))
+    return out

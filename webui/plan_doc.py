@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import string
+from collections import Counter
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -25,6 +26,8 @@ if TYPE_CHECKING:
 
 #: The paper's point names (also the roles of its A-H procedure).
 PAPER_IDS: tuple[str, ...] = STATOR_POINT_IDS
+#: The role of a point that has none yet (every role of the procedure is full).
+NO_ROLE = ""
 
 
 @dataclass(frozen=True)
@@ -56,13 +59,24 @@ class UiPlan:
         points: the probe points, in procedure order.
         name: a short name of the plan for titles and file names.
         roles: the roles the plan's procedure allows, offered in the role dropdown.
+        role_limits: how many points each of ``roles`` takes at most (``None``: any number),
+            from the procedure's ``role_limits``; ``None``: each role once (the paper's A-H).
+        method: the procedure's name (:data:`calib.procedures.PROCEDURES`).
         source: the loaded plan object (``calib.plan.file``) the points came from, or ``None``.
     """
 
     points: tuple[UiPoint, ...] = ()
     name: str = "plan"
     roles: tuple[str, ...] = PAPER_IDS
+    role_limits: tuple[int | None, ...] | None = None
+    method: str = "hultman2013"
     source: Plan | None = field(default=None, compare=False)
+
+    def limit_of(self, role: str) -> int | None:
+        """How many points ``role`` takes at most (``None``: any number; 0: not a role here)."""
+        if role not in self.roles:
+            return 0
+        return 1 if self.role_limits is None else self.role_limits[self.roles.index(role)]
 
     @property
     def ids(self) -> tuple[str, ...]:
@@ -87,6 +101,52 @@ def next_id(plan: UiPlan) -> str:
     while f"P{k}" in used:
         k += 1
     return f"P{k}"
+
+
+def next_free_role(plan: UiPlan, prefer: str | None = None) -> str:
+    """The role a new point takes: ``prefer`` when it is a role not yet full, else the first
+    role of the procedure not yet full, else :data:`NO_ROLE` (never a duplicate)."""
+    counts = Counter(p.role for p in plan.points)
+
+    def free(role: str) -> bool:
+        limit = plan.limit_of(role)
+        return limit is None or counts[role] < limit
+
+    if prefer is not None and prefer in plan.roles and free(prefer):
+        return prefer
+    return next((r for r in plan.roles if free(r)), NO_ROLE)
+
+
+def role_refusal(plan: UiPlan) -> str:
+    """Why the points' roles cannot go into a plan file, naming the points (``""``: they can).
+
+    Points without a role and roles taken by more points than the procedure allows are named,
+    e.g. ``role A is taken by points A, I, J (hultman2013 takes 1)``.
+    """
+    problems = []
+    unset = [p.id for p in plan.points if p.role == NO_ROLE]
+    if unset:
+        problems.append(
+            f"point{'s' if len(unset) > 1 else ''} {', '.join(unset)} "
+            f"{'have' if len(unset) > 1 else 'has'} no role: give "
+            f"{'each' if len(unset) > 1 else 'it'} one of {', '.join(plan.roles)} or delete "
+            f"{'them' if len(unset) > 1 else 'it'}"
+        )
+    for role in plan.roles:
+        holders = [p.id for p in plan.points if p.role == role]
+        limit = plan.limit_of(role)
+        if limit is not None and len(holders) > limit:
+            problems.append(
+                f"role {role} is taken by points {', '.join(holders)} ({plan.method} takes {limit})"
+            )
+    other = sorted({p.role for p in plan.points if p.role not in (*plan.roles, NO_ROLE)})
+    for role in other:
+        holders = [p.id for p in plan.points if p.role == role]
+        problems.append(
+            f"{plan.method} has no role {role!r} (points {', '.join(holders)}); its roles are "
+            f"{', '.join(plan.roles)}"
+        )
+    return "; ".join(problems)
 
 
 def _tuple3(v: ArrayLike) -> tuple[float, float, float]:
@@ -118,7 +178,8 @@ def place_point(
 
     An existing point keeps its role and search settings (an edge direction is projected into the
     new face); a new one gets an approach search and the role ``role`` (default: its id when the
-    procedure has such a role, else the procedure's first role).
+    procedure has such a role and it is free, else the first role not yet full, else
+    :data:`NO_ROLE`: never a duplicate, see :func:`next_free_role`).
     """
     if not point_id:
         raise InputError("point id must not be empty")
@@ -136,8 +197,7 @@ def place_point(
         edge_normal=edge_normal,
     )
     if role is None:
-        role = old.role if old is not None else (point_id if point_id in plan.roles else "")
-        role = role or (plan.roles[0] if plan.roles else point_id)
+        role = old.role if old is not None else next_free_role(plan, prefer=point_id)
     speed = 0.010 if old is None else old.speed_m_s
     new = UiPoint(probe=probe, role=role, speed_m_s=speed)
     if old is None:

@@ -20,14 +20,24 @@ from calib.probing import SearchCommand
 from planner.check import PointCheck
 from webui.plan_doc import UiPlan, UiPoint
 
-#: RGB colour of each feasibility status (``pending``: being computed); ``unknown`` is the
-#: fallback colour of any other status.
+#: RGB colour of each feasibility status (``pending``: being computed; ``role``: the point is
+#: on a face, or holds a role, its procedure cannot use); ``unknown`` is the fallback colour
+#: of any other status.
 STATUS_RGB: dict[str, tuple[int, int, int]] = {
     "feasible": (40, 170, 60),
     "marginal": (240, 165, 0),
     "infeasible": (215, 40, 40),
+    "role": (190, 60, 200),
     "pending": (150, 150, 150),
     "unknown": (110, 110, 140),
+}
+#: What each colour means, for the legend (:func:`legend_html`).
+STATUS_MEANING: dict[str, str] = {
+    "feasible": "reachable, search path clear",
+    "marginal": "little clearance or near a joint limit",
+    "infeasible": "out of reach, at a limit, colliding or off a planar face",
+    "role": "the procedure cannot use the point there (its role or face)",
+    "pending": "being checked",
 }
 WOBJ_RGB = (170, 185, 200)
 SELECTED_RGB = (60, 120, 255)
@@ -61,12 +71,18 @@ class PlanScene:
         self._heat: Any = None
         self._wobj_mesh: trimesh.Trimesh | None = None
 
-    def color_work_object(self, vertex_rgb: ArrayLike | None) -> None:
-        """Overlay the work object with per-vertex colours (``(V, 3)`` uint8), or remove it."""
+    def color_work_object(
+        self, vertex_rgb: ArrayLike | None, mesh: trimesh.Trimesh | None = None
+    ) -> None:
+        """Overlay the work object with per-vertex colours (``(V, 3)`` uint8), or remove it.
+
+        ``mesh``: a refined copy of the work object (wobj frame) the colours belong to;
+        default the work object itself.
+        """
         if vertex_rgb is None or self._wobj_mesh is None:
             self._scene.remove_by_name("/wobj/heat_mesh")
             return
-        colored = self._wobj_mesh.copy()
+        colored = (self._wobj_mesh if mesh is None else mesh).copy()
         rgb = np.asarray(vertex_rgb, dtype=np.uint8)
         colored.visual = trimesh.visual.ColorVisuals(
             colored, vertex_colors=np.hstack([rgb, np.full((len(rgb), 1), 255, np.uint8)])
@@ -88,7 +104,13 @@ class PlanScene:
             color=WOBJ_RGB,
             flat_shading=True,
         )
-        self._scene.add_label("/wobj/name", "WOCS (nominal)", position=(0.0, 0.0, 0.03))
+        self._scene.add_label(
+            "/wobj/name",
+            "WOCS",
+            position=(0.0, 0.0, 0.0),
+            anchor="top-right",
+            font_screen_scale=0.8,
+        )
         return self.wobj_mesh_handle
 
     def draw_fixtures(self, fixtures: Mapping[str, tuple[trimesh.Trimesh, ArrayLike]]) -> None:
@@ -110,7 +132,9 @@ class PlanScene:
         self._scene.add_frame(
             "/wobj_calibrated", axes_length=0.15, axes_radius=0.003, **pose_kwargs(T_world_wobj)
         )
-        self._scene.add_label("/wobj_calibrated/name", "WOCS (calibrated)")
+        self._scene.add_label(
+            "/wobj_calibrated/name", "WOCS cal.", anchor="bottom-right", font_screen_scale=0.8
+        )
 
     def draw_points(
         self,
@@ -118,22 +142,39 @@ class PlanScene:
         checks: Mapping[str, PointCheck],
         selected: str | None = None,
         only: list[str] | None = None,
+        flags: Mapping[str, str] | None = None,
     ) -> None:
-        """Draw the points of ``plan`` (or just those in ``only``), coloured by their check.
+        """Draw the points of ``plan`` (or just those in ``only``), coloured by their check,
+        or in the ``role`` colour when ``flags`` names them (their procedure cannot use them).
 
         Points no longer in the plan are removed.
         """
+        flags = flags or {}
         for pid in set(self._point_nodes) - set(plan.ids):
             self._remove_point(pid)
         wanted = None if only is None else set(only)
         with self._server.atomic():
             for point in plan.points:
                 if wanted is None or point.id in wanted:
-                    self.draw_point(point, checks.get(point.id), selected == point.id)
+                    self.draw_point(
+                        point, checks.get(point.id), selected == point.id, point.id in flags
+                    )
 
-    def draw_point(self, point: UiPoint, check: PointCheck | None, selected: bool = False) -> None:
-        """Draw (or redraw) one point: marker, label, approach arrow and search path."""
-        status = "pending" if check is None else check.status
+    def draw_point(
+        self,
+        point: UiPoint,
+        check: PointCheck | None,
+        selected: bool = False,
+        flagged: bool = False,
+    ) -> None:
+        """Draw (or redraw) one point: marker, its id as label, approach arrow and search path.
+
+        The label is the id only (the status is the colour, the reason is in the points table):
+        short labels next to their marker, hidden behind the part (depth-tested).
+        """
+        status: str = "pending" if check is None else check.status
+        if flagged and status != "pending":
+            status = "role"
         rgb = STATUS_RGB.get(status, STATUS_RGB["unknown"])
         p = np.asarray(point.probe.position_m, dtype=np.float64)
         n = np.asarray(point.probe.normal, dtype=np.float64)
@@ -149,7 +190,14 @@ class PlanScene:
                 subdivisions=2,
                 position=p,
             ),
-            self._scene.add_label(f"{base}/label", f"{point.id} ({status})", position=p + 0.02 * n),
+            self._scene.add_label(
+                f"{base}/label",
+                point.id,
+                position=p + 0.012 * n,
+                anchor="bottom-left",
+                depth_test=True,
+                font_screen_scale=0.9,
+            ),
             self._scene.add_arrows(
                 f"{base}/approach",
                 points=np.stack([tail, p + n * 0.004])[None, :, :],
@@ -185,6 +233,22 @@ class PlanScene:
             point_size=0.006,
             point_shape="circle",
         )
+
+
+def legend_html(
+    entries: Mapping[str, str] = STATUS_MEANING,
+    colours: Mapping[str, tuple[int, int, int]] = STATUS_RGB,
+) -> str:
+    """HTML of a colour legend: a swatch of ``colours`` and the meaning, per entry."""
+    rows = []
+    for status, meaning in entries.items():
+        r, g, b = colours.get(status, STATUS_RGB["unknown"])
+        rows.append(
+            f'<div style="display:flex;gap:6px;align-items:center;font-size:0.8em">'
+            f'<span style="width:12px;height:12px;border-radius:6px;flex:none;'
+            f'background:rgb({r},{g},{b})"></span><b>{status}</b> {meaning}</div>'
+        )
+    return "".join(rows)
 
 
 def heat_rgb(score: ArrayLike) -> NDArray[np.uint8]:

@@ -132,6 +132,9 @@ def run(
         server.stop()
         raise
     server.gui.configure_theme(control_width="large", show_share_button=False)
+    # the control panel docked on the right: the 3D view is the rest of the window, nothing
+    # floats over the cell (the framing of the first view relies on it)
+    server.gui.main_panel.dock_right()
     logger.info("wobjcal UI at http://%s:%d", host, bound)
     if path is not None:
         logger.info("the session plan autosaves to %s", path)

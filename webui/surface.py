@@ -7,6 +7,7 @@ installed (about a millisecond on a 100,000-triangle mesh), else trimesh's pure-
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -104,6 +105,30 @@ class SurfacePicker:
         """Like :meth:`project` for a point given in the world frame."""
         p = transform_points(self._T_wobj_world, check_vector3(point_world, "point_world"))
         return self.project(p)
+
+
+def marker_on_ray(
+    centres_world: Sequence[ArrayLike],
+    origin_world: ArrayLike,
+    direction_world: ArrayLike,
+    radius_m: float,
+    hit_world: ArrayLike | None = None,
+) -> int | None:
+    """Index of the marker (sphere of ``radius_m`` at each centre, world, m) the ray passes
+    through nearest the camera, not counting markers hidden behind the surface point the ray
+    hits (``hit_world``); ``None`` when it passes through none."""
+    o = np.asarray(origin_world, dtype=np.float64)
+    d = np.asarray(direction_world, dtype=np.float64)
+    d = d / np.linalg.norm(d)
+    t_part = np.inf if hit_world is None else float((np.asarray(hit_world) - o) @ d)
+    best: tuple[float, int] | None = None
+    for k, c in enumerate(centres_world):
+        rel = np.asarray(c, dtype=np.float64) - o
+        t = float(rel @ d)
+        miss = float(np.linalg.norm(rel - t * d))
+        if 0 < t <= t_part + 1.25 * radius_m and miss <= radius_m and (best is None or t < best[0]):
+            best = (t, k)
+    return None if best is None else best[1]
 
 
 def _make_intersector(mesh: trimesh.Trimesh) -> Any:

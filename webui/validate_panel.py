@@ -1,6 +1,11 @@
 """The "Validate" panel: Monte Carlo validation of any plan with a progress bar, the report's
 rows (simulated beside predicted), histograms, and the simulated error painted on the part.
 
+The report opens in its own wide window ("Validation report", floating over the 3D view,
+wide enough for the Table-1 rows; "Show report window" hides or shows it), with one
+histogram per row on a value axis in the row's unit (mm or deg). When the plan changes after
+a validation, the report is marked stale at once.
+
 Validation runs on its own thread (:class:`webui.worker.CellWorker` without a shared resource),
 not on the cell worker: point checks from any tab stay fast while it runs. Whatever simulator
 state ``planner.sim.montecarlo`` needs it builds itself, inside that thread. A plan that cannot
@@ -29,6 +34,11 @@ if TYPE_CHECKING:
 
 logger = logging.getLogger(__name__)
 
+#: Size of the report window, px: the Table-1 rows (simulated, predicted, bias, the paper)
+#: fit without cutting.
+REPORT_WIDTH_PX = 640
+REPORT_HEIGHT_PX = 560
+
 
 class ValidatePanel:
     """GUI widgets of the validation, shared by all tabs.
@@ -44,18 +54,30 @@ class ValidatePanel:
         self._start_lock = threading.Lock()
         self.last_report: ValidationReport | None = None
         self.last_markdown = ""
+        #: Why the shown report no longer fits the plan (``""``: it does).
+        self.stale = ""
         gui = app.server.gui
-        self._folder = gui.add_folder("Validate", expand_by_default=True)
-        with self._folder:
+        with app.tab("Validate"):
             self.trials = gui.add_number("Trials", 200, min=10, max=100000, step=10)
             self.button = gui.add_button("Validate plan", color="blue")
             self.progress = gui.add_progress_bar(0.0, visible=False, animated=True)
-            self.result_md = gui.add_markdown("")
+            self.status_md = gui.add_markdown("")
+            self.show_report = gui.add_checkbox("Show report window", False, disabled=True)
             self.show_error = gui.add_checkbox("Show error on part", False, disabled=True)
             self.error_md = gui.add_markdown("")
-            self.plots: list[Any] = []
+        self.report_window = gui.add_panel(visible=False)
+        with self.report_window.add_tab("Validation report"):
+            self.stale_md = gui.add_markdown("")
+            self.result_md = gui.add_markdown("")
+            self._plots_folder = gui.add_folder("Histograms", expand_by_default=True)
+        # floating over the 3D view's top-left corner: wide enough for the whole table next to
+        # the control panel docked on the right, also in a 1100 px window
+        self.report_window.float(x=12, y=12, width=REPORT_WIDTH_PX, height=REPORT_HEIGHT_PX)
+        self.plots: list[Any] = []
         self.button.on_click(self._on_click)
         self.show_error.on_update(self._on_show_error)
+        self.show_report.on_update(lambda _ev: self._show_window(bool(self.show_report.value)))
+        app.state.subscribe(self._on_plan_change)
 
     def _on_click(self, event: Any) -> None:
         client = getattr(event, "client", None)
@@ -80,7 +102,7 @@ class ValidatePanel:
         self.button.disabled = True
         self.progress.value = 0.0
         self.progress.visible = True
-        self.result_md.content = f"Running {trials} trials..."
+        self.status_md.content = f"Running {trials} trials..."
         last = [0.0]
 
         def progress(done: int, total: int) -> None:
@@ -110,16 +132,19 @@ class ValidatePanel:
         try:
             summary = fut.result()
         except PlanError as exc:  # refused before any trial ran: the point and why
-            self.result_md.content = f"**Validation not started:** {exc}"
+            self.status_md.content = f"**Validation not started:** {exc}"
             self._app.notify("Validation not started", str(exc))
             return
         except Exception as exc:
             logger.exception("validation failed")
-            self.result_md.content = f"**Validation failed:** {exc}"
+            self.status_md.content = f"**Validation failed:** {exc}"
             self._app.notify("Validation failed", str(exc))
             return
         self.last_report = summary.report
         self.last_markdown = summary.markdown
+        self.stale = ""
+        self.stale_md.content = ""
+        self.status_md.content = f"{summary.headline}; the report is in its own window."
         self.result_md.content = summary.markdown
         self.show_error.disabled = summary.report.error_map is None
         self.paint_error()
@@ -127,23 +152,46 @@ class ValidatePanel:
             plot.remove()
         self.plots = []
         gui = self._app.server.gui
-        for title, edges, counts in summary.histograms:
-            with self._folder:
-                self._add_plot(gui, title, edges, counts)
+        with self._plots_folder:
+            for title, unit, edges, counts in summary.histograms:
+                self._add_plot(gui, title, unit, edges, counts)
+        self.show_report.disabled = False
+        self._show_window(True)
         if summary.T_world_wobj_example is not None:
             self._app.scene.draw_calibrated_frame(summary.T_world_wobj_example)
         self._app.notify("Validation done", summary.headline, error=False)
 
-    def _add_plot(self, gui: Any, title: str, edges: Any, counts: Any) -> None:
+    def _add_plot(self, gui: Any, title: str, unit: str, edges: Any, counts: Any) -> None:
+        """One histogram: bin centres on a value axis (not uPlot's default time axis) in
+        ``unit``, sample counts up."""
         centers = 0.5 * (np.asarray(edges[:-1], float) + np.asarray(edges[1:], float))
         self.plots.append(
             gui.add_uplot(
                 data=(centers, np.asarray(counts, dtype=np.float64)),
-                series=({"label": "error (mm)"}, {"label": "trials", "stroke": "steelblue"}),
+                series=(
+                    {"label": f"error ({unit})"},
+                    {"label": "samples", "stroke": "steelblue", "fill": "rgba(70,130,180,0.3)"},
+                ),
+                scales={"x": {"time": False}},
+                axes=({"label": f"error ({unit})"}, {"label": "samples", "size": 60}),
                 title=title,
-                aspect=2.0,
+                aspect=2.2,
             )
         )
+
+    def _show_window(self, visible: bool) -> None:
+        """Show or hide the report window (the box in the tab follows)."""
+        self.report_window.visible = visible and self.last_report is not None
+        if bool(self.show_report.value) != self.report_window.visible:
+            self.show_report.value = self.report_window.visible
+
+    def _on_plan_change(self, change: Any) -> None:
+        """Mark the shown report stale when the plan changes after it was made."""
+        if self.last_report is None or self.stale:
+            return
+        self.stale = f"the plan changed after this validation ({change.label})"
+        self.stale_md.content = f"**Stale:** {self.stale}; validate again for current figures."
+        self.status_md.content = f"**Stale report:** {self.stale}."
 
     def _on_show_error(self, _event: Any) -> None:
         self.paint_error()

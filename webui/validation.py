@@ -32,14 +32,15 @@ class ValidationSummary:
     Attributes:
         report: the report :func:`planner.validate.validate_plan` returned.
         markdown: the report's rows (simulated, predicted, bias), per-point outcomes, failures.
-        histograms: ``(title, bin_edges (B+1,), counts (B,))`` for each error histogram.
+        histograms: ``(title, unit, bin_edges (B+1,), counts (B,))`` for each error
+            histogram: edges in ``unit`` (``"mm"`` or ``"deg"``), counts of samples.
         headline: one line for the notification.
         T_world_wobj_example: ``(4, 4)`` one calibrated frame to draw, or ``None``.
     """
 
     report: ValidationReport
     markdown: str
-    histograms: tuple[tuple[str, NDArray[np.float64], NDArray[np.float64]], ...]
+    histograms: tuple[tuple[str, str, NDArray[np.float64], NDArray[np.float64]], ...]
     headline: str
     T_world_wobj_example: NDArray[np.float64] | None = None
 
@@ -80,7 +81,8 @@ def summarize(report: ValidationReport) -> ValidationSummary:
         unit = units.get(key, "mm")
         scale = 1000.0 if unit == "mm" else float(np.degrees(1.0))
         edges, counts = _histogram(samples, scale)
-        hists.append((f"{labels.get(key, key)} ({unit})", edges, counts.astype(np.float64)))
+        title = f"{labels.get(key, key)} ({unit}, {int(counts.sum())} samples)"
+        hists.append((title, unit, edges, counts.astype(np.float64)))
     failed = sum(report.failures.values())
     headline = f"{report.n_ok}/{report.n_trials} trials calibrated, {failed} failed"
     return ValidationSummary(report, markdown, tuple(hists), headline)

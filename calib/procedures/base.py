@@ -72,12 +72,15 @@ class ProcedureKind(Protocol):
         settings_type: its settings struct (a member of
             :data:`calib.procedures.ProcedureSettings`).
         roles: the roles a point of this procedure may take.
+        role_limits: how many points each role takes at most (``None``: any number); an
+            editor gives a new point the first role not yet full.
         summary: one line for humans.
     """
 
     method: str
     settings_type: type
     roles: tuple[str, ...]
+    role_limits: Mapping[str, int | None]
     summary: str
 
     def role_problem(self, roles: Sequence[str], complete: bool) -> str:

@@ -6,7 +6,8 @@ constrains two faces). The fit itself is :func:`calib.estimators.best_fit.best_f
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from types import MappingProxyType
 
 import msgspec
 import numpy as np
@@ -64,6 +65,7 @@ class BestFitProcedure:
     method = "best_fit"
     settings_type: type = BestFit
     roles: tuple[str, ...] = (ROLE,)
+    role_limits: Mapping[str, int | None] = MappingProxyType({ROLE: None})
     summary = "least-squares fit of every point to its face"
     #: Its linearised covariance is the least-squares one of its searches, ``(A^T W A)^-1``,
     #: for approach searches without a shared TCP error (a test checks it against the

@@ -7,7 +7,8 @@ module adapts them to the :class:`calib.procedures.base.ProcedureKind` protocol.
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from types import MappingProxyType
 
 import numpy as np
 
@@ -45,6 +46,7 @@ class Hultman2013Procedure:
     method = "hultman2013"
     settings_type: type = Hultman2013
     roles: tuple[str, ...] = ROLES
+    role_limits: Mapping[str, int | None] = MappingProxyType(dict.fromkeys(ROLES, 1))
     summary = "the paper's A-H procedure: 3 points fix the plane, searches fix the origin"
 
     def role_problem(self, roles: Sequence[str], complete: bool) -> str:

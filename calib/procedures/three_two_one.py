@@ -9,7 +9,8 @@ from the faces the points lie on.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from types import MappingProxyType
 
 import msgspec
 import numpy as np
@@ -150,6 +151,7 @@ class ThreeTwoOneProcedure:
     method = "three_two_one"
     settings_type: type = ThreeTwoOne
     roles: tuple[str, ...] = tuple(ROLE_COUNTS)
+    role_limits: Mapping[str, int | None] = MappingProxyType(dict(ROLE_COUNTS))
     summary = "3 points on a primary face, 2 on a secondary, 1 on a tertiary"
     #: Six face constraints, solved exactly: its linearised covariance is the least-squares
     #: one of its searches (a test checks it against the linearisation to 1e-9).

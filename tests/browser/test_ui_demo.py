@@ -8,9 +8,18 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from ui_helpers import REPO, UiSession, rendered, set_camera, wait_for
+from ui_helpers import (
+    REPO,
+    UiSession,
+    open_tab,
+    rendered,
+    save_screenshot,
+    set_camera,
+    wait_for,
+)
 
 from calib.atomic_io import write_bytes_atomic
+from calib.frames import transform_points
 from webui.plan_doc import PAPER_IDS
 
 pytestmark = pytest.mark.browser
@@ -38,6 +47,7 @@ def test_demo_loads_with_ah_points_and_statuses(demo: UiSession) -> None:
 
 def test_validate_button_produces_table_and_histograms(demo: UiSession) -> None:
     demo.app.validate_panel.trials.value = 30
+    open_tab(demo.page, "Validate")
     demo.page.get_by_role("button", name="Validate plan").click()
     panel = demo.app.validate_panel
     wait_for(lambda: not panel.running and panel.result_md.content, timeout=300, what="validation")
@@ -47,6 +57,75 @@ def test_validate_button_produces_table_and_histograms(demo: UiSession) -> None:
     wait_for(lambda: "WOCS origin x-axis" in demo.page.inner_text("body"), what="table on page")
     assert len(demo.app.validate_panel.plots) >= 6
     assert demo.app.validate_panel.last_report.n_trials == 30
+
+
+def test_validation_report_reads_in_full_with_value_axes_and_goes_stale(
+    demo: UiSession, tmp_path: Path
+) -> None:
+    """Issue 14, item 4: the report's window is wide enough for the whole table (no cell cut
+    off), the histograms have value axes in the row's unit, the error map paints the part,
+    and a plan change marks the report stale at once."""
+    panel = demo.app.validate_panel
+    if panel.last_report is None or panel.stale:
+        panel.trials.value = 30
+        open_tab(demo.page, "Validate")
+        demo.page.get_by_role("button", name="Validate plan").click()
+        wait_for(lambda: not panel.running and panel.last_report is not None and not panel.stale,
+                 timeout=300, what="validation")  # fmt: skip
+    assert panel.report_window.visible
+    table = demo.page.locator("table", has_text="WOCS origin x-axis").first
+    table.wait_for(state="visible")
+    overflow = table.evaluate(
+        """t => { let e = t.parentElement; while (e && e.clientWidth >= t.scrollWidth - 1
+                   && e !== document.body) e = e.parentElement;
+                 const r = t.getBoundingClientRect();
+                 return {cut: e !== document.body && e !== null, right: r.right,
+                         width: window.innerWidth}; }"""
+    )
+    assert not overflow["cut"] and overflow["right"] <= overflow["width"], overflow
+    for plot in panel.plots:
+        assert plot.scales == {"x": {"time": False}}, "a value axis, not uPlot's time axis"
+        unit = "deg" if "(deg," in plot.title else "mm"
+        assert plot.axes[0]["label"] == f"error ({unit})"
+    assert any("(deg," in p.title for p in panel.plots) and any(
+        "(mm," in p.title for p in panel.plots
+    )
+    panel.show_error.value = True
+    wait_for(lambda: "place each point within" in panel.error_md.content, what="the error map")
+    demo.page.set_viewport_size({"width": 1500, "height": 900})
+    save_screenshot(demo.page, "validation_tab.png", tmp_path)
+    panel.show_error.value = False
+    a = demo.app.state.doc.get("A").probe.position_m
+    demo.app.move_point_to("A", np.add(a, [0.0, 0.002, 0.0]))
+    try:
+        assert panel.stale and "move A" in panel.stale
+        wait_for(lambda: "Stale" in demo.page.inner_text("body"), what="the stale mark")
+    finally:
+        demo.app.state.undo()
+
+
+def test_heat_map_colours_the_part_by_what_fails(demo: UiSession, tmp_path: Path) -> None:
+    """Issue 14, item 6: the map runs on the cell worker, colours each sample by what fails,
+    ends with smooth colours over a refined surface, and shows its legend."""
+    from webui.heatmap import CATEGORY_RGB
+
+    open_tab(demo.page, "Points")
+    demo.page.get_by_text("Reachability heat map", exact=True).click()
+    heat = demo.app.heatmap
+    wait_for(lambda: heat.done.is_set() and heat.summary, timeout=600, what="the heat map")
+    assert len(heat.categories) == len(heat.points) and set(heat.categories) <= set(CATEGORY_RGB)
+    assert len(set(heat.categories)) >= 3, heat.summary
+    mesh = demo.app.server.scene.get_handle_by_name("/wobj/heat_mesh")
+    assert mesh is not None
+    wait_for(lambda: "robot or tool collides" in demo.page.inner_text("body"), what="legend")
+    view = demo.app.view
+    centre = transform_points(view.T_world_wobj, view.wobj_mesh.bounds.mean(axis=0))
+    set_camera(demo.client(), np.add(centre, [0.5, -1.3, 0.9]), centre)
+    demo.app.validate_panel.report_window.visible = False  # the part, not the last report
+    save_screenshot(demo.page, "heat_map.png", tmp_path)
+    demo.page.get_by_text("Reachability heat map", exact=True).click()
+    wait_for(lambda: demo.app.server.scene.get_handle_by_name("/wobj/heat_mesh") is None,
+             what="the map hidden")  # fmt: skip
 
 
 def test_screenshot_of_demo_cell(demo: UiSession, tmp_path: Path) -> None:
@@ -75,7 +154,8 @@ def test_checks_run_while_validation_runs(demo: UiSession) -> None:
     fut = panel.start(400)
     try:
         a = demo.app.state.doc.get("A")
-        check = demo.app.move_point_to("A", a.probe.position_m)  # a no-op move, re-checked
+        moved = np.add(a.probe.position_m, [0.0, 0.002, 0.0])  # 2 mm along the side face
+        check = demo.app.move_point_to("A", moved)
         assert check is not None and panel.running, "the check waited for the validation"
     finally:
         fut.result(300)

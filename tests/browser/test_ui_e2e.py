@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ui_helpers import VIEWPORT, UiSession, set_camera, wait_for
+from ui_helpers import VIEWPORT, UiSession, open_tab, set_camera, wait_for
 
 from calib.frames import transform_points
 from webui.testing import T_WORLD_WOBJ_BOX, project_to_screen
@@ -35,11 +35,9 @@ def click_world_point(ui: UiSession, p_world: Any) -> None:
 
 
 def open_folder(ui: UiSession, button: str) -> None:
-    """Expand the "Files" folder unless ``button`` is already visible."""
-    target = ui.page.get_by_role("button", name=button)
-    if not target.is_visible():
-        ui.page.get_by_text("Files", exact=True).first.click()
-    target.wait_for(state="visible")
+    """Show the "Files" tab, where ``button`` is."""
+    open_tab(ui.page, "Files")
+    ui.page.get_by_role("button", name=button).wait_for(state="visible")
 
 
 def test_page_loads_with_plan_points_and_status(ui: UiSession) -> None:
@@ -109,17 +107,30 @@ def test_validate_refuses_a_plan_that_cannot_work_naming_the_point(ui: UiSession
     """The box plan's searches start 30 mm out, closer than the default 20 mm, 3 deg
     misplacement allows (and earlier tests of this module add points the 3-2-1 has no role
     for): the validation does not start, and says which points and why."""
+    open_tab(ui.page, "Validate")
     ui.page.get_by_role("button", name="Validate plan").click()
     msg = wait_for(
         lambda: "Validation not started" in ui.notifications() and ui.notifications(),
         what="the notification",
     )
-    assert "the search starts 30.0 mm out" in msg or "points: three_two_one needs" in msg, msg
+    named = "points A, Z have no role" in msg  # the clicks above found every 3-2-1 role full
+    assert "the search starts 30.0 mm out" in msg or named, msg
     assert ui.app.validate_panel.last_report is None
+
+
+def drop_points_without_role(ui: UiSession) -> None:
+    """Delete the points placed by earlier tests with every 3-2-1 role full (they have none,
+    and a plan file refuses them, naming them)."""
+    from webui import plan_doc
+
+    for p in ui.app.state.doc.points:
+        if p.role == plan_doc.NO_ROLE:
+            ui.app.state.update(lambda d, pid=p.id: plan_doc.delete_point(d, pid), "delete")
 
 
 def test_plan_download_matches_server_plan(ui: UiSession, tmp_path: Path) -> None:
     wait_for(lambda: "P1" in ui.page.content(), what="page ready")
+    drop_points_without_role(ui)
     with ui.page.expect_download() as dl:
         open_folder(ui, "Download plan JSON")
         ui.page.get_by_role("button", name="Download plan JSON").click()
@@ -163,6 +174,7 @@ def test_second_tab_sees_the_same_session(ui: UiSession, browser: Any) -> None:
 
 def test_rapid_download_is_the_server_export(ui: UiSession, tmp_path: Path) -> None:
     wait_for(lambda: "P1" in ui.page.content(), what="page ready")
+    drop_points_without_role(ui)
     with ui.page.expect_download() as dl:
         open_folder(ui, "Download RAPID")
         ui.page.get_by_role("button", name="Download RAPID").click()

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ui_helpers import REPO, UiSession, open_page, start_ui, wait_for
+from ui_helpers import REPO, UiSession, open_page, open_tab, start_ui, wait_for
 
 from webui.validation import error_colours
 
@@ -34,6 +34,7 @@ def plate(
 def test_plate_plan_validates_and_paints_the_error(plate: UiSession) -> None:
     panel = plate.app.validate_panel
     panel.trials.value = 40
+    open_tab(plate.page, "Validate")
     plate.page.get_by_role("button", name="Validate plan").click()
     wait_for(
         lambda: panel.last_report is not None and not panel.running,

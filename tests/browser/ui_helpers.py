@@ -104,3 +104,55 @@ def set_camera(client: Any, position: Any, look_at: Any) -> None:
 def rendered(page: Any) -> None:
     """Wait until the page has drawn two more animation frames (the new view is on screen)."""
     page.evaluate("new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))")
+
+
+def open_tab(page: Any, name: str) -> None:
+    """Show the control panel's tab ``name`` (Points, Cell, Teach, Validate, Files)."""
+    tab = page.get_by_role("tab", name=name, exact=True)
+    tab.click()
+    wait_for(lambda: tab.get_attribute("aria-selected") == "true", what=f"the {name} tab")
+
+
+def choose(page: Any, label: str, value: str) -> None:
+    """Pick ``value`` in the dropdown labelled ``label``, as a user does (open, click)."""
+    page.get_by_label(label, exact=True).click()
+    page.get_by_role("option", name=value, exact=True).click()
+
+
+#: Screenshots for the docs: every run writes them to ``artifacts/`` (git-ignored); with
+#: WOBJCAL_UPDATE_SCREENSHOTS=1 they are also copied to ``docs/img/`` (commit them yourself).
+ARTIFACTS = REPO / "artifacts"
+DOCS_IMG = REPO / "docs" / "img"
+
+
+def save_screenshot(page: Any, name: str, tmp_path: Path) -> Path:
+    """Screenshot the page (notifications hidden) into ``artifacts/<name>``, and into
+    ``docs/img/<name>`` when WOBJCAL_UPDATE_SCREENSHOTS=1; returns this run's own file."""
+    import os
+    import shutil
+
+    from calib.atomic_io import write_bytes_atomic
+
+    page.add_style_tag(content=".mantine-Notification-root { display: none !important; }")
+    rendered(page)
+    shot = tmp_path / name
+    page.screenshot(path=str(shot))
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    write_bytes_atomic(ARTIFACTS / name, shot.read_bytes())
+    if os.environ.get("WOBJCAL_UPDATE_SCREENSHOTS") == "1":
+        shutil.copyfile(shot, DOCS_IMG / name)
+    return shot
+
+
+def canvas_point(ui: UiSession, p_world: Any) -> tuple[float, float]:
+    """Page coordinates where the world point ``p_world`` appears in the page's camera."""
+    from webui.testing import project_to_screen
+
+    cam = ui.client().camera
+    u, v = project_to_screen(
+        p_world, cam.position, cam.wxyz, cam.fov, cam.image_width, cam.image_height
+    )
+    box = ui.page.locator("canvas").first.bounding_box()
+    return box["x"] + u * box["width"] / cam.image_width, box["y"] + v * box[
+        "height"
+    ] / cam.image_height

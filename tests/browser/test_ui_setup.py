@@ -1,0 +1,126 @@
+"""Issue 14 in Chromium, on the demo: cell setup (item 1) and jog and teach (item 2), driven
+through the page's own fields and buttons; every test checks the server's state."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from ui_helpers import UiSession, open_tab, save_screenshot, set_camera, wait_for
+
+from calib.frames import transform_points
+from webui.cell_edits import WORK_OBJECT, pose_of
+from webui.plan_doc import PAPER_IDS
+
+pytestmark = pytest.mark.browser
+
+
+def _input_of(page: Any, handle: Any) -> Any:
+    """The (first) number input of a viser vector or slider widget."""
+    first = page.locator(f'[id="{handle._impl.uuid}"]')
+    if first.evaluate("e => e.tagName") == "INPUT":
+        return first
+    return first.locator("xpath=following-sibling::*//input").first
+
+
+def test_typing_a_position_and_applying_moves_the_part(demo: UiSession) -> None:
+    app, page = demo.app, demo.page
+    open_tab(page, "Cell")
+    panel = app.cell_panel
+    assert panel.target.value == WORK_OBJECT
+    T0 = pose_of(app.state.doc.source, WORK_OBJECT)
+    x_mm = round(T0[0, 3] * 1000.0 + 50.0, 3)
+    field = _input_of(page, panel.position)
+    field.fill(f"{x_mm}")
+    field.press("Tab")
+    wait_for(lambda: abs(panel.position.value[0] - x_mm) < 1e-6, what="x on the server")
+    page.get_by_role("button", name="Apply pose").click()
+    wait_for(
+        lambda: abs(app.view.T_world_wobj[0, 3] - T0[0, 3] - 0.05) < 1e-9, what="the part moved"
+    )
+    wait_for(lambda: len(app.checks()) == 8, what="every point checked in the new cell")
+    open_tab(page, "Points")
+    page.get_by_role("button", name="Undo", exact=True).click()
+    wait_for(lambda: np.allclose(app.view.T_world_wobj, T0, atol=1e-12), what="undo")
+
+
+def test_snap_button_rests_the_part_on_the_table(demo: UiSession) -> None:
+    app, page = demo.app, demo.page
+    open_tab(page, "Cell")
+    page.get_by_role("button", name="Snap part onto fixture").click()
+    mesh, T_table = app.view.fixtures["table"]
+    top = transform_points(T_table, mesh.vertices)[:, 2].max()
+
+    def resting() -> bool:
+        low = transform_points(app.view.T_world_wobj, app.view.wobj_mesh.vertices)[:, 2].min()
+        return abs(low - top) < 1e-9
+
+    wait_for(resting, what="the part on the table")
+    app.state.undo()
+
+
+def test_jog_slider_and_teach_in_the_page(demo: UiSession, tmp_path: Path) -> None:
+    app, page = demo.app, demo.page
+    panel = app.teach_panel
+    app.select("D")
+    check = wait_for(lambda: app.check_of("D"), what="D's check")
+    open_tab(page, "Teach")
+    page.get_by_role("button", name="Jog to selected point").click()
+    wait_for(lambda: np.allclose(panel.q, check.q), what="the robot at D's pose")
+    j1 = _input_of(page, panel.sliders[0])
+    want = round(float(np.degrees(check.q[0])) + 2.0, 1)  # the slider step: 0.1 deg
+    j1.fill(f"{want}")
+    j1.press("Tab")
+    wait_for(lambda: abs(np.degrees(panel.q[0]) - want) < 1e-3, what="J1 jogged on the server")
+    np.testing.assert_allclose(app.robot.q, panel.q)
+    wait_for(
+        lambda: panel.last_status is not None and "**" in panel.status_md.content, what="status"
+    )
+    page.get_by_role("button", name="Jog to selected point").click()
+    wait_for(lambda: np.allclose(panel.q, check.q), what="back at D")
+    T = panel.T_world_tcp()
+    T[:3, 3] -= 0.05 * T[:3, 2]  # 50 mm back along the sensor axis, through the IK
+    assert panel.move_tcp(T) is not None
+    n_before = len(app.state.doc.points)
+    page.get_by_role("button", name="Teach pose").click()
+    wait_for(lambda: len(app.state.doc.points) == n_before + 1, what="the taught point")
+    taught = app.state.doc.points[-1]
+    d = app.state.doc.get("D").probe
+    np.testing.assert_allclose(taught.probe.position_m, d.position_m, atol=5e-4)  # mesh face
+    assert taught.probe.search.start_offset_m == pytest.approx(0.05, abs=5e-4)
+    p = transform_points(app.view.T_world_wobj, d.position_m)
+    set_camera(demo.client(), np.add(p, [-1.6, -1.9, 1.0]), np.add(p, [-0.4, 0.0, 0.1]))
+    save_screenshot(page, "taught_pose.png", tmp_path)
+    app.state.undo()
+
+
+def test_uploading_a_part_shows_its_size_then_reframes_and_lists_points_off_it(
+    demo: UiSession, reference_dir: Path
+) -> None:
+    from webui import clients
+
+    app, page = demo.app, demo.page
+    files = app.files_panel
+    before = app.state.doc
+    open_tab(page, "Files")
+    files.units.value = "mm"
+    with page.expect_file_chooser() as fc:
+        page.get_by_role("button", name="Upload work-object mesh").click()
+    fc.value.set_files(str(reference_dir / "parts" / "plate_holes.STL"))
+    wait_for(lambda: "203.2 x 304.8 x 12.7 mm" in page.inner_text("body"), what="the size")
+    assert app.state.doc is before, "not used before it is accepted"
+    page.get_by_role("button", name="Use this part").click()
+    wait_for(lambda: app.state.doc.source.work_object.units == "mm", what="the new part")
+    want = clients.framed_camera(app.view, clients.ISO_DIRECTION, demo.client().camera.fov)[1]
+    wait_for(lambda: np.allclose(demo.client().camera.look_at, want, atol=1e-3), what="reframed")
+    wait_for(lambda: "off the new part" in page.inner_text("body"), what="the list")
+    assert set(files.off) == set(PAPER_IDS)
+    page.get_by_role("button", name="Project them onto the part").click()
+    wait_for(lambda: not files.off, what="the points projected")
+    for p in app.state.doc.points:
+        assert app.picker.project(p.probe.position_m).distance_m < 1e-9
+    app.state.undo()
+    app.state.undo()
+    wait_for(lambda: app.state.doc.source is before.source, what="the demo back")

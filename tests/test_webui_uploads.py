@@ -1,0 +1,112 @@
+"""Uploading a part and a robot, server side (issue 14, item 5): the size in the chosen units
+before accepting, points off the new surface listed, projected or dropped; a URDF zipped with
+its meshes; errors name the user's file."""
+
+from __future__ import annotations
+
+import io
+import re
+import zipfile
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from calib.errors import InputError
+from webui.app import WobjcalApp
+from webui.part_upload import OFF_SURFACE_M
+from webui.server import run
+from webui.testing import box_plan, free_port
+
+
+@pytest.fixture(scope="module")
+def app(tmp_path_factory: pytest.TempPathFactory) -> Iterator[WobjcalApp]:
+    folder = tmp_path_factory.mktemp("uploads")
+    a = run(box_plan(folder), port=free_port(), block=False, autosave_path=folder / "auto.json")
+    a.files_panel.upload_dir = folder / "kept"
+    yield a
+    a.stop()
+
+
+def test_a_part_waits_for_its_units_with_its_size_shown(
+    app: WobjcalApp, reference_dir: Path
+) -> None:
+    files = app.files_panel
+    before = app.state.doc
+    data = (reference_dir / "parts" / "plate_holes.STL").read_bytes()
+    files.units.value = "mm"
+    files.stage_mesh("plate_holes.STL", data)
+    assert app.state.doc is before, "nothing changes before the part is accepted"
+    assert "plate_holes.STL in mm: 203.2 x 304.8 x 12.7 mm" in files.pending_md.content
+    files.units.value = "m"  # the size follows the units at once
+    assert "203200.0 x 304800.0 x 12700.0 mm" in files.pending_md.content
+    files.units.value = "auto"
+    assert "auto picks mm" in files.pending_md.content
+    files.units.value = "mm"
+    files.accept_mesh()
+    assert app.state.doc.source.work_object.units == "mm"
+    np.testing.assert_allclose(app.view.wobj_mesh.extents, [0.2032, 0.3048, 0.0127], atol=1e-6)
+    assert files.pending is None and not files.accept.visible
+    # the box plan's points are not on the plate: listed with their distances
+    assert set(files.off) == set(app.state.doc.ids)
+    assert all(d > OFF_SURFACE_M for d in files.off.values())
+    assert "Points off the new part's surface:" in files.off_md.content
+    files.fix_off_surface("project")
+    picker = app.picker
+    for p in app.state.doc.points:
+        assert picker.project(p.probe.position_m).distance_m < 1e-9
+    assert files.off == {} and not files.project_off.visible
+    app.state.undo()  # the projection
+    files._list_off_surface()
+    files.fix_off_surface("drop")
+    assert app.state.doc.points == ()
+    app.state.undo()
+    app.state.undo()  # the new part
+    np.testing.assert_allclose(app.view.wobj_mesh.extents, [0.6, 0.4, 0.3], atol=1e-9)
+
+
+def test_a_bad_part_is_refused_naming_the_users_file(app: WobjcalApp) -> None:
+    before = app.state.doc
+    with pytest.raises(InputError, match=r"broken_part\.stl") as info:
+        app.files_panel.stage_mesh("broken_part.stl", b"solid x\nendsolid x\n")
+    assert str(app.files_panel.upload_dir) not in str(info.value), "no internal cache path"
+    assert app.state.doc is before and app.files_panel.pending is None
+
+
+def _ur5_zip(reference_dir: Path, drop: str | None = None) -> bytes:
+    """The reference UR5 as a ROS package zip: ``package://ur_description/...`` references."""
+    root = reference_dir / "robots" / "ur5"
+    text = (root / "ur5.urdf").read_text()
+    text = re.sub(r'filename="(meshes/[^"]+)"', r'filename="package://ur_description/\1"', text)
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as z:
+        z.writestr("ur_description/urdf/ur5.urdf", text)
+        for stl in sorted((root / "meshes" / "collision").glob("*.stl")):
+            if stl.name != drop:
+                z.write(stl, f"ur_description/meshes/collision/{stl.name}")
+    return buf.getvalue()
+
+
+def test_a_robot_zip_brings_its_meshes(app: WobjcalApp, reference_dir: Path) -> None:
+    files = app.files_panel
+    files.upload_urdf("ur5_package.zip", _ur5_zip(reference_dir))
+    try:
+        assert app.view.chain is not None and app.view.chain.n_joints == 6
+        urdf = Path(app.state.doc.source.cell.robot.urdf)
+        assert urdf.is_file() and files.upload_dir in urdf.parents
+        assert 'filename="package://' not in urdf.read_text()
+        assert app.robot is not None, "the robot is drawn from the zip's meshes"
+    finally:
+        app.state.undo()
+    before = app.state.doc
+    with pytest.raises(InputError, match=r"ur5_missing\.zip: .*refers to .*wrist3\.stl"):
+        files.upload_urdf("ur5_missing.zip", _ur5_zip(reference_dir, drop="wrist3.stl"))
+    assert app.state.doc is before
+    evil = io.BytesIO()
+    with zipfile.ZipFile(evil, "w") as z:
+        z.writestr("../escape.urdf", "<robot name='x'/>")
+    with pytest.raises(InputError, match="unsafe path"):
+        files.upload_urdf("evil.zip", evil.getvalue())
+    with pytest.raises(InputError, match="not a zip"):
+        files.upload_urdf("fake.zip", b"not a zip at all")

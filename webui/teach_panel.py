@@ -1,0 +1,291 @@
+"""The "Teach" panel: jog the robot and teach its pose as a probe point's approach.
+
+Joint sliders (deg, within the URDF's limits) and a TCP gizmo driven by the inverse kinematics
+(the solution nearest the current joint values, so the arm keeps its branch) move the drawn
+robot; after every move the joint limits and the clearance of the whole robot are checked in
+the cell (on the cell worker) and shown at once. **Teach pose** puts a probe point where the
+sensor axis meets the part, with the search starting from the taught TCP position
+(its distance from the surface is the start offset).
+
+The plan file has no via points and does not store the sensor's rotation about the normal (the
+check picks it), so a taught pose fixes the point and its start offset, not the wrist's roll.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import itertools
+import logging
+import threading
+from collections.abc import Iterator
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from calib.errors import InputError
+from calib.frames import (
+    make_transform,
+    matrix_from_quat_wxyz,
+    quat_wxyz_from_matrix,
+    transform_points,
+)
+from webui import plan_doc
+from webui.backend import JogStatus
+
+if TYPE_CHECKING:
+    from webui.context import AppContext
+
+logger = logging.getLogger(__name__)
+
+NEW_POINT = "new point"
+#: A ray cast from this far behind the TCP along the sensor axis finds the taught point, m.
+BEHIND_M = 0.2
+#: Smallest search start offset a taught pose gives, m.
+MIN_START_M = 0.001
+
+
+class TeachPanel:
+    """Jog sliders, TCP gizmo and teaching (shared by all tabs).
+
+    Args:
+        app: the app whose robot is jogged.
+    """
+
+    def __init__(self, app: AppContext) -> None:
+        self._app = app
+        self._sync = threading.local()
+        self.sliders: list[Any] = []
+        self._gizmo: Any = None
+        self.q: NDArray[np.float64] = np.zeros(0)
+        self.last_status: JogStatus | None = None
+        gui = app.server.gui
+        with app.tab("Teach"):
+            gui.add_markdown("Jog the robot; teach the pose as a point's approach.")
+            self.joints = gui.add_folder("Joints (deg)")
+            self.status_md = gui.add_markdown("")
+            self.from_point = gui.add_button("Jog to selected point")
+            self.drag_tcp = gui.add_checkbox("Drag TCP (IK)", False)
+            self.target = gui.add_dropdown("Teach as", (NEW_POINT,))
+            self.teach_button = gui.add_button("Teach pose", color="blue")
+            self.show_moves = gui.add_checkbox("Show moves between points", False)
+            self.moves_md = gui.add_markdown("")
+        self.from_point.on_click(lambda ev: self._guard(ev, self.jog_to_selected))
+        self.drag_tcp.on_update(lambda ev: self._guard(ev, self._update_gizmo))
+        self.teach_button.on_click(lambda ev: self._guard(ev, self.teach, str(self.target.value)))
+        self.show_moves.on_update(lambda ev: self._guard(ev, self.draw_moves))
+        app.state.subscribe(lambda _c: self._refresh_targets())
+        #: ``{"A->B": problem}`` of the last drawn moves (``""``: clear).
+        self.moves: dict[str, str] = {}
+
+    # ---- helpers ---------------------------------------------------------------------------
+    @contextlib.contextmanager
+    def _programmatic(self) -> Iterator[None]:
+        self._sync.on = True
+        try:
+            yield
+        finally:
+            self._sync.on = False
+
+    def _guard(self, event: Any, fn: Any, *args: Any) -> Any:
+        try:
+            return fn(*args)
+        except InputError as exc:
+            self._app.notify("Not done", str(exc), client=getattr(event, "client", None))
+        except Exception as exc:  # never a traceback in the browser
+            logger.exception("teach action failed")
+            self._app.notify("Error", f"{type(exc).__name__}: {exc}")
+        return None
+
+    def _tcp(self) -> str:
+        source = self._app.state.doc.source
+        return "sensor" if source is None else source.cell.tool.tcp
+
+    def _refresh_targets(self) -> None:
+        options = (NEW_POINT, *self._app.state.doc.ids)
+        if tuple(self.target.options) != options:
+            self.target.options = options
+
+    # ---- joints ----------------------------------------------------------------------------
+    def on_cell(self) -> None:
+        """Rebuild the joint sliders for the loaded cell's robot (its limits, in degrees)."""
+        view = self._app.view
+        for s in self.sliders:
+            s.remove()
+        self.sliders = []
+        if view is None or view.chain is None:
+            return
+        chain = view.chain
+        robot = self._app.robot
+        q0 = robot.q if robot is not None and len(robot.q) == chain.n_joints else None
+        q0 = np.clip(np.zeros(chain.n_joints), chain.lower, chain.upper) if q0 is None else q0
+        gui = self._app.server.gui
+        with self.joints:
+            for i, name in enumerate(chain.joint_names):
+                lo = -360.0 if not np.isfinite(chain.lower[i]) else np.degrees(chain.lower[i])
+                hi = 360.0 if not np.isfinite(chain.upper[i]) else np.degrees(chain.upper[i])
+                slider = gui.add_slider(
+                    f"J{i + 1}", float(round(lo, 3)), float(round(hi, 3)), 0.1,
+                    float(np.clip(round(np.degrees(q0[i]), 3), lo, hi)), hint=name,
+                )  # fmt: skip
+                slider.on_update(self._on_slider)
+                self.sliders.append(slider)
+        self.q = np.asarray(q0, dtype=np.float64)
+        self._refresh_targets()
+
+    def _on_slider(self, event: Any) -> None:
+        if getattr(self._sync, "on", False):
+            return
+        q = np.radians([float(s.value) for s in self.sliders])
+        self._guard(event, self.jog, q)
+
+    def jog(self, q: ArrayLike) -> JogStatus:
+        """Put the robot at ``q`` (rad): draw it, check limits and clearance, show the status."""
+        qa = np.asarray(q, dtype=np.float64).reshape(-1)
+        if len(qa) != len(self.sliders):
+            raise InputError(f"jog: {len(self.sliders)} joint values expected, got {len(qa)}")
+        self.q = qa
+        robot = self._app.robot
+        if robot is not None:
+            robot.stop()
+            robot.set_q(qa)
+        with self._programmatic():
+            for s, v in zip(self.sliders, np.degrees(qa), strict=True):
+                if abs(float(s.value) - v) > 1e-6:
+                    s.value = float(np.clip(round(v, 3), s.min, s.max))
+        with self._app.busy("checking the jogged pose"):
+            status: JogStatus = self._app.worker.call(lambda s: s.jog_status(qa))
+        self.last_status = status
+        colour = {"feasible": "green", "marginal": "orange", "infeasible": "red"}[status.status]
+        self.status_md.content = (
+            f"<span style='color:{colour}'>**{status.status}**</span>: {status.describe()}"
+        )
+        self._update_gizmo()
+        return status
+
+    def jog_to_selected(self) -> JogStatus:
+        """Jog to the selected point's probe pose (from its check)."""
+        sel = self._app.selected
+        check = None if sel is None else self._app.check_of(sel)
+        if check is None or check.q is None:
+            raise InputError("select a point whose probe pose was found (a reachable point)")
+        return self.jog(check.q)
+
+    # ---- TCP gizmo ---------------------------------------------------------------------------
+    def T_world_tcp(self) -> NDArray[np.float64]:
+        """``(4, 4)`` the TCP at the jogged joint values, world frame."""
+        q, tcp = self.q.copy(), self._tcp()
+        return np.asarray(self._app.worker.call(lambda s: s.T_world_tcp(q, tcp)))
+
+    def _update_gizmo(self) -> None:
+        if not self.drag_tcp.value or len(self.q) == 0:
+            if self._gizmo is not None:
+                self._gizmo.remove()
+                self._gizmo = None
+            return
+        T = self.T_world_tcp()
+        if self._gizmo is None:
+            self._gizmo = self._app.server.scene.add_transform_controls(
+                "/teach_tcp", scale=0.2, line_width=4.0, depth_test=False
+            )
+            self._gizmo.on_update(self._on_gizmo)
+        with self._programmatic():
+            self._gizmo.wxyz = quat_wxyz_from_matrix(T[:3, :3])
+            self._gizmo.position = T[:3, 3]
+
+    def _on_gizmo(self, event: Any) -> None:
+        if getattr(self._sync, "on", False):
+            return
+        g = event.target
+        self._guard(event, self.move_tcp, make_transform(matrix_from_quat_wxyz(g.wxyz), g.position))
+
+    def move_tcp(self, T_world_tcp: ArrayLike) -> JogStatus | None:
+        """Jog so that the TCP is at ``T_world_tcp`` (IK nearest the current joints: the
+        branch is kept); out of reach leaves the robot where it is and says so."""
+        T = np.asarray(T_world_tcp, dtype=np.float64)
+        q0, tcp = self.q.copy(), self._tcp()
+        q = self._app.worker.call(lambda s: s.ik_near(T, q0, tcp))
+        if q is None:
+            self.status_md.content = (
+                "<span style='color:red'>**out of reach**</span>: no joint values within the "
+                "limits put the TCP there; the robot stays where it was"
+            )
+            return None
+        return self.jog(q)
+
+    # ---- moves between points --------------------------------------------------------------
+    def draw_moves(self) -> dict[str, str]:
+        """Draw and check the joint moves between consecutive points of the plan (from each
+        feasible point's probe pose to the next one's, linear in joint space), while the box is
+        ticked; say which collide. Recomputed when the box is ticked again."""
+        scene = self._app.server.scene
+        scene.remove_by_name("/moves")
+        self.moves = {}
+        if not self.show_moves.value:
+            self.moves_md.content = ""
+            return self.moves
+        doc, checks, tcp = self._app.state.doc, self._app.checks(), self._tcp()
+        posed = [
+            (p.id, c.q)
+            for p in doc.points
+            if (c := checks.get(p.id)) is not None and c.q is not None and c.status != "infeasible"
+        ]
+        lines = []
+        for (a, qa), (b, qb) in itertools.pairwise(posed):
+            move = self._app.worker.call(lambda s, qa=qa, qb=qb: s.check_move(qa, qb, tcp))
+            self.moves[f"{a}->{b}"] = move.problem
+            rgb = (215, 40, 40) if move.problem else (40, 170, 60)
+            path = move.tcp_path_world
+            scene.add_line_segments(
+                f"/moves/{a}_{b}",
+                points=np.stack([path[:-1], path[1:]], axis=1),
+                colors=rgb,
+                thickness=2.0,
+                thickness_units="screen",
+            )
+            lines.append(f"- {a} → {b}: {move.problem or 'clear'}")
+        skipped = [p.id for p in doc.points if p.id not in dict(posed)]
+        if skipped:
+            lines.append(f"- left out (no feasible pose): {', '.join(skipped)}")
+        self.moves_md.content = "\n".join(lines) or "no two points with a pose"
+        return self.moves
+
+    # ---- teach -----------------------------------------------------------------------------
+    def teach(self, target: str) -> str:
+        """Teach the jogged pose as ``target``'s approach (``"new point"``: the next free id):
+        the point is where the sensor axis meets the part, the search starts at the TCP.
+
+        Returns:
+            The taught point's id.
+
+        Raises:
+            InputError: no robot or part, or the sensor axis does not meet the part.
+        """
+        picker, view = self._app.picker, self._app.view
+        if picker is None or view is None or len(self.q) == 0:
+            raise InputError("load a plan with a robot and a work object first")
+        T = self.T_world_tcp()
+        axis, origin = T[:3, 2], T[:3, 3]
+        hit = picker.pick(origin - BEHIND_M * axis, axis)
+        if hit is None:
+            raise InputError(
+                "the sensor axis does not meet the work object: jog the sensor to point at it"
+            )
+        hit_world = transform_points(view.T_world_wobj, hit.position_wobj)
+        start = float((hit_world - origin) @ axis)
+        doc = self._app.state.doc
+        pid = plan_doc.next_id(doc) if target == NEW_POINT else target
+
+        def edit(d: plan_doc.UiPlan) -> plan_doc.UiPlan:
+            d = plan_doc.place_point(d, pid, hit.position_wobj, hit.normal_wobj)
+            s = d.get(pid).probe.search
+            if start < MIN_START_M:  # the TCP is at or inside the surface: keep the offset
+                return d
+            return plan_doc.edit_search(
+                d, pid, kind=s.kind, start_offset_m=start, overtravel_m=s.overtravel_m,
+                edge_direction=s.edge_direction,
+            )  # fmt: skip
+
+        self._app.state.update(edit, f"teach {pid}")
+        self._app.select(pid)
+        return pid
