@@ -3,8 +3,8 @@
 :func:`suggest_plan` takes a plan (its cell, part, sensor, noise figures, misplacement and
 points of interest) and proposes the points:
 
-1. candidates on the part's planar faces whose sensor footprint, grown by the in-plane shift
-   the misplacement allows, lies on the face (:mod:`planner.faces.candidates`); approach
+1. candidates on the part's planar faces whose sensor footprint lies on the face with a
+   floor of margin (:mod:`planner.faces.candidates`); approach
    searches started and run long enough for the misplacement
    (:class:`planner.export.safety.SafetySpec`, as the exported programs and the validation's
    preflight size them), so they still hit their face;
@@ -13,7 +13,10 @@ points of interest) and proposes the points:
    and, for every point the design picks, the search path
    (:meth:`~planner.cell.cell.Cell.check_search`; a blocked one is dropped and the design redone);
 3. chosen by :func:`calib.estimators.design.select` (greedy plus exchange on the information
-   matrix, minimising the largest error over the points of interest), growing the number of
+   matrix, minimising the largest error over the points of interest), ordered for measuring
+   (:mod:`planner.suggest_order`: each point's footprint, grown by the in-plane shift left by
+   the points measured before it, the whole misplacement for the first ones, stays on its
+   face; points that fit in no order are set aside and the design redone), growing the number of
    points until the predicted error at every point of interest holds ``target_m`` at the
    confidence, or ``max_points`` is reached (3-2-1: six points, every ordered triple of faces);
 4. the written plan's quality predicted exactly (:func:`planner.check.plan_quality`: the
@@ -41,9 +44,11 @@ from planner.check import plan_quality
 from planner.export.safety import SafetySpec
 from planner.faces.candidates import Candidates, FaceTried, face_candidates
 from planner.faces.detection import find_planar_faces
+from planner.faces.outline import FaceOutlines
 from planner.plan_cell import open_cell
 from planner.sim.report_points import poi_rows
 from planner.sim.rows import RowSpec, z_values
+from planner.suggest_order import FLOOR_M, Sequencer
 from planner.suggest_steps import (
     Context,
     SuggestProgress,
@@ -118,6 +123,12 @@ def _pois(plan: Plan, mesh: object, at_m: FloatArray | None) -> list[RowSpec]:
         ]
         spec = msgspec.structs.replace(spec, points_of_interest=pts)
     return poi_rows(spec, mesh)  # type: ignore[arg-type]
+
+
+def _event_var(plan: Plan) -> float:
+    """The event variance of one approach search, m^2 (as the design's rows)."""
+    s = plan.validation.sensor.search_noise("approach", 0.003).sensor_sigma_m
+    return float(s**2 + plan.validation.robot_error.repeatability_sigma_m**2)
 
 
 def suggest_plan(
@@ -197,8 +208,8 @@ def suggest_plan(
         raise SuggestError(f"no layout: {exc}") from None
     m = plan.validation.misplacement
 
-    def shift(P: FloatArray) -> FloatArray:
-        return np.full(len(P), m.max_translation_m)
+    def shift(P: FloatArray) -> FloatArray:  # the least any search is off: the floor
+        return np.full(len(P), FLOOR_M)
 
     say("candidates", 0, len(faces.faces))
     cands = face_candidates(faces, r, per_face, shift)
@@ -225,18 +236,30 @@ def suggest_plan(
     corners = np.array(
         [[x, y, w] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for w in (lo[2], hi[2])]
     )
-    ctx = Context(cell, plan, pool, safety, rows_poi, z, r, corners)
     fixed = fixed_rows(plan) if add else None
+    old = [p.to_probe_point() for p in plan.points] if add else []
+    sequencer = Sequencer(
+        FaceOutlines(faces, r),
+        pool.positions_m,
+        pool.normals,
+        pool.face,
+        m,
+        _event_var(plan),
+        np.array([p.position_m for p in old]).reshape(-1, 3),
+        np.array([p.normal for p in old]).reshape(-1, 3),
+    )
+    ctx = Context(cell, plan, pool, safety, rows_poi, z, r, corners, sequencer, tuple(old))
     if procedure == "three_two_one":
         design, history = three_two_one_design(ctx, say)
     else:
         design, history = best_fit_design(ctx, target_m, max_points, add, fixed, say)
     if design is None:
         raise SuggestError(
-            "no layout fixes all 6 degrees of freedom with the feasible candidates (the "
-            "footprint is grown by the misplacement's translation, "
-            f"{plan.validation.misplacement.max_translation_m * 1e3:.1f} mm): "
-            + faces_text(tried, pool, ctx)
+            "no layout fixes all 6 degrees of freedom with the feasible candidates (each "
+            "footprint grown by the in-plane shift it has when measured: the whole "
+            f"misplacement, {plan.validation.misplacement.max_translation_m * 1e3:.1f} mm and "
+            f"{math.degrees(plan.validation.misplacement.max_angle_rad):.2f} deg, for the "
+            "first points): " + faces_text(tried, pool, ctx)
         )
     new_plan = suggested_plan(plan, ctx, design, procedure, add, at_m)
     say("prediction", 0, 1)

@@ -26,6 +26,7 @@ from planner.export.safety import SafetySpec
 from planner.faces.candidates import Candidates, FaceTried
 from planner.plan_cell import nominal_T_base_wobj
 from planner.sim.rows import RowSpec, predicted_sigma
+from planner.suggest_order import Ordered, Sequencer
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
@@ -60,8 +61,12 @@ class Context:
     z: float
     radius_m: float
     corners: FloatArray | None = None
+    sequencer: Sequencer | None = None
+    fixed_points: tuple[ProbePoint, ...] = ()
     path_ok: dict[int, bool] = field(default_factory=dict)
     path_why: dict[int, str] = field(default_factory=dict)
+    #: candidates a design picked whose footprint left their face in every order tried
+    off_face: set[int] = field(default_factory=set)
 
     @property
     def poi(self) -> list[FloatArray]:
@@ -97,6 +102,30 @@ class Context:
             if self.probe(i, "c").search != old[i]:
                 self.path_ok.pop(i, None)
         return self.paths_ok(chosen)
+
+    def sequence(self, chosen: tuple[int, ...], quota: dict[int, int] | None) -> Ordered:
+        """The measuring order of ``chosen`` (3-2-1: by ``quota``, largest group first) and
+        the candidates whose footprint leaves their face in it."""
+        if self.sequencer is None:
+            return Ordered(chosen, ())
+        if quota is None:
+            return self.sequencer.order_progressive(chosen)
+        face = self.pool.face
+        groups = [
+            [i for i in chosen if int(face[i]) == f] for f in sorted(quota, key=lambda f: -quota[f])
+        ]
+        return self.sequencer.order_groups(groups)
+
+    def weak(self, chosen: tuple[int, ...]) -> bool:
+        """The layout (with the plan's points when adding) is rated weak by the check
+        (noise gain above :data:`calib.estimators.observability.WEAK_NOISE_GAIN`)."""
+        from calib.estimators.observability import WEAK_NOISE_GAIN, analyze_layout
+
+        pts = [self.probe(i, f"c{i}") for i in chosen]
+        if self.fixed_points:
+            pts = list(self.fixed_points) + pts
+        gain = analyze_layout(search_constraint_set(pts)).noise_gain
+        return not gain <= WEAK_NOISE_GAIN
 
     def worst(self, cov: FloatArray) -> float:
         if not np.all(np.isfinite(cov)):
@@ -167,8 +196,9 @@ def fixed_rows(plan: Plan) -> tuple[FloatArray, FloatArray]:
 def _select_feasible(ctx: Context, n: int, **kw: object) -> Design | None:
     """The design of ``n`` points whose search paths are all feasible (blocked ones dropped)."""
     A, var = ctx.rows()
+    stuck: set[int] = set()
     for _ in range(50):
-        blocked = np.array([ctx.path_ok.get(i, True) is False for i in range(len(A))])
+        blocked = np.array([ctx.path_ok.get(i, True) is False or i in stuck for i in range(len(A))])
         d = select(
             A,
             var,
@@ -183,6 +213,14 @@ def _select_feasible(ctx: Context, n: int, **kw: object) -> Design | None:
         )
         if len(d.chosen) < n or not np.isfinite(d.score):
             return None
+        ordered = ctx.sequence(d.chosen, kw.get("quota"))  # type: ignore[arg-type]
+        if ordered.stuck:
+            assert ctx.sequencer is not None  # stuck points come from it
+            stuck.update(ordered.stuck)
+            stuck.update(ctx.sequencer.alike(ordered.stuck))
+            ctx.off_face.update(ordered.stuck)
+            continue
+        d = dataclasses.replace(d, chosen=ordered.order)
         if ctx.paths_ok(d.chosen) and ctx.size_searches(d.chosen):
             return d
     return None
@@ -213,8 +251,8 @@ def best_fit_design(
         worst = ctx.worst(d.covariance)
         history.append((n + (len(fixed[0]) if fixed is not None else 0), worst))
         best, start = d, d.chosen
-        if target_m is not None and worst <= target_m:
-            break
+        if target_m is not None and worst <= target_m and not ctx.weak(d.chosen):
+            break  # a layout the check would call weak grows on
     return best, history
 
 
@@ -324,12 +362,17 @@ def faces_text(tried: tuple[FaceTried, ...], pool: Candidates, ctx: Context) -> 
         idx = np.flatnonzero(pool.face == f.face_id)
         n = len(idx)
         blocked = [ctx.path_why[int(i)] for i in idx if ctx.path_ok.get(int(i)) is False]
+        off = sum(int(i) in ctx.off_face for i in idx)
+        aside = (
+            f", {off} set aside (footprint off the face in every measuring order)" if off else ""
+        )
         if n and len(blocked) == n:
             parts.append(f"{f.name}: every search path blocked (e.g. {blocked[0]})")
         elif n:
             parts.append(
                 f"{f.name}: {n} feasible poses"
                 + (f", {len(blocked)} search paths blocked" if blocked else "")
+                + aside
             )
         elif f.kept == 0:
             parts.append(f"{f.name}: footprint ({f.footprint_reason})")
@@ -351,6 +394,5 @@ def nothing_message(tried: tuple[FaceTried, ...], rejected: dict[str, int], n: i
     why = ", ".join(f"{k} {v}" for k, v in sorted(rejected.items())) or "none checked"
     return (
         f"no feasible candidate: {n} candidates on {len(tried)} planar faces, none with a "
-        f"feasible probe pose (dropped: {why}). Faces tried: {faces}. The footprint is grown "
-        "by the in-plane shift the plan's misplacement allows."
+        f"feasible probe pose (dropped: {why}). Faces tried: {faces}."
     )

@@ -2,7 +2,8 @@
 
 Per planar face (:func:`planner.faces.detection.find_planar_faces` with the sensor's
 footprint): area-weighted samples on its triangles (fixed seed), kept where the footprint
-*grown by the part's possible in-plane shift* lies wholly on the face
+*grown by a shift margin* (``shift_m``; ``wobjcal suggest`` passes a floor and checks
+each chosen point's real shift in its measuring order) lies wholly on the face
 (:func:`planner.faces.checks.check_probe_faces`: not over a hole or an edge even when the part
 lies misplaced), then thinned by farthest-point sampling so the candidates spread over the
 face, its extremes included. Every face tried is reported with what stopped its samples.

@@ -1,0 +1,71 @@
+"""A planar face's outline in its own plane, to check a footprint that may shift on it.
+
+:class:`FaceOutlines` projects each planar face's triangles into the face's in-plane basis
+(:func:`calib.estimators.steering.plane_basis` of its normal), unions them (holes and notches
+stay open) and erodes the union by the sensor's footprint radius: a footprint centred at ``c``
+lies wholly on the face exactly when ``c`` lies in that eroded region. A search whose point
+may land anywhere in a convex set of in-plane shifts (``steering.shift_outline``) keeps its
+footprint on the face when the point plus that set, grown by a floor, lies in it
+(:meth:`FaceOutlines.holds`). Outlines are built on first use, per face.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+from numpy.typing import NDArray
+
+from calib.estimators.steering import plane_basis
+from planner.faces.detection import PlanarFaces
+
+FloatArray = NDArray[np.float64]
+
+#: Welds the projected triangles (float noise between neighbours), metres.
+_WELD_M = 1e-7
+
+
+class FaceOutlines:
+    """The eroded in-plane outlines of a part's planar faces (wobj frame, metres)."""
+
+    def __init__(self, faces: PlanarFaces, footprint_radius_m: float) -> None:
+        """Args:
+        faces: the part's planar faces.
+        footprint_radius_m: the sensor footprint's radius, metres.
+        """
+        self._faces = faces
+        self._radius = float(footprint_radius_m)
+        self._free: dict[int, shapely.Geometry] = {}
+
+    def basis(self, face_id: int) -> FloatArray:
+        """``(3, 2)`` the face's in-plane basis."""
+        return plane_basis(self._faces.faces[face_id].normal)
+
+    def free(self, face_id: int) -> shapely.Geometry:
+        """Where a footprint's centre may lie on the face, in :meth:`basis` coordinates."""
+        if face_id not in self._free:
+            tri = np.asarray(self._faces.mesh.triangles, dtype=np.float64)
+            mine = tri[self._faces.face_id == face_id]  # (T, 3, 3)
+            uv = mine @ self.basis(face_id)  # (T, 3, 2)
+            polys = shapely.polygons(uv)
+            face = shapely.union_all(polys).buffer(_WELD_M)
+            self._free[face_id] = face.buffer(-(self._radius + _WELD_M))
+        return self._free[face_id]
+
+    def holds(
+        self, face_id: int, point_m: FloatArray, shifts_m: FloatArray, floor_m: float
+    ) -> bool:
+        """The footprint at ``point_m`` (``(3,)``, on the face) stays on the face for every
+        shift in the convex hull of ``shifts_m`` (``(M, 2)``, in :meth:`basis` coordinates,
+        metres), grown by ``floor_m``."""
+        c = np.asarray(point_m, dtype=np.float64) @ self.basis(face_id)
+        pts = c[None, :] + np.asarray(shifts_m, dtype=np.float64).reshape(-1, 2)
+        region = shapely.MultiPoint(pts).convex_hull.buffer(max(floor_m, _WELD_M), quad_segs=4)
+        return bool(self.free(face_id).contains(region))
+
+    def clearance_m(self, face_id: int, point_m: FloatArray) -> float:
+        """How far the footprint at ``point_m`` may move in any direction and stay on the
+        face, metres (negative: it is already off)."""
+        free = self.free(face_id)
+        c = shapely.Point(np.asarray(point_m, dtype=np.float64) @ self.basis(face_id))
+        d = float(free.boundary.distance(c))
+        return d if free.contains(c) else -d

@@ -1,0 +1,155 @@
+"""The order a suggested layout is measured in, and its footprints checked for that order.
+
+A search is commanded in the frame estimated from the searches before it
+(:mod:`calib.estimators.steering`), so how far it lands from its nominal spot depends on what
+was measured first: the first points land anywhere the whole misplacement allows, a point on a
+side face measured after three points on the top is off in height only by noise, and so on.
+:class:`Sequencer` orders a chosen set so that every point's footprint, grown by the in-plane
+shift it will really have (the misplacement the earlier points leave times :data:`SAFETY`,
+plus :data:`NOISE_SIGMAS` of what their noise leaves, plus :data:`FLOOR_M`; the whole
+misplacement, plus the floor, for a point measured first), stays on its face
+(:class:`planner.faces.outline.FaceOutlines`), and names the points that fit in no order.
+
+Best fit (progressive, one point after another): greedy; of the points that fit now, the one
+after which most of the others fit. 3-2-1: the order of the roles (primary, secondary,
+tertiary), each group commanded in the estimate of the groups before it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from calib.estimators.layout import MIN_SCALE_M
+from calib.estimators.steering import (
+    ellipse_support,
+    inplane_noise_cov,
+    inplane_shift_maps,
+    shift_outline,
+)
+from calib.models import Misplacement
+from planner.faces.outline import FaceOutlines
+
+FloatArray = NDArray[np.float64]
+
+#: Factor on the in-plane shift left by earlier points (the first-order model, the noise).
+SAFETY = 1.5
+#: Added to every shift, metres: second-order terms of the rotation, model error.
+FLOOR_M = 0.25e-3
+#: Sigmas of the in-plane shift the earlier points' noise leaves (added to the outline).
+NOISE_SIGMAS = 4.0
+#: Candidates this close to a stuck one, and nearer the face's edges, are set aside with it.
+NEIGHBOUR_M = 0.02
+
+
+@dataclass(frozen=True)
+class Ordered:
+    """The order of a chosen set.
+
+    Attributes:
+        order: the chosen candidates in measuring order (all of them when ``stuck`` is empty).
+        stuck: candidates whose footprint leaves its face in every order tried.
+    """
+
+    order: tuple[int, ...]
+    stuck: tuple[int, ...]
+
+
+class Sequencer:
+    """Orders chosen candidates (indices into ``positions_m``) for the step-by-step procedure.
+
+    Args:
+        outlines: the part's face outlines with the sensor footprint.
+        positions_m: ``(C, 3)`` candidate points, wobj frame, metres.
+        normals: ``(C, 3)`` their faces' unit normals.
+        faces: ``(C,)`` their planar face ids.
+        misplacement: the plan's misplacement bound.
+        var_m2: the event variance of one search, m^2 (sensor and robot repeatability).
+        fixed_m: ``(F, 3)`` points measured before any candidate (``--add``), with
+            ``fixed_normals`` ``(F, 3)``.
+    """
+
+    def __init__(
+        self,
+        outlines: FaceOutlines,
+        positions_m: FloatArray,
+        normals: FloatArray,
+        faces: NDArray[np.int64],
+        misplacement: Misplacement,
+        var_m2: float,
+        fixed_m: FloatArray | None = None,
+        fixed_normals: FloatArray | None = None,
+    ) -> None:
+        self.outlines = outlines
+        self.P = positions_m
+        self.N = normals
+        self.face = faces
+        self.a = float(misplacement.max_translation_m)
+        self.b = float(misplacement.max_angle_rad)
+        self.var = float(var_m2)
+        self.fixed_m = np.zeros((0, 3)) if fixed_m is None else np.reshape(fixed_m, (-1, 3))
+        self.fixed_n = (
+            np.zeros((0, 3)) if fixed_normals is None else np.reshape(fixed_normals, (-1, 3))
+        )
+
+    def fits(self, i: int, earlier: Sequence[int], layout: Sequence[int]) -> bool:
+        """Candidate ``i``'s footprint stays on its face when measured after the fixed points
+        and ``earlier``, in a layout of the fixed points and ``layout`` (its centroid is the
+        misplacement's pivot and the update's centre)."""
+        allp = np.concatenate([self.fixed_m, self.P[list(layout)]])
+        c = allp.mean(axis=0)
+        L = max(float(np.sqrt(np.mean(np.sum((allp - c) ** 2, axis=1)))), MIN_SCALE_M)
+        X = np.concatenate([self.fixed_m, self.P[list(earlier)]])
+        Nn = np.concatenate([self.fixed_n, self.N[list(earlier)]])
+        G_t, G_w = inplane_shift_maps(self.P[i], self.N[i], X, Nn, c, L, c)
+        factor = SAFETY if len(X) else 1.0
+        cov = inplane_noise_cov(self.P[i], self.N[i], X, Nn, c, L, np.full(len(X), self.var))
+        shifts = factor * shift_outline(G_t, G_w, self.a, self.b) + ellipse_support(
+            cov, NOISE_SIGMAS
+        )
+        return self.outlines.holds(int(self.face[i]), self.P[i], shifts, FLOOR_M)
+
+    def alike(self, stuck: Sequence[int], radius_m: float = NEIGHBOUR_M) -> list[int]:
+        """Candidates as stuck as ``stuck``: on the same face, within ``radius_m`` of one,
+        and no farther from the face's edges and holes (what a design would pick next)."""
+        out: list[int] = []
+        for i in stuck:
+            f = int(self.face[i])
+            ci = self.outlines.clearance_m(f, self.P[i])
+            near = np.flatnonzero(
+                (self.face == f) & (np.linalg.norm(self.P - self.P[i], axis=1) <= radius_m)
+            )
+            out += [int(j) for j in near if self.outlines.clearance_m(f, self.P[j]) <= ci]
+        return out
+
+    def order_progressive(self, chosen: Sequence[int]) -> Ordered:
+        """Best fit: one point after another (see the module docstring)."""
+        layout = list(chosen)
+        left = list(chosen)
+        done: list[int] = []
+        while left:
+            now = [i for i in left if self.fits(i, done, layout)]
+            if not now:
+                return Ordered(tuple(done), tuple(left))
+
+            def after(i: int) -> int:
+                return sum(self.fits(j, [*done, i], layout) for j in left if j != i)
+
+            best = max(now, key=after) if len(now) > 1 else now[0]
+            done.append(best)
+            left.remove(best)
+        return Ordered(tuple(done), ())
+
+    def order_groups(self, groups: Sequence[Sequence[int]]) -> Ordered:
+        """3-2-1: groups measured one after the other, each in the estimate of the ones
+        before it."""
+        layout = [i for g in groups for i in g]
+        done: list[int] = []
+        stuck: list[int] = []
+        for g in groups:
+            stuck += [i for i in g if not self.fits(i, done, layout)]
+            done += list(g)
+        return Ordered(tuple(layout), tuple(stuck))
