@@ -41,6 +41,11 @@ def test_typing_a_position_and_applying_moves_the_part(demo: UiSession) -> None:
         lambda: abs(app.view.T_world_wobj[0, 3] - T0[0, 3] - 0.05) < 1e-9, what="the part moved"
     )
     wait_for(lambda: len(app.checks()) == 8, what="every point checked in the new cell")
+    # the cell is rebuilt before the plan changes: undo only once the change is in the plan
+    wait_for(
+        lambda: abs(pose_of(app.state.doc.source, WORK_OBJECT)[0, 3] - T0[0, 3] - 0.05) < 1e-9,
+        what="the move in the plan",
+    )
     open_tab(page, "Points")
     page.get_by_role("button", name="Undo", exact=True).click()
     wait_for(lambda: np.allclose(app.view.T_world_wobj, T0, atol=1e-12), what="undo")
@@ -49,6 +54,7 @@ def test_typing_a_position_and_applying_moves_the_part(demo: UiSession) -> None:
 def test_snap_button_rests_the_part_on_the_table(demo: UiSession) -> None:
     app, page = demo.app, demo.page
     open_tab(page, "Cell")
+    T0 = pose_of(app.state.doc.source, WORK_OBJECT)
     page.get_by_role("button", name="Snap part onto fixture").click()
     mesh, T_table = app.view.fixtures["table"]
     top = transform_points(T_table, mesh.vertices)[:, 2].max()
@@ -58,7 +64,10 @@ def test_snap_button_rests_the_part_on_the_table(demo: UiSession) -> None:
         return abs(low - top) < 1e-9
 
     wait_for(resting, what="the part on the table")
+    # the cell is rebuilt before the plan changes: undo only once the change is in the plan
+    wait_for(lambda: not np.allclose(pose_of(app.state.doc.source, WORK_OBJECT), T0), what="plan")
     app.state.undo()
+    wait_for(lambda: np.allclose(app.view.T_world_wobj, T0, atol=1e-12), what="undo")
 
 
 def test_jog_slider_and_teach_in_the_page(demo: UiSession, tmp_path: Path) -> None:
