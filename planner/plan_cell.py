@@ -18,6 +18,7 @@ from calib.plan.file import Plan, resolve_ref
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
+    from planner.cell.workobject import WorkObject
 
 FloatArray = NDArray[np.float64]
 
@@ -46,6 +47,33 @@ def resolved_refs(plan: Plan, plan_dir: Path) -> dict[str, str | Path]:
     }
 
 
+def plan_work_object(plan: Plan, plan_dir: Path, reach_m: float | None = None) -> WorkObject:
+    """The plan's work object in the work-object frame, metres: the one place every job (check,
+    validate, suggest, export, the UI) loads the part.
+
+    The mesh file (or built-in) is loaded in its ``units`` and lightly repaired
+    (:func:`planner.cell.workobject.load_work_object`), then put at
+    ``work_object.T_wobj_mesh`` (identity when the plan leaves it out).
+
+    Args:
+        plan: the plan.
+        plan_dir: the folder relative references resolve against.
+        reach_m: the robot's reach, m, for ``units: auto`` (default: the loader's).
+
+    Raises:
+        MeshError: the mesh cannot be loaded (the message names the file).
+    """
+    from planner.cell.workobject import WorkObject, load_work_object
+
+    wo = plan.work_object
+    loaded = load_work_object(resolve_ref(wo.mesh, plan_dir), units=wo.units, reach_m=reach_m)
+    if wo.mesh_pose is None:
+        return loaded
+    mesh = loaded.mesh.copy()
+    mesh.apply_transform(wo.mesh_matrix())
+    return WorkObject(name=loaded.name, mesh=mesh, report=loaded.report)
+
+
 def open_cell(plan: Plan, plan_dir: Path) -> Cell:
     """Build the plan's :class:`planner.cell.cell.Cell` (robot, tool, work object, fixtures).
 
@@ -69,10 +97,8 @@ def open_cell(plan: Plan, plan_dir: Path) -> Cell:
         T_flange_tool=None if mount is None else mount.matrix(),
     )
     try:
-        wo = plan.work_object
-        cell.set_work_object(
-            str(refs["work_object"]), units=wo.units, T_world_wobj=wo.T_world_wobj.matrix()
-        )
+        wobj = plan_work_object(plan, plan_dir, reach_m=cell.reach_model.reach_m)
+        cell.set_work_object(wobj, T_world_wobj=plan.work_object.T_world_wobj.matrix())
         for f in plan.cell.fixtures:
             T = f.T_world_fixture.matrix()
             if f.box_size_m is not None:
@@ -146,6 +172,7 @@ __all__ = [
     "T_base_world",
     "nominal_T_base_wobj",
     "open_cell",
+    "plan_work_object",
     "resolved_refs",
     "tool_data",
 ]

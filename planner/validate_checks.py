@@ -22,7 +22,7 @@ from calib.errors import InputError
 from calib.estimators.layout import search_constraint_set
 from calib.estimators.observability import analyze_layout
 from calib.models import Misplacement, RobotErrorModel
-from calib.plan.file import Plan, PlanError, resolve_ref
+from calib.plan.file import Plan, PlanError
 from calib.procedures import RolePoint, procedure_kind
 from planner.export.safety import SafetySpec
 from planner.parts.stator import StatorGeometry
@@ -123,12 +123,13 @@ def check_simulatable(plan: Plan) -> ValidationModels:
             f"by its edge coordinate only): {free}"
         )
     geometry = None
-    if plan.work_object.mesh in SIMULATED_PARTS:
+    if plan.work_object.mesh in SIMULATED_PARTS and plan.work_object.mesh_pose is None:
         geometry = getattr(StatorGeometry, SIMULATED_PARTS[plan.work_object.mesh])()
     if getattr(plan.procedure, "xoffset", None) is not None and geometry is None:
         raise PlanError(
             "procedure.xoffset: the x-offset run is simulated only on a built-in stator "
-            f"(its true slot holes), not on {plan.work_object.mesh!r}"
+            f"(its true slot holes) in its own frame (no work_object.T_wobj_mesh), not on "
+            f"{plan.work_object.mesh!r}"
         )
     return ValidationModels(
         sensor=v.sensor,
@@ -144,7 +145,8 @@ def check_simulatable(plan: Plan) -> ValidationModels:
 
 def work_object_mesh(plan: Plan, plan_dir: Path, models: ValidationModels) -> trimesh.Trimesh:
     """The true part's mesh in wobj, metres: a built-in stator's from its geometry, else the
-    plan's file (or built-in) loaded in its units and lightly repaired, as the cell does.
+    plan's file (or built-in) as every job loads it (:func:`planner.plan_cell.plan_work_object`:
+    its units, light repair, ``work_object.T_wobj_mesh``).
 
     Raises:
         InputError: the mesh cannot be loaded (the message names the file).
@@ -153,10 +155,9 @@ def work_object_mesh(plan: Plan, plan_dir: Path, models: ValidationModels) -> tr
         from planner.parts.stator_mesh import build_stator_mesh
 
         return build_stator_mesh(models.geometry)
-    from planner.cell.workobject import load_work_object
+    from planner.plan_cell import plan_work_object
 
-    wo = plan.work_object
-    return load_work_object(resolve_ref(wo.mesh, plan_dir), units=wo.units).mesh
+    return plan_work_object(plan, plan_dir).mesh
 
 
 def preflight(plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh) -> None:

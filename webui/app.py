@@ -31,7 +31,7 @@ from webui.plan_adapter import autosave_bytes, plan_point, with_source
 from webui.plan_doc import UiPlan
 from webui.robot_view import RobotView, robot_view_or_reason
 from webui.role_check import RoleFlags, role_flags
-from webui.scene import MARKER_RADIUS_M, PlanScene, legend_html
+from webui.scene import MARKER_RADIUS_M, PlanScene
 from webui.state import DEFAULT_AUTOSAVE, Change, SessionState
 from webui.surface import SurfacePicker, marker_on_ray
 from webui.tabs import AppTabs
@@ -65,6 +65,7 @@ class WobjcalApp:
             calibrate_panel,
             cell_panel,
             files_panel,
+            frame_panel,
             layout_panel,
             points_panel,
             teach_panel,
@@ -74,7 +75,7 @@ class WobjcalApp:
         self.server = server
         self.plan_dir = Path(plan_dir)
         self.busy = BusyIndicator(server.gui)
-        self._add_view_bar()
+        clients.add_view_bar(server, lambda: self.view, self.notify)
         self.tabs = AppTabs(server.gui)
         self.scene = PlanScene(server)
         self.state: SessionState[UiPlan] = SessionState(
@@ -96,6 +97,7 @@ class WobjcalApp:
         self.heatmap = HeatMap(self)
         self.points_panel = points_panel.PointsPanel(self)
         self.cell_panel = cell_panel.CellPanel(self)
+        self.frame_panel = frame_panel.FramePanel(self)  # 3-point work-object frame
         self.teach_panel = teach_panel.TeachPanel(self)
         self.validate_panel = validate_panel.ValidatePanel(self)
         self.files_panel = files_panel.FilesPanel(self)
@@ -338,21 +340,6 @@ class WobjcalApp:
     def tab(self, name: str) -> Any:
         """The control panel's tab ``name`` (a context for a panel's widgets)."""
         return self.tabs.tab(name)
-
-    def _add_view_bar(self) -> None:
-        """The view buttons (front, top, side, fit: each tab's own camera) and the legend."""
-        gui = self.server.gui
-        bar = gui.add_button_group("View", tuple(clients.VIEWS))
-        bar.on_click(self._on_view_button)
-        with gui.add_folder("Legend", expand_by_default=False):
-            gui.add_html(legend_html())
-
-    def _on_view_button(self, event: Any) -> None:
-        view = self.view
-        if view is None:
-            self.notify("View not changed", "no cell is loaded yet", client=event.client)
-            return
-        clients.frame_client(event.client, view, clients.VIEWS[str(event.target.value)])
 
     def _on_connect(self, client: viser.ClientHandle) -> None:
         if self.view is not None:

@@ -1,5 +1,5 @@
 """Pure edits of the cell of a plan: poses of the work object, the robot base and fixtures,
-and snapping the part onto a fixture's top face.
+snapping the part onto a fixture's top face, and a new work-object frame (3 points).
 
 Humans see millimetres and Tait-Bryan z-y'-x'' angles in degrees (``calib/frames.py``); the
 plan keeps metres and ``quat_wxyz``. Every function returns a new :class:`calib.plan.file.Plan`;
@@ -8,6 +8,8 @@ the UI makes it the session's in one undoable step (:meth:`webui.app.WobjcalApp.
 
 from __future__ import annotations
 
+import dataclasses
+
 import msgspec
 import numpy as np
 import trimesh
@@ -15,6 +17,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import InputError
 from calib.frames import (
+    check_transform,
+    invert_transform,
     make_transform,
     matrix_from_tait_bryan_zyx,
     tait_bryan_zyx_from_matrix,
@@ -22,6 +26,10 @@ from calib.frames import (
 )
 from calib.plan.cell import Pose
 from calib.plan.file import Plan
+from calib.plan.reframe import plan_in_frame
+from calib.user_frame import probe_point_in
+from webui.plan_adapter import with_source
+from webui.plan_doc import UiPlan
 
 #: What the cell panel can move: the work object, the robot base, or ``fixture:<name>``.
 WORK_OBJECT = "work object"
@@ -120,3 +128,20 @@ def snapped_onto(
     out = T.copy()
     out[:3, 3] += shift
     return out
+
+
+def reframed(ui: UiPlan, T_old_new: ArrayLike) -> UiPlan:
+    """``ui`` in a new work-object frame ``T_old_new`` (the new frame in the old, 4x4, m):
+    its points and its plan re-expressed, the part and the points unmoved in the world
+    (:func:`calib.plan.reframe.plan_in_frame`).
+
+    Raises:
+        InputError: no plan is loaded, or ``T_old_new`` is not a rigid transform.
+    """
+    if not isinstance(ui.source, Plan):
+        raise InputError("load a plan first: there is no work object to give a frame")
+    T_new_old = invert_transform(check_transform(T_old_new, "T_old_new"))
+    points = tuple(
+        dataclasses.replace(p, probe=probe_point_in(T_new_old, p.probe)) for p in ui.points
+    )
+    return with_source(dataclasses.replace(ui, points=points), plan_in_frame(ui.source, T_old_new))

@@ -10,6 +10,8 @@ camera is now; each moves only the camera of the tab whose button was pressed.
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import viser
@@ -140,3 +142,32 @@ def notify(
             with_close_button=True,
             auto_close_seconds=None if error else OK_SECONDS,
         )
+
+
+def add_view_bar(
+    server: viser.ViserServer,
+    view_of: Callable[[], CellView | None],
+    notify: Callable[..., None],
+) -> None:
+    """The view buttons (front, top, side, fit: each tab's own camera) and the colour legend.
+
+    Args:
+        server: the server whose control panel gets them.
+        view_of: the cell's current geometry (``None`` before a cell is loaded).
+        notify: ``notify(title, body, client=...)``: tells the tab why a button did nothing.
+    """
+    from webui.scene import legend_html
+
+    gui = server.gui
+    bar = gui.add_button_group("View", tuple(VIEWS))
+
+    def on_click(event: Any) -> None:
+        view = view_of()
+        if view is None:
+            notify("View not changed", "no cell is loaded yet", client=event.client)
+            return
+        frame_client(event.client, view, VIEWS[str(event.target.value)])
+
+    bar.on_click(on_click)
+    with gui.add_folder("Legend", expand_by_default=False):
+        gui.add_html(legend_html())

@@ -144,12 +144,26 @@ class WorkObjectSpec(Strict, frozen=True, kw_only=True):
         units: length unit of the mesh file (``auto`` lets the loader guess).
         sha256: hex digest of the mesh file; a mismatch on load is an error naming the file.
         T_world_wobj: nominal pose of the work-object frame (WOCS) in the world frame.
+        T_wobj_mesh: the mesh file's frame in the work-object frame (metres, after ``units``),
+            e.g. from a 3-point user frame taught on the part. Left out (default): identity,
+            the work-object frame is the file's. Read it through :meth:`mesh_matrix`.
     """
 
     mesh: str = "builtin:stator_section"
     units: MeshUnits = "m"
     sha256: str | None = None
     T_world_wobj: Pose = Pose()
+    T_wobj_mesh: Pose | msgspec.UnsetType = msgspec.UNSET
 
     def __post_init__(self) -> None:
         check_sha256(self.sha256, self.mesh, "sha256")
+
+    @property
+    def mesh_pose(self) -> Pose | None:
+        """``T_wobj_mesh`` when the plan sets it, else ``None`` (the identity)."""
+        return self.T_wobj_mesh if isinstance(self.T_wobj_mesh, Pose) else None
+
+    def mesh_matrix(self) -> NDArray[np.float64]:
+        """``(4, 4)`` ``T_wobj_mesh``: the mesh file's frame in the work-object frame."""
+        pose = self.mesh_pose
+        return np.eye(4) if pose is None else pose.matrix()
