@@ -133,11 +133,8 @@ class MeshRayCaster:
         idx = np.flatnonzero(tri >= 0)
         if len(idx) == 0:
             return out, tri_out
-        n = self._normals[tri[idx]]
-        denom = np.einsum("ij,ij->i", n, d[idx])
-        num = self._offsets[tri[idx]] - np.einsum("ij,ij->i", n, o[idx])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t = np.maximum(np.where(np.abs(denom) > 1e-15, num / denom, 0.0), 0.0)
+        denom, t = self._plane_hits(o[idx], d[idx], tri[idx], parallel=0.0)
+        t = np.maximum(t, 0.0)
         beyond = self._beyond_real_edge(o[idx] + t[:, None] * d[idx], tri[idx])
         if np.any(beyond):  # across a seam of one face: the ray hits the triangle next door
             b = np.flatnonzero(beyond)
@@ -180,27 +177,37 @@ class MeshRayCaster:
 
         Two triangles of one machined face stored in float32 (an STL) meet at 1e-8 to 1e-4
         rad; a ray through their seam may be reported on the one it grazes."""
-        p = o + t[:, None] * d
-        dist = np.einsum("kej,kj->ke", self._edge_normals[tri], p) - self._edge_offsets[tri]
+        dist = self._edge_distances(o + t[:, None] * d, tri)
         nb = self._neighbour[tri, np.argmin(dist, axis=1)]
         out_tri = np.full(len(tri), -1, dtype=np.int64)
         out_t = np.array(t, dtype=np.float64)
         has = np.flatnonzero(nb >= 0)
         if len(has) == 0:
             return out_tri, out_t
-        n = self._normals[nb[has]]
-        denom = np.einsum("ij,ij->i", n, d[has])
-        num = self._offsets[nb[has]] - np.einsum("ij,ij->i", n, o[has])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t_nb = np.where(np.abs(denom) > 1e-15, num / denom, np.inf)
+        _, t_nb = self._plane_hits(o[has], d[has], nb[has], parallel=np.inf)
         q = o[has] + np.where(np.isfinite(t_nb), t_nb, 0.0)[:, None] * d[has]
-        inside = (
-            np.einsum("kej,kj->ke", self._edge_normals[nb[has]], q) - self._edge_offsets[nb[has]]
-        ).min(axis=1) >= -1e-12 * self._scale
+        inside = self._edge_distances(q, nb[has]).min(axis=1) >= -1e-12 * self._scale
         ok = inside & (np.abs(t_nb - t[has]) <= 1e-7 * self._scale)
         out_tri[has[ok]] = nb[has[ok]]
         out_t[has[ok]] = np.maximum(t_nb[ok], 0.0)
         return out_tri, out_t
+
+    def _plane_hits(
+        self, o: FloatArray, d: FloatArray, tri: NDArray[np.int64], parallel: float
+    ) -> tuple[FloatArray, FloatArray]:
+        """``(denom, t)`` of rays ``(K,)`` against the planes of triangles ``tri``, float64:
+        ``denom = n . d`` (positive: the face seen from behind), ``t`` the distance along the
+        ray to the plane (``parallel`` where the ray runs parallel to it)."""
+        n = self._normals[tri]
+        denom = np.einsum("ij,ij->i", n, d)
+        num = self._offsets[tri] - np.einsum("ij,ij->i", n, o)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return denom, np.where(np.abs(denom) > 1e-15, num / denom, parallel)
+
+    def _edge_distances(self, p: FloatArray, tri: NDArray[np.int64]) -> FloatArray:
+        """``(K, 3)`` in-plane distances of points ``p`` inside the edges of triangles ``tri``
+        (edge opposite vertex k; negative: outside it), metres."""
+        return np.einsum("kej,kj->ke", self._edge_normals[tri], p) - self._edge_offsets[tri]
 
     def _beyond_real_edge(self, p: FloatArray, tri: NDArray[np.int64]) -> NDArray[np.bool_]:
         """True where hit points ``(K, 3)`` lie outside their triangle across a real edge."""
@@ -209,7 +216,7 @@ class MeshRayCaster:
         if len(check) == 0:
             return flags
         t = tri[check]
-        dist = np.einsum("kej,kj->ke", self._edge_normals[t], p[check]) - self._edge_offsets[t]
+        dist = self._edge_distances(p[check], t)
         worst = np.argmin(dist, axis=1)
         outside = dist[np.arange(len(t)), worst] < -1e-12 * self._scale
         flags[check] = outside & self._sharp[t, worst]
