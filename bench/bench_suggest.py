@@ -8,7 +8,9 @@
    against the hand-placed A-H, predicted (the procedure linearised) and simulated
    (``validate_plan``, ``--trials``), and against ``--random`` random feasible 8-point best-fit
    layouts drawn from the same candidate pool (predicted: median and best).
-3. Error against number of points: the suggestion with 6 ... ``--max`` points (predicted), and
+3. The machined plate: the suggestion at the hand-made plan's ten points against that plan,
+   predicted and simulated (``--trials``).
+4. Error against number of points: the suggestion with 6 ... ``--max`` points (predicted), and
    ``docs/img/suggest_points.png``.
 
 Run: ``python -m bench.bench_suggest [--trials 400] [--random 100] [--max 14]``; writes
@@ -116,6 +118,30 @@ def _large_part(ah: Any) -> dict[str, Any]:
     }
 
 
+def _plate(trials: int) -> dict[str, Any]:
+    """The machined plate (``plate_holes_best_fit.json``, touch probe, 10 hand-placed points):
+    the suggestion at the same number of points against the hand-made plan, predicted and
+    simulated (``validate_plan``, ``trials``), at the plan's point of interest."""
+    from planner.validate_checks import check_simulatable, work_object_mesh
+
+    hand = load_plan(PLANS / "plate_holes_best_fit.json")
+    mesh = work_object_mesh(hand, PLANS, check_simulatable(hand))
+    t = time.perf_counter()
+    sug = suggest_plan(hand, PLANS, max_points=len(hand.points))
+    dt = time.perf_counter() - t
+    out: dict[str, Any] = {"points": len(hand.points), "suggest_s": dt}
+    for name, plan in (("hand-made", hand), ("suggested", sug.plan)):
+        q, why = plan_quality(plan, mesh)
+        assert q is not None, why
+        keys = [p.key for p in q.poi]
+        out[name] = {
+            "n_points": len(plan.points),
+            "predicted": {p.key: p.at(LEVEL) * 1e3 for p in q.poi},
+            "simulated": _simulated(plan, trials, keys),
+        }
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the benchmark; print a summary and write the JSON."""
     ap = argparse.ArgumentParser(prog="python -m bench.bench_suggest", description=__doc__)
@@ -199,6 +225,8 @@ def main(argv: list[str] | None = None) -> int:
     comp["A-H_worst_mm"] = q_ah.worst_poi_m(LEVEL) * 1e3
     comp["suggested_8_worst_mm"] = s8.worst_m * 1e3
     out["stator_8"] = comp
+
+    out["plate_10"] = _plate(args.trials)
 
     curve = []
     for n in range(6, args.max + 1):

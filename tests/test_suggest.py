@@ -105,13 +105,9 @@ def test_plate_suggestion_lands_on_its_faces(reference_dir: Path) -> None:
     check = check_plan(res.plan, ASSETS)
     assert check.feasible, [(p.point_id, p.reason) for p in check.points if not p.feasible]
     report = validate_plan(res.plan, trials=200, seed=5, workers=1, plan_dir=ASSETS)
-    n_rays = plan.validation.sensor.n_rays  # type: ignore[union-attr]
-    for o in report.outcomes:
-        # one ray of the footprint in one search (seed 5: 1 of 400 at S3, 13 mm from any
-        # edge or hole, 5 mm of shift at most) is a ray through a triangle seam, not a
-        # footprint off its face; anything more fails
-        assert o.failed == {} and o.landed_off == 0, o
-        assert o.partly_off <= 1 and o.off_fraction_max <= 1.0 / n_rays + 1e-12, o
+    for o in report.outcomes:  # every ray of every footprint on its face (seams included:
+        # tests/test_raycast_seams.py)
+        assert o.failed == {} and o.landed_off == 0 and o.partly_off == 0, o
     (row,) = [r for r in report.rows if r.key == "xyz_farthest" and r.level_percent == 95.5]
     assert row.procedure <= 0.1  # simulated half-width, mm
     assert row.procedure == pytest.approx(row.procedure_predicted, rel=0.25)

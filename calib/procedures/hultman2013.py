@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Mapping, Sequence
+from functools import lru_cache
 from types import MappingProxyType
 
 import numpy as np
@@ -74,9 +75,13 @@ class Hultman2013Procedure:
         points_by_role(points)
         return list(points)
 
-    def _keyed(self, points: Sequence[RolePoint]) -> tuple[dict[str, ProbePoint], dict[str, str]]:
+    def _keyed(self, points: Sequence[RolePoint]) -> tuple[StatorLayout, dict[str, str]]:
         by_role = points_by_role(points)
-        return by_role, {role: p.id for role, p in by_role.items()}
+        ids = {role: p.id for role, p in by_role.items()}
+        try:
+            return _layout(tuple(by_role.items())), ids
+        except TypeError:  # a point holding a list is not hashable: validate it uncached
+            return check_stator_points(by_role), ids
 
     def run(
         self,
@@ -86,8 +91,8 @@ class Hultman2013Procedure:
         settings: object,
     ) -> ProcedureRun:
         """Run A-H step by step (:func:`calib.paper.stator_procedure.run_stator_procedure`)."""
-        by_role, ids = self._keyed(points)
-        res = run_stator_procedure(by_role, T_base_wobj_nominal, probe, _settings(settings))
+        layout, ids = self._keyed(points)
+        res = run_stator_procedure(layout, T_base_wobj_nominal, probe, _settings(settings))
         measured = {_key(k, ids): v for k, v in res.measured_m.items()}
         return ProcedureRun(res.T_base_wobj, tuple(ids[r] for r in ROLES), measured)
 
@@ -104,7 +109,7 @@ class Hultman2013Procedure:
         Raises:
             ProbeFailedError: the replay needs a point that was not measured.
         """
-        by_role, ids = self._keyed(points)
+        layout, ids = self._keyed(points)
         table: dict[str, FloatArray] = {}
         for role, pid in ids.items():
             if pid in measured:
@@ -115,7 +120,7 @@ class Hultman2013Procedure:
             else:
                 measured[pid]  # raises naming the point (and why it failed on the robot)
         res = run_stator_procedure(
-            by_role, T_base_wobj_nominal, probe_from_measurements(table), _settings(settings)
+            layout, T_base_wobj_nominal, probe_from_measurements(table), _settings(settings)
         )
         return ProcedureRun(
             res.T_base_wobj,
@@ -128,6 +133,15 @@ class Hultman2013Procedure:
         if self.role_problem([rp.role for rp in points], complete=True):
             return None
         return check_stator_points(points_by_role(points))
+
+
+@lru_cache(maxsize=16)
+def _layout(by_role: tuple[tuple[str, ProbePoint], ...]) -> StatorLayout:
+    """The validated A-H layout of ``by_role``, cached: the linearisation of one plan runs the
+    procedure on the same points once per search and sign (:mod:`calib.procedures.linearize`),
+    and validating them is about a tenth of a run. Keyed by value (frozen points), so a moved
+    point is a new key."""
+    return check_stator_points(dict(by_role))
 
 
 def _settings(settings: object) -> Hultman2013:

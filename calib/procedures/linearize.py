@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.errors import InputError
-from calib.frames import check_transform, invert_transform
+from calib.frames import check_transform
 from calib.models.sensor import SearchNoise, tool_rotation
 from calib.probing import Probe, ProbeResult, SearchCommand
 
@@ -72,16 +72,18 @@ class PlaneProbe:
         self.commands.append(cmd)
         d = np.asarray(cmd.direction, dtype=np.float64)
         stop = -d if cmd.stop_normal is None else np.asarray(cmd.stop_normal, dtype=np.float64)
-        T_move = self.T_base_wobj_true @ invert_transform(cmd.T_base_wobj_estimate)
-        p = T_move[:3, :3] @ np.asarray(cmd.nominal_m, dtype=np.float64) + T_move[:3, 3]
-        m = T_move[:3, :3] @ stop
+        T_est = cmd.T_base_wobj_estimate  # the estimate onto the true part: R_move, t_move
+        R_move = self.T_base_wobj_true[:3, :3] @ T_est[:3, :3].T
+        t_move = self.T_base_wobj_true[:3, 3] - R_move @ T_est[:3, 3]
+        p = R_move @ np.asarray(cmd.nominal_m, dtype=np.float64) + t_move
+        m = R_move @ stop
         denom = float(d @ m)
         if abs(denom) < 1e-9:
             return ProbeResult(None, "search runs parallel to the face that should stop it")
         start = np.asarray(cmd.start_m, dtype=np.float64)
         t = float((p - start) @ m) / denom
         if cmd.kind == "edge":  # the track's standoff where it crosses the edge
-            face_n = -(T_move[:3, :3] @ np.asarray(cmd.sensor_axis, dtype=np.float64))
+            face_n = -(R_move @ np.asarray(cmd.sensor_axis, dtype=np.float64))
             closer = -float((start + t * d - p) @ face_n)
             t += self.edge_offset_m + self.edge_axis_gain * closer
         t += float(self.eps.get(j, 0.0))

@@ -195,7 +195,7 @@ def layout_quality(setup: SimulationSetup, rows: Sequence[RowSpec]) -> LayoutQua
         return unobservable_quality(obs.messages, noise)
     cov = least_squares_covariance(setup)
     if cov is None:
-        cov = predict(setup).cov_procedure
+        cov = predict(setup, best_fit=False).cov_procedure
     return quality_from_covariance(cov, setup, rows, obs.noise_gain, obs.singular_values, noise)
 
 

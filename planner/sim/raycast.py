@@ -62,6 +62,7 @@ class MeshRayCaster:
         self._offsets = np.einsum("ij,ij->i", self._normals, tri[:, 0])
         self._triangles = tri
         self._sharp = self._sharp_local_edges(mesh)
+        self._neighbour = self._local_neighbours(mesh)
         self._has_sharp: NDArray[np.bool_] = np.any(self._sharp, axis=1)
         # inward in-plane normals of the edge opposite each vertex, and their offsets
         edge_dir = tri[:, [2, 0, 1]] - tri[:, [1, 2, 0]]  # (F, 3 edges, 3)
@@ -81,6 +82,22 @@ class MeshRayCaster:
         smooth = np.isin(eu[:, 0] * nv + eu[:, 1], ae[:, 0] * nv + ae[:, 1])
         # faces_unique_edges columns are the edges (a, b), (b, c), (c, a)
         return ~smooth[np.asarray(mesh.faces_unique_edges)[:, [1, 2, 0]]]
+
+    @staticmethod
+    def _local_neighbours(mesh: trimesh.Trimesh) -> NDArray[np.int64]:
+        """``(F, 3)``: the triangle across a face's edge opposite vertex k (``-1``: none)."""
+        ue = np.asarray(mesh.faces_unique_edges, dtype=np.int64)[:, [1, 2, 0]]
+        out = np.full(ue.shape, -1, dtype=np.int64)
+        flat_e, flat_f = ue.ravel(), np.repeat(np.arange(len(ue)), 3)
+        order = np.argsort(flat_e, kind="stable")
+        e, f = flat_e[order], flat_f[order]
+        pair = np.flatnonzero(e[1:] == e[:-1])  # an edge shared by two faces (manifold)
+        first, second = f[pair], f[pair + 1]
+        slot = np.arange(3)
+        for a, b in ((first, second), (second, first)):
+            k = np.argmax(ue[a] == e[pair][:, None], axis=1)
+            out[a, slot[k]] = b
+        return out
 
     def first_hits(self, origins: FloatArray, directions: FloatArray) -> FloatArray:
         """Distance along each ray to the first surface it meets, metres.
@@ -116,12 +133,16 @@ class MeshRayCaster:
         idx = np.flatnonzero(tri >= 0)
         if len(idx) == 0:
             return out, tri_out
-        n = self._normals[tri[idx]]
-        denom = np.einsum("ij,ij->i", n, d[idx])
-        num = self._offsets[tri[idx]] - np.einsum("ij,ij->i", n, o[idx])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t = np.maximum(np.where(np.abs(denom) > 1e-15, num / denom, 0.0), 0.0)
+        denom, t = self._plane_hits(o[idx], d[idx], tri[idx], parallel=0.0)
+        t = np.maximum(t, 0.0)
         beyond = self._beyond_real_edge(o[idx] + t[:, None] * d[idx], tri[idx])
+        if np.any(beyond):  # across a seam of one face: the ray hits the triangle next door
+            b = np.flatnonzero(beyond)
+            nb_tri, nb_t = self._neighbour_hits(o[idx[b]], d[idx[b]], t[b], tri[idx[b]])
+            on = nb_tri >= 0
+            tri[idx[b[on]]], t[b[on]] = nb_tri[on], nb_t[on]
+            denom[b[on]] = np.einsum("ij,ij->i", self._normals[nb_tri[on]], d[idx[b[on]]])
+            beyond[b[on]] = False
         keep = ~beyond
         out[idx[keep]] = np.where(denom[keep] > 0, 0.0, t[keep])  # back face: origin inside
         tri_out[idx[keep]] = tri[idx[keep]]
@@ -147,6 +168,47 @@ class MeshRayCaster:
         """Plane offset ``d`` of a triangle (or triangles): its plane is ``normal . x = d``, m."""
         return np.asarray(self._offsets[triangle], dtype=np.float64)
 
+    def _neighbour_hits(
+        self, o: FloatArray, d: FloatArray, t: FloatArray, tri: NDArray[np.int64]
+    ) -> tuple[NDArray[np.int64], FloatArray]:
+        """For rays ``(K,)`` that met ``tri`` at ``t`` just outside it: the triangle across the
+        edge they passed and the distance to it, where the ray meets that triangle inside it
+        (float64) within Embree's widening of ``t``; ``-1`` where it does not (a real edge).
+
+        Two triangles of one machined face stored in float32 (an STL) meet at 1e-8 to 1e-4
+        rad; a ray through their seam may be reported on the one it grazes."""
+        dist = self._edge_distances(o + t[:, None] * d, tri)
+        nb = self._neighbour[tri, np.argmin(dist, axis=1)]
+        out_tri = np.full(len(tri), -1, dtype=np.int64)
+        out_t = np.array(t, dtype=np.float64)
+        has = np.flatnonzero(nb >= 0)
+        if len(has) == 0:
+            return out_tri, out_t
+        _, t_nb = self._plane_hits(o[has], d[has], nb[has], parallel=np.inf)
+        q = o[has] + np.where(np.isfinite(t_nb), t_nb, 0.0)[:, None] * d[has]
+        inside = self._edge_distances(q, nb[has]).min(axis=1) >= -1e-12 * self._scale
+        ok = inside & (np.abs(t_nb - t[has]) <= 1e-7 * self._scale)
+        out_tri[has[ok]] = nb[has[ok]]
+        out_t[has[ok]] = np.maximum(t_nb[ok], 0.0)
+        return out_tri, out_t
+
+    def _plane_hits(
+        self, o: FloatArray, d: FloatArray, tri: NDArray[np.int64], parallel: float
+    ) -> tuple[FloatArray, FloatArray]:
+        """``(denom, t)`` of rays ``(K,)`` against the planes of triangles ``tri``, float64:
+        ``denom = n . d`` (positive: the face seen from behind), ``t`` the distance along the
+        ray to the plane (``parallel`` where the ray runs parallel to it)."""
+        n = self._normals[tri]
+        denom = np.einsum("ij,ij->i", n, d)
+        num = self._offsets[tri] - np.einsum("ij,ij->i", n, o)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return denom, np.where(np.abs(denom) > 1e-15, num / denom, parallel)
+
+    def _edge_distances(self, p: FloatArray, tri: NDArray[np.int64]) -> FloatArray:
+        """``(K, 3)`` in-plane distances of points ``p`` inside the edges of triangles ``tri``
+        (edge opposite vertex k; negative: outside it), metres."""
+        return np.einsum("kej,kj->ke", self._edge_normals[tri], p) - self._edge_offsets[tri]
+
     def _beyond_real_edge(self, p: FloatArray, tri: NDArray[np.int64]) -> NDArray[np.bool_]:
         """True where hit points ``(K, 3)`` lie outside their triangle across a real edge."""
         flags = np.zeros(len(tri), bool)
@@ -154,7 +216,7 @@ class MeshRayCaster:
         if len(check) == 0:
             return flags
         t = tri[check]
-        dist = np.einsum("kej,kj->ke", self._edge_normals[t], p[check]) - self._edge_offsets[t]
+        dist = self._edge_distances(p[check], t)
         worst = np.argmin(dist, axis=1)
         outside = dist[np.arange(len(t)), worst] < -1e-12 * self._scale
         flags[check] = outside & self._sharp[t, worst]
