@@ -8,6 +8,10 @@ points of interest) and proposes the points:
    searches started and run long enough for the misplacement
    (:class:`planner.export.safety.SafetySpec`, as the exported programs and the validation's
    preflight size them), so they still hit their face;
+   with a sensor that runs edge searches, when the approach candidates together leave a
+   motion free or weak, also edge searches toward the straight outer edges of those faces
+   (:mod:`planner.faces.edges`; each counts by its edge coordinate only, measured after the
+   approaches);
 2. feasible in the cell: the probe pose (:meth:`planner.cell.cell.Cell.check_probes`, six
    spread samples per face first, a face whose samples all fail is dropped with the reason)
    and, for every point the design picks, the search path
@@ -38,12 +42,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.errors import InputError
+from calib.estimators.layout import search_constraint_set
 from calib.plan.file import Plan, PlanError
 from calib.plan.report_spec import PointOfInterest
+from calib.probing import ProbePoint, SearchSpec
 from planner.check import plan_quality
 from planner.export.safety import SafetySpec
 from planner.faces.candidates import Candidates, FaceTried, face_candidates
 from planner.faces.detection import find_planar_faces
+from planner.faces.edges import edge_candidates
 from planner.faces.outline import FaceOutlines
 from planner.plan_cell import open_cell
 from planner.sim.report_points import poi_rows
@@ -129,6 +136,20 @@ def _event_var(plan: Plan) -> float:
     """The event variance of one approach search, m^2 (as the design's rows)."""
     s = plan.validation.sensor.search_noise("approach", 0.003).sensor_sigma_m
     return float(s**2 + plan.validation.robot_error.repeatability_sigma_m**2)
+
+
+def _approaches_weak(pool: Candidates) -> bool:
+    """All the approach candidates together leave a motion free or weak (the check's
+    rating): edge searches are then worth offering."""
+    from calib.estimators.observability import analyze_layout
+
+    if len(pool) == 0:
+        return True
+    pts = [
+        ProbePoint(f"c{i}", tuple(p), tuple(n), SearchSpec("approach"))
+        for i, (p, n) in enumerate(zip(pool.positions_m, pool.normals, strict=True))
+    ]
+    return analyze_layout(search_constraint_set(pts)).rating != "ok"
 
 
 def suggest_plan(
@@ -218,6 +239,19 @@ def suggest_plan(
     pool = cands.subset(feasible)
     if len(pool) == 0:
         raise SuggestError(nothing_message(tried, rejected, len(cands)))
+    outlines = FaceOutlines(faces, r)
+    lo, hi = mesh.bounds
+    # the most a point moves in its face when the part lies misplaced about its middle
+    worst_shift = m.max_translation_m + m.max_angle_rad * float(np.linalg.norm(hi - lo))
+    edge_start = r + 2.0 * worst_shift + 0.005
+    if sensor.runs_edge_searches and _approaches_weak(pool):
+        edges = edge_candidates(
+            outlines, sorted(set(pool.face.tolist())), r, edge_start, worst_shift + FLOOR_M
+        )
+        ok_e, rej_e = feasible_poses(cell, plan, edges, say)
+        for k, v in rej_e.items():
+            rejected[k] = rejected.get(k, 0) + v
+        pool = pool.joined(edges.subset(ok_e))
     pivot = pool.positions_m.mean(axis=0)  # the probed region: the misplacement's pivot
     safety = SafetySpec(
         max_translation_m=m.max_translation_m,
@@ -232,14 +266,13 @@ def suggest_plan(
         else float(rows_poi[0].levels_percent[0])
     )
     z = float(z_values((level,))[0])
-    lo, hi = mesh.bounds
     corners = np.array(
         [[x, y, w] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for w in (lo[2], hi[2])]
     )
     fixed = fixed_rows(plan) if add else None
     old = [p.to_probe_point() for p in plan.points] if add else []
     sequencer = Sequencer(
-        FaceOutlines(faces, r),
+        outlines,
         pool.positions_m,
         pool.normals,
         pool.face,
@@ -247,8 +280,10 @@ def suggest_plan(
         _event_var(plan),
         np.array([p.position_m for p in old]).reshape(-1, 3),
         np.array([p.normal for p in old]).reshape(-1, 3),
+        pool.is_edge,
     )
     ctx = Context(cell, plan, pool, safety, rows_poi, z, r, corners, sequencer, tuple(old))
+    ctx.edge_start_m, ctx.edge_overtravel_m = edge_start, 2.0 * worst_shift + 0.02
     if procedure == "three_two_one":
         design, history = three_two_one_design(ctx, say)
     else:

@@ -82,7 +82,9 @@ class Sequencer:
         var_m2: float,
         fixed_m: FloatArray | None = None,
         fixed_normals: FloatArray | None = None,
+        edge: NDArray[np.bool_] | None = None,
     ) -> None:
+        self.edge = np.zeros(len(positions_m), dtype=bool) if edge is None else edge
         self.outlines = outlines
         self.P = positions_m
         self.N = normals
@@ -126,14 +128,17 @@ class Sequencer:
         return out
 
     def order_progressive(self, chosen: Sequence[int]) -> Ordered:
-        """Best fit: one point after another (see the module docstring)."""
+        """Best fit: one point after another (see the module docstring); edge searches
+        last, once the approaches have fixed the height and tilts their tracks run at (their
+        tracks are checked on the face with the start the searches are sized for)."""
+        edges = [i for i in chosen if self.edge[i]]
         layout = list(chosen)
-        left = list(chosen)
+        left = [i for i in chosen if not self.edge[i]]
         done: list[int] = []
         while left:
             now = [i for i in left if self.fits(i, done, layout)]
             if not now:
-                return Ordered(tuple(done), tuple(left))
+                return Ordered(tuple(done + edges), tuple(left))
 
             def after(i: int) -> int:
                 return sum(self.fits(j, [*done, i], layout) for j in left if j != i)
@@ -141,7 +146,7 @@ class Sequencer:
             best = max(now, key=after) if len(now) > 1 else now[0]
             done.append(best)
             left.remove(best)
-        return Ordered(tuple(done), ())
+        return Ordered(tuple(done + edges), ())
 
     def order_groups(self, groups: Sequence[Sequence[int]]) -> Ordered:
         """3-2-1: groups measured one after the other, each in the estimate of the ones

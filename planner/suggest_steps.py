@@ -17,7 +17,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.estimators.design import Design, poi_jacobians, select
-from calib.estimators.layout import constraint_jacobian, search_constraint_set
+from calib.estimators.layout import (
+    constraint_jacobian,
+    point_motion_jacobian,
+    search_constraint_set,
+)
 from calib.plan.file import Plan, PlanPoint
 from calib.plan.report_spec import PointOfInterest, ReportSpec
 from calib.probing import ProbePoint, SearchCommand, SearchSpec
@@ -36,6 +40,8 @@ FloatArray = NDArray[np.float64]
 SuggestProgress = Callable[[str, int, int], None]
 #: Samples tried first on each face (a face whose samples all fail is dropped).
 PROBE_FIRST = 6
+#: Edge searches run this far inside the face along the sensor axis (as the simulation), m.
+EDGE_INSET_M = 0.003
 
 
 def _why(reason: str) -> str:
@@ -67,21 +73,62 @@ class Context:
     path_why: dict[int, str] = field(default_factory=dict)
     #: candidates a design picked whose footprint left their face in every order tried
     off_face: set[int] = field(default_factory=set)
+    #: edge searches: start inside the edge and travel past it, metres
+    edge_start_m: float = 0.0
+    edge_overtravel_m: float = 0.0
 
     @property
     def poi(self) -> list[FloatArray]:
+        """The design's points of interest; with edge candidates, also the height of each
+        edge track scaled by the sensor's edge gain (an edge search is commanded at the
+        height the approaches before it estimate, and its event moves by the gain times that
+        height's error), so the approaches are spread to fix the height along every edge."""
         pts = np.concatenate([r.points_wobj for r in self.rows_poi if r.points_wobj is not None])
-        return poi_jacobians(pts, [r.components for r in self.rows_poi])
+        out = poi_jacobians(pts, [r.components for r in self.rows_poi])
+        edge = np.flatnonzero(self.pool.is_edge)
+        if len(edge):
+            sensor = self.plan.validation.sensor
+            k = abs(sensor.search_noise("edge", EDGE_INSET_M).axis_gain)
+            J = point_motion_jacobian(self.pool.positions_m[edge])  # (E, 3, 6)
+            h = np.einsum("ek,ekj->ej", self.pool.normals[edge], J)
+            rows = out[0].shape[0]  # the design stacks them: zero rows pad to the same shape
+            out += [np.vstack([k * row, np.zeros((rows - 1, 6))]) for row in h]
+        return out
 
     def rows(self) -> tuple[FloatArray, FloatArray]:
-        A = constraint_jacobian(self.pool.normals, self.pool.positions_m)
+        """The design's rows: an approach constrains its face, an edge search only its edge
+        coordinate (its edge direction, the square edge's other face normal)."""
+        edge = self.pool.is_edge
+        normals = self.pool.normals.copy()
+        if edge.any():
+            assert self.pool.edge_dirs is not None
+            normals[edge] = self.pool.edge_dirs[edge]
+        A = constraint_jacobian(normals, self.pool.positions_m)
         sensor = self.plan.validation.sensor
-        s = sensor.search_noise("approach", 0.003).sensor_sigma_m
-        var = s**2 + self.plan.validation.robot_error.repeatability_sigma_m**2
-        return A, np.full(len(A), var)
+        rep2 = self.plan.validation.robot_error.repeatability_sigma_m**2
+        var = np.full(len(A), sensor.search_noise("approach", 0.003).sensor_sigma_m ** 2 + rep2)
+        if edge.any():
+            var[edge] = sensor.search_noise("edge", EDGE_INSET_M).sensor_sigma_m ** 2 + rep2
+        return A, var
 
     def probe(self, i: int, pid: str) -> ProbePoint:
         p = self.pool.positions_m[i]
+        if self.pool.is_edge[i]:
+            assert self.pool.edge_dirs is not None
+            d = tuple(float(c) for c in self.pool.edge_dirs[i])
+            edge = SearchSpec(
+                "edge",
+                start_offset_m=self.edge_start_m,
+                overtravel_m=self.edge_overtravel_m,
+                edge_direction=d,  # type: ignore[arg-type]
+            )
+            return ProbePoint(
+                pid,
+                tuple(float(c) for c in p),  # type: ignore[arg-type]
+                tuple(float(c) for c in self.pool.normals[i]),  # type: ignore[arg-type]
+                edge,
+                edge_normal=d,  # type: ignore[arg-type]
+            )
         search = SearchSpec(
             "approach",
             start_offset_m=max(0.015, self.safety.start_clearance_m(p)),
@@ -199,6 +246,8 @@ def _select_feasible(ctx: Context, n: int, **kw: object) -> Design | None:
     stuck: set[int] = set()
     for _ in range(50):
         blocked = np.array([ctx.path_ok.get(i, True) is False or i in stuck for i in range(len(A))])
+        if kw.get("quota") is not None:  # 3-2-1 takes approach searches only
+            blocked |= ctx.pool.is_edge
         d = select(
             A,
             var,

@@ -69,19 +69,47 @@ class Candidates:
         normals: ``(C, 3)`` their faces' unit outward normals, wobj frame.
         face: ``(C,)`` the planar face of each.
         faces: every planar face tried, with what stopped its samples.
+        edge_dirs: ``(C, 3)`` for an edge search, its unit direction of motion over the face
+            toward the edge (also the outward normal of the square edge's other face, whose
+            end it finds), zeros for an approach search; ``None``: approaches only.
     """
 
     positions_m: FloatArray = field(repr=False)
     normals: FloatArray = field(repr=False)
     face: IntArray = field(repr=False)
     faces: tuple[FaceTried, ...]
+    edge_dirs: FloatArray | None = field(default=None, repr=False)
 
     def __len__(self) -> int:
         return len(self.positions_m)
 
     def subset(self, keep: NDArray[np.bool_] | IntArray) -> Candidates:
         """The candidates ``keep`` (a mask or indices), with the same faces tried."""
-        return Candidates(self.positions_m[keep], self.normals[keep], self.face[keep], self.faces)
+        e = None if self.edge_dirs is None else self.edge_dirs[keep]
+        return Candidates(
+            self.positions_m[keep], self.normals[keep], self.face[keep], self.faces, e
+        )
+
+    @property
+    def is_edge(self) -> NDArray[np.bool_]:
+        """``(C,)`` which candidates are edge searches."""
+        if self.edge_dirs is None:
+            return np.zeros(len(self), dtype=bool)
+        return np.any(self.edge_dirs != 0.0, axis=1)
+
+    def joined(self, other: Candidates) -> Candidates:
+        """These candidates followed by ``other``'s (the faces tried are these)."""
+
+        def dirs(c: Candidates) -> FloatArray:
+            return np.zeros((len(c), 3)) if c.edge_dirs is None else c.edge_dirs
+
+        return Candidates(
+            np.concatenate([self.positions_m, other.positions_m]),
+            np.concatenate([self.normals, other.normals]),
+            np.concatenate([self.face, other.face]),
+            self.faces,
+            np.concatenate([dirs(self), dirs(other)]),
+        )
 
 
 def face_candidates(

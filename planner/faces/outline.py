@@ -35,20 +35,35 @@ class FaceOutlines:
         self._faces = faces
         self._radius = float(footprint_radius_m)
         self._free: dict[int, shapely.Geometry] = {}
+        self._face: dict[int, shapely.Geometry] = {}
 
     def basis(self, face_id: int) -> FloatArray:
         """``(3, 2)`` the face's in-plane basis."""
         return plane_basis(self._faces.faces[face_id].normal)
 
-    def free(self, face_id: int) -> shapely.Geometry:
-        """Where a footprint's centre may lie on the face, in :meth:`basis` coordinates."""
-        if face_id not in self._free:
+    def face(self, face_id: int) -> shapely.Geometry:
+        """The face itself (not eroded), in :meth:`basis` coordinates."""
+        if face_id not in self._face:
             tri = np.asarray(self._faces.mesh.triangles, dtype=np.float64)
             mine = tri[self._faces.face_id == face_id]  # (T, 3, 3)
             uv = mine @ self.basis(face_id)  # (T, 3, 2)
-            polys = shapely.polygons(uv)
-            face = shapely.union_all(polys).buffer(_WELD_M)
-            self._free[face_id] = face.buffer(-(self._radius + _WELD_M))
+            self._face[face_id] = shapely.union_all(shapely.polygons(uv)).buffer(_WELD_M)
+        return self._face[face_id]
+
+    def normal(self, face_id: int) -> FloatArray:
+        """``(3,)`` the face's unit outward normal."""
+        return np.asarray(self._faces.faces[face_id].normal, dtype=np.float64)
+
+    def height_m(self, face_id: int) -> float:
+        """The face plane's offset along its normal, metres (``normal . x`` on the face)."""
+        tri = np.asarray(self._faces.mesh.triangles, dtype=np.float64)
+        first = tri[self._faces.face_id == face_id][0, 0]
+        return float(self.normal(face_id) @ first)
+
+    def free(self, face_id: int) -> shapely.Geometry:
+        """Where a footprint's centre may lie on the face, in :meth:`basis` coordinates."""
+        if face_id not in self._free:
+            self._free[face_id] = self.face(face_id).buffer(-(self._radius + _WELD_M))
         return self._free[face_id]
 
     def holds(
