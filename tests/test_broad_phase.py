@@ -22,6 +22,7 @@ from planner.cell.collision import DEFAULT_MARGIN_M
 from planner.cell.feasibility import tcp_frames
 from planner.cell.pybullet_client import pb
 from planner.cell.reachability_map import sample_surface
+from tests.cells import add_box_on_table
 
 MARGIN = DEFAULT_MARGIN_M
 
@@ -29,17 +30,7 @@ MARGIN = DEFAULT_MARGIN_M
 @pytest.fixture(scope="module")
 def cell() -> Iterator[Cell]:
     with Cell(use_acl_cache=False) as c:
-        box = trimesh.creation.box([0.6, 0.5, 0.4]).subdivide_to_size(0.03)
-        c.set_work_object(box, "m", make_transform(p=[1.3, 0.1, 0.45]), name="part")
-        c.add_fixture(
-            "table", size_m=(1.0, 1.0, 0.05), T_world_fixture=make_transform(p=[1.3, 0, 0.225])
-        )
-        c.add_fixture(
-            "post",
-            radius_m=0.05,
-            height_m=0.6,
-            T_world_fixture=make_transform(p=[1.0, -0.45, 0.55]),
-        )
+        add_box_on_table(c, 0.03, (1.0, -0.45, 0.55))
         ball = trimesh.creation.icosphere(subdivisions=2, radius=0.08)
         c.add_fixture(
             "ball", mesh=ball, units="m", T_world_fixture=make_transform(p=[1.0, 0.45, 0.75])

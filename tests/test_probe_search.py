@@ -19,6 +19,7 @@ from planner.cell.cell import Cell
 from planner.cell.clearance import Clearance
 from planner.cell.probe_rule import CLEARANCE_TIE_M, least_bad, select
 from planner.cell.reachability_map import sample_surface
+from tests.cells import add_box_on_table
 
 
 def cl(slack: float, margin: float = 0.005) -> Clearance:
@@ -48,17 +49,7 @@ def cell() -> Iterator[Cell]:
     """A dense box on a table, a post beside it: probe poses near the table, the post, the
     part's edges and the robot's own links."""
     with Cell(use_acl_cache=False) as c:
-        box = trimesh.creation.box([0.6, 0.5, 0.4]).subdivide_to_size(0.02)
-        c.set_work_object(box, "m", make_transform(p=[1.3, 0.1, 0.45]), name="part")
-        c.add_fixture(
-            "table", size_m=(1.0, 1.0, 0.05), T_world_fixture=make_transform(p=[1.3, 0, 0.225])
-        )
-        c.add_fixture(
-            "post",
-            radius_m=0.05,
-            height_m=0.6,
-            T_world_fixture=make_transform(p=[1.05, -0.2, 0.75]),
-        )
+        add_box_on_table(c, 0.02, (1.05, -0.2, 0.75))
         yield c
 
 

@@ -28,6 +28,7 @@ from scipy.spatial import cKDTree
 from calib.errors import InputError
 from planner.cell.reachability_map import sample_surface
 from planner.faces.checks import check_probe_faces
+from webui.scene import STATUS_RGB
 
 if TYPE_CHECKING:
     from webui.backend import CellSession
@@ -39,8 +40,8 @@ logger = logging.getLogger(__name__)
 SCORE = {"infeasible": 0.0, "marginal": 0.5, "feasible": 1.0}
 #: What a sample's colour says, in legend order.
 CATEGORY_RGB: dict[str, tuple[int, int, int]] = {
-    "feasible": (40, 170, 60),
-    "marginal": (240, 165, 0),
+    "feasible": STATUS_RGB["feasible"],  # the markers' colours, so the legend agrees
+    "marginal": STATUS_RGB["marginal"],
     "reach": (150, 20, 20),
     "joint limit": (150, 70, 200),
     "collision": (235, 80, 30),

@@ -74,7 +74,13 @@ def _add(
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``wobjcal`` command."""
-    from planner.cli import calibrate, check, export, misc, suggest, validate
+    # each command group by its own module (not through the package, which imports this one)
+    import planner.cli.calibrate as calibrate
+    import planner.cli.check as check
+    import planner.cli.export as export
+    import planner.cli.misc as misc
+    import planner.cli.suggest as suggest
+    import planner.cli.validate as validate
 
     parser = argparse.ArgumentParser(
         prog="wobjcal",
