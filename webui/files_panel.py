@@ -63,6 +63,18 @@ def check_upload(name: str, content: bytes, suffixes: tuple[str, ...], what: str
         raise UploadError(f"{name}: a {what} must end in {', '.join(suffixes)}")
 
 
+def _frame_note(had_frame: bool, kept: bool) -> str:
+    """What became of the earlier part's 3-point frame (``work_object.T_wobj_mesh``)."""
+    if not had_frame:
+        return ""
+    if kept:
+        return "; the earlier part's work-object frame (T_wobj_mesh) is kept"
+    return (
+        "; its work-object frame is the file's own (T_wobj_mesh identity): the earlier "
+        "part's 3-point frame was not kept (tick Keep work-object frame to keep it)"
+    )
+
+
 class FilesPanel:
     """GUI widgets for uploads and downloads.
 
@@ -79,6 +91,12 @@ class FilesPanel:
             self.plan_upload = gui.add_upload_button("Upload plan (.json)", mime_type=".json")
             self.mesh_upload = gui.add_upload_button("Upload work-object mesh")
             self.units = gui.add_dropdown("Mesh units", MESH_UNITS, initial_value="mm")
+            self.keep_frame = gui.add_checkbox(
+                "Keep work-object frame",
+                False,
+                hint="a new part keeps the earlier part's 3-point frame (T_wobj_mesh); "
+                "unticked it starts with the file's own frame",
+            )
             self.pending_md = gui.add_markdown("")
             self.accept = gui.add_button("Use this part", color="green", visible=False)
             self.cancel = gui.add_button("Cancel upload", visible=False)
@@ -194,18 +212,21 @@ class FilesPanel:
         if pending is None:
             raise InputError("upload a mesh first: no part is waiting")
         source = self._current_plan()
+        old_frame = source.work_object.mesh_pose
+        keep = old_frame is not None and bool(self.keep_frame.value)
         work_object = msgspec.structs.replace(
             source.work_object,
             mesh=str(pending.path),
             units=str(self.units.value),
             sha256=pending.digest,
+            T_wobj_mesh=source.work_object.T_wobj_mesh if keep else msgspec.UNSET,
         )
         plan = msgspec.structs.replace(source, work_object=work_object)
         self._apply_source(plan, "new mesh", pending.path, pending.name)
         self.pending = None
         self._show_pending()
         self._list_off_surface()
-        return f"Work object {pending.name} loaded"
+        return f"Work object {pending.name} loaded{_frame_note(old_frame is not None, keep)}"
 
     def upload_mesh(self, name: str, content: bytes) -> str:
         """Use an uploaded mesh (in the chosen units) as the work object at once (scripts)."""
