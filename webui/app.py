@@ -205,6 +205,7 @@ class WobjcalApp:
             except Exception as exc:
                 self.notify("Cell not loaded", str(exc), error=True)
             self._redraw()
+            self.selection.follow(change.doc, set())  # deleted points, highlights moved
             return
         before = {p.id: p for p in change.previous.points}
         changed = [p.id for p in change.doc.points if before.get(p.id) != p]

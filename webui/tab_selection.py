@@ -59,6 +59,8 @@ class TabSelection:
         #: The tab's selected point, or ``None``.
         self.point_id: str | None = None
         self._syncing = False
+        #: Where this tab's highlight is drawn (world, m), or ``None``.
+        self._shown: tuple[float, ...] | None = None
         doc = app.state.doc
         gui = client.gui
         with folder:
@@ -121,16 +123,22 @@ class TabSelection:
         """A blue sphere over the selected marker in this tab's scene only (world frame)."""
         view = self._app.view
         if self.point_id is None or self.point_id not in doc.ids or view is None:
-            self.client.scene.remove_by_name(HIGHLIGHT)
+            if self._shown is not None:
+                self.client.scene.remove_by_name(HIGHLIGHT)
+                self._shown = None
             return
         p = transform_points(view.T_world_wobj, doc.get(self.point_id).probe.position_m)
+        at = tuple(float(v) for v in np.asarray(p, dtype=np.float64).reshape(3))
+        if at == self._shown:  # already there: nothing sent
+            return
         self.client.scene.add_icosphere(
             HIGHLIGHT,
             radius=1.5 * MARKER_RADIUS_M,
             color=SELECTED_RGB,
             subdivisions=2,
-            position=np.asarray(p, dtype=np.float64).reshape(3),
+            position=np.asarray(at),
         )
+        self._shown = at
 
     # ---- actions ---------------------------------------------------------------------------
     def apply_settings(self) -> None:

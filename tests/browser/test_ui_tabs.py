@@ -12,11 +12,12 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ui_helpers import choose, open_page, open_tab, start_ui, wait_for
+from ui_helpers import VIEWPORT, choose, open_page, open_tab, set_camera, start_ui, wait_for
 
 from calib.frames import transform_points
 from webui.app import WobjcalApp
 from webui.tab_selection import HIGHLIGHT
+from webui.testing import project_to_screen
 
 
 class Tab:
@@ -27,6 +28,21 @@ class Tab:
 
     def selected_in_page(self) -> str:
         return str(self.page.get_by_label("Selected", exact=True).input_value())
+
+    def notifications(self) -> str:
+        return " ".join(self.page.locator(".mantine-Notification-root").all_inner_texts())
+
+    def click_world(self, p_world: Any) -> None:
+        """Click the canvas where ``p_world`` appears in this tab's camera."""
+        cam = self.client.camera
+        u, v = project_to_screen(
+            p_world, cam.position, cam.wxyz, cam.fov, cam.image_width, cam.image_height
+        )
+        box = self.page.locator("canvas").first.bounding_box()
+        x = box["x"] + u * box["width"] / cam.image_width
+        y = box["y"] + v * box["height"] / cam.image_height
+        assert 0 < x < VIEWPORT["width"] * 0.6, "keep the target clear of the control panel"
+        self.page.mouse.click(float(x), float(y))
 
     def row(self, point_id: str) -> str:
         rows = self.page.locator("tr").filter(has_text=point_id)
@@ -130,3 +146,40 @@ def test_deleting_the_point_the_other_tab_selected_clears_it(
     finally:
         app.state.undo()
     wait_for(lambda: two.row("S2") != "", what="S2 back in page 2 after the undo")
+
+
+def test_a_click_through_the_tabs_robot_places_nothing(tabs: tuple[WobjcalApp, Tab, Tab]) -> None:
+    """Tab 1's robot stands at a top-face point's probe pose; both tabs look down that point's
+    sensor axis and click the point: tab 1 meets its tool first and is told so, nothing is
+    placed or selected; tab 2, whose robot stands elsewhere, selects the point's marker."""
+    app, one, two = tabs
+    T = app.view.T_world_wobj
+    doc = app.state.doc
+    pid = next(
+        p.id
+        for p in doc.points
+        if np.allclose(p.probe.normal, (0.0, 0.0, 1.0))
+        and (c := app.check_of(p.id)) is not None
+        and c.q is not None
+    )
+    choose(one.page, "Selected", pid)
+    choose(two.page, "Selected", "(none)")
+    check = app.check_of(pid)
+    assert check is not None and check.q is not None
+    wait_for(
+        lambda: np.allclose(app.robot.q_of(one.client.client_id), check.q), what="tab 1's pose"
+    )
+    assert not np.allclose(app.robot.q_of(two.client.client_id), check.q)
+    target = transform_points(T, doc.get(pid).probe.position_m)
+    n = T[:3, :3] @ np.array([0.0, 0.0, 1.0])
+    side = T[:3, :3] @ np.array([0.03, 0.0, 0.0])  # a little off the axis: a defined view
+    for tab in (one, two):
+        set_camera(tab.client, target + 1.2 * n + side, target)
+    before = app.state.doc
+    one.click_world(target)
+    wait_for(lambda: "not the part" in one.notifications(), what="tab 1 told why")
+    assert "nothing placed: clicked the" in one.notifications()
+    assert app.state.doc is before and app.selection_of(one.client) == pid
+    two.click_world(target)
+    wait_for(lambda: app.selection_of(two.client) == pid, what="tab 2 selects the marker")
+    assert app.state.doc is before and "not the part" not in two.notifications()
