@@ -18,7 +18,7 @@ from calib.errors import InputError
 from calib.plan.file import Plan, PlanError
 from calib.units import MESH_UNITS
 from webui.exports import FORMATS, ExportResult, export_program
-from webui.part_upload import PendingPart, drop_points, off_surface, project_points
+from webui.part_upload import PendingPart, drop_points, frame_note, off_surface, project_points
 from webui.plan_adapter import plan_from_ui, plan_json_from_ui, ui_plan_from_bytes, with_source
 from webui.state import atomic_write_bytes
 from webui.urdf_zip import unpack_robot_zip
@@ -61,18 +61,6 @@ def check_upload(name: str, content: bytes, suffixes: tuple[str, ...], what: str
         raise UploadError(f"{name}: the file is empty")
     if not name.lower().endswith(suffixes):
         raise UploadError(f"{name}: a {what} must end in {', '.join(suffixes)}")
-
-
-def _frame_note(had_frame: bool, kept: bool) -> str:
-    """What became of the earlier part's 3-point frame (``work_object.T_wobj_mesh``)."""
-    if not had_frame:
-        return ""
-    if kept:
-        return "; the earlier part's work-object frame (T_wobj_mesh) is kept"
-    return (
-        "; its work-object frame is the file's own (T_wobj_mesh identity): the earlier "
-        "part's 3-point frame was not kept (tick Keep work-object frame to keep it)"
-    )
 
 
 class FilesPanel:
@@ -226,7 +214,7 @@ class FilesPanel:
         self.pending = None
         self._show_pending()
         self._list_off_surface()
-        return f"Work object {pending.name} loaded{_frame_note(old_frame is not None, keep)}"
+        return f"Work object {pending.name} loaded{frame_note(old_frame is not None, keep)}"
 
     def upload_mesh(self, name: str, content: bytes) -> str:
         """Use an uploaded mesh (in the chosen units) as the work object at once (scripts)."""

@@ -16,7 +16,7 @@ from webui import heatmap, plan_doc
 from webui.plan_adapter import with_procedure
 from webui.plan_doc import PAPER_IDS
 from webui.scene import legend_html
-from webui.tab_selection import NO_ROLE_LABEL
+from webui.tab_selection import NO_ROLE_LABEL, set_options
 
 if TYPE_CHECKING:
     from webui.context import AppContext
@@ -26,14 +26,9 @@ logger = logging.getLogger(__name__)
 NEXT = "next"
 
 
-def _set_options(dropdown: Any, options: tuple[str, ...]) -> None:
-    """Send new dropdown options only when they changed (each update re-renders the panel)."""
-    if tuple(dropdown.options) != options:
-        dropdown.options = options
-
-
 class PointsPanel:
-    """GUI widgets for placing, selecting, editing and inspecting points (shared by all tabs).
+    """GUI widgets for placing and inspecting points and editing the plan (shared by all tabs;
+    each tab's selection and its settings are :mod:`webui.tab_selection`'s).
 
     Args:
         app: the app whose plan the panel edits.
@@ -113,7 +108,7 @@ class PointsPanel:
         checks = self._app.checks()
         with self._programmatic():
             extra = tuple(i for i in doc.ids if i not in PAPER_IDS)
-            _set_options(self.place, (NEXT, *PAPER_IDS, *extra))
+            set_options(self.place, (NEXT, *PAPER_IDS, *extra))
             if self.procedure.value != doc.method:
                 self.procedure.value = doc.method
         kind = PROCEDURES.get(doc.method)

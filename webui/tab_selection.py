@@ -38,7 +38,7 @@ NO_ROLE_LABEL = "(none)"
 HIGHLIGHT = "/selection"
 
 
-def _options(widget: Any, options: tuple[str, ...]) -> None:
+def set_options(widget: Any, options: tuple[str, ...]) -> None:
     """Send new dropdown options only when they changed (each update re-renders the panel)."""
     if tuple(widget.options) != options:
         widget.options = options
@@ -96,8 +96,8 @@ class TabSelection:
         """Update the lists, the dropdown's value and (``settings``) the point's settings."""
         self._syncing = True
         try:
-            _options(self.selected, (NONE, *doc.ids))
-            _options(self.role, (*doc.roles, NO_ROLE_LABEL))
+            set_options(self.selected, (NONE, *doc.ids))
+            set_options(self.role, (*doc.roles, NO_ROLE_LABEL))
             value = self.point_id if self.point_id in doc.ids else NONE
             if self.selected.value != value:
                 self.selected.value = value

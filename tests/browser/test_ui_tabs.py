@@ -12,12 +12,11 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ui_helpers import VIEWPORT, choose, open_page, open_tab, set_camera, start_ui, wait_for
+from ui_helpers import choose, click_world, open_page, open_tab, set_camera, start_ui, wait_for
 
 from calib.frames import transform_points
 from webui.app import WobjcalApp
 from webui.tab_selection import HIGHLIGHT
-from webui.testing import project_to_screen
 
 
 class Tab:
@@ -33,16 +32,7 @@ class Tab:
         return " ".join(self.page.locator(".mantine-Notification-root").all_inner_texts())
 
     def click_world(self, p_world: Any) -> None:
-        """Click the canvas where ``p_world`` appears in this tab's camera."""
-        cam = self.client.camera
-        u, v = project_to_screen(
-            p_world, cam.position, cam.wxyz, cam.fov, cam.image_width, cam.image_height
-        )
-        box = self.page.locator("canvas").first.bounding_box()
-        x = box["x"] + u * box["width"] / cam.image_width
-        y = box["y"] + v * box["height"] / cam.image_height
-        assert 0 < x < VIEWPORT["width"] * 0.6, "keep the target clear of the control panel"
-        self.page.mouse.click(float(x), float(y))
+        click_world(self.page, self.client, p_world)
 
     def row(self, point_id: str) -> str:
         rows = self.page.locator("tr").filter(has_text=point_id)
