@@ -12,7 +12,8 @@ cache only ever costs time, never an answer: numba checks each entry against the
 stamp and the CPU before it loads it.
 
 Each kernel module calls :func:`configure` before its first ``@njit``: numba picks the
-directory when a function is decorated.
+directory when a function is decorated. The first call also starts the background compile of
+:mod:`planner.cell.warmup` when that directory was never warmed.
 """
 
 from __future__ import annotations
@@ -45,12 +46,21 @@ def configure() -> Path | None:
     if _CONFIG.CACHE_DIR:  # NUMBA_CACHE_DIR or an earlier call
         return Path(_CONFIG.CACHE_DIR)
     path = cache_root() / "numba"
+    if _writable(path):
+        _CONFIG.CACHE_DIR = str(path)
+        from planner.cell.warmup import start_background  # the helper imports this module
+
+        start_background(path)
+        return path
+    return None
+
+
+def _writable(path: Path) -> bool:
     try:
         path.mkdir(parents=True, exist_ok=True)
         if not os.access(path, os.W_OK):
             raise PermissionError(f"{path} is not writable")
     except OSError as exc:
         log.info("numba kernels cached by numba's defaults: %s", exc)
-        return None
-    _CONFIG.CACHE_DIR = str(path)
-    return path
+        return False
+    return True
