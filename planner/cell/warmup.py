@@ -7,36 +7,31 @@ user from paying the compile on a check:
 
 - ``python -m planner.cell.warmup`` (the install step: ``.ci/test`` and the README's install
   command run it) compiles every kernel into the cache;
-- :func:`start_background`, called when the first kernel module is imported with a cache that
-  was never warmed, starts that same command in a second process that compiles the kernels in
-  the reverse of the order a check first needs them: the check compiles from the front, the
-  helper from the back, and each loads what the other already wrote (numba looks in its cache
-  before compiling). On a second free core a cold map is ~3 s shorter; under the UI, where the
-  cell loads well before the first click, the click finds the kernels compiled.
+- :func:`planner.cell.kernel_cache.start_background`, called when the first kernel module is
+  imported with a cache that was never warmed, starts that command in a second process at low
+  priority, which compiles the kernels in the reverse of the order a check first needs them:
+  the check compiles from the front, the helper from the back, and each loads what the other
+  already wrote (numba looks in its cache before compiling). Under the UI, where the cell
+  loads well before the first click, the click finds the kernels compiled; a cold map in a
+  script gains only what a spare core gives (figures in ``docs/cell.md``).
 
-A marker file (:func:`marker_path`, keyed by the kernels' source, numba's and Python's versions)
-says the cache was warmed; the cache itself is still checked by numba entry by entry, so a
-stale or missing entry costs a compile, never an answer. ``WOBJCAL_BACKGROUND_COMPILE=0``
-turns the helper off.
+A marker file (:func:`~planner.cell.kernel_cache.marker_path`, keyed by the kernels' source,
+numba's and Python's versions) says the cache was warmed; numba still checks each entry
+against its source and the CPU, so a stale or missing entry costs a compile, never an answer.
+``WOBJCAL_BACKGROUND_COMPILE=0`` turns the helper off.
 """
 
 from __future__ import annotations
 
 import argparse
-import hashlib
 import importlib
-import logging
 import os
-import subprocess
 import sys
-import threading
 import time
-from pathlib import Path
 
-import numba
 from numba.core import sigutils
 
-log = logging.getLogger(__name__)
+from planner.cell.kernel_cache import CHILD_ENV, configure, marker_path
 
 #: The kernels a check calls from Python (module, function), in the order a map first needs
 #: them, with the argument types it calls them with (numba's signature syntax; checked against
@@ -76,33 +71,6 @@ KERNELS: tuple[tuple[str, str, str], ...] = (
         f"{_I}, {_T3}, {_M}, {_I}, {_I}, {_M}, {_I}, {_I}, {_I}, {_T3}, {_M})",
     ),
 )
-#: Modules whose source the compiled kernels depend on (the marker's key).
-SOURCES = (
-    "gjk_kernels",
-    "bound_kernels",
-    "broad_kernels",
-    "field_kernels",
-    "mesh_kernels",
-    "kernel_cache",
-    "warmup",
-)
-_ENV_OFF = "WOBJCAL_BACKGROUND_COMPILE"
-_ENV_CHILD = "WOBJCAL_WARMUP_CHILD"
-_started = threading.Lock()
-_helper: list[subprocess.Popen[bytes]] = []
-
-
-def _key() -> str:
-    here = Path(__file__).resolve().parent
-    h = hashlib.sha256(f"{numba.__version__} {sys.version}".encode())
-    for name in SOURCES:
-        h.update((here / f"{name}.py").read_bytes())
-    return h.hexdigest()[:16]
-
-
-def marker_path(cache_dir: Path) -> Path:
-    """The file that says ``cache_dir`` holds the kernels of this source and numba."""
-    return cache_dir / f"warm-{_key()}"
 
 
 def compile_kernels(reverse: bool = False) -> float:
@@ -123,48 +91,13 @@ def compile_kernels(reverse: bool = False) -> float:
     return time.perf_counter() - t0
 
 
-def start_background(cache_dir: Path | None) -> bool:
-    """Start the helper process (module docstring) unless ``cache_dir`` was warmed, it runs
-    already, this is the helper, or ``WOBJCAL_BACKGROUND_COMPILE=0``; True when started."""
-    if (
-        cache_dir is None
-        or os.environ.get(_ENV_CHILD)
-        or os.environ.get(_ENV_OFF, "1") == "0"
-        or marker_path(cache_dir).exists()
-    ):
-        return False
-    with _started:
-        if _helper:
-            return False
-        env = dict(os.environ, NUMBA_CACHE_DIR=str(cache_dir), **{_ENV_CHILD: "1"})
-        src = str(Path(__file__).resolve().parents[2])
-        env["PYTHONPATH"] = os.pathsep.join(p for p in (src, env.get("PYTHONPATH")) if p)
-        try:
-            proc = subprocess.Popen(
-                [sys.executable, "-m", "planner.cell.warmup", "--reverse"],
-                env=env,
-                stdin=subprocess.DEVNULL,
-                stdout=subprocess.DEVNULL,
-                stderr=subprocess.DEVNULL,
-            )
-        except OSError as exc:  # no helper: the check compiles what it needs itself
-            log.info("no background compile of the kernels: %s", exc)
-            return False
-        _helper.append(proc)
-    threading.Thread(target=proc.wait, name="wobjcal-warmup-reaper", daemon=True).start()
-    log.info("compiling the broad phase's kernels in the background (pid %d)", proc.pid)
-    return True
-
-
 def main(argv: list[str] | None = None) -> int:
     """``python -m planner.cell.warmup [--reverse]``: compile every kernel into the cache."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
     ap.add_argument("--reverse", action="store_true", help="last needed first (the helper)")
     args = ap.parse_args(argv)
-    if os.environ.get(_ENV_CHILD) and hasattr(os, "nice"):
+    if os.environ.get(CHILD_ENV) and hasattr(os, "nice"):
         os.nice(10)  # the helper takes a spare core, never the check's
-    from planner.cell.kernel_cache import configure
-
     cache_dir = configure()
     seconds = compile_kernels(reverse=args.reverse)
     if cache_dir is not None:
@@ -172,7 +105,7 @@ def main(argv: list[str] | None = None) -> int:
         tmp = marker.with_suffix(f".{os.getpid()}.tmp")
         tmp.write_text(f"{seconds:.2f} s\n")
         tmp.replace(marker)
-    if not os.environ.get(_ENV_CHILD):
+    if not os.environ.get(CHILD_ENV):
         sys.stdout.write(f"wobjcal kernels ready in {cache_dir or 'numba default cache'} ")
         sys.stdout.write(f"({seconds:.1f} s)\n")
     return 0
