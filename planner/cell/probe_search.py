@@ -17,7 +17,9 @@ The work is done in four passes; the answers do not depend on them:
    skipped), each one's open parts cheapest first, stopping as soon as its slack is shown
    below the margin; then the least-bad one, best candidates first (by upper bounds: GJK's and
    those of the parts already known), a candidate dropped as soon as its slack is shown to be
-   more than the tie below the best exact slack found.
+   more than the tie below the best exact slack found. With ``statuses_only`` (the heat map's
+   :func:`planner.cell.probe_status.probe_statuses`), a point none of whose candidates passes
+   stops at its status instead (:meth:`ProbeSearch._status`).
 """
 
 from __future__ import annotations
