@@ -20,6 +20,7 @@ BENCHMARKS: list[tuple[str, list[str], list[str]]] = [
     ("bench.bench_ui_latency", ["--browser"], ["--clicks", "10"]),
     ("bench.bench_suggest", [], ["--trials", "100", "--random", "30", "--max", "10"]),
     ("bench.bench_click_ray", [], ["--clicks", "50"]),
+    ("bench.bench_edge_events", [], ["--trials", "100"]),
 ]
 
 

@@ -3,7 +3,7 @@
 Used by ``bench/bench_validate.py`` and ``tests/test_box_prediction.py`` to compare the
 simulated intervals with the predicted ones: on a box there is nothing position-dependent
 (no hole, no bulge, flat faces), so the two must agree up to the Monte Carlo's own scatter and
-what the prediction leaves out on purpose (the ray bundle's quantisation of edge events, kept
+what the prediction leaves out on purpose (the ray bundle's residual error of edge events, kept
 small here with a finely sampled sensor face, and the early switch over faces tilted by the
 misplacement, second order).
 

@@ -283,23 +283,42 @@ def best_fit_design(
     fixed: tuple[FloatArray, FloatArray] | None,
     say: SuggestProgress,
 ) -> tuple[Design | None, list[tuple[int, float]]]:
+    """The best-fit design: grown from 6 points (or ``add`` more) until the target holds, or up
+    to ``max_points`` (without a target, every size up to it is designed on the way).
+
+    Each size keeps the best (smallest worst half-width) of three designs: one from scratch,
+    the smaller size's design grown by one point and exchanged, and that design grown by the
+    one best point without exchange. Adding a search only adds information, so the last never
+    predicts a larger error than the smaller design: the error never grows with the number of
+    points (designed from scratch, 11 points once predicted 0.114 mm against 0.099 mm at 10).
+    """
     history: list[tuple[int, float]] = []
     best: Design | None = None
     sizes = [add] if add else list(range(6, max_points + 1))
-    if target_m is None and not add:
-        sizes = [max_points]
-    start: tuple[int, ...] = ()
+    extra: dict[str, object] = {}
+    if fixed is not None:
+        extra.update(fixed_rows=fixed[0], fixed_var=fixed[1])
     for k, n in enumerate(sizes):
         say("design", k, len(sizes))
-        kw: dict[str, object] = {"start": start}
-        if fixed is not None:
-            kw.update(fixed_rows=fixed[0], fixed_var=fixed[1])
-        d = _select_feasible(ctx, n, **kw)
-        if d is None:
+        tries = [_select_feasible(ctx, n, **extra)]
+        if best is not None:
+            tries.append(_select_feasible(ctx, n, start=best.chosen, **extra))
+            tries.append(_select_feasible(ctx, n, start=best.chosen, max_passes=0, **extra))
+        found = [(ctx.worst(d.covariance), i, d) for i, d in enumerate(tries) if d is not None]
+        # the searches are sized about the chosen points' centroid: size them for the one kept
+        kept = next(
+            (
+                f
+                for f in sorted(found, key=lambda f: (f[0], f[1]))
+                if ctx.size_searches(f[2].chosen)
+            ),
+            None,
+        )
+        if kept is None:
             continue
-        worst = ctx.worst(d.covariance)
+        worst, _, d = kept
         history.append((n + (len(fixed[0]) if fixed is not None else 0), worst))
-        best, start = d, d.chosen
+        best = d
         if target_m is not None and worst <= target_m and not ctx.weak(d.chosen):
             break  # a layout the check would call weak grows on
     return best, history

@@ -9,6 +9,7 @@ from pathlib import Path
 import msgspec
 import numpy as np
 import pytest
+import shapely
 import trimesh
 
 from calib.estimators.layout import search_constraint_set
@@ -35,17 +36,15 @@ def _box(folder: Path) -> Path:
 @pytest.fixture(scope="module")
 def box_plan(tmp_path_factory: pytest.TempPathFactory) -> Plan:
     """The plate's cell (IRB 4400, pedestal) with the thin box and the stator plan's proximity
-    sensor. The simulation resolves the footprint with 1024 rays: with the default 256 the
-    coverage near the rim, where an edge search switches off, moves in steps of up to about a
-    millimetre, an error the prediction (the exact disk) leaves out (x, y, rz scatter about
-    1.5 times the prediction on this box)."""
+    sensor, as it is (256 rays: the simulation resolves edge events between them,
+    :mod:`planner.sim.subray`; with plain rays x and the turn about z simulated 1.59 times the
+    prediction)."""
     stl = _box(tmp_path_factory.mktemp("box"))
     plate = load_plan(ASSETS / "plate_holes_best_fit.json")
     sensor = load_plan(ASSETS / "stator_section_ah.json").validation.sensor
+    assert sensor.n_rays == 256
     wo = msgspec.structs.replace(plate.work_object, mesh=str(stl), sha256=file_sha256(stl))
-    v = msgspec.structs.replace(
-        plate.validation, sensor=msgspec.structs.replace(sensor, n_rays=1024)
-    )
+    v = msgspec.structs.replace(plate.validation, sensor=sensor)
     return msgspec.structs.replace(plate, work_object=wo, validation=v)
 
 
@@ -102,3 +101,37 @@ def test_thin_box_is_fixed_by_edge_searches(box_plan: Plan) -> None:
     for row in sim.rows:
         if row.level_percent == 95.5:
             assert row.procedure == pytest.approx(row.procedure_predicted, rel=0.25), row.key
+
+
+def _block(slope_deg: float) -> trimesh.Trimesh:
+    """A 200 x 300 x 20 mm block (metres): a 5 x 5 mm chamfer along its top +x edge and its
+    -x side sloped by ``slope_deg`` (leaning out, so the rays past the top edge see it)."""
+    s = 0.020 * np.tan(np.radians(slope_deg))
+    profile = shapely.Polygon(  # (x, z)
+        [(-s, 0.0), (0.2, 0.0), (0.2, 0.015), (0.195, 0.020), (0.0, 0.020)]
+    )
+    mesh = trimesh.creation.extrude_polygon(profile, 0.3)  # along w: (u, v, w) = (x, z, -y)
+    mesh.apply_transform(np.array([[1, 0, 0, 0], [0, 0, -1, 0.3], [0, 1, 0, 0], [0, 0, 0, 1.0]]))
+    return mesh
+
+
+@pytest.mark.parametrize(("slope_deg", "kept_minus_x"), [(10.0, False), (2.0, True)])
+def test_edges_that_are_not_square_get_no_edge_search(slope_deg: float, kept_minus_x: bool) -> None:
+    """The chamfered +x edge never, the -x edge when its side is within 3 degrees of square;
+    the square +-y edges (the block's ends) always."""
+    mesh = _block(slope_deg)
+    assert mesh.is_watertight and mesh.volume > 0
+    r = 0.009
+    faces = find_planar_faces(mesh, min_area_m2=np.pi * r**2, footprint_radius_m=r)
+    top = [i for i, f in enumerate(faces.faces) if f.normal[2] > 0.99]
+    assert len(top) == 1
+    c = edge_candidates(FaceOutlines(faces, r), top, r, start_m=0.03, shift_m=0.005)
+    D = c.edge_dirs
+    assert D is not None
+    sides = {tuple(np.round(d).astype(int)) for d in D}
+    want = {(0, 1, 0), (0, -1, 0)} | ({(-1, 0, 0)} if kept_minus_x else set())
+    assert sides == want
+    assert np.allclose(c.positions_m[:, 2], 0.020)
+    # the chamfer's face ends 5 mm in: without the check the +x edge search was offered there
+    ends, across = FaceOutlines(faces, r).rim(top[0])
+    assert len(ends) and np.any(np.isclose(across @ [1, 0, 0], np.cos(np.pi / 4), atol=1e-6))

@@ -39,6 +39,11 @@ from calib.probing import Probe, ProbePoint, SearchCommand
 from calib.validation import check_vector3
 
 FloatArray = NDArray[np.float64]
+#: A motion counts as fixed by a layout when its scaled singular value is above this part of the
+#: largest: below it, a measurement's noise moves the estimate by ten thousand times as much
+#: (float32 meshes leave "parallel" rows 1e-6 apart; a genuinely weak layout, two points 5 mm
+#: apart turning a 100 mm layout, sits at about 0.05).
+FIXED_RCOND = 1e-4
 logger = logging.getLogger(__name__)
 
 
@@ -131,6 +136,15 @@ def min_norm_update(
     by ``scale_m`` (default: the layout size); constraints that the points do not fix are left
     as they were. With a full-rank layout this is the least-squares best fit.
 
+    Which motions the points fix is decided on the *nominal* layout (the plan's points, as the
+    prediction and :mod:`calib.estimators.steering` see it), not on the measured points: two
+    edge searches on opposite, parallel edges at the same coordinate fix no turn between them,
+    but measured a few micrometres apart they would "fix" it with a noise gain of thousands (a
+    0.04 mm disagreement turned the plate's estimate by 40 degrees and commanded the next
+    search 63 m away; the plate's mesh is float32, so "the same coordinate" differs by 0.1 um
+    and the relative threshold is :data:`FIXED_RCOND`, not machine precision). The step is the
+    min-norm solution in the nominally fixed motions only.
+
     Args:
         cs: constraints of the points measured so far.
         measured_base: ``(N, 3)`` their measurements, base frame, metres.
@@ -143,17 +157,31 @@ def min_norm_update(
     q = np.asarray(measured_base, dtype=np.float64)[cs.point_index]
     c = cs.centroid_m if pivot_m is None else pivot_m
     L = cs.scale_m if scale_m is None else scale_m
+    V = fixed_motions(cs, c, L)
     for _ in range(iterations):
         x = (q - T[:3, 3]) @ T[:3, :3]
         r = np.einsum("ij,ij->i", cs.normals, x - cs.nominal_m)
         J = constraint_jacobian(cs.normals, x - c)
         J[:, 3:] /= L
-        step = -np.linalg.pinv(J, rcond=1e-9) @ r
+        step = -V @ (np.linalg.pinv(J @ V, rcond=1e-9) @ r)
         w = step[3:] / L
         T = T @ small_motion_matrix(np.concatenate([step[:3] - cross_rows(w, c), w]))
         if float(np.max(np.abs(step))) < 1e-9:  # 1 nm: the estimate only steers the next search
             break
     return T
+
+
+def fixed_motions(cs: ConstraintSet, pivot_m: FloatArray, scale_m: float) -> FloatArray:
+    """``(6, r)`` orthonormal basis of the scaled motions ``(t, L w)`` the nominal layout fixes.
+
+    The row space of the nominal constraint rows ``[n, (x - c) x n / L]``: singular values
+    above :data:`FIXED_RCOND` of the largest (as :mod:`calib.estimators.steering` takes them).
+    """
+    J = constraint_jacobian(cs.normals, cs.nominal_m - pivot_m)
+    J[:, 3:] /= scale_m
+    _, sv, Vt = np.linalg.svd(J, full_matrices=False)
+    rank = int(np.sum(sv > FIXED_RCOND * sv[0])) if len(sv) and sv[0] > 0 else 0
+    return np.ascontiguousarray(Vt[:rank].T)
 
 
 def leading_points(cs: ConstraintSet, n: int) -> ConstraintSet:

@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import ShapeError
+from calib.estimators.runners import FIXED_RCOND
 
 FloatArray = NDArray[np.float64]
 
@@ -89,7 +90,7 @@ def inplane_shift_maps(
     S[3:, 3:] *= L
     if len(X):
         J = np.hstack([Nn, np.cross(X - c, Nn) / L])
-        residual = np.eye(6) - np.linalg.pinv(J, rcond=1e-9) @ J
+        residual = np.eye(6) - np.linalg.pinv(J, rcond=FIXED_RCOND) @ J
     else:
         residual = np.eye(6)
     motion = np.hstack([np.eye(3), -_skew(p - c) / L])
@@ -123,7 +124,7 @@ def inplane_noise_cov(
     K = (
         plane_basis(normal).T
         @ np.hstack([np.eye(3), -_skew(p - c) / L])
-        @ np.linalg.pinv(J, rcond=1e-9)
+        @ np.linalg.pinv(J, rcond=FIXED_RCOND)
     )
     return (K * v[None, :]) @ K.T
 

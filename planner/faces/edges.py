@@ -10,6 +10,14 @@ square edge (``edge_normal``). A candidate is kept when its whole track, from a 
 ``start_m`` inside the edge to the edge, keeps the footprint on the face (the face eroded by
 the footprint radius, :meth:`~planner.faces.outline.FaceOutlines.free`) even when moved in
 the plane by the misplacement (a hole beside the track would end the search early).
+
+The design and the prediction take the edge as square (the face across it along the search
+direction), and the sensor's edge-event offset is that of a square edge; a chamfer, a fillet
+or a sloped side is seen by the rays past the edge and moves the event by an amount nothing
+models. So a segment is used only when the mesh says it is square: the triangles across every
+mesh edge along it (:meth:`~planner.faces.outline.FaceOutlines.rim`) must cover it
+(:data:`MIN_RIM_COVER`) and have their normals within :data:`SQUARE_TOL_RAD` of the search
+direction (:func:`square_edge`).
 """
 
 from __future__ import annotations
@@ -33,6 +41,45 @@ FRACTIONS = (0.25, 0.5, 0.75)
 MIN_EDGE_FOOTPRINTS = 3.0
 #: The track's end is checked this far inside the eroded outline's rim, metres.
 _INSIDE_M = 1e-4
+#: Largest angle between the face across an edge and the search direction (a draft of a few
+#: degrees hides the side from the rays past the edge; a 45 degree chamfer does not), radians.
+SQUARE_TOL_RAD = float(np.radians(3.0))
+#: Least part of a segment's length the mesh edges along it must cover to show what is across.
+MIN_RIM_COVER = 0.95
+#: A mesh edge lies on a segment when both its ends are this close to it, metres.
+_ON_SEGMENT_M = 1e-4
+
+
+def square_edge(
+    ends: FloatArray, across: FloatArray, a: FloatArray, b: FloatArray, out3: FloatArray
+) -> bool:
+    """Whether the mesh shows a square edge along the segment ``a``-``b`` of a face's outline.
+
+    Args:
+        ends: ``(E, 2, 2)`` the face's boundary edges in its basis (metres).
+        across: ``(E, 3)`` the unit normal of the triangle across each.
+        a, b: ``(2,)`` the segment's ends in the same basis.
+        out3: ``(3,)`` the search direction (the segment's outward normal, wobj frame).
+
+    Returns:
+        True when the edges along the segment cover :data:`MIN_RIM_COVER` of it and every
+        triangle across is within :data:`SQUARE_TOL_RAD` of ``out3``.
+    """
+    seg = b - a
+    length = float(np.linalg.norm(seg))
+    along = seg / length
+    normal2 = np.array([-along[1], along[0]])
+    rel = ends - a  # (E, 2, 2)
+    off = np.abs(rel @ normal2)  # (E, 2)
+    t = rel @ along  # (E, 2)
+    on = (off.max(axis=1) <= _ON_SEGMENT_M) & (t.min(axis=1) >= -_ON_SEGMENT_M)
+    on &= t.max(axis=1) <= length + _ON_SEGMENT_M
+    if not on.any():
+        return False
+    cover = float(np.sum(np.abs(t[on, 1] - t[on, 0])))
+    if cover < MIN_RIM_COVER * length:
+        return False
+    return bool(np.all(across[on] @ out3 >= np.cos(SQUARE_TOL_RAD)))
 
 
 def edge_candidates(
@@ -63,6 +110,7 @@ def edge_candidates(
         n = outlines.normal(fid)
         h = outlines.height_m(fid)
         free = outlines.free(fid)
+        rim_ends, rim_across = outlines.rim(fid)
         shape = outlines.face(fid).simplify(1e-6)
         polys = list(shape.geoms) if hasattr(shape, "geoms") else [shape]
         for poly in polys:
@@ -74,6 +122,8 @@ def edge_candidates(
                     continue
                 out = np.array([seg[1], -seg[0]]) / length  # outward: exterior is CCW
                 along = seg / length
+                if not square_edge(rim_ends, rim_across, a, b, B @ out):
+                    continue
                 for t in FRACTIONS:
                     c = a + t * seg
                     # the track from its start (moved back by the shift) to a footprint radius

@@ -36,6 +36,7 @@ class FaceOutlines:
         self._radius = float(footprint_radius_m)
         self._free: dict[int, shapely.Geometry] = {}
         self._face: dict[int, shapely.Geometry] = {}
+        self._rim: dict[int, tuple[FloatArray, FloatArray]] = {}
 
     def basis(self, face_id: int) -> FloatArray:
         """``(3, 2)`` the face's in-plane basis."""
@@ -59,6 +60,27 @@ class FaceOutlines:
         tri = np.asarray(self._faces.mesh.triangles, dtype=np.float64)
         first = tri[self._faces.face_id == face_id][0, 0]
         return float(self.normal(face_id) @ first)
+
+    def rim(self, face_id: int) -> tuple[FloatArray, FloatArray]:
+        """The face's boundary as the mesh has it, with what lies across it.
+
+        Returns:
+            ``(ends, across)``: ``(E, 2, 2)`` the ends of each mesh edge between a triangle of
+            the face and one that is not, in :meth:`basis` coordinates (metres), and ``(E, 3)``
+            the unit normal of the triangle across it (wobj frame). An edge of an open mesh
+            with nothing across is left out.
+        """
+        if face_id not in self._rim:
+            mesh = self._faces.mesh
+            pairs = np.asarray(mesh.face_adjacency, dtype=np.int64).reshape(-1, 2)
+            edges = np.asarray(mesh.face_adjacency_edges, dtype=np.int64).reshape(-1, 2)
+            mine = self._faces.face_id[pairs] == face_id  # (A, 2)
+            one = mine[:, 0] != mine[:, 1]
+            other = np.where(mine[one, 0], pairs[one, 1], pairs[one, 0])
+            verts = np.asarray(mesh.vertices, dtype=np.float64)[edges[one]]  # (E, 2, 3)
+            normals = np.asarray(mesh.face_normals, dtype=np.float64)[other]
+            self._rim[face_id] = (verts @ self.basis(face_id), normals)
+        return self._rim[face_id]
 
     def free(self, face_id: int) -> shapely.Geometry:
         """Where a footprint's centre may lie on the face, in :meth:`basis` coordinates."""

@@ -9,8 +9,9 @@ TCP position at the switching event, in the base frame.
 - Approach search (motion along the sensor axis): every ray shortens by the travel, so the
   switching travel is solved in closed form from one ray cast (no stepping).
 - Edge search ("move until the sensor stops detecting"): a coarse scan with few rays finds the
-  step where the signal drops below the switch-off level, then the full bundle refines it
-  (regula falsi on the log signal), re-casting only the rays whose surface changes.
+  step where the signal drops below the switch-off level, then the full bundle brackets it and
+  the switch is resolved between rays (:mod:`planner.sim.subray`: each ray's switch bisected,
+  its share handed over across its cell), re-casting only the rays whose surface changes.
 
 Failures are returned as :class:`~calib.probing.ProbeResult` with a reason, never as a number:
 no detection within the search length, already detecting at the start, not detecting at the
@@ -41,6 +42,7 @@ from planner.sim.search_events import (
     cell_search_hook,
     robot_offset,
 )
+from planner.sim.subray import CellSignal, cell_width_m, first_switch
 
 __all__ = ["ProbeEvent", "ReachabilityHook", "SimulatedProbe", "cell_search_hook", "robot_offset"]
 
@@ -68,6 +70,9 @@ class SimulatedProbe:
             stays on the commanded path, i.e. on the face (the contract of the A-H procedure).
         scan_step_m: step of the coarse edge scan, m.
         edge_tolerance_m: bisection tolerance of the edge event, m.
+        between_rays: resolve a scanning search's switch between the rays of the bundle
+            (:mod:`planner.sim.subray`); False: plain rays, each switching at once (for
+            comparison: ``bench/bench_edge_events.py``).
     """
 
     caster: MeshRayCaster
@@ -82,6 +87,7 @@ class SimulatedProbe:
     edge_inset_m: float = 0.003
     scan_step_m: float = 0.0025
     edge_tolerance_m: float = 2e-5
+    between_rays: bool = True
     events: list[ProbeEvent] = field(default_factory=list)
 
     def __post_init__(self) -> None:
@@ -220,52 +226,35 @@ class SimulatedProbe:
                 what = "detection" if want_on else "edge (sensor still detecting)"
                 return self._fail(cmd, f"no {what} within {length * 1e3:.0f} mm")
             d_lo, d_hi = d_hi, full([float(s_grid[k])])[0]
+        # the switch between rays (planner.sim.subray): in the bracket widened by a ray cell on
+        # each side, the rays whose surface changes count by their share across their cell
+        w = cell_width_m(self.sensor.radius_m, n_fine) if self.between_rays else 0.0
         lo0, hi0 = float(s_grid[k - 1]), float(s_grid[k])
-        # rays that see the same surface at both ends keep seeing it in between (the bracket is
-        # shorter than any hole): interpolate them, cast only the rays that change
-        finite = np.isfinite(d_lo) & np.isfinite(d_hi)
-        jump = np.zeros_like(d_lo)
-        np.subtract(d_lo, d_hi, out=jump, where=finite)
-        changing = np.flatnonzero(
-            (np.isinf(d_lo) != np.isinf(d_hi))
-            | (np.abs(jump) > 1e-4)
-            | (d_lo <= 0.0)
-            | (d_hi <= 0.0)
-        )
-        steady_lo, steady_hi = d_lo.copy(), d_hi.copy()
-        both_inf = np.isinf(d_lo) & np.isinf(d_hi)
-        steady_lo[both_inf] = steady_hi[both_inf] = 0.0
-        sub_off = fine_off[changing]
+        lo_e, hi_e = max(0.0, lo0 - w), min(length, hi0 + w)
+        if lo_e < lo0 or hi_e > hi0:
+            d_lo, d_hi = full([lo_e, hi_e])
 
-        def fine(s: float) -> float:
-            f = (s - lo0) / (hi0 - lo0)
-            d = steady_lo + f * (steady_hi - steady_lo)
-            d[both_inf] = np.inf
-            if len(changing):
-                d[changing] = self._distances((tcp0 + s * direction)[None], axis, sub_off)[0]
-            return float(self._signal_of(d[None])[0])
+        def cast(travels: FloatArray, rays: NDArray[np.int64]) -> FloatArray:
+            tcps = tcp0 + travels[:, None] * direction - self.sensor.sensing_distance_m * axis
+            origins = (tcps[:, None, :] + fine_off[rays]).reshape(-1, 3)
+            d_part = np.broadcast_to(self._T_wobj_base[:3, :3] @ axis, origins.shape)
+            d = self.caster.first_hits(self._to_part(origins), d_part)
+            return d.reshape(len(travels), len(rays))
+
+        def terms(d: FloatArray) -> FloatArray:
+            return self.sensor.signal(d[..., None])
 
         def margin(sig: float) -> float:  # log distance from the switching level, < 0 = event
             log_s = math.log(max(sig, 1e-300))
             return math.log(on) - log_s if want_on else log_s - math.log(off)
 
-        lo, hi = lo0, hi0
-        s_lo = float(self._signal_of(d_lo[None])[0])
-        s_hi = float(self._signal_of(d_hi[None])[0])
-        g_lo, g_hi = margin(s_lo), margin(s_hi)
-        it = 0
-        while hi - lo > self.edge_tolerance_m:
-            it += 1
-            width = hi - lo
-            if it % 3 == 0 or not 0 < g_lo - g_hi < 50:  # bisect every third step, or when
-                s = lo + 0.5 * width  # a side saw no metal at all: sure progress
-            else:  # regula falsi on the log signal, kept 5 % inside the bracket
-                s = lo + width * min(max(g_lo / (g_lo - g_hi), 0.05), 0.95)
-            sig = fine(s)
-            if event(np.array([sig]))[0]:
-                hi, g_hi, s_hi = s, margin(sig), sig
-            else:
-                lo, g_lo = s, margin(sig)
+        signal = CellSignal(cast, terms, lo_e, hi_e, d_lo, d_hi, w)
+        knots = np.unique(np.array([lo_e, lo0, hi0, hi_e]))
+        found = first_switch(signal, knots, event, margin, self.edge_tolerance_m)
+        if found is None:  # the cells' average never crosses in the bracket: the plain rays'
+            hi, s_hi = hi0, float(self._signal_of(full([hi0]))[0])
+        else:
+            hi, s_hi = found
         if s_hi < 0:
             return self._fail(cmd, "sensor face collided with the part during the search")
         triangles = None

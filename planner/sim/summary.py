@@ -38,7 +38,7 @@ PREDICTION_NOTE = (
     "predicted: the procedure linearised around the ideal part at the nominal pose, with the "
     "sensor, robot-repeatability and TCP noise above; it leaves out what depends on where the "
     "misplaced part puts a search (holes and edges under the footprint, the stator's bulge), "
-    "the sensor's response to tilted faces, the ray bundle's quantisation of edge events, and "
+    "the sensor's response to tilted faces, the ray bundle's residual error of edge events, and "
     "the robot's accuracy field"
 )
 
