@@ -110,6 +110,8 @@ class WobjcalApp:
         #: What the app said about the autosave at start (restored, set aside), for new tabs.
         self.autosave_note = ""
         self.autosave_lock: AutosaveLock | None = None
+        #: Tabs whose own widgets, robot and first view are set up (connect handler finished).
+        self.ready_clients: set[int] = set()
         server.on_client_connect(self._on_connect)
         server.on_client_disconnect(self._on_disconnect)
         if isinstance(plan.source, Plan):
@@ -144,7 +146,7 @@ class WobjcalApp:
                 logger.warning("%s", why)
                 self.notify("Robot not drawn", why, error=True)
         self.teach_panel.on_cell()
-        if old_part is not None and old_part is not view.wobj_mesh:  # a new part: reframe
+        if old_part is None or old_part is not view.wobj_mesh:  # first cell or a new part: frame
             for client in self.server.get_clients().values():
                 clients.set_default_camera(client, view)
         self.recheck(self.state.doc.ids)
@@ -326,8 +328,10 @@ class WobjcalApp:
             clients.set_default_camera(client, self.view)
         if self.autosave_note:
             self.notify("Autosave", self.autosave_note, client=client, error=False)
+        self.ready_clients.add(client.client_id)
 
     def _on_disconnect(self, client: viser.ClientHandle) -> None:
+        self.ready_clients.discard(client.client_id)
         self.selection.remove_client(client.client_id)
         if self.robot is not None:
             self.robot.remove_client(client.client_id)

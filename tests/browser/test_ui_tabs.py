@@ -48,7 +48,14 @@ def tabs(
     c1 = first.client()
     second = open_page(browser, app)
     c2 = wait_for(
-        lambda: next((c for i, c in app.server.get_clients().items() if i != c1.client_id), None),
+        lambda: next(
+            (
+                c
+                for i, c in app.server.get_clients().items()
+                if i != c1.client_id and i in app.ready_clients
+            ),
+            None,
+        ),
         what="the second tab's connection",
     )
     one, two = Tab(first.page, c1), Tab(second.page, c2)

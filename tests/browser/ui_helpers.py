@@ -55,9 +55,18 @@ class UiSession:
         self.url = url
 
     def client(self) -> Any:
-        """The server-side handle of the page's connection."""
+        """The server-side handle of the page's connection, once the app has set the tab up
+        (its own widgets, robot and first camera: a camera set before that would be undone)."""
         return wait_for(
-            lambda: next(iter(self.app.server.get_clients().values()), None), what="client"
+            lambda: next(
+                (
+                    c
+                    for c in self.app.server.get_clients().values()
+                    if c.client_id in self.app.ready_clients
+                ),
+                None,
+            ),
+            what="the tab to be set up",
         )
 
     def notifications(self) -> str:
