@@ -1,8 +1,8 @@
 """The moves of the plan in the 3D view: the via points and the checked joint moves.
 
 Each via (``points[i].vias``, joint values) is drawn where the probing TCP is at its joint
-values: a small violet octahedron-like sphere (distinct from the probe markers' status colours
-and from their size), and a thin violet polyline from the via(s) to the point they lead to
+values: a small near-black sphere (distinct from the probe markers' status colours
+and from their size), and a thin near-black polyline from the via(s) to the point they lead to
 (the TCP at the point's checked pose, else the point itself); redrawn only when the vias or
 their points change (a click that edits no via sends nothing).
 
@@ -24,8 +24,8 @@ from calib.frames import transform_points
 if TYPE_CHECKING:
     from webui.context import AppContext
 
-#: Colour of via markers and paths (violet: not a status colour).
-VIA_RGB = (140, 60, 200)
+#: Colour of via markers and paths (near black: no status colour, not the selection's blue).
+VIA_RGB = (35, 35, 40)
 #: Radius of a via marker, m.
 VIA_RADIUS_M = 0.008
 ROOT = "/vias"
