@@ -24,6 +24,7 @@ BENCHMARKS: list[tuple[str, list[str], list[str]]] = [
         ["--clicks", "4", "--refs", "4", "--order", "baseline", "ours"],
     ),
     ("bench.bench_suggest", [], ["--trials", "100", "--random", "30", "--max", "10"]),
+    ("bench.bench_click_ray", [], ["--clicks", "50"]),
 ]
 
 

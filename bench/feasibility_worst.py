@@ -4,7 +4,8 @@ In the demo cell (stator section on a table) ``n`` stator samples are checked on
 (a UI click); those whose answer is a collision (every candidate collides) are the worst
 case, the feasible ones the typical case. Each is checked by ``check_probes`` (the default
 path), by ``check_probes(staged=False)`` (one whole Bullet query per candidate: the exact
-check) and by the plain PyBullet loop; then all samples as one heat-map batch, both ways.
+check) and by the plain PyBullet loop; then all samples as one heat-map batch, both ways;
+then the UI's heat map (500 samples at its settings): statuses alone against the full check.
 """
 
 from __future__ import annotations
@@ -17,6 +18,8 @@ from rich.table import Table
 
 from bench.feasibility_cell import run_plain_loop
 from planner.cell.cell import Cell
+from planner.cell.feasibility import check_probes
+from planner.cell.probe_status import probe_statuses
 from planner.cell.reachability_map import reachability_map, sample_surface
 
 
@@ -65,7 +68,37 @@ def run_worst_case(n_samples: int, seed: int) -> dict[str, object]:
             reachability_map(cell, n_samples, np.random.default_rng(seed), staged=staged)
             heat[label] = 1e3 * (time.perf_counter() - t0) / n_samples
         out["heat_map_ms_per_sample"] = heat
+        out["ui_heat_map"] = _ui_heat_map(cell, seed)
     return out
+
+
+def _ui_heat_map(cell: Cell, seed: int) -> dict[str, object]:
+    """The UI's heat map (its samples and search settings), one batch each way (CPU ms per
+    sample, best of 2): the statuses alone (:func:`probe_statuses`, what the UI runs) and the
+    full check (:func:`check_probes`, what it ran before); the statuses compared."""
+    from webui.heatmap import MAX_CHECKS, N_SAMPLES, ROTATION_STEP_DEG
+
+    pts, nrm, _ = sample_surface(cell.work_object.mesh, N_SAMPLES, np.random.default_rng(seed))
+    kw: dict = {"rotation_step_deg": ROTATION_STEP_DEG, "max_checks": MAX_CHECKS}
+    ms: dict[str, float] = {}
+    for label, fn in (("statuses", probe_statuses), ("full_check", check_probes)):
+        best = np.inf
+        for _ in range(2):
+            c0 = time.process_time()
+            res = fn(cell, pts, nrm, **kw)
+            best = min(best, time.process_time() - c0)
+        ms[label] = 1e3 * best / N_SAMPLES
+        if label == "statuses":
+            statuses = list(res.statuses)  # type: ignore[union-attr]
+        else:
+            full = [r.status for r in res]  # type: ignore[union-attr]
+    return {
+        "samples": N_SAMPLES,
+        "cpu_ms_per_sample": ms,
+        "ratio": ms["full_check"] / ms["statuses"],
+        "different_statuses": sum(a != b for a, b in zip(statuses, full)),
+        "statuses": {k: statuses.count(k) for k in sorted(set(statuses))},
+    }
 
 
 def print_worst(w: dict) -> None:
@@ -88,4 +121,11 @@ def print_worst(w: dict) -> None:
     h = w["heat_map_ms_per_sample"]
     Console().print(
         f"heat map: {h['ours']:.2f} ms/sample, exact check {h['exact_check']:.1f} ms/sample"
+    )
+    u = w["ui_heat_map"]
+    ms = u["cpu_ms_per_sample"]
+    Console().print(
+        f"UI heat map ({u['samples']} samples, its settings), CPU per sample: statuses "
+        f"{ms['statuses']:.2f} ms, full check {ms['full_check']:.2f} ms = {u['ratio']:.1f}x "
+        f"({u['different_statuses']} different statuses; {u['statuses']})"
     )

@@ -110,3 +110,54 @@ def test_a_robot_zip_brings_its_meshes(app: WobjcalApp, reference_dir: Path) -> 
         files.upload_urdf("evil.zip", evil.getvalue())
     with pytest.raises(InputError, match="not a zip"):
         files.upload_urdf("fake.zip", b"not a zip at all")
+
+
+def _with_frame(app: WobjcalApp, T_wobj_mesh: np.ndarray) -> None:
+    """Give the session plan's part a 3-point frame (``work_object.T_wobj_mesh``)."""
+    import msgspec
+
+    from calib.plan.cell import Pose
+
+    source = app.state.doc.source
+    wo = msgspec.structs.replace(source.work_object, T_wobj_mesh=Pose.from_matrix(T_wobj_mesh))
+    app.replace_source(msgspec.structs.replace(source, work_object=wo), "3-point frame")
+
+
+def test_a_new_part_starts_with_its_own_frame_unless_the_frame_is_kept(
+    app: WobjcalApp, reference_dir: Path
+) -> None:
+    """Issue 14: a new part kept the earlier part's 3-point frame (``T_wobj_mesh``) and came
+    in shifted and turned by it; now it starts with the identity and the notice says so."""
+    from calib.frames import make_transform, matrix_from_rotvec
+
+    files = app.files_panel
+    data = (reference_dir / "parts" / "plate_holes.STL").read_bytes()
+    T_old = make_transform(matrix_from_rotvec([0.0, 0.0, 0.7]), [0.05, -0.02, 0.01])
+    _with_frame(app, T_old)
+    undo_depth = 1
+    try:
+        np.testing.assert_allclose(app.state.doc.source.work_object.mesh_matrix(), T_old)
+        files.units.value = "mm"
+        files.keep_frame.value = False
+        files.stage_mesh("plate_holes.STL", data)
+        said = files.accept_mesh()
+        undo_depth += 1
+        assert app.state.doc.source.work_object.mesh_pose is None, "identity: the file's frame"
+        assert "file's own" in said and "not kept" in said, said
+        # the part lies in the wobj frame as in its file (mm -> m), not moved by T_old
+        lo = app.view.wobj_mesh.bounds[0]
+        plate_lo = np.array([0.0, 0.0, 0.0])  # the plate's file has its corner at the origin
+        np.testing.assert_allclose(lo, plate_lo, atol=1e-6)
+        app.state.undo()
+        undo_depth -= 1
+        np.testing.assert_allclose(app.state.doc.source.work_object.mesh_matrix(), T_old)
+        files.keep_frame.value = True  # the user chooses to keep it
+        files.stage_mesh("plate_holes.STL", data)
+        said = files.accept_mesh()
+        undo_depth += 1
+        np.testing.assert_allclose(app.state.doc.source.work_object.mesh_matrix(), T_old)
+        assert "is kept" in said, said
+    finally:
+        files.keep_frame.value = False
+        for _ in range(undo_depth):
+            app.state.undo()

@@ -18,22 +18,22 @@ import viser
 from numpy.typing import ArrayLike
 
 from calib.errors import InputError
-from calib.frames import transform_points
 from calib.plan.file import CellSpec, Plan, WorkObjectSpec
 from calib.probing import ProbePoint
 from planner.check import PointCheck
-from webui import clients, plan_doc
+from webui import click_place, clients, plan_doc
 from webui.autosave import AutosaveLock
 from webui.backend import CellSession, CellView
 from webui.busy import BusyIndicator
 from webui.heatmap import HeatMap
 from webui.plan_adapter import autosave_bytes, plan_point, with_source
 from webui.plan_doc import UiPlan
-from webui.robot_view import RobotView, robot_view_or_reason
 from webui.role_check import RoleFlags, role_flags
-from webui.scene import MARKER_RADIUS_M, PlanScene
+from webui.scene import PlanScene
 from webui.state import DEFAULT_AUTOSAVE, Change, SessionState
-from webui.surface import SurfacePicker, marker_on_ray
+from webui.surface import SurfacePicker
+from webui.tab_robots import TabRobots, tab_robots_or_reason
+from webui.tab_selection import Selections
 from webui.tabs import AppTabs
 from webui.upload_guard import guard_uploads
 from webui.worker import CellWorker
@@ -84,18 +84,19 @@ class WobjcalApp:
         self.worker: CellWorker[CellSession | None] = CellWorker(None)
         self.view: CellView | None = None
         self.picker: SurfacePicker | None = None
-        self.robot: RobotView | None = None
-        self.selected: str | None = None
+        self.robot: TabRobots | None = None  # one drawing per tab, each at its own pose
         self._checks: dict[str, tuple[ProbePoint, PointCheck]] = {}
         self._lock = threading.RLock()
         self._cell_key: tuple[CellSpec, WorkObjectSpec] | None = None
         self.flags = RoleFlags()
         #: Handlers of scene clicks by mode (``"place"``: click-to-place); a panel may set
         #: :attr:`click_mode` to its own (e.g. picking the points of a 3-point frame).
-        self.click_handlers: dict[str, Any] = {"place": self._click_place}
+        self.click_handlers: dict[str, Any] = {"place": lambda e: click_place.click_place(self, e)}
         self.click_mode = "place"
         self.heatmap = HeatMap(self)
         self.points_panel = points_panel.PointsPanel(self)
+        #: each tab's selected point, its settings widgets and highlight (issue 14, item 9)
+        self.selection = Selections(self, self.points_panel.selection_folder)
         self.cell_panel = cell_panel.CellPanel(self)
         self.frame_panel = frame_panel.FramePanel(self)  # 3-point work-object frame
         self.teach_panel = teach_panel.TeachPanel(self)
@@ -110,6 +111,7 @@ class WobjcalApp:
         self.autosave_note = ""
         self.autosave_lock: AutosaveLock | None = None
         server.on_client_connect(self._on_connect)
+        server.on_client_disconnect(self._on_disconnect)
         if isinstance(plan.source, Plan):
             self.load_cell(plan.source, self.plan_dir)
 
@@ -137,7 +139,7 @@ class WobjcalApp:
             self.robot.remove()
             self.robot = None
         if view.robot_urdf is not None:
-            self.robot, why = robot_view_or_reason(self.server, view)
+            self.robot, why = tab_robots_or_reason(self.server, view)
             if why:
                 logger.warning("%s", why)
                 self.notify("Robot not drawn", why, error=True)
@@ -195,9 +197,7 @@ class WobjcalApp:
         # batch with scene messages only in its next frame (0.2-1 s with software WebGL)
         self.points_panel.refresh()
         self.server.flush()
-        self.scene.draw_points(
-            doc, self.checks(), self.selected, only=point_ids, flags=self.flags.by_point
-        )
+        self.scene.draw_points(doc, self.checks(), None, only=point_ids, flags=self.flags.by_point)
         self.server.flush()
 
     def _on_change(self, change: Change[UiPlan]) -> None:
@@ -208,6 +208,7 @@ class WobjcalApp:
             except Exception as exc:
                 self.notify("Cell not loaded", str(exc), error=True)
             self._redraw()
+            self.selection.follow(change.doc, set())  # deleted points, highlights moved
             return
         before = {p.id: p for p in change.previous.points}
         changed = [p.id for p in change.doc.points if before.get(p.id) != p]
@@ -217,10 +218,8 @@ class WobjcalApp:
         if len(changed) > 2 or not changed:  # grey "pending" markers for bulk changes
             self._redraw(changed)
         self.recheck(changed)  # draws the changed points (one round trip per click)
-        if self.selected is not None and self.selected not in change.doc.ids:
-            self.select(None)
-        elif self.selected in changed:
-            self._show_selected()
+        for cid in self.selection.follow(change.doc, set(changed)):  # tabs whose point changed
+            self._pose_robot(cid)
 
     def show_reachability(self, n_samples: int = 1000) -> None:
         """Start the reachability heat map (computed in chunks on the cell worker)."""
@@ -229,11 +228,16 @@ class WobjcalApp:
 
     # ---- editing ---------------------------------------------------------------------------
     def place_at_ray(
-        self, origin_world: ArrayLike, direction_world: ArrayLike, point_id: str | None = None
+        self,
+        origin_world: ArrayLike,
+        direction_world: ArrayLike,
+        point_id: str | None = None,
+        client: viser.ClientHandle | None = None,
     ) -> PointCheck | None:
         """Put a point where a ray (world frame) hits the work object; return its check.
 
-        This is what a click on the work object does.
+        This is what a click on the work object does; the new point is selected in the tab of
+        ``client`` (every tab when ``None``).
 
         Raises:
             InputError: no work object is loaded or the ray misses it.
@@ -249,8 +253,8 @@ class WobjcalApp:
         def edit(doc: UiPlan) -> UiPlan:
             return plan_doc.place_point(doc, pid, hit.position_wobj, hit.normal_wobj)
 
-        self.selected = pid
         self.state.update(edit, f"place {pid}")
+        self.select(pid, client)
         return self.check_of(pid)
 
     def move_point_to(self, point_id: str, point_wobj: ArrayLike) -> PointCheck | None:
@@ -273,26 +277,33 @@ class WobjcalApp:
         )
         return self.check_of(point_id)
 
-    def select(self, point_id: str | None) -> None:
-        """Select a point: highlight it and show the robot at its probe pose."""
-        previous, self.selected = self.selected, point_id
-        ids = self.state.doc.ids
-        self._redraw([i for i in (previous, point_id) if i is not None and i in ids])
-        self._show_selected()
+    @property
+    def selected(self) -> str | None:
+        """The latest point selected in any tab or by a script (see :meth:`selection_of`)."""
+        return self.selection.latest
 
-    def _show_selected(self) -> None:
-        """Robot at the selected point's probe pose; its settings in the panel."""
-        point_id = self.selected
+    def selection_of(self, client: viser.ClientHandle | None) -> str | None:
+        """The point the tab of ``client`` has selected (``None``: the latest anywhere)."""
+        return self.selection.of(None if client is None else client.client_id)
+
+    def select(self, point_id: str | None, client: viser.ClientHandle | None = None) -> None:
+        """Select a point in one tab (``client``) or in every tab (``None``, e.g. a script):
+        highlight it there and show that tab's robot at its probe pose."""
+        cid = None if client is None else client.client_id
+        self.selection.select(point_id, cid)
+        self._pose_robot(cid)
+        self.points_panel.refresh()  # the drag gizmo follows the latest selection
+
+    def _pose_robot(self, client_id: int | None) -> None:
+        """Robot of tab ``client_id`` (every tab: ``None``) at its selected point's probe pose."""
+        point_id = self.selection.of(client_id)
         check = None if point_id is None else self.check_of(point_id)
         if self.robot is not None and check is not None and check.q is not None:
-            self.robot.stop()
-            self.robot.set_q(check.q)
-        self.points_panel.on_select(point_id)
+            self.robot.set_q(check.q, client_id)
 
-    # ---- clicks ----------------------------------------------------------------------------
     def _on_scene_click(self, event: Any) -> None:
         """Every click on the 3D view: handled by the current mode, or told why it did nothing."""
-        handler = self.click_handlers.get(self.click_mode, self._click_place)
+        handler = self.click_handlers.get(self.click_mode, self.click_handlers["place"])
         try:
             handler(event)
         except InputError as exc:
@@ -300,40 +311,6 @@ class WobjcalApp:
         except Exception as exc:  # never a traceback in the browser
             logger.exception("a click failed")
             self.notify("Click not used", f"{type(exc).__name__}: {exc}", client=event.client)
-
-    def marker_at_ray(
-        self, origin_world: ArrayLike, direction_world: ArrayLike, hit: Any = None
-    ) -> str | None:
-        """The point whose marker the ray passes through (see :func:`webui.surface.
-        marker_on_ray`), or ``None``."""
-        view = self.view
-        if view is None:
-            return None
-        doc = self.state.doc
-        positions = [transform_points(view.T_world_wobj, p.probe.position_m) for p in doc.points]
-        hit_world = None if hit is None else transform_points(view.T_world_wobj, hit.position_wobj)
-        k = marker_on_ray(
-            positions, origin_world, direction_world, 1.6 * MARKER_RADIUS_M, hit_world
-        )
-        return None if k is None else doc.points[k].id
-
-    def _click_place(self, event: Any) -> None:
-        """A click in place mode: on a marker selects it, on the part places a point, anywhere
-        else says that nothing was placed and why."""
-        picker = self.picker
-        hit = None if picker is None else picker.pick(event.ray_origin, event.ray_direction)
-        marker = self.marker_at_ray(event.ray_origin, event.ray_direction, hit)
-        if marker is not None:
-            self.select(marker)
-            return
-        if picker is None:
-            raise InputError("no work object is loaded: load a plan first")
-        if hit is None:
-            raise InputError(
-                "nothing placed: the click did not hit the work object (points go on the part; "
-                "to select a point, click its marker or pick it under Selected)"
-            )
-        self.place_at_ray(event.ray_origin, event.ray_direction)
 
     # ---- clients ---------------------------------------------------------------------------
     def _upload_refused(self, client_id: int, name: str, message: str) -> None:
@@ -345,10 +322,18 @@ class WobjcalApp:
         return self.tabs.tab(name)
 
     def _on_connect(self, client: viser.ClientHandle) -> None:
+        self.selection.add_client(client)
+        if self.robot is not None:
+            self.robot.add_client(client)
         if self.view is not None:
             clients.set_default_camera(client, self.view)
         if self.autosave_note:
             self.notify("Autosave", self.autosave_note, client=client, error=False)
+
+    def _on_disconnect(self, client: viser.ClientHandle) -> None:
+        self.selection.remove_client(client.client_id)
+        if self.robot is not None:
+            self.robot.remove_client(client.client_id)
 
     def notify(
         self, title: str, body: str, client: viser.ClientHandle | None = None, error: bool = True

@@ -19,6 +19,7 @@ from calib.plan.file import Plan, PlanPoint, resolve_ref
 from planner.builtins import robot_urdf
 from planner.cell.cell import Cell
 from planner.cell.moves import MoveCheck, ViaPath, check_joint_move, check_via_path
+from planner.cell.ray_hit import RayHit, first_hit
 from planner.cell.workobject import load_work_object
 from planner.check import PointCheck, check_points
 from planner.plan_cell import open_cell
@@ -227,6 +228,18 @@ class CellSession:
         """The moves from ``q_prev`` through the vias to ``q_point``
         (:func:`planner.cell.moves.check_via_path`, as ``wobjcal check`` runs them)."""
         return check_via_path(self._cell(), q_prev, vias_q, q_point, tcp)
+
+    def first_hit(
+        self, origin_world: ArrayLike, direction_world: ArrayLike, q: ArrayLike | None
+    ) -> RayHit | None:
+        """What the ray (world) meets first in the cell with the robot at ``q`` (rad; ``None``
+        or a length that is not the chain's: its current pose): :func:`planner.cell.ray_hit.
+        first_hit`."""
+        cell = self._cell()
+        qa = None if q is None else np.asarray(q, dtype=np.float64).reshape(-1)
+        if qa is not None and qa.shape[0] != cell.chain.n_joints:
+            qa = None
+        return first_hit(cell, origin_world, direction_world, q=qa)
 
     def _cell(self) -> Cell:
         if self.cell is None:

@@ -20,11 +20,11 @@ if TYPE_CHECKING:
     from webui.backend import CellSession, CellView
     from webui.busy import BusyIndicator
     from webui.plan_doc import UiPlan
-    from webui.robot_view import RobotView
     from webui.role_check import RoleFlags
     from webui.scene import PlanScene
     from webui.state import SessionState
     from webui.surface import SurfacePicker
+    from webui.tab_robots import TabRobots
     from webui.worker import CellWorker
 
 
@@ -33,6 +33,13 @@ class HeatMapControl(Protocol):
 
     def stop(self) -> None:
         """Stop a heat map being computed (and keep what is drawn)."""
+
+
+class SelectionControl(Protocol):
+    """Each tab's selection as the panels see it (:class:`webui.tab_selection.Selections`)."""
+
+    def of(self, client_id: int | None) -> str | None:
+        """The point tab ``client_id`` has selected (``None``: the latest anywhere)."""
 
 
 class AppContext(Protocol):
@@ -46,8 +53,9 @@ class AppContext(Protocol):
         plan_dir: folder the plan's relative file references resolve against.
         view: the cell's geometry (``None`` before a cell is loaded).
         picker: click-to-place on the work object (``None`` before a cell is loaded).
-        robot: the robot drawn in the scene, or ``None``.
-        selected: the selected point's id, or ``None``.
+        robot: the robot drawn in every tab (each at its own pose), or ``None``.
+        selected: the latest point selected in any tab or by a script, or ``None``.
+        selection: each tab's selected point (:mod:`webui.tab_selection`).
         busy: the busy indicator (``with app.busy("checking B"): ...``).
         flags: the points the procedure cannot use where they are (role or face), and why.
         click_mode: what a click on the 3D view does (a key of ``click_handlers``).
@@ -61,8 +69,7 @@ class AppContext(Protocol):
     plan_dir: Path
     view: CellView | None
     picker: SurfacePicker | None
-    robot: RobotView | None
-    selected: str | None
+    robot: TabRobots | None
     busy: BusyIndicator
     flags: RoleFlags
     click_mode: str
@@ -70,6 +77,10 @@ class AppContext(Protocol):
 
     def tab(self, name: str) -> Any:
         """The control panel's tab ``name`` (a context for a panel's widgets)."""
+
+    @property
+    def selection(self) -> SelectionControl:
+        """Each tab's selected point."""
 
     @property
     def heatmap(self) -> HeatMapControl:
@@ -87,8 +98,21 @@ class AppContext(Protocol):
         """Make ``plan`` (another cell) the session's in one undoable step; raise (changing
         nothing) when its cell cannot be built."""
 
-    def select(self, point_id: str | None) -> None:
-        """Select a point (or none)."""
+    @property
+    def selected(self) -> str | None:
+        """The latest point selected in any tab or by a script."""
+
+    def select(self, point_id: str | None, client: viser.ClientHandle | None = None) -> None:
+        """Select a point (or none) in the tab of ``client``, or in every tab (``None``)."""
+
+    def place_at_ray(
+        self,
+        origin_world: ArrayLike,
+        direction_world: ArrayLike,
+        point_id: str | None = None,
+        client: viser.ClientHandle | None = None,
+    ) -> PointCheck | None:
+        """Put a point where a ray (world) hits the work object, selected in ``client``'s tab."""
 
     def move_point_to(self, point_id: str, point_wobj: ArrayLike) -> PointCheck | None:
         """Move a point to the surface point nearest ``point_wobj`` (wobj frame, m)."""

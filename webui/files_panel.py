@@ -18,7 +18,7 @@ from calib.errors import InputError
 from calib.plan.file import Plan, PlanError
 from calib.units import MESH_UNITS
 from webui.exports import FORMATS, ExportResult, export_program
-from webui.part_upload import PendingPart, drop_points, off_surface, project_points
+from webui.part_upload import PendingPart, drop_points, frame_note, off_surface, project_points
 from webui.plan_adapter import plan_from_ui, plan_json_from_ui, ui_plan_from_bytes, with_source
 from webui.state import atomic_write_bytes
 from webui.urdf_zip import unpack_robot_zip
@@ -79,6 +79,12 @@ class FilesPanel:
             self.plan_upload = gui.add_upload_button("Upload plan (.json)", mime_type=".json")
             self.mesh_upload = gui.add_upload_button("Upload work-object mesh")
             self.units = gui.add_dropdown("Mesh units", MESH_UNITS, initial_value="mm")
+            self.keep_frame = gui.add_checkbox(
+                "Keep work-object frame",
+                False,
+                hint="a new part keeps the earlier part's 3-point frame (T_wobj_mesh); "
+                "unticked it starts with the file's own frame",
+            )
             self.pending_md = gui.add_markdown("")
             self.accept = gui.add_button("Use this part", color="green", visible=False)
             self.cancel = gui.add_button("Cancel upload", visible=False)
@@ -194,18 +200,21 @@ class FilesPanel:
         if pending is None:
             raise InputError("upload a mesh first: no part is waiting")
         source = self._current_plan()
+        old_frame = source.work_object.mesh_pose
+        keep = old_frame is not None and bool(self.keep_frame.value)
         work_object = msgspec.structs.replace(
             source.work_object,
             mesh=str(pending.path),
             units=str(self.units.value),
             sha256=pending.digest,
+            T_wobj_mesh=source.work_object.T_wobj_mesh if keep else msgspec.UNSET,
         )
         plan = msgspec.structs.replace(source, work_object=work_object)
         self._apply_source(plan, "new mesh", pending.path, pending.name)
         self.pending = None
         self._show_pending()
         self._list_off_surface()
-        return f"Work object {pending.name} loaded"
+        return f"Work object {pending.name} loaded{frame_note(old_frame is not None, keep)}"
 
     def upload_mesh(self, name: str, content: bytes) -> str:
         """Use an uploaded mesh (in the chosen units) as the work object at once (scripts)."""

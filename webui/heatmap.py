@@ -1,7 +1,9 @@
 """The reachability heat map: surface samples checked as probe poses, drawn on the work object.
 
-The samples go through the fast batched check of a click (:func:`planner.cell.feasibility.
-check_probes`: a broad phase decides most clearance parts, Bullet only the rest), with a
+The samples go through :func:`planner.cell.probe_status.probe_statuses`: the statuses of the
+fast batched check of a click (a broad phase decides most clearance parts, Bullet only the
+rest) without the least-bad pose of a point that cannot be probed (the map asks whether and
+why not, not which pose: it stops at the first candidate that settles the status), with a
 coarser search over the sensor's rotation (:data:`ROTATION_STEP_DEG`, :data:`MAX_CHECKS`: a
 map, not a verdict; a click checks its point fully), in chunks queued on the cell worker:
 clicks from any tab slip in between chunks, the map grows on screen as chunks finish, and
@@ -26,6 +28,7 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from calib.errors import InputError
+from planner.cell.probe_status import probe_statuses
 from planner.cell.reachability_map import sample_surface
 from planner.faces.checks import check_probe_faces
 from webui.scene import STATUS_RGB
@@ -209,10 +212,11 @@ class HeatMap:
         if stop.is_set() or session is None or session.cell is None:
             return [], 0.0
         t0 = time.perf_counter()
-        res = session.cell.check_probes(
-            pts, nrm, tcp=tcp, rotation_step_deg=ROTATION_STEP_DEG, max_checks=MAX_CHECKS
-        )
-        return [(str(r.status), r.reason) for r in res], time.perf_counter() - t0
+        res = probe_statuses(
+            session.cell, pts, nrm, tcp=tcp, rotation_step_deg=ROTATION_STEP_DEG,
+            max_checks=MAX_CHECKS,
+        )  # fmt: skip
+        return list(zip(res.statuses, res.reasons)), time.perf_counter() - t0
 
     def rgb(self) -> NDArray[np.uint8]:
         """``(n, 3)`` colours of the samples checked so far (by :data:`CATEGORY_RGB`)."""

@@ -6,7 +6,8 @@ no longer lie on the new surface (listed, then dropped or projected onto it).
 including what ``auto`` would pick (:func:`planner.cell.workobject.load_work_object`, the
 loader every plan uses). :func:`off_surface` lists the points farther than
 :data:`OFF_SURFACE_M` from a mesh; :func:`project_points` and :func:`drop_points` are the two
-fixes, each a pure edit of the UI plan.
+fixes, each a pure edit of the UI plan. A new part starts with its file's own frame as the
+work-object frame unless the user keeps the earlier one (:func:`frame_note` says which).
 """
 
 from __future__ import annotations
@@ -89,3 +90,15 @@ def drop_points(plan: UiPlan, ids: list[str]) -> UiPlan:
     for pid in ids:
         plan = plan_doc.delete_point(plan, pid)
     return plan
+
+
+def frame_note(had_frame: bool, kept: bool) -> str:
+    """What became of the earlier part's 3-point frame (``work_object.T_wobj_mesh``)."""
+    if not had_frame:
+        return ""
+    if kept:
+        return "; the earlier part's work-object frame (T_wobj_mesh) is kept"
+    return (
+        "; its work-object frame is the file's own (T_wobj_mesh identity): the earlier "
+        "part's 3-point frame was not kept (tick Keep work-object frame to keep it)"
+    )

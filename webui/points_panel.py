@@ -14,8 +14,9 @@ from calib.errors import InputError
 from calib.procedures import PROCEDURES
 from webui import heatmap, plan_doc
 from webui.plan_adapter import with_procedure
-from webui.plan_doc import NO_ROLE, PAPER_IDS
+from webui.plan_doc import PAPER_IDS
 from webui.scene import legend_html
+from webui.tab_selection import NO_ROLE_LABEL, set_options
 
 if TYPE_CHECKING:
     from webui.context import AppContext
@@ -23,19 +24,11 @@ if TYPE_CHECKING:
 logger = logging.getLogger(__name__)
 
 NEXT = "next"
-NONE = "(none)"
-#: The role dropdown's entry for "no role" (:data:`webui.plan_doc.NO_ROLE`).
-NO_ROLE_LABEL = "(none)"
-
-
-def _set_options(dropdown: Any, options: tuple[str, ...]) -> None:
-    """Send new dropdown options only when they changed (each update re-renders the panel)."""
-    if tuple(dropdown.options) != options:
-        dropdown.options = options
 
 
 class PointsPanel:
-    """GUI widgets for placing, selecting, editing and inspecting points (shared by all tabs).
+    """GUI widgets for placing and inspecting points and editing the plan (shared by all tabs;
+    each tab's selection and its settings are :mod:`webui.tab_selection`'s).
 
     Args:
         app: the app whose plan the panel edits.
@@ -62,14 +55,8 @@ class PointsPanel:
                 "Click the work object to place the point on its surface; click a marker to "
                 "select it."
             )
-            self.selected = gui.add_dropdown("Selected", (NONE,), initial_value=NONE)
-            self.role = gui.add_dropdown("Role", (*PAPER_IDS, NO_ROLE_LABEL), initial_value="A")
-            self.kind = gui.add_dropdown("Search", ("approach", "edge"), initial_value="approach")
-            self.start_mm = gui.add_number("Start offset (mm)", 30.0, min=0.1, step=0.5)
-            self.over_mm = gui.add_number("Overtravel (mm)", 20.0, min=0.1, step=0.5)
-            self.edge_dir = gui.add_vector3("Edge direction", (0.0, 0.0, 1.0), step=0.1)
-            self.apply = gui.add_button("Apply settings")
-            self.delete = gui.add_button("Delete point", color="red")
+            #: each tab's own Selected dropdown and settings (:mod:`webui.tab_selection`)
+            self.selection_folder = gui.add_folder("Selected point")
             self.undo = gui.add_button("Undo")
             self.redo = gui.add_button("Redo")
             self.drag = gui.add_checkbox("Drag selected point", False)
@@ -79,10 +66,7 @@ class PointsPanel:
                 legend_html(heatmap.CATEGORY_MEANING, heatmap.CATEGORY_RGB), visible=False
             )
             self.status_md = gui.add_markdown("")
-        self.selected.on_update(self._on_selected)
         self.procedure.on_update(self._on_procedure)
-        self.apply.on_click(self._on_apply)
-        self.delete.on_click(self._on_delete)
         self.undo.on_click(lambda ev: self._guard(ev, self._app.state.undo))
         self.redo.on_click(lambda ev: self._guard(ev, self._app.state.redo))
         self.drag.on_update(lambda ev: self._guard(ev, self._update_gizmo))
@@ -124,13 +108,9 @@ class PointsPanel:
         checks = self._app.checks()
         with self._programmatic():
             extra = tuple(i for i in doc.ids if i not in PAPER_IDS)
-            _set_options(self.place, (NEXT, *PAPER_IDS, *extra))
-            _set_options(self.selected, (NONE, *doc.ids))
-            _set_options(self.role, (*doc.roles, NO_ROLE_LABEL))
+            set_options(self.place, (NEXT, *PAPER_IDS, *extra))
             if self.procedure.value != doc.method:
                 self.procedure.value = doc.method
-            sel = self._app.selected
-            self.selected.value = sel if sel in doc.ids else NONE
         kind = PROCEDURES.get(doc.method)
         summary = "" if kind is None else f"*{kind.summary}*; roles: {', '.join(kind.roles)}"
         if self.procedure_md.content != summary:
@@ -155,25 +135,6 @@ class PointsPanel:
         if self.status_md.content != content:
             self.status_md.content = content
         self._update_gizmo()
-
-    def on_select(self, point_id: str | None) -> None:
-        """Show the selected point's settings in the widgets."""
-        doc = self._app.state.doc
-        if point_id is None or point_id not in doc.ids:
-            return
-        p = doc.get(point_id)
-        s = p.probe.search
-        with self._programmatic():
-            self.selected.value = point_id
-            role = p.role or NO_ROLE_LABEL
-            if role in self.role.options:
-                self.role.value = role
-            self.kind.value = s.kind
-            self.start_mm.value = round(s.start_offset_m * 1000.0, 3)
-            self.over_mm.value = round(s.overtravel_m * 1000.0, 3)
-            if s.edge_direction is not None:
-                dx, dy, dz = (round(v, 4) for v in s.edge_direction)
-                self.edge_dir.value = (dx, dy, dz)
 
     def gizmo_geometry(self) -> tuple[float, float]:
         """``(scale, offset)`` of the drag gizmo, m: sized for the part (a third of its largest
@@ -217,31 +178,6 @@ class PointsPanel:
         self._gizmo_for = (sel, tuple(pos))
 
     # ---- callbacks -------------------------------------------------------------------------
-    def _on_selected(self, event: Any) -> None:
-        if self._is_programmatic():
-            return
-        value = str(self.selected.value)
-        self._guard(event, self._app.select, None if value == NONE else value)
-
-    def _on_apply(self, event: Any) -> None:
-        sel = self._app.selected
-        if sel is None:
-            self._app.notify("Not done", "select a point first", client=event.client)
-            return
-
-        def edit(doc: plan_doc.UiPlan) -> plan_doc.UiPlan:
-            return plan_doc.edit_search(
-                doc,
-                sel,
-                kind=str(self.kind.value),
-                start_offset_m=float(self.start_mm.value) / 1000.0,
-                overtravel_m=float(self.over_mm.value) / 1000.0,
-                edge_direction=self.edge_dir.value if self.kind.value == "edge" else None,
-                role=NO_ROLE if self.role.value == NO_ROLE_LABEL else str(self.role.value),
-            )
-
-        self._guard(event, self._app.state.update, edit, f"edit {sel}")
-
     def _on_procedure(self, event: Any) -> None:
         if self._is_programmatic():
             return
@@ -253,15 +189,6 @@ class PointsPanel:
             self._app.state.update,
             lambda d: with_procedure(d, method),
             f"procedure {method}",
-        )
-
-    def _on_delete(self, event: Any) -> None:
-        sel = self._app.selected
-        if sel is None:
-            self._app.notify("Not done", "select a point first", client=event.client)
-            return
-        self._guard(
-            event, self._app.state.update, lambda d: plan_doc.delete_point(d, sel), f"delete {sel}"
         )
 
     def _on_gizmo(self, event: Any) -> None:
@@ -295,14 +222,17 @@ class PointsPanel:
         self._guard(event, self._app.move_point_to, sel, pos)
 
     def _on_play(self, event: Any) -> None:
-        sel = self._app.selected
+        """Play the search of the point this tab has selected, on this tab's robot."""
+        client = getattr(event, "client", None)
+        cid = None if client is None else client.client_id
+        sel = self._app.selection.of(cid)
         check = None if sel is None else self._app.check_of(sel)
         robot = self._app.robot
         if check is None or check.q_path is None or robot is None:
             why = "select a point whose search path was computed" if robot else "no robot loaded"
-            self._app.notify("Nothing to play", why, client=event.client)
+            self._app.notify("Nothing to play", why, client=client)
             return
-        robot.play(check.q_path)
+        robot.play(check.q_path, client_id=cid)
 
     def _on_heat(self, event: Any) -> None:
         if self._is_programmatic():

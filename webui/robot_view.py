@@ -1,14 +1,14 @@
-"""The robot in the scene: its URDF visual meshes, posed by joint values, and path playback."""
+"""The robot drawn in one scene (the server's or one browser tab's): its URDF visual meshes and
+tool, posed by joint values. :mod:`webui.tab_robots` keeps one per browser tab."""
 
 from __future__ import annotations
 
 import logging
 import threading
-import time
-from pathlib import Path
 
 import numpy as np
 import viser
+import yourdfpy
 from numpy.typing import ArrayLike
 from viser.extras import ViserUrdf
 
@@ -18,52 +18,39 @@ from webui.scene import pose_kwargs
 logger = logging.getLogger(__name__)
 
 
-def robot_view_or_reason(server: viser.ViserServer, view: CellView) -> tuple[RobotView | None, str]:
-    """The robot drawn in the scene, or ``None`` and why it could not be drawn.
-
-    The robot's visual meshes are only for the eye: a URDF whose visuals cannot be read (e.g.
-    COLLADA ``.dae`` files without ``pycollada``) still checks, validates and exports; the
-    reason names the file and the fix instead of an "internal error: ImportError".
-    """
-    try:
-        return RobotView(server, view), ""
-    except ImportError as exc:
-        text = str(exc).lower()
-        hint = " (pip install pycollada)" if "collada" in text and "pip" not in text else ""
-        why = f"{exc}{hint}"
-    except Exception as exc:  # a visual mesh trimesh cannot read: draw no robot, say why
-        why = f"{type(exc).__name__}: {exc}"
-    server.scene.remove_by_name("/robot")
-    server.scene.remove_by_name("/tool")
-    return None, (
-        f"robot not drawn: the visual meshes of {view.robot_urdf} cannot be read: {why}; the "
-        "checks, validation and exports are not affected"
-    )
-
-
 class RobotView:
-    """The robot model drawn under ``/robot`` (posed at ``T_world_base``).
+    """The robot model drawn under ``/robot`` (posed at ``T_world_base``) and its tool under
+    ``/tool``, in the scene of ``target``.
 
     Args:
-        server: the viser server.
+        target: the server (every tab) or one tab's client handle.
         view: the cell geometry: robot URDF and base pose, tool, kinematic chain.
+        urdf: the robot's model with its visual meshes loaded (shared by the tabs' views;
+            posing it is serialized by ``lock``).
+        lock: held while the shared model is posed.
     """
 
-    def __init__(self, server: viser.ViserServer, view: CellView) -> None:
-        self._server = server
+    def __init__(
+        self,
+        target: viser.ViserServer | viser.ClientHandle,
+        view: CellView,
+        urdf: yourdfpy.URDF,
+        lock: threading.Lock,
+    ) -> None:
+        self._target = target
         self._view = view
-        server.scene.add_frame("/robot", show_axes=False, **pose_kwargs(view.T_world_base))
-        if view.robot_urdf is None:
-            raise ValueError("the cell has no robot URDF to draw")
-        self._urdf = ViserUrdf(server, Path(view.robot_urdf), root_node_name="/robot/urdf")
+        self._lock = lock
+        target.scene.add_frame("/robot", show_axes=False, **pose_kwargs(view.T_world_base))
+        with lock:  # the shared model is read while the meshes are added
+            self._urdf = ViserUrdf(target, urdf, root_node_name="/robot/urdf")
         self._tool: ViserUrdf | None = None
         self._tool_frame: viser.FrameHandle | None = None
         if view.chain is not None and (view.tool_urdf is not None or view.tool_mesh is not None):
-            self._tool_frame = server.scene.add_frame("/tool", show_axes=False)
+            self._tool_frame = target.scene.add_frame("/tool", show_axes=False)
             if view.tool_urdf is not None:
-                self._tool = ViserUrdf(server, Path(view.tool_urdf), root_node_name="/tool/urdf")
+                self._tool = ViserUrdf(target, view.tool_urdf, root_node_name="/tool/urdf")
             elif (mesh := view.tool_mesh) is not None:
-                server.scene.add_mesh_simple(
+                target.scene.add_mesh_simple(
                     "/tool/mesh",
                     np.asarray(mesh.vertices, np.float32),
                     np.asarray(mesh.faces, np.uint32),
@@ -76,12 +63,10 @@ class RobotView:
             chain_names if set(chain_names) == set(urdf_names) else urdf_names
         )
         self._to_urdf = np.array([self.joint_names.index(n) for n in urdf_names], dtype=int)
-        self._play_stop = threading.Event()
-        self._play_thread: threading.Thread | None = None
         self.q = np.zeros(len(self.joint_names))
-        self.set_q(self._home())
 
-    def _home(self) -> np.ndarray:
+    def home(self) -> np.ndarray:
+        """``(n,)`` zero joint values clipped into the URDF's limits, rad."""
         limits = self._urdf.get_actuated_joint_limits()
         q = []
         for name in self.joint_names:
@@ -100,7 +85,7 @@ class RobotView:
             )
             return
         self.q = q_arr
-        with self._server.atomic():
+        with self._lock, self._target.atomic():
             self._urdf.update_cfg(q_arr[self._to_urdf])
             T = self._view.T_world_flange(q_arr)
             if T is not None and self._tool_frame is not None:
@@ -108,42 +93,8 @@ class RobotView:
                 self._tool_frame.wxyz = pose["wxyz"]
                 self._tool_frame.position = pose["position"]
 
-    def play(self, q_path: ArrayLike, duration_s: float = 2.0, loops: int = 1) -> None:
-        """Animate ``q_path (M, n)`` in a background thread (stops a running animation)."""
-        path = np.asarray(q_path, dtype=np.float64)
-        self.stop()
-        self._play_stop = stop = threading.Event()
-
-        def run() -> None:
-            dt = duration_s / max(len(path) - 1, 1)
-            for _ in range(loops):
-                for q in path:
-                    if stop.is_set():
-                        return
-                    self.set_q(q)
-                    time.sleep(dt)
-
-        self._play_thread = threading.Thread(target=run, name="wobjcal-play", daemon=True)
-        self._play_thread.start()
-
-    def wait(self, timeout: float | None = None) -> bool:
-        """Wait for a running animation to end; True when none is running any more."""
-        thread = self._play_thread
-        if thread is not None:
-            thread.join(timeout)
-            return not thread.is_alive()
-        return True
-
-    def stop(self) -> None:
-        """Stop a running animation."""
-        self._play_stop.set()
-        if self._play_thread is not None and self._play_thread is not threading.current_thread():
-            self._play_thread.join(1.0)
-        self._play_thread = None
-
     def remove(self) -> None:
-        """Remove the robot from the scene."""
-        self.stop()
-        # removing the root nodes removes every link under them
-        self._server.scene.remove_by_name("/robot")
-        self._server.scene.remove_by_name("/tool")
+        """Remove the robot and its tool from the scene (removing the root nodes removes every
+        link under them)."""
+        self._target.scene.remove_by_name("/robot")
+        self._target.scene.remove_by_name("/tool")

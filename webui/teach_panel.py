@@ -78,7 +78,7 @@ class TeachPanel:
             )
             self.show_moves = gui.add_checkbox("Show moves between points", False)
             self.moves_md = gui.add_markdown("")
-        self.from_point.on_click(lambda ev: self._guard(ev, self.jog_to_selected))
+        self.from_point.on_click(lambda ev: self._guard(ev, self.jog_to_selected, ev.client))
         self.drag_tcp.on_update(lambda ev: self._guard(ev, self._update_gizmo))
         self.teach_button.on_click(lambda ev: self._guard(ev, self.teach, str(self.target.value)))
         self.via_button.on_click(lambda ev: self._guard(ev, self.teach_via))
@@ -180,9 +180,10 @@ class TeachPanel:
         self._update_gizmo()
         return status
 
-    def jog_to_selected(self) -> JogStatus:
-        """Jog to the selected point's probe pose (from its check)."""
-        sel = self._app.selected
+    def jog_to_selected(self, client: Any = None) -> JogStatus:
+        """Jog to the probe pose (from its check) of the point the tab of ``client`` has
+        selected (``None``: the latest selected anywhere)."""
+        sel = self._app.selection.of(None if client is None else client.client_id)
         check = None if sel is None else self._app.check_of(sel)
         if check is None or check.q is None:
             raise InputError("select a point whose probe pose was found (a reachable point)")

@@ -69,26 +69,6 @@ def gjk_upper(
 
 
 @nb.njit(cache=True)
-def _link_upper(
-    Tl, k, kind, T, dims, vs, vc, sh_kind, sh_T, sh_dims, sh_vs, sh_vc, verts, link_sh0,
-    link_shn, TA,
-):  # fmt: skip
-    """Upper bound of the distance of link ``k`` (pose ``Tl``) to one shape (``kind``, pose
-    ``T``, ``dims``, hull vertices ``verts[vs : vs + vc]``)."""
-    best = np.inf
-    for i in range(link_sh0[k], link_sh0[k] + link_shn[k]):
-        _compose(Tl, sh_T[i], TA)
-        d = gjk_upper(
-            sh_kind[i], TA, sh_dims[i], verts, sh_vs[i], sh_vc[i], kind, T, dims, verts, vs, vc,
-            1e-7,
-        )  # fmt: skip
-        if d <= 0.0 and kind <= G.SPHERE:  # overlap with a primitive body: how deep, at least
-            d = -_depth_lower(sh_kind[i], TA, sh_dims[i], verts, sh_vs[i], sh_vc[i], kind, T, dims)
-        best = min(best, d)
-    return best
-
-
-@nb.njit(cache=True)
 def _depth(kind, T, dims, x, y, z):  # fmt: skip
     """How deep world point ``(x, y, z)`` lies inside a box, cylinder or sphere (pose ``T``),
     m; negative outside."""
@@ -142,6 +122,35 @@ def _depth_lower(kA, TA, dA, verts, sA, cA, kB, TB, dB):  # fmt: skip
         y = TA[1, 0] * px + TA[1, 1] * py + TA[1, 2] * pz + TA[1, 3]
         z = TA[2, 0] * px + TA[2, 1] * py + TA[2, 2] * pz + TA[2, 3]
         best = max(best, _depth(kB, TB, dB, x, y, z))
+    return best
+
+
+# Explicit: the constant arguments of one call site would otherwise get a literal-typed copy
+# (1.4 s more of compile on first use).
+_I = "int64[::1]"
+_LINK = (
+    f"float64({G._M}, int64, int64, {G._M}, {G._V}, int64, int64, {_I}, float64[:, :, ::1], "
+    f"{G._M}, {_I}, {_I}, {G._M}, {_I}, {_I}, {G._M})"
+)
+
+
+@nb.njit(_LINK, cache=True)
+def _link_upper(
+    Tl, k, kind, T, dims, vs, vc, sh_kind, sh_T, sh_dims, sh_vs, sh_vc, verts, link_sh0,
+    link_shn, TA,
+):  # fmt: skip
+    """Upper bound of the distance of link ``k`` (pose ``Tl``) to one shape (``kind``, pose
+    ``T``, ``dims``, hull vertices ``verts[vs : vs + vc]``)."""
+    best = np.inf
+    for i in range(link_sh0[k], link_sh0[k] + link_shn[k]):
+        _compose(Tl, sh_T[i], TA)
+        d = gjk_upper(
+            sh_kind[i], TA, sh_dims[i], verts, sh_vs[i], sh_vc[i], kind, T, dims, verts, vs, vc,
+            1e-7,
+        )  # fmt: skip
+        if d <= 0.0 and kind <= G.SPHERE:  # overlap with a primitive body: how deep, at least
+            d = -_depth_lower(sh_kind[i], TA, sh_dims[i], verts, sh_vs[i], sh_vc[i], kind, T, dims)
+        best = min(best, d)
     return best
 
 

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Literal, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -56,7 +56,9 @@ __all__ = [
     "WRIST_SINGULAR_RAD",
     "ProbeFeasibility",
     "check_probes",
+    "feasibility_of",
     "limit_margin",
+    "prepare_candidates",
     "singular",
     "tcp_frames",
 ]
@@ -145,6 +147,38 @@ def check_probes(
         UnknownFrameError: unknown TCP (the message lists the valid names).
     """
 
+    prep = prepare_candidates(
+        cell, points_wobj, normals_wobj, tcp, rotation_step_deg, margin_m, q_ref, max_checks
+    )
+    if prep is None:
+        return []
+    cands, margin, max_checks = prep
+    with cell.saved_state():
+        decisions: list[Decision | None]
+        if staged:
+            # without statuses_only every answer is a Decision (or None)
+            found = ProbeSearch(cell, margin, max_checks).run(cands)
+            decisions = cast(list[Decision | None], found)
+        else:
+            decisions = _reference(cell, cands, margin, max_checks)
+    return [
+        feasibility_of(cell.chain, cands, i, d, margin) if d is not None else _none(why or "")
+        for i, (d, why) in enumerate(zip(decisions, cands.reasons))
+    ]
+
+
+def prepare_candidates(
+    cell: CellScene,
+    points_wobj: ArrayLike,
+    normals_wobj: ArrayLike,
+    tcp: str,
+    rotation_step_deg: float,
+    margin_m: float | None,
+    q_ref: ArrayLike | None,
+    max_checks: int,
+) -> tuple[ProbeCandidates, float, int] | None:
+    """:func:`check_probes`'s arguments validated, and the points' candidates: ``(candidates,
+    margin_m, max_checks)``, ``None`` for no points (raises as :func:`check_probes` does)."""
     pts = check_shape(points_wobj, (None, 3), "points_wobj")
     nrm = check_shape(normals_wobj, (None, 3), "normals_wobj")
     if nrm.shape != pts.shape:
@@ -162,17 +196,8 @@ def check_probes(
         raise ShapeError(f"max_checks must be >= 1, got {max_checks}")
     angles = np.arange(0.0, 2 * np.pi - 1e-9, step)
     if pts.shape[0] == 0:
-        return []
-    cands = probe_candidates(cell, pts, nrm, T_flange_tcp, angles, ref)
-    with cell.saved_state():
-        if staged:
-            decisions = ProbeSearch(cell, margin, max_checks).run(cands)
-        else:
-            decisions = _reference(cell, cands, margin, max_checks)
-    return [
-        _feasibility(cell.chain, cands, i, d, margin) if d is not None else _none(why or "")
-        for i, (d, why) in enumerate(zip(decisions, cands.reasons))
-    ]
+        return None
+    return probe_candidates(cell, pts, nrm, T_flange_tcp, angles, ref), margin, max_checks
 
 
 def _reference(
@@ -193,10 +218,10 @@ def _reference(
     return out
 
 
-def _feasibility(
+def feasibility_of(
     chain: KinematicChain, cands: ProbeCandidates, i: int, d: Decision, margin: float
 ) -> ProbeFeasibility:
-    """The :class:`ProbeFeasibility` of point ``i``'s decision."""
+    """The :class:`ProbeFeasibility` of point ``i``'s decision ``d``."""
     c, cl = d.candidate, d.clearance
     K = cands.per_rotation
     r = c // K

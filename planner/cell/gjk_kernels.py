@@ -99,7 +99,7 @@ def support(
     )
 
 
-@nb.njit(cache=True)
+@nb.njit(f"void({_M}, int64, float64, float64, float64)", cache=True)
 def _set(W: np.ndarray, i: int, x: float, y: float, z: float) -> None:
     W[i, 0], W[i, 1], W[i, 2] = x, y, z
 
@@ -236,7 +236,7 @@ def start_direction(TA: np.ndarray, TB: np.ndarray, v: np.ndarray) -> None:
         v[0] = 1.0
 
 
-@nb.njit(cache=True)
+@nb.njit(f"int64({_M}, int64, float64, float64, float64, {_M}, {_V})", cache=True)
 def add_point(
     W: np.ndarray, n: int, wx: float, wy: float, wz: float, scratch: np.ndarray, v: np.ndarray
 ) -> int:

@@ -12,13 +12,18 @@ cache only ever costs time, never an answer: numba checks each entry against the
 stamp and the CPU before it loads it.
 
 Each kernel module calls :func:`configure` before its first ``@njit``: numba picks the
-directory when a function is decorated.
+directory when a function is decorated. The first call also starts the background compile of
+:mod:`planner.cell.warmup` when that directory was never warmed (:func:`start_background`).
 """
 
 from __future__ import annotations
 
+import hashlib
 import logging
 import os
+import subprocess
+import sys
+import threading
 from pathlib import Path
 from typing import Any
 
@@ -45,12 +50,83 @@ def configure() -> Path | None:
     if _CONFIG.CACHE_DIR:  # NUMBA_CACHE_DIR or an earlier call
         return Path(_CONFIG.CACHE_DIR)
     path = cache_root() / "numba"
+    if _writable(path):
+        _CONFIG.CACHE_DIR = str(path)
+        start_background(path)
+        return path
+    return None
+
+
+def _writable(path: Path) -> bool:
     try:
         path.mkdir(parents=True, exist_ok=True)
         if not os.access(path, os.W_OK):
             raise PermissionError(f"{path} is not writable")
     except OSError as exc:
         log.info("numba kernels cached by numba's defaults: %s", exc)
-        return None
-    _CONFIG.CACHE_DIR = str(path)
-    return path
+        return False
+    return True
+
+
+#: Modules whose source the compiled kernels depend on (the marker's key).
+SOURCES = (
+    "gjk_kernels",
+    "bound_kernels",
+    "broad_kernels",
+    "field_kernels",
+    "mesh_kernels",
+    "kernel_cache",
+    "warmup",
+)
+_ENV_OFF = "WOBJCAL_BACKGROUND_COMPILE"
+#: Set in the helper process (it starts no helper of its own).
+CHILD_ENV = "WOBJCAL_WARMUP_CHILD"
+_started = threading.Lock()
+_helper: list[subprocess.Popen[bytes]] = []
+
+
+def _key() -> str:
+    here = Path(__file__).resolve().parent
+    h = hashlib.sha256(f"{numba.__version__} {sys.version}".encode())
+    for name in SOURCES:
+        h.update((here / f"{name}.py").read_bytes())
+    return h.hexdigest()[:16]
+
+
+def marker_path(cache_dir: Path) -> Path:
+    """The file that says ``cache_dir`` holds the kernels of this source and numba."""
+    return cache_dir / f"warm-{_key()}"
+
+
+def start_background(cache_dir: Path | None) -> bool:
+    """Start the helper process of :mod:`planner.cell.warmup` unless ``cache_dir`` was
+    warmed, it runs already, this is the helper, or ``WOBJCAL_BACKGROUND_COMPILE=0``; True
+    when started."""
+    if (
+        cache_dir is None
+        or os.environ.get(CHILD_ENV)
+        or os.environ.get(_ENV_OFF, "1") == "0"
+        or marker_path(cache_dir).exists()
+    ):
+        return False
+    with _started:
+        if _helper:
+            return False
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(cache_dir), **{CHILD_ENV: "1"})
+        src = str(Path(__file__).resolve().parents[2])
+        env["PYTHONPATH"] = os.pathsep.join(p for p in (src, env.get("PYTHONPATH")) if p)
+        try:
+            proc = subprocess.Popen(
+                [sys.executable, "-m", "planner.cell.warmup", "--reverse"],
+                env=env,
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+            )
+        except OSError as exc:  # no helper: the check compiles what it needs itself
+            log.info("no background compile of the kernels: %s", exc)
+            return False
+        _helper.append(proc)
+    threading.Thread(target=proc.wait, name="wobjcal-warmup-reaper", daemon=True).start()
+    log.info("compiling the broad phase's kernels in the background (pid %d)", proc.pid)
+    return True

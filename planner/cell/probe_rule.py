@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -43,6 +44,21 @@ class Decision:
     candidate: int
     clearance: Clearance
     chosen: bool
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """The status of a point that the rule leaves to its least-bad candidate, found without
+    finding that candidate (:class:`planner.cell.probe_search.ProbeSearch` with
+    ``statuses_only``: the heat map's question is "can this point be probed, and if not,
+    why", not "which pose and how near").
+
+    Attributes:
+        status: ``"marginal"`` (the least-bad candidate does not collide) or
+            ``"infeasible"`` (every candidate collides).
+    """
+
+    status: Literal["marginal", "infeasible"]
 
 
 def select(

@@ -17,13 +17,16 @@ The work is done in four passes; the answers do not depend on them:
    skipped), each one's open parts cheapest first, stopping as soon as its slack is shown
    below the margin; then the least-bad one, best candidates first (by upper bounds: GJK's and
    those of the parts already known), a candidate dropped as soon as its slack is shown to be
-   more than the tie below the best exact slack found.
+   more than the tie below the best exact slack found. With ``statuses_only`` (the heat map's
+   :func:`planner.cell.probe_status.probe_statuses`), a point none of whose candidates passes
+   stops at its status instead (:meth:`ProbeSearch._status`).
 """
 
 from __future__ import annotations
 
 import heapq
 import math
+from collections.abc import Callable
 from functools import partial
 from typing import TYPE_CHECKING
 
@@ -37,7 +40,7 @@ from planner.cell.clearance import Clearance, QueryPart
 from planner.cell.probe_clearance import ProbeClearance
 from planner.cell.probe_flags import Block, CandidateFlags, clear_ahead
 from planner.cell.probe_parts import OpenParts
-from planner.cell.probe_rule import CLEARANCE_TIE_M, Decision, least_bad, passes
+from planner.cell.probe_rule import CLEARANCE_TIE_M, Decision, Verdict, least_bad, passes
 from planner.cell.slack_bounds import SlackBounds
 
 if TYPE_CHECKING:
@@ -61,8 +64,11 @@ class ProbeSearch:
         max_checks: most candidates considered per point.
     """
 
-    def __init__(self, cell: CellScene, margin_m: float, max_checks: int) -> None:
+    def __init__(
+        self, cell: CellScene, margin_m: float, max_checks: int, statuses_only: bool = False
+    ) -> None:
         self._cell = cell
+        self.statuses_only = statuses_only
         self.margin = margin_m
         self.max_checks = max_checks
         self.stages = ProbeClearance(cell, margin_m)
@@ -80,10 +86,12 @@ class ProbeSearch:
         #: how many points each pass decided (for profiling and the bench).
         self.decided_by = {"broad": 0, "first": 0, "ahead": 0, "search": 0}
 
-    def run(self, cands: ProbeCandidates) -> list[Decision | None]:
-        """One decision per point (``None`` for points without a usable candidate)."""
+    def run(self, cands: ProbeCandidates) -> list[Decision | Verdict | None]:
+        """One decision per point (``None`` for points without a usable candidate); with
+        ``statuses_only``, a :class:`~planner.cell.probe_rule.Verdict` for a point none of
+        whose candidates passes when its status is known without the least-bad one."""
         N = cands.q.shape[0]
-        out: list[Decision | None] = [None] * N
+        out: list[Decision | Verdict | None] = [None] * N
         first = cands.first()
         idx = np.flatnonzero(first >= 0)
         if idx.size == 0:
@@ -159,7 +167,7 @@ class ProbeSearch:
 
     def _search(
         self, cands: ProbeCandidates, i: int, order: NDArray[np.int_], flags: CandidateFlags
-    ) -> Decision:
+    ) -> Decision | Verdict:
         """Pass 4 for point ``i``: candidates ``order``, broad-phase flags from ``flags``."""
         K = cands.per_rotation
         near = cands.near_limit[i]
@@ -201,6 +209,10 @@ class ProbeSearch:
             run(j, self.margin)
             if j in exact and passes(exact[j], self.margin):
                 return Decision(c, exact[j], True)
+        if self.statuses_only:
+            verdict = self._status(order, flags, exact, bound, run)
+            if verdict is not None:
+                return verdict
         # the least-bad one: candidates the broad phase clears have the look distance
         for j in range(len(order)):
             if j not in exact and flags.all_clear(j):
@@ -239,3 +251,36 @@ class ProbeSearch:
                 heapq.heappush(heap, (-bound[j], opened, j))
         seen = [(int(order[j]), exact[j]) for j in sorted(exact)]
         return least_bad(seen)
+
+    def _status(
+        self,
+        order: NDArray[np.int_],
+        flags: CandidateFlags,
+        exact: dict[int, Clearance],
+        bound: dict[int, float],
+        run: Callable[..., None],
+    ) -> Verdict | None:
+        """The status of a point none of whose candidates passes, without its least-bad one.
+
+        The least-bad candidate is ``marginal`` when its slack is >= 0 (no collision); it has
+        the largest slack but for the tie, so a candidate with slack >= the tie makes the point
+        ``marginal`` and every candidate shown below 0 makes it ``infeasible``. Candidates go
+        highest upper bound first; each one's open parts stop as soon as its slack is shown
+        below 0 (deep work-object parts with a capped query first). ``None`` (decide it by the
+        rule) when the largest slack lies within the tie above 0.
+        """
+        tie = False
+        look = self.stages.look_slack_m
+        rows = sorted(range(len(order)), key=lambda j: -min(bound.get(j, look), flags.upper(j)))
+        for j in rows:
+            if flags.all_clear(j):
+                return Verdict("marginal")  # the look distance: no collision
+            if min(bound.get(j, look), flags.upper(j)) < 0.0 and j not in exact:
+                continue  # shown to collide
+            if j not in exact:
+                run(j, 0.0, certify=True)
+            if j in exact:
+                if exact[j].slack_m >= CLEARANCE_TIE_M:
+                    return Verdict("marginal")
+                tie = tie or exact[j].slack_m >= 0.0
+        return None if tie else Verdict("infeasible")

@@ -13,25 +13,17 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ui_helpers import VIEWPORT, UiSession, open_tab, set_camera, wait_for
+from ui_helpers import UiSession, click_world, open_tab, set_camera, wait_for
 
 from calib.frames import transform_points
-from webui.testing import T_WORLD_WOBJ_BOX, project_to_screen
+from webui.testing import T_WORLD_WOBJ_BOX
 
 pytestmark = pytest.mark.browser
 
 
 def click_world_point(ui: UiSession, p_world: Any) -> None:
     """Click the canvas where ``p_world`` appears in the page's camera."""
-    cam = ui.client().camera
-    u, v = project_to_screen(
-        p_world, cam.position, cam.wxyz, cam.fov, cam.image_width, cam.image_height
-    )
-    box = ui.page.locator("canvas").first.bounding_box()
-    x = box["x"] + u * box["width"] / cam.image_width
-    y = box["y"] + v * box["height"] / cam.image_height
-    assert 0 < x < VIEWPORT["width"] * 0.6, "keep the target clear of the control panel"
-    ui.page.mouse.click(float(x), float(y))
+    click_world(ui.page, ui.client(), p_world)
 
 
 def open_folder(ui: UiSession, button: str) -> None:

@@ -144,6 +144,22 @@ def save_screenshot(page: Any, name: str, tmp_path: Path) -> Path:
     return shot
 
 
+def click_world(page: Any, client: Any, p_world: Any) -> None:
+    """Click the canvas of ``page`` where ``p_world`` appears in its camera (``client``: the
+    page's connection), keeping clear of the control panel."""
+    from webui.testing import project_to_screen
+
+    cam = client.camera
+    u, v = project_to_screen(
+        p_world, cam.position, cam.wxyz, cam.fov, cam.image_width, cam.image_height
+    )
+    box = page.locator("canvas").first.bounding_box()
+    x = box["x"] + u * box["width"] / cam.image_width
+    y = box["y"] + v * box["height"] / cam.image_height
+    assert 0 < x < VIEWPORT["width"] * 0.6, "keep the target clear of the control panel"
+    page.mouse.click(float(x), float(y))
+
+
 def canvas_point(ui: UiSession, p_world: Any) -> tuple[float, float]:
     """Page coordinates where the world point ``p_world`` appears in the page's camera."""
     from webui.testing import project_to_screen

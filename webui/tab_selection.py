@@ -1,0 +1,251 @@
+"""Each browser tab's own selection: the selected point, its settings widgets and its highlight.
+
+The plan (points, edits, statuses, undo) is shared by every tab; what depends on the
+selection is per tab: the **Selected** dropdown and the selected point's settings (Role,
+Search, Start offset, Overtravel, Edge direction, Apply settings, Delete point) are widgets of
+the tab's own GUI (``client.gui``) inside the Points tab's shared "Selected point" folder, and
+the highlight (a blue sphere over the marker) is a node of the tab's own scene
+(``client.scene``). :class:`Selections` keeps them, follows every edit of the plan (a point
+deleted in another tab clears this tab's selection; a point moved there moves the highlight),
+and answers which point a tab has selected. The robot's pose per tab is
+:class:`webui.tab_robots.TabRobots`'s.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import viser
+
+from calib.errors import InputError
+from calib.frames import transform_points
+from webui import plan_doc
+from webui.plan_doc import NO_ROLE, UiPlan
+from webui.scene import MARKER_RADIUS_M, SELECTED_RGB
+
+if TYPE_CHECKING:
+    from webui.context import AppContext
+
+logger = logging.getLogger(__name__)
+
+NONE = "(none)"
+#: The role dropdown's entry for "no role" (:data:`webui.plan_doc.NO_ROLE`).
+NO_ROLE_LABEL = "(none)"
+#: Name of a tab's highlight node in its own scene.
+HIGHLIGHT = "/selection"
+
+
+def set_options(widget: Any, options: tuple[str, ...]) -> None:
+    """Send new dropdown options only when they changed (each update re-renders the panel)."""
+    if tuple(widget.options) != options:
+        widget.options = options
+
+
+class TabSelection:
+    """One tab's selection widgets (in ``folder``, a shared container) and highlight.
+
+    Args:
+        app: the app whose plan the tab edits.
+        client: the tab.
+        folder: the shared GUI container the tab's widgets go in.
+    """
+
+    def __init__(self, app: AppContext, client: viser.ClientHandle, folder: Any) -> None:
+        self._app = app
+        self.client = client
+        #: The tab's selected point, or ``None``.
+        self.point_id: str | None = None
+        self._syncing = False
+        #: Where this tab's highlight is drawn (world, m), or ``None``.
+        self._shown: tuple[float, ...] | None = None
+        doc = app.state.doc
+        gui = client.gui
+        with folder:
+            self.selected = gui.add_dropdown("Selected", (NONE, *doc.ids), initial_value=NONE)
+            self.role = gui.add_dropdown("Role", (*doc.roles, NO_ROLE_LABEL))
+            self.kind = gui.add_dropdown("Search", ("approach", "edge"), initial_value="approach")
+            self.start_mm = gui.add_number("Start offset (mm)", 30.0, min=0.1, step=0.5)
+            self.over_mm = gui.add_number("Overtravel (mm)", 20.0, min=0.1, step=0.5)
+            self.edge_dir = gui.add_vector3("Edge direction", (0.0, 0.0, 1.0), step=0.1)
+            self.apply = gui.add_button("Apply settings")
+            self.delete = gui.add_button("Delete point", color="red")
+        self.selected.on_update(self._on_selected)
+        self.apply.on_click(lambda ev: self._guard(self.apply_settings))
+        self.delete.on_click(lambda ev: self._guard(self.delete_selected))
+
+    def _guard(self, fn: Any, *args: Any) -> None:
+        try:
+            fn(*args)
+        except InputError as exc:
+            self._app.notify("Not done", str(exc), client=self.client)
+        except Exception as exc:  # never a traceback in the browser
+            logger.exception("selection action failed")
+            self._app.notify("Error", f"{type(exc).__name__}: {exc}", client=self.client)
+
+    def _on_selected(self, event: Any) -> None:
+        if self._syncing:
+            return
+        value = str(self.selected.value)
+        self._guard(self._app.select, None if value == NONE else value, self.client)
+
+    # ---- from the plan ---------------------------------------------------------------------
+    def show(self, doc: UiPlan, settings: bool) -> None:
+        """Update the lists, the dropdown's value and (``settings``) the point's settings."""
+        self._syncing = True
+        try:
+            set_options(self.selected, (NONE, *doc.ids))
+            set_options(self.role, (*doc.roles, NO_ROLE_LABEL))
+            value = self.point_id if self.point_id in doc.ids else NONE
+            if self.selected.value != value:
+                self.selected.value = value
+            if settings and self.point_id in doc.ids:
+                self._show_settings(doc.get(self.point_id))
+        finally:
+            self._syncing = False
+        self._highlight(doc)
+
+    def _show_settings(self, point: plan_doc.UiPoint) -> None:
+        s = point.probe.search
+        role = point.role or NO_ROLE_LABEL
+        if role in self.role.options:
+            self.role.value = role
+        self.kind.value = s.kind
+        self.start_mm.value = round(s.start_offset_m * 1000.0, 3)
+        self.over_mm.value = round(s.overtravel_m * 1000.0, 3)
+        if s.edge_direction is not None:
+            dx, dy, dz = (round(v, 4) for v in s.edge_direction)
+            self.edge_dir.value = (dx, dy, dz)
+
+    def _highlight(self, doc: UiPlan) -> None:
+        """A blue sphere over the selected marker in this tab's scene only (world frame)."""
+        view = self._app.view
+        if self.point_id is None or self.point_id not in doc.ids or view is None:
+            if self._shown is not None:
+                self.client.scene.remove_by_name(HIGHLIGHT)
+                self._shown = None
+            return
+        p = transform_points(view.T_world_wobj, doc.get(self.point_id).probe.position_m)
+        at = tuple(float(v) for v in np.asarray(p, dtype=np.float64).reshape(3))
+        if at == self._shown:  # already there: nothing sent
+            return
+        self.client.scene.add_icosphere(
+            HIGHLIGHT,
+            radius=1.5 * MARKER_RADIUS_M,
+            color=SELECTED_RGB,
+            subdivisions=2,
+            position=np.asarray(at),
+        )
+        self._shown = at
+
+    # ---- actions ---------------------------------------------------------------------------
+    def apply_settings(self) -> None:
+        """Apply the settings widgets to the tab's selected point (one undoable step)."""
+        sel = self.point_id
+        if sel is None:
+            raise InputError("select a point first")
+
+        def edit(doc: UiPlan) -> UiPlan:
+            return plan_doc.edit_search(
+                doc,
+                sel,
+                kind=str(self.kind.value),
+                start_offset_m=float(self.start_mm.value) / 1000.0,
+                overtravel_m=float(self.over_mm.value) / 1000.0,
+                edge_direction=self.edge_dir.value if self.kind.value == "edge" else None,
+                role=NO_ROLE if self.role.value == NO_ROLE_LABEL else str(self.role.value),
+            )
+
+        self._app.state.update(edit, f"edit {sel}")
+
+    def delete_selected(self) -> None:
+        """Delete the tab's selected point (one undoable step)."""
+        sel = self.point_id
+        if sel is None:
+            raise InputError("select a point first")
+        self._app.state.update(lambda d: plan_doc.delete_point(d, sel), f"delete {sel}")
+
+
+class Selections:
+    """Every tab's selection, and the selection scripts make (``client_id=None``: every tab).
+
+    Args:
+        app: the app.
+        folder: the shared GUI container the tabs' selection widgets go in.
+    """
+
+    def __init__(self, app: AppContext, folder: Any) -> None:
+        self._app = app
+        self._folder = folder
+        self._lock = threading.RLock()
+        self._tabs: dict[int, TabSelection] = {}
+        #: The latest point selected anywhere (a tab or a script), or ``None``.
+        self.latest: str | None = None
+
+    def add_client(self, client: viser.ClientHandle) -> TabSelection:
+        """Build a newly connected tab's widgets (nothing selected)."""
+        tab = TabSelection(self._app, client, self._folder)
+        with self._lock:
+            self._tabs[client.client_id] = tab
+        return tab
+
+    def remove_client(self, client_id: int) -> None:
+        """Forget a tab that disconnected (its widgets and scene went with it)."""
+        with self._lock:
+            self._tabs.pop(client_id, None)
+
+    def tab(self, client_id: int) -> TabSelection | None:
+        """The selection of tab ``client_id``, or ``None`` when it is not connected."""
+        with self._lock:
+            return self._tabs.get(client_id)
+
+    def of(self, client_id: int | None) -> str | None:
+        """The point tab ``client_id`` has selected (``None``: the latest anywhere)."""
+        with self._lock:
+            if client_id is None:
+                return self.latest
+            tab = self._tabs.get(client_id)
+            return None if tab is None else tab.point_id
+
+    def by_tab(self) -> dict[int, str | None]:
+        """``{client id: selected point or None}`` of every connected tab."""
+        with self._lock:
+            return {cid: t.point_id for cid, t in self._tabs.items()}
+
+    def select(self, point_id: str | None, client_id: int | None = None) -> None:
+        """Select ``point_id`` (or none) in one tab, or in every tab (``client_id=None``)."""
+        doc = self._app.state.doc
+        if point_id is not None and point_id not in doc.ids:
+            raise InputError(f"no point {point_id!r}; points: {', '.join(doc.ids) or 'none'}")
+        with self._lock:
+            self.latest = point_id
+            if client_id is None:
+                tabs = list(self._tabs.values())
+            else:
+                one = self._tabs.get(client_id)
+                tabs = [] if one is None else [one]
+            for tab in tabs:
+                tab.point_id = point_id
+        for tab in tabs:
+            tab.show(doc, settings=True)
+
+    def follow(self, doc: UiPlan, changed: set[str]) -> list[int]:
+        """Follow an edit of the plan in every tab: a deleted point is no longer selected, a
+        changed one shows its new settings and place. Returns the tabs whose selected point
+        changed (their robot moves to its new pose)."""
+        with self._lock:
+            if self.latest is not None and self.latest not in doc.ids:
+                self.latest = None
+            tabs = list(self._tabs.items())
+            for _, tab in tabs:
+                if tab.point_id is not None and tab.point_id not in doc.ids:
+                    tab.point_id = None
+        moved = []
+        for cid, tab in tabs:
+            hit = tab.point_id in changed
+            tab.show(doc, settings=hit)
+            if hit:
+                moved.append(cid)
+        return moved
