@@ -227,11 +227,6 @@ def add_via(plan: UiPlan, point_id: str, via: ViaPoint) -> UiPlan:
     return replace_point(plan, dataclasses.replace(old, vias=(*old.vias, via)))
 
 
-def clear_vias(plan: UiPlan, point_id: str) -> UiPlan:
-    """Remove every via of point ``point_id`` (which must exist)."""
-    return replace_point(plan, dataclasses.replace(plan.get(point_id), vias=()))
-
-
 def replace_point(plan: UiPlan, point: UiPoint) -> UiPlan:
     """Replace the point with the same id (which must exist)."""
     plan.get(point.id)
