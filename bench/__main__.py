@@ -18,6 +18,11 @@ BENCHMARKS: list[tuple[str, list[str], list[str]]] = [
     ("bench.bench_rays", [], ["--rays", "20000"]),
     ("bench.bench_validate", [], ["--small", "100", "--large", "400"]),
     ("bench.bench_ui_latency", ["--browser"], ["--clicks", "10"]),
+    (
+        "bench.bench_ui_render",
+        [],
+        ["--clicks", "4", "--refs", "4", "--order", "baseline", "ours"],
+    ),
     ("bench.bench_suggest", [], ["--trials", "100", "--random", "30", "--max", "10"]),
     ("bench.bench_click_ray", [], ["--clicks", "50"]),
     ("bench.bench_edge_events", [], ["--trials", "100"]),

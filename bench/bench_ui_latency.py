@@ -18,6 +18,7 @@ import platform
 import statistics
 import tempfile
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -164,6 +165,28 @@ def bench_demo(clicks: int, rng: np.random.Generator) -> dict[str, object]:
 REF_JS = "t => document.body.innerText.includes(t)"
 
 
+def page_targets(
+    view: Any, cam: Any, box: dict[str, float], pts: np.ndarray, nrm: np.ndarray
+) -> Iterator[tuple[float, float]]:
+    """Page coordinates (px) of the surface points ``pts`` (wobj, with normals ``nrm``) that face
+    the camera ``cam`` and fall on the left 60 % of the canvas ``box`` (clear of the panel)."""
+    for p, n in zip(pts, nrm, strict=True):
+        pw_ = transform_points(view.T_world_wobj, p)
+        n_w = view.T_world_wobj[:3, :3] @ n
+        if float(n_w @ (np.asarray(cam.position) - pw_)) <= 0:
+            continue  # faces away from the camera
+        try:
+            u, v = project_to_screen(
+                pw_, cam.position, cam.wxyz, cam.fov, cam.image_width, cam.image_height
+            )
+        except ValueError:
+            continue
+        x = box["x"] + u * box["width"] / cam.image_width
+        y = box["y"] + v * box["height"] / cam.image_height
+        if 20 < x < 0.6 * box["width"] and 20 < y < box["height"] - 20:
+            yield float(x), float(y)
+
+
 def _dom_round_trip_ms(app: Any, page: Any, n: int = 10) -> list[float]:
     """The reference: a server-side Markdown update until the page shows it, ms (the floor of
     any status update on this machine and browser)."""
@@ -209,23 +232,9 @@ def bench_demo_browser(clicks: int, rng: np.random.Generator) -> dict[str, objec
             pts, nrm, _ = sample_surface(view.wobj_mesh, 400, rng)
             box = page.locator("canvas").first.bounding_box()
             click_ms, status_ms, statuses = [], [], []
-            for p, n in zip(pts, nrm, strict=True):
+            for x, y in page_targets(view, cam, box, pts, nrm):
                 if len(click_ms) >= clicks:
                     break
-                pw_ = transform_points(view.T_world_wobj, p)
-                n_w = view.T_world_wobj[:3, :3] @ n
-                if float(n_w @ (np.asarray(cam.position) - pw_)) <= 0:
-                    continue  # faces away from the camera
-                try:
-                    u, v = project_to_screen(
-                        pw_, cam.position, cam.wxyz, cam.fov, cam.image_width, cam.image_height
-                    )
-                except ValueError:
-                    continue
-                x = box["x"] + u * box["width"] / cam.image_width
-                y = box["y"] + v * box["height"] / cam.image_height
-                if not (20 < x < 0.6 * box["width"] and 20 < y < box["height"] - 20):
-                    continue
                 pid = f"Z{len(click_ms)}"
                 app.points_panel.place.value = pid
                 t0 = time.perf_counter()

@@ -17,6 +17,14 @@ Per point, three checks:
 A point is ``infeasible`` when any of the three fails, ``marginal`` when only the pose is
 marginal, else ``feasible``.
 
+A point with via points (``points[i].vias``) has a fourth check in :func:`check_plan`
+(:func:`check_via_moves`): every via within the joint limits, and the joint moves from the
+previous point's pose (none for the first point, or after a point without a pose) through the
+vias, in order, to the point's pose clear of collisions (:func:`planner.cell.moves.check_via_path`,
+the move check the Teach tab draws). A via that fails makes the point ``infeasible`` and names
+the via and the clearance pair. :func:`check_points` (one edited point, in the UI) leaves the
+vias out: their moves depend on the neighbours' poses.
+
 Per plan, the procedure's own preconditions (:func:`layout_problem`): the plan has points, every
 role the procedure needs, and the procedure computes the nominal frame from exact measurements
 of the nominal points (a dry run of the same ``estimate`` that ``wobjcal calibrate`` runs), so
@@ -60,6 +68,7 @@ __all__ = [
     "Status",
     "check_plan",
     "check_points",
+    "check_via_moves",
     "layout_problem",
     "plan_quality",
 ]
@@ -82,6 +91,7 @@ def check_plan(plan: Plan, plan_dir: Path | None = None, *, cell: Cell | None = 
         with open_cell(plan, plan_dir or Path.cwd()) as own:
             return check_plan(plan, cell=own)
     checks, error = _check(plan, list(plan.points), cell)
+    checks = check_via_moves(cell, plan, checks)
     layout = layout_problem(plan)
     quality, note = None, ""
     if not layout and cell.work_object is not None:
@@ -169,6 +179,34 @@ def check_points(cell: Cell, plan: Plan, points: Sequence[PlanPoint]) -> tuple[P
     point's ``face_reason``.
     """
     return _check(plan, list(points), cell)[0]
+
+
+def check_via_moves(cell: Cell, plan: Plan, checks: Sequence[PointCheck]) -> tuple[PointCheck, ...]:
+    """``checks`` (of all of ``plan``'s points, in plan order) with their via moves checked.
+
+    For each point with vias: the moves from the previous point's pose (when it has one) through
+    the vias to the point's pose (when found), joint space, in the open ``cell``. A problem makes
+    the point ``infeasible``, with ``via_reason`` (and ``reason``) naming the via and the pair.
+    """
+    from planner.cell.moves import check_via_path
+
+    out = []
+    q_prev = None
+    for p, c in zip(plan.points, checks, strict=True):
+        vias = p.via_points
+        if vias:
+            path = check_via_path(cell, q_prev, [v.q_rad for v in vias], c.q, plan.cell.tool.tcp)
+            why = f"vias: {path.problem}" if path.problem else ""
+            c = replace(
+                c,
+                n_vias=len(vias),
+                via_reason=path.problem,
+                status="infeasible" if why else c.status,
+                reason="; ".join(x for x in (c.reason, why) if x),
+            )
+        out.append(c)
+        q_prev = c.q if c.pose_status != "infeasible" else None
+    return tuple(out)
 
 
 def _check(plan: Plan, points: list[PlanPoint], cell: Cell) -> tuple[tuple[PointCheck, ...], str]:

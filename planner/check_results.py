@@ -54,6 +54,11 @@ class PointCheck:
         elapsed_s: time this point's check took, s.
         T_base_tcp: ``(4, 4)`` the probing TCP at ``q`` (through the tool's mount), robot base
             frame, m, or ``None``.
+        n_vias: how many via points the plan gives the point (``points[i].vias``).
+        via_reason: why the moves from the previous point through the vias to this point
+            cannot be run (a via outside the joint limits, a leg that collides, naming the via
+            and the clearance pair); ``""`` when clear or without vias
+            (:func:`planner.cell.moves.check_via_path`).
     """
 
     point_id: str
@@ -77,6 +82,8 @@ class PointCheck:
     T_base_flange: FloatArray | None
     elapsed_s: float = 0.0
     T_base_tcp: FloatArray | None = None
+    n_vias: int = 0
+    via_reason: str = ""
 
     @property
     def feasible(self) -> bool:
@@ -103,7 +110,7 @@ class PointCheck:
             "confdata": list(self.confdata) if self.confdata else None,
             "ik_kind": self.ik_kind,
             "feasible": self.feasible,
-        }
+        } | ({"vias": {"count": self.n_vias, "reason": self.via_reason}} if self.n_vias else {})
 
 
 @dataclass(frozen=True)

@@ -108,7 +108,7 @@ def test_moves_between_points_are_drawn_and_checked(demo_app: WobjcalApp) -> Non
         assert list(panel.moves) == want and len(want) >= 3
         for key in want:
             a, b = key.split("->")
-            assert demo_app.server.scene.get_handle_by_name(f"/moves/{a}_{b}") is not None
+            assert demo_app.server.scene.get_handle_by_name(f"/moves/{a}_{b}_0") is not None
             assert f"{a} → {b}" in panel.moves_md.content
         # a move through the part is caught: A's pose to A's pose with the arm leaned in
         qa = demo_app.check_of("A").q
@@ -122,3 +122,44 @@ def test_moves_between_points_are_drawn_and_checked(demo_app: WobjcalApp) -> Non
     finally:
         panel.show_moves.value = False
     assert demo_app.server.scene.get_handle_by_name("/moves") is None
+
+
+def test_teach_as_via_point_adds_one_undoable_autosaved_via(demo_app: WobjcalApp) -> None:
+    import json
+
+    panel, state = demo_app.teach_panel, demo_app.state
+    qa = demo_app.check_of("A").q
+    lifted = qa + np.array([0.0, -0.2, 0.0, 0.0, 0.0, 0.0])  # retracted above the part
+    panel.jog(lifted)
+    demo_app.select("B")
+    undo_depth = len(state._undo)
+    assert panel.teach_via() == 1
+    assert len(state._undo) == undo_depth + 1  # one undo step
+    via = state.doc.get("B").vias[0]
+    np.testing.assert_allclose(via.q_rad, lifted, atol=1e-12)
+    T_wobj_tcp = np.linalg.solve(demo_app.view.T_world_wobj, panel.T_world_tcp())
+    np.testing.assert_allclose(via.tcp_wobj.matrix(), T_wobj_tcp, atol=1e-9)
+    saved = json.loads(demo_app.state._autosave_path.read_text())
+    b = next(p for p in saved["points"] if p["id"] == "B")
+    np.testing.assert_allclose(b["vias"][0]["q_rad"], lifted, atol=1e-12)
+    assert all("vias" not in p for p in saved["points"] if p["id"] != "B")
+    # drawn: a marker at the via's TCP and the path to B
+    marker = demo_app.server.scene.get_handle_by_name("/vias/B/v1")
+    assert marker is not None
+    np.testing.assert_allclose(marker.position, panel.T_world_tcp()[:3, 3], atol=1e-6)
+    assert demo_app.server.scene.get_handle_by_name("/vias/B/path") is not None
+    panel.show_moves.value = True
+    try:
+        assert panel.moves["A->B"] == "", panel.moves_md.content
+        assert "A → B (through 1 via): clear" in panel.moves_md.content
+    finally:
+        panel.show_moves.value = False
+    state.undo()
+    assert state.doc.get("B").vias == ()
+    assert demo_app.server.scene.get_handle_by_name("/vias") is None
+
+
+def test_teach_as_via_point_needs_a_selected_point(demo_app: WobjcalApp) -> None:
+    demo_app.select(None)
+    with pytest.raises(InputError, match="select the point the via leads to"):
+        demo_app.teach_panel.teach_via()

@@ -195,8 +195,11 @@ class WobjcalApp:
         if point_ids is not None:  # a point whose flag came or went is redrawn too
             moved = set(before.by_point) ^ set(self.flags.by_point)
             point_ids = [*point_ids, *(i for i in moved if i not in point_ids and i in doc.ids)]
-        self.scene.draw_points(doc, self.checks(), None, only=point_ids, flags=self.flags.by_point)
+        # the table first, on its own: the page applies a batch of GUI messages at once, but a
+        # batch with scene messages only in its next frame (0.2-1 s with software WebGL)
         self.points_panel.refresh()
+        self.server.flush()
+        self.scene.draw_points(doc, self.checks(), None, only=point_ids, flags=self.flags.by_point)
         self.server.flush()
 
     def _on_change(self, change: Change[UiPlan]) -> None:

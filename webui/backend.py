@@ -18,6 +18,7 @@ from calib.frames import invert_transform
 from calib.plan.file import Plan, PlanPoint, resolve_ref
 from planner.builtins import robot_urdf
 from planner.cell.cell import Cell
+from planner.cell.moves import MoveCheck, ViaPath, check_joint_move, check_via_path
 from planner.cell.ray_hit import RayHit, first_hit
 from planner.cell.workobject import load_work_object
 from planner.check import PointCheck, check_points
@@ -101,19 +102,6 @@ class JogStatus:
             parts.append(f"near a limit: {', '.join(self.near)}")
         parts.append(self.clearance)
         return "; ".join(parts)
-
-
-@dataclass(frozen=True)
-class MoveCheck:
-    """A joint move between two poses.
-
-    Attributes:
-        tcp_path_world: ``(steps, 3)`` the TCP along the move, world frame, m.
-        problem: where and what collides first (``""``: the move is clear).
-    """
-
-    tcp_path_world: NDArray[np.float64]
-    problem: str
 
 
 def resolve_robot_urdf(ref: str, plan_dir: Path) -> Path | None:
@@ -225,25 +213,21 @@ class CellSession:
             return None
         return np.asarray(q[int(np.argmin(np.linalg.norm(q - q0, axis=1)))], dtype=np.float64)
 
-    def check_move(
-        self, q_from: ArrayLike, q_to: ArrayLike, tcp: str, steps: int = 20
-    ) -> MoveCheck:
-        """The joint move from ``q_from`` to ``q_to`` (linear in joint space, ``steps``
-        poses): the TCP's path (world) and the first pose that collides, if any."""
-        cell = self._cell()
-        a = np.asarray(q_from, dtype=np.float64).reshape(-1)
-        b = np.asarray(q_to, dtype=np.float64).reshape(-1)
-        qs = a + np.linspace(0.0, 1.0, steps)[:, None] * (b - a)
-        T = cell.T_world_base @ np.asarray(cell.chain.fk(qs)) @ cell.T_flange_tcp(tcp)
-        problem = ""
-        with cell.saved_state():
-            for k, q in enumerate(qs):
-                cell.set_joint_positions(q)
-                c = cell.clearance()
-                if not c.ok:
-                    problem = f"at {100 * k // (steps - 1)} %: {c.describe()}"
-                    break
-        return MoveCheck(T[:, :3, 3].copy(), problem)
+    def check_move(self, q_from: ArrayLike, q_to: ArrayLike, tcp: str) -> MoveCheck:
+        """The joint move from ``q_from`` to ``q_to`` (rad): the TCP's path (world) and the
+        first pose that collides, if any (:func:`planner.cell.moves.check_joint_move`)."""
+        return check_joint_move(self._cell(), q_from, q_to, tcp)
+
+    def check_via_path(
+        self,
+        q_prev: ArrayLike | None,
+        vias_q: list[NDArray[np.float64]],
+        q_point: ArrayLike | None,
+        tcp: str,
+    ) -> ViaPath:
+        """The moves from ``q_prev`` through the vias to ``q_point``
+        (:func:`planner.cell.moves.check_via_path`, as ``wobjcal check`` runs them)."""
+        return check_via_path(self._cell(), q_prev, vias_q, q_point, tcp)
 
     def first_hit(
         self, origin_world: ArrayLike, direction_world: ArrayLike, q: ArrayLike | None

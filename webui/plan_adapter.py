@@ -46,7 +46,12 @@ def _procedure_fields(plan: Plan) -> dict[str, Any]:
 def ui_plan_from_plan(plan: Plan, name: str | None = None) -> UiPlan:
     """The editable points of ``plan`` (the plan itself rides along as ``source``)."""
     points = tuple(
-        UiPoint(probe=p.to_probe_point(), role=p.role, speed_m_s=p.search.speed_m_s)
+        UiPoint(
+            probe=p.to_probe_point(),
+            role=p.role,
+            speed_m_s=p.search.speed_m_s,
+            vias=p.via_points,
+        )
         for p in plan.points
     )
     return UiPlan(
@@ -56,7 +61,7 @@ def ui_plan_from_plan(plan: Plan, name: str | None = None) -> UiPlan:
 
 def plan_point(point: UiPoint) -> PlanPoint:
     """The plan-file form of one edited point (what :func:`planner.check.check_points` takes)."""
-    return PlanPoint.from_probe_point(point.probe, point.role, point.speed_m_s)
+    return PlanPoint.from_probe_point(point.probe, point.role, point.speed_m_s, point.vias)
 
 
 def _plan_points(ui: UiPlan) -> list[PlanPoint]:

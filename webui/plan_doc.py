@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike
 
 from calib.errors import InputError
 from calib.paper.stator_layout import STATOR_POINT_IDS
+from calib.plan.vias import ViaPoint
 from calib.probing import ProbePoint, SearchSpec
 
 if TYPE_CHECKING:
@@ -39,11 +40,14 @@ class UiPoint:
         role: what the point is for in the procedure (e.g. ``"A"`` for the paper's A-H
             procedure, ``"primary"`` for 3-2-1); see :mod:`calib.procedures`.
         speed_m_s: search speed written into robot programs, m/s.
+        vias: the joint configurations the robot passes on its way to the point, in order
+            (:mod:`calib.plan.vias`; joint values authoritative).
     """
 
     probe: ProbePoint
     role: str = "A"
     speed_m_s: float = 0.010
+    vias: tuple[ViaPoint, ...] = ()
 
     @property
     def id(self) -> str:
@@ -199,12 +203,28 @@ def place_point(
     if role is None:
         role = old.role if old is not None else next_free_role(plan, prefer=point_id)
     speed = 0.010 if old is None else old.speed_m_s
-    new = UiPoint(probe=probe, role=role, speed_m_s=speed)
+    vias = () if old is None else old.vias
+    new = UiPoint(probe=probe, role=role, speed_m_s=speed, vias=vias)
     if old is None:
         return dataclasses.replace(plan, points=(*plan.points, new))
     return dataclasses.replace(
         plan, points=tuple(new if p.id == point_id else p for p in plan.points)
     )
+
+
+def add_via(plan: UiPlan, point_id: str, via: ViaPoint) -> UiPlan:
+    """Add ``via`` as the last via before point ``point_id`` (which must exist).
+
+    Raises:
+        InputError: unknown point, or a via whose joint count differs from the plan's others.
+    """
+    old = plan.get(point_id)
+    counts = {len(v.q_rad) for p in plan.points for v in p.vias}
+    if counts and len(via.q_rad) not in counts:
+        raise InputError(
+            f"via of {point_id}: {len(via.q_rad)} joint values, the plan's vias have {counts.pop()}"
+        )
+    return replace_point(plan, dataclasses.replace(old, vias=(*old.vias, via)))
 
 
 def replace_point(plan: UiPlan, point: UiPoint) -> UiPlan:
@@ -261,4 +281,6 @@ def edit_search(
     edge_normal = old.probe.edge_normal if kind == "edge" else None
     probe = dataclasses.replace(old.probe, search=search, edge_normal=edge_normal)
     new_role = old.role if role is None else role
-    return replace_point(plan, UiPoint(probe=probe, role=new_role, speed_m_s=old.speed_m_s))
+    return replace_point(
+        plan, UiPoint(probe=probe, role=new_role, speed_m_s=old.speed_m_s, vias=old.vias)
+    )

@@ -44,6 +44,29 @@ SELECTED_RGB = (60, 120, 255)
 MARKER_RADIUS_M = 0.008
 
 
+def configure_lighting(scene: viser.SceneApi) -> None:
+    """Light the cell cheaply: viser's two directional lights without their cascaded shadow
+    maps, no image-based (environment map) lighting, a hemisphere light for the faces the
+    directional lights miss.
+
+    The page renders with software WebGL on the machines this runs on (headless Chromium,
+    SwiftShader; no GPU): there the shadows (three cascades, each a pass over the scene, and
+    filtered lookups per pixel) and the environment map's per-pixel lookups cost most of each
+    frame, and every update the page shows waits for a frame (``bench/bench_ui_render.py``).
+    """
+    scene.configure_default_lights(enabled=True, cast_shadow=False)
+    scene.configure_environment_map(None)
+    # side lights from four directions: URDF visuals come as glTF meshes, metallic by the
+    # glTF default, which only specular light (never an ambient or hemisphere light) shows
+    for k, (x, y) in enumerate(((1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0))):
+        scene.add_light_directional(
+            f"/lights/side_{k}", intensity=1.2, position=(x, y, 0.6), cast_shadow=False
+        )
+    scene.add_light_hemisphere(
+        "/lights/fill", sky_color=(255, 255, 255), ground_color=(110, 110, 120), intensity=1.0
+    )
+
+
 def pose_kwargs(T: ArrayLike) -> dict[str, Any]:
     """viser ``wxyz``/``position`` keyword arguments of a 4x4 transform."""
     T_arr = np.asarray(T, dtype=np.float64)

@@ -29,6 +29,7 @@ from webui.autosave import (
 )
 from webui.plan_adapter import autosave_bytes, ui_plan_from_file
 from webui.plan_doc import UiPlan
+from webui.scene import configure_lighting
 
 logger = logging.getLogger(__name__)
 
@@ -132,6 +133,7 @@ def run(
         server.stop()
         raise
     server.gui.configure_theme(control_width="large", show_share_button=False)
+    configure_lighting(server.scene)  # cheap to render in software WebGL (issue 14 latency)
     # the control panel docked on the right: the 3D view is the rest of the window, nothing
     # floats over the cell (the framing of the first view relies on it)
     server.gui.main_panel.dock_right()

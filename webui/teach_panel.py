@@ -1,4 +1,4 @@
-"""The "Teach" panel: jog the robot and teach its pose as a probe point's approach.
+"""The "Teach" panel: jog the robot and teach its pose as a probe point's approach or a via.
 
 Joint sliders (deg, within the URDF's limits) and a TCP gizmo driven by the inverse kinematics
 (the solution nearest the current joint values, so the arm keeps its branch) move the drawn
@@ -7,14 +7,16 @@ the cell (on the cell worker) and shown at once. **Teach pose** puts a probe poi
 sensor axis meets the part, with the search starting from the taught TCP position
 (its distance from the surface is the start offset).
 
-The plan file has no via points and does not store the sensor's rotation about the normal (the
-check picks it), so a taught pose fixes the point and its start offset, not the wrist's roll.
+**Teach as via point** adds the jogged joint values as the last via before the selected point
+(``points[i].vias``); :mod:`webui.moves_view` draws the vias and the checked moves.
+
+The plan file does not store the sensor's rotation about the normal (the check picks it), so a
+taught approach fixes the point and its start offset, not the wrist's roll.
 """
 
 from __future__ import annotations
 
 import contextlib
-import itertools
 import logging
 import threading
 from collections.abc import Iterator
@@ -30,8 +32,11 @@ from calib.frames import (
     quat_wxyz_from_matrix,
     transform_points,
 )
+from calib.plan.cell import Pose
+from calib.plan.vias import ViaPoint
 from webui import plan_doc
 from webui.backend import JogStatus
+from webui.moves_view import ViaView, draw_moves
 
 if TYPE_CHECKING:
     from webui.context import AppContext
@@ -68,13 +73,18 @@ class TeachPanel:
             self.drag_tcp = gui.add_checkbox("Drag TCP (IK)", False)
             self.target = gui.add_dropdown("Teach as", (NEW_POINT,))
             self.teach_button = gui.add_button("Teach pose", color="blue")
+            self.via_button = gui.add_button(
+                "Teach as via point", hint="add the jogged pose as a via before the selected point"
+            )
             self.show_moves = gui.add_checkbox("Show moves between points", False)
             self.moves_md = gui.add_markdown("")
         self.from_point.on_click(lambda ev: self._guard(ev, self.jog_to_selected, ev.client))
         self.drag_tcp.on_update(lambda ev: self._guard(ev, self._update_gizmo))
         self.teach_button.on_click(lambda ev: self._guard(ev, self.teach, str(self.target.value)))
+        self.via_button.on_click(lambda ev: self._guard(ev, self.teach_via))
         self.show_moves.on_update(lambda ev: self._guard(ev, self.draw_moves))
-        app.state.subscribe(lambda _c: self._refresh_targets())
+        self.via_view = ViaView(app)
+        app.state.subscribe(lambda _c: self._on_change())
         #: ``{"A->B": problem}`` of the last drawn moves (``""``: clear).
         self.moves: dict[str, str] = {}
 
@@ -100,6 +110,13 @@ class TeachPanel:
     def _tcp(self) -> str:
         source = self._app.state.doc.source
         return "sensor" if source is None else source.cell.tool.tcp
+
+    def _on_change(self) -> None:
+        self._refresh_targets()
+        try:
+            self.via_view.draw()
+        except Exception:  # a drawing problem must not break the edit
+            logger.exception("drawing the vias failed")
 
     def _refresh_targets(self) -> None:
         options = (NEW_POINT, *self._app.state.doc.ids)
@@ -225,33 +242,31 @@ class TeachPanel:
         if not self.show_moves.value:
             self.moves_md.content = ""
             return self.moves
-        doc, checks, tcp = self._app.state.doc, self._app.checks(), self._tcp()
-        posed = [
-            (p.id, c.q)
-            for p in doc.points
-            if (c := checks.get(p.id)) is not None and c.q is not None and c.status != "infeasible"
-        ]
-        lines = []
-        for (a, qa), (b, qb) in itertools.pairwise(posed):
-            move = self._app.worker.call(lambda s, qa=qa, qb=qb: s.check_move(qa, qb, tcp))
-            self.moves[f"{a}->{b}"] = move.problem
-            rgb = (215, 40, 40) if move.problem else (40, 170, 60)
-            path = move.tcp_path_world
-            scene.add_line_segments(
-                f"/moves/{a}_{b}",
-                points=np.stack([path[:-1], path[1:]], axis=1),
-                colors=rgb,
-                thickness=2.0,
-                thickness_units="screen",
-            )
-            lines.append(f"- {a} → {b}: {move.problem or 'clear'}")
-        skipped = [p.id for p in doc.points if p.id not in dict(posed)]
-        if skipped:
-            lines.append(f"- left out (no feasible pose): {', '.join(skipped)}")
-        self.moves_md.content = "\n".join(lines) or "no two points with a pose"
+        self.moves, self.moves_md.content = draw_moves(self._app, self._tcp())
         return self.moves
 
     # ---- teach -----------------------------------------------------------------------------
+    def teach_via(self) -> int:
+        """Add the jogged joint values as the last via before the selected point (one undo
+        step, autosaved); return how many vias the point has now.
+
+        Raises:
+            InputError: no robot, or no point selected.
+        """
+        view, pid = self._app.view, self._app.selected
+        if view is None or len(self.q) == 0:
+            raise InputError("load a plan with a robot first")
+        if pid is None:
+            raise InputError("select the point the via leads to (click its marker or row)")
+        T_wobj_tcp = np.linalg.solve(view.T_world_wobj, self.T_world_tcp())
+        via = ViaPoint(
+            q_rad=[float(v) for v in self.q], tcp_wobj=Pose.from_matrix(T_wobj_tcp)
+        )  # fmt: skip
+        change = self._app.state.update(
+            lambda d: plan_doc.add_via(d, pid, via), f"via before {pid}"
+        )  # fmt: skip
+        return len(change.doc.get(pid).vias)
+
     def teach(self, target: str) -> str:
         """Teach the jogged pose as ``target``'s approach (``"new point"``: the next free id):
         the point is where the sensor axis meets the part, the search starts at the TCP.

@@ -17,6 +17,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Final, Literal, get_args
 
+import msgspec
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -51,6 +52,7 @@ from calib.plan.json_io import (
 )
 from calib.plan.models import ValidationSpec
 from calib.plan.report_spec import COMPONENTS
+from calib.plan.vias import ViaPoint, check_via_counts
 from calib.probing import ProbePoint, SearchSpec
 from calib.procedures import METHODS, ProcedureSettings, method_of, procedure_kind
 from calib.procedures.base import RolePoint
@@ -78,6 +80,7 @@ __all__ = [
     "Search",
     "ToolSpec",
     "ValidationSpec",
+    "ViaPoint",
     "WorkObjectSpec",
     "check_plan_files",
     "file_sha256",
@@ -130,6 +133,9 @@ class PlanPoint(Strict, frozen=True, kw_only=True):
         normal: ``(3,)`` unit outward normal of the face, wobj frame.
         search: how the point is searched for.
         edge_normal: ``(3,)`` unit normal of the face whose end an edge search finds, or ``None``.
+        vias: the joint configurations the robot passes, in order, on its way from the previous
+            point to this one (:mod:`calib.plan.vias`); left out of the file when there are
+            none (:attr:`via_points` reads both).
     """
 
     id: PointId
@@ -138,6 +144,16 @@ class PlanPoint(Strict, frozen=True, kw_only=True):
     normal: Vec3
     search: Search = Search()
     edge_normal: Vec3 | None = None
+    vias: list[ViaPoint] | msgspec.UnsetType = msgspec.UNSET
+
+    @property
+    def via_points(self) -> tuple[ViaPoint, ...]:
+        """The point's vias in order (``()`` when the file has none)."""
+        return () if isinstance(self.vias, msgspec.UnsetType) else tuple(self.vias)
+
+    def with_vias(self, vias: list[ViaPoint] | tuple[ViaPoint, ...]) -> PlanPoint:
+        """This point with ``vias`` (none: the field is left out of the file, as before vias)."""
+        return msgspec.structs.replace(self, vias=list(vias) if vias else msgspec.UNSET)
 
     def __post_init__(self) -> None:
         check_pattern(self.id, POINT_ID_PATTERN, "id", "a point id")
@@ -168,8 +184,15 @@ class PlanPoint(Strict, frozen=True, kw_only=True):
         )
 
     @classmethod
-    def from_probe_point(cls, point: ProbePoint, role: str, speed_m_s: float = 0.010) -> PlanPoint:
-        """The plan form of ``point`` with its ``role`` (numbers converted to plain floats)."""
+    def from_probe_point(
+        cls,
+        point: ProbePoint,
+        role: str,
+        speed_m_s: float = 0.010,
+        vias: tuple[ViaPoint, ...] = (),
+    ) -> PlanPoint:
+        """The plan form of ``point`` with its ``role`` and ``vias`` (numbers converted to plain
+        floats)."""
 
         def vec(v: ArrayLike | None) -> Vec3 | None:
             if v is None:
@@ -191,6 +214,7 @@ class PlanPoint(Strict, frozen=True, kw_only=True):
                 speed_m_s=speed_m_s,
             ),
             edge_normal=vec(point.edge_normal),
+            vias=list(vias) if vias else msgspec.UNSET,
         )
 
 
@@ -215,6 +239,7 @@ class Plan(Strict, frozen=True, kw_only=True):
                     f"points[{i}].id: duplicate id {p.id!r} (also points[{seen[p.id]}])"
                 )
             seen[p.id] = i
+        check_via_counts([(p.id, p.via_points) for p in self.points])
         names = [f.name for f in self.cell.fixtures]
         if len(set(names)) != len(names):
             raise PlanError(f"cell.fixtures: duplicate fixture names in {names}")

@@ -34,6 +34,8 @@ _PATH_RE = re.compile(r"^(?P<msg>.*?)(?: - at `\$(?P<path>[^`]*)`)?$", re.DOTALL
 _REWORDS: tuple[tuple[re.Pattern[str], str], ...] = (
     (re.compile(r"^Expected `array` of length (\d+), got (\d+)$"), r"must have length \1, got \2"),
     (re.compile(r"^Expected `array` of length >= (\d+), got (\d+)$"), r"needs at least \1 items"),
+    (re.compile(r"^Expected `array` of length >= (\d+)$"), r"needs at least \1 items"),
+    (re.compile(r"^Expected `array` of length <= (\d+)$"), r"holds at most \1 items"),
     (re.compile(r"^Expected `float`, got `(\w+)`$"), r"must be a number, got \1"),
     (re.compile(r"^Expected `int`, got `(\w+)`$"), r"must be an integer, got \1"),
     (re.compile(r"^Expected `str`, got `(\w+)`$"), r"must be a string, got \1"),

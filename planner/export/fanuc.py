@@ -29,6 +29,11 @@ Limits relied on (conservative; larger on recent controllers): program names of 
 characters (letters, digits, ``_``, starting with a letter), ``!`` comments of at most 32
 characters, position comments of at most 16, ``PR[1..100]``, ``R[1..200]`` (the default register
 counts), user frames 1-9 and tool frames 1-10.
+
+Via points (``points[i].vias``) are ``P[]`` in joint representation (``J1= ... deg``), reached
+with ``J P[n] ... FINE`` before the point's safe start. The joint values are the URDF's: on a
+controller whose J3 is measured against the horizontal (the FANUC J2/J3 interaction that the
+ROS-Industrial driver converts) J3 must be corrected before running; the program says so.
 """
 
 from __future__ import annotations
@@ -139,6 +144,23 @@ class _Program:
         )
         return n
 
+    def joint_position(self, deg: tuple[float, ...], label: str) -> int:
+        """Add the joint values ``deg`` (J1..J6, degrees) as the next ``P[n]`` in joint
+        representation (no frame, no configuration: a joint target is unambiguous); return
+        ``n``."""
+        n = len(self.positions) + 1
+        j = [f"J{k}= {_pos_num(v)} deg" for k, v in enumerate(deg, start=1)]
+        first, second = ",\t".join(j[:3]), ",\t".join(j[3:])
+        self.positions.append(
+            f'P[{n}:"{label[:POS_COMMENT_MAX]}"]{{\n'
+            "   GP1:\n"
+            f"\tUF : {UFRAME_NO}, UT : {UTOOL_NO},\n"
+            f"\t{first},\n"
+            f"\t{second}\n"
+            "};"
+        )
+        return n
+
     def set_register(self, pr: int, T: np.ndarray) -> None:
         """``PR[pr]`` = the pose ``T`` (m), component by component (mm, degrees)."""
         self.add(f"PR[{pr}]=LPOS")  # a Cartesian position register, then its six components
@@ -244,6 +266,12 @@ def _header(prog: _Program, job: ExportJob, name: str) -> None:
         f"R[1..{R_COUNT}].",
     ):
         prog.comment(text)
+    if any(t.vias_q_rad for t in job.targets):
+        prog.comment(
+            "Via points: P[] in joint representation, the URDF's joint values (no offsets). "
+            "Where the controller measures J3 against the horizontal (J2/J3 interaction), "
+            "correct J3 first. Joint positions have no CONFIG."
+        )
 
 
 def _point(prog: _Program, i: int, t: TargetPair) -> None:
@@ -253,8 +281,14 @@ def _point(prog: _Program, i: int, t: TargetPair) -> None:
     code, meas, label = R_CODE_BASE + i, PR_MEAS_BASE + i, i
     speed = max(1, round(t.speed_m_s * 1000.0))
     keep = POS_COMMENT_MAX - 6
+    vias = [
+        prog.joint_position(deg, f"{ident[:keep]} v{k}")
+        for k, deg in enumerate(t.vias_deg("FANUC"), start=1)
+    ]
     safe = prog.position(t, "safe", f"{ident[:keep]} safe")
     prog.comment(f"--- point {i} {ident}: {t.kind} search")
+    for n in vias:
+        prog.add(f"J P[{n}] {JOINT_PCT}% FINE")
     prog.add(f"J P[{safe}] {JOINT_PCT}% FINE")
     prog.add(f"R[{code}]=2")
     prog.add(f"IF DI[{SENSOR_DI}]=ON,JMP LBL[{label}]")

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.errors import InputError
 from calib.frames import check_transform, make_transform
 from calib.paper.settings import Hultman2013
 from calib.plan.file import Plan
@@ -72,6 +73,9 @@ class TargetPair:
         arm: ``{kind: ArmPose}`` the robot's joint values and configuration at each target of
             :data:`TARGET_KINDS` (from IK next to the checked pose), or ``None`` without a
             check (or for robots that are not 6-axis OPW arms).
+        vias_q_rad: the plan's via points of this point (``points[i].vias``), in order: joint
+            values, rad, URDF joint order and directions. Every writer moves through them with
+            joint moves, fine points, before the approach to the safe start.
     """
 
     point_id: str
@@ -85,6 +89,24 @@ class TargetPair:
     T_wobj_safe: FloatArray | None = None
     T_wobj_face: FloatArray | None = None
     arm: Mapping[str, ArmPose] | None = None
+    vias_q_rad: tuple[tuple[float, ...], ...] = ()
+
+    def vias_deg(self, language: str, n_axes: int = 6) -> list[tuple[float, ...]]:
+        """The vias in degrees for a controller of ``n_axes`` axes (the URDF's joint order
+        and directions: the exporters apply no joint offsets).
+
+        Raises:
+            InputError: a via does not have ``n_axes`` joint values (names the point and via).
+        """
+        out = []
+        for k, q in enumerate(self.vias_q_rad, start=1):
+            if len(q) != n_axes:
+                raise InputError(
+                    f"{language} export: point {self.point_id}, via {k}: {len(q)} joint values, "
+                    f"the program writes {n_axes}-axis joint targets"
+                )
+            out.append(tuple(float(np.degrees(v)) for v in q))
+        return out
 
     def target(self, kind: str) -> FloatArray:
         """``(4, 4)`` the target of ``kind`` (one of :data:`TARGET_KINDS`), wobj frame."""
@@ -253,6 +275,7 @@ def build_job(
                 normal_wobj=(float(n[0]), float(n[1]), float(n[2])),
                 T_wobj_safe=make_transform(R, safe),
                 T_wobj_face=make_transform(R, face_end),
+                vias_q_rad=tuple(tuple(float(v) for v in via.q_rad) for via in p.via_points),
             )
         )
     return ExportJob(

@@ -109,6 +109,9 @@ def _dat(job: ExportJob, names: list[str]) -> str:
         ]
         if t.kind == "edge":
             lines.append(f"DECL E6POS {name}_face={e6pos_text(t.face_end, t.arm_pose('face'))}")
+        for k, deg in enumerate(t.vias_deg("KRL"), start=1):
+            axes = ",".join(f"A{j} {fmt(v, 4)}" for j, v in enumerate(deg, start=1))
+            lines.append(f"DECL AXIS {name}_v{k}={{{axes}}}")
     lines.append("ENDDAT")
     return "\n".join(lines) + "\n"
 
@@ -178,8 +181,12 @@ def _point_lines(i: int, t: TargetPair, name: str) -> list[str]:
     """Probe one point: an approach search from ``_safe``; for an edge point, then the edge
     search from the measured face point along the plan's direction, up to the plan's end."""
     v = fmt(t.speed_m_s, 6)
+    vias = [
+        f"  PTP {name}_v{k} ; via {k} (axis angles, deg)" for k in range(1, len(t.vias_q_rad) + 1)
+    ]
     head = [
         f"  ; --- point {comment_text(t.point_id)} ({comment_text(t.kind)} search)",
+        *vias,
         "  $VEL.CP=0.1",
         f"  PTP {name}_safe",
         "  IF diSensor==TRUE THEN",

@@ -109,6 +109,11 @@ def _declarations(job: ExportJob, names: list[str]) -> list[str]:
         lines.append(
             f"    CONST speeddata vSearch_{name}:=[{fmt(t.speed_m_s * 1000.0, 3)},30,5000,1000];"
         )
+        for k, deg in enumerate(t.vias_deg("RAPID"), start=1):
+            lines.append(
+                f"    CONST jointtarget {name}_via{k}:=[[{','.join(fmt(v, 4) for v in deg)}],"
+                "[9E9,9E9,9E9,9E9,9E9,9E9]];"
+            )
     return lines
 
 

@@ -92,9 +92,14 @@ def probe_proc(t: TargetPair, name: str, from_measured: float | None) -> list[st
     """
     wobj = f"tSensor{BS}WObj:={WOBJ}"
     safe = f"{name}_safe"
+    vias = [
+        f"        MoveAbsJ {name}_via{k},vApproach,fine,tSensor;"
+        for k in range(1, len(t.vias_q_rad) + 1)
+    ]
     if t.kind == "approach":
         return [
             f"    PROC Probe_{name}(num i)",
+            *vias,
             f"        MoveJ {safe},vApproach,fine,{wobj};",
             f"        SearchL{BS}SStop,diSensor,pMeas,{name}_end,vSearch_{name},{wobj};",
             *_store("i"),
@@ -107,6 +112,7 @@ def probe_proc(t: TargetPair, name: str, from_measured: float | None) -> list[st
         "        VAR robtarget pStart;",
         "        VAR robtarget pEnd;",
         "        VAR num nStage:=1;",
+        *vias,
         f"        pStart:={name}_start;",
     ]
     if from_measured is None:  # approach the face the edge search runs along, from outside

@@ -112,10 +112,16 @@ def export_urscript(job: ExportJob) -> str:
     ]
     for t in job.targets:
         want = "False" if t.kind == "edge" else "True"
+        t.vias_deg("URScript")  # six joint values each, or a clear error
+        vias = [
+            f"  movej([{', '.join(fmt(v, 6) for v in q)}], a=1.4, v=1.05)  # via {k} (rad)"
+            for k, q in enumerate(t.vias_q_rad, start=1)
+        ]
         lines += [
             f"  # {comment_text(t.point_id)}: {comment_text(t.kind)} search, role "
             f"{comment_text(t.role)}, "
             f"{fmt(t.length_m * 1000.0, 1)} mm at {fmt(t.speed_m_s * 1000.0, 1)} mm/s",
+            *vias,
             f'  {identifier("meas_" + t.point_id)} = probe("{literal_text(t.point_id)}", '
             f"{pose_text(t.T_wobj_start)}, {pose_text(t.T_wobj_end)}, {want}, "
             f"{fmt(t.speed_m_s, 6)}, {pose_text(t.safe_start)}, {pose_text(t.face_end)})",

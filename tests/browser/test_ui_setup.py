@@ -105,6 +105,31 @@ def test_jog_slider_and_teach_in_the_page(demo: UiSession, tmp_path: Path) -> No
     app.state.undo()
 
 
+def test_teach_as_via_point_in_the_page(demo: UiSession) -> None:
+    import json
+
+    from calib.plan import plan_from_json
+
+    app, page = demo.app, demo.page
+    panel = app.teach_panel
+    qa = wait_for(lambda: app.check_of("A"), what="A's check").q
+    lifted = qa + np.array([0.0, -0.2, 0.0, 0.0, 0.0, 0.0])  # retracted above the part
+    panel.jog(lifted)
+    app.select("B")
+    open_tab(page, "Teach")
+    page.get_by_role("button", name="Teach as via point").click()
+    wait_for(lambda: len(app.state.doc.get("B").vias) == 1, what="the via on the server")
+    np.testing.assert_allclose(app.state.doc.get("B").vias[0].q_rad, lifted, atol=1e-12)
+    # the autosaved plan is a valid plan with the via (joint values as taught)
+    saved = plan_from_json(app.state._autosave_path.read_text())
+    np.testing.assert_allclose(saved.point("B").via_points[0].q_rad, lifted, atol=1e-12)
+    assert json.loads(app.state._autosave_path.read_text())["points"][0].get("vias") is None
+    wait_for(lambda: app.server.scene.get_handle_by_name("/vias/B/v1"), what="the via marker")
+    open_tab(page, "Points")
+    page.get_by_role("button", name="Undo", exact=True).click()
+    wait_for(lambda: app.state.doc.get("B").vias == (), what="undo removes the via")
+
+
 def test_uploading_a_part_shows_its_size_then_reframes_and_lists_points_off_it(
     demo: UiSession, reference_dir: Path
 ) -> None:
