@@ -87,7 +87,9 @@ def test_suggest_shows_progress_and_replaces_the_points_in_one_undo_step(
     try:
         suggest.click()
         wait_for(lambda: panel.progress.visible, what="the progress bar on the server")
-        page.get_by_role("progressbar").first.wait_for(state="visible")
+        # the bar's root: at 0 % its fill (role "progressbar") has no width, so Playwright
+        # counts the fill as hidden however long it waits
+        page.locator(".mantine-Progress-root").first.wait_for(state="visible")
         wait_for(suggest.is_disabled, what="the Suggest button disabled while it runs")
         assert app.state.doc.ids == ah_ids, "nothing replaced before the suggestion is done"
     finally:
@@ -98,7 +100,7 @@ def test_suggest_shows_progress_and_replaces_the_points_in_one_undo_step(
     assert 6 <= len(doc.points) <= n_max
     wait_for(lambda: not panel.progress.visible, what="the progress bar to go (server)")
     assert panel.progress.value > 0.0, "the suggestion reported its progress"
-    page.get_by_role("progressbar").first.wait_for(state="hidden")
+    page.locator(".mantine-Progress-root").first.wait_for(state="detached")  # viser drops it
     wait_for(suggest.is_enabled, what="the Suggest button back")
     q = _settled(demo)
     assert q is not None and q.rating == "ok"
