@@ -15,7 +15,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
-from scipy.stats import qmc
 
 from calib.frames import check_transform
 from calib.validation import check_shape
@@ -82,6 +81,8 @@ class NumericIK:
         self._hi = np.where(np.isfinite(chain.upper), chain.upper, np.pi)
         self._wrap = ~np.isfinite(chain.lower) | ~np.isfinite(chain.upper)
         if rng is None:
+            from scipy.stats import qmc  # here: scipy.stats costs ~0.2 s at import
+
             unit = qmc.Halton(d=n, scramble=False).random(int(n_seeds) + 1)[1:]
         else:
             unit = rng.uniform(size=(int(n_seeds), n))
