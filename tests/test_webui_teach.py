@@ -159,6 +159,31 @@ def test_teach_as_via_point_adds_one_undoable_autosaved_via(demo_app: WobjcalApp
     assert demo_app.server.scene.get_handle_by_name("/vias") is None
 
 
+def test_remove_last_via_keeps_the_others(demo_app: WobjcalApp) -> None:
+    panel, state = demo_app.teach_panel, demo_app.state
+    qa = demo_app.check_of("A").q
+    first, second = (qa + np.array([0.0, d, 0.0, 0.0, 0.0, 0.0]) for d in (-0.2, -0.1))
+    demo_app.select("B")
+    for q in (first, second):
+        panel.jog(q)
+        panel.teach_via()
+    assert demo_app.server.scene.get_handle_by_name("/vias/B/v2") is not None
+    undo_depth = len(state._undo)
+    assert panel.remove_via() == 1
+    assert len(state._undo) == undo_depth + 1  # one undo step
+    np.testing.assert_allclose(state.doc.get("B").vias[0].q_rad, first, atol=1e-12)
+    assert demo_app.server.scene.get_handle_by_name("/vias/B/v2") is None
+    assert demo_app.server.scene.get_handle_by_name("/vias/B/v1") is not None
+    assert panel.remove_via() == 0
+    with pytest.raises(InputError, match="point B has no via to remove"):
+        panel.remove_via()
+    state.undo()
+    state.undo()
+    state.undo()
+    state.undo()
+    assert state.doc.get("B").vias == ()
+
+
 def test_teach_as_via_point_needs_a_selected_point(demo_app: WobjcalApp) -> None:
     demo_app.select(None)
     with pytest.raises(InputError, match="select the point the via leads to"):

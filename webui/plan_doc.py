@@ -227,6 +227,18 @@ def add_via(plan: UiPlan, point_id: str, via: ViaPoint) -> UiPlan:
     return replace_point(plan, dataclasses.replace(old, vias=(*old.vias, via)))
 
 
+def remove_last_via(plan: UiPlan, point_id: str) -> UiPlan:
+    """Remove the last via before point ``point_id``.
+
+    Raises:
+        InputError: unknown point, or a point with no via.
+    """
+    old = plan.get(point_id)
+    if not old.vias:
+        raise InputError(f"point {point_id} has no via to remove")
+    return replace_point(plan, dataclasses.replace(old, vias=old.vias[:-1]))
+
+
 def replace_point(plan: UiPlan, point: UiPoint) -> UiPlan:
     """Replace the point with the same id (which must exist)."""
     plan.get(point.id)

@@ -76,12 +76,16 @@ class TeachPanel:
             self.via_button = gui.add_button(
                 "Teach as via point", hint="add the jogged pose as a via before the selected point"
             )
+            self.unvia_button = gui.add_button(
+                "Remove last via", hint="remove the selected point's last via"
+            )
             self.show_moves = gui.add_checkbox("Show moves between points", False)
             self.moves_md = gui.add_markdown("")
         self.from_point.on_click(lambda ev: self._guard(ev, self.jog_to_selected, ev.client))
         self.drag_tcp.on_update(lambda ev: self._guard(ev, self._update_gizmo))
         self.teach_button.on_click(lambda ev: self._guard(ev, self.teach, str(self.target.value)))
         self.via_button.on_click(lambda ev: self._guard(ev, self.teach_via))
+        self.unvia_button.on_click(lambda ev: self._guard(ev, self.remove_via))
         self.show_moves.on_update(lambda ev: self._guard(ev, self.draw_moves))
         self.via_view = ViaView(app)
         app.state.subscribe(lambda _c: self._on_change())
@@ -264,6 +268,21 @@ class TeachPanel:
         )  # fmt: skip
         change = self._app.state.update(
             lambda d: plan_doc.add_via(d, pid, via), f"via before {pid}"
+        )  # fmt: skip
+        return len(change.doc.get(pid).vias)
+
+    def remove_via(self) -> int:
+        """Remove the selected point's last via (one undo step, autosaved); return how many
+        vias it has left.
+
+        Raises:
+            InputError: no point selected, or it has no via.
+        """
+        pid = self._app.selected
+        if pid is None:
+            raise InputError("select the point whose via to remove (click its marker or row)")
+        change = self._app.state.update(
+            lambda d: plan_doc.remove_last_via(d, pid), f"via of {pid} removed"
         )  # fmt: skip
         return len(change.doc.get(pid).vias)
 
