@@ -13,7 +13,6 @@ they agree on hit or miss (they differ where a ray passes a hollow of a link's h
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from pathlib import Path
 
@@ -21,6 +20,7 @@ import numpy as np
 import trimesh
 import yourdfpy
 
+from bench.result_file import write_result
 from calib.frames import invert_transform
 from planner.cell.cell import Cell
 from planner.cell.ray_hit import first_hit
@@ -106,7 +106,7 @@ def main(argv: list[str] | None = None) -> int:
         result["trimesh_visual_median_ms"] / result["pybullet_median_ms"]
     )
     RESULTS.parent.mkdir(exist_ok=True)
-    RESULTS.write_text(json.dumps(result, indent=2, sort_keys=True) + "\n")
+    write_result(RESULTS, result, echo=False)
     for k, v in result.items():
         print(f"{k:32s} {v:.4g}" if isinstance(v, float) else f"{k:32s} {v}")
     return 0

@@ -17,7 +17,6 @@ Run: ``python -m bench.bench_edge_events [--trials 300]``; writes
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import platform
 import tempfile
@@ -29,6 +28,7 @@ import msgspec
 import numpy as np
 import trimesh
 
+from bench.result_file import write_result
 from calib.frames import make_transform, matrix_from_rotvec
 from calib.models.proximity import ProximitySensor
 from calib.models.robot_error import RobotErrorModel
@@ -137,9 +137,7 @@ def main(argv: list[str] | None = None) -> int:
     for row in out["events"].values():
         row["time_vs_256_plain"] = row["ms_per_search"] / ref
     out["thin_box"] = _thin_box(args.trials)
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    OUT.write_text(json.dumps(out, indent=2, default=float))
-    print(json.dumps(out, indent=2, default=float))
+    write_result(OUT, out)
     return 0
 
 

@@ -20,7 +20,6 @@ Run: ``python -m bench.bench_suggest [--trials 400] [--random 100] [--max 14]``;
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import platform
 import time
@@ -30,6 +29,7 @@ from typing import Any
 import msgspec
 import numpy as np
 
+from bench.result_file import write_result
 from calib.plan.file import load_plan
 from planner.check import check_plan, plan_quality
 from planner.suggest import suggest_plan
@@ -252,8 +252,7 @@ def main(argv: list[str] | None = None) -> int:
     except ImportError:  # matplotlib is optional
         pass
     OUT.parent.mkdir(parents=True, exist_ok=True)
-    OUT.write_text(json.dumps(out, indent=2, default=float))
-    print(json.dumps(out, indent=2, default=float))
+    write_result(OUT, out)
     return 0
 
 
