@@ -184,28 +184,47 @@ def check_points(cell: Cell, plan: Plan, points: Sequence[PlanPoint]) -> tuple[P
 def check_via_moves(cell: Cell, plan: Plan, checks: Sequence[PointCheck]) -> tuple[PointCheck, ...]:
     """``checks`` (of all of ``plan``'s points, in plan order) with their via moves checked.
 
-    For each point with vias: the moves from the previous point's pose (when it has one) through
-    the vias to the point's pose (when found), joint space, in the open ``cell``. A problem makes
-    the point ``infeasible``, with ``via_reason`` (and ``reason``) naming the via and the pair.
+    For each point with vias: the moves through the vias to the point's pose (when found),
+    joint space, in the open ``cell``, from the pose of every point an exported program probes
+    just before it (:func:`planner.export.job.probe_orders`: plan order, and the adaptive RAPID
+    program's A-H order with the C and D retakes); the first point of a program has no
+    previous pose and its first leg is not checked. A problem makes the point ``infeasible``,
+    with ``via_reason`` (and ``reason``) naming the previous point, the via and the pair.
     """
     from planner.cell.moves import check_via_path
+    from planner.export.job import probe_orders
 
-    out = []
-    q_prev = None
-    for p, c in zip(plan.points, checks, strict=True):
+    ids = [p.id for p in plan.points]
+    before: dict[int, list[int | None]] = {}
+    for order in probe_orders(plan):
+        for k, i in enumerate(order):
+            prev = order[k - 1] if k else None
+            if prev not in before.setdefault(i, []):
+                before[i].append(prev)
+    out = list(checks)
+    for i, (p, c) in enumerate(zip(plan.points, checks, strict=True)):
         vias = p.via_points
-        if vias:
-            path = check_via_path(cell, q_prev, [v.q_rad for v in vias], c.q, plan.cell.tool.tcp)
-            why = f"vias: {path.problem}" if path.problem else ""
-            c = replace(
-                c,
-                n_vias=len(vias),
-                via_reason=path.problem,
-                status="infeasible" if why else c.status,
-                reason="; ".join(x for x in (c.reason, why) if x),
-            )
-        out.append(c)
-        q_prev = c.q if c.pose_status != "infeasible" else None
+        if not vias:
+            continue
+        problem = ""
+        for prev in before.get(i, [None]):
+            q_prev = None
+            if prev is not None and checks[prev].pose_status != "infeasible":
+                q_prev = checks[prev].q
+            name = "previous point" if prev is None else ids[prev]
+            qs = [v.q_rad for v in vias]
+            path = check_via_path(cell, q_prev, qs, c.q, plan.cell.tool.tcp, name)
+            if path.problem:
+                problem = path.problem
+                break
+        why = f"vias: {problem}" if problem else ""
+        out[i] = replace(
+            c,
+            n_vias=len(vias),
+            via_reason=problem,
+            status="infeasible" if why else c.status,
+            reason="; ".join(x for x in (c.reason, why) if x),
+        )
     return tuple(out)
 
 

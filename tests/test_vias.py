@@ -131,7 +131,7 @@ def test_colliding_via_move_names_the_via_and_the_pair(
     plan = with_vias(demo, 1, [mid.tolist()])
     c = check_plan(plan, cell=demo_cell).points[1]  # type: ignore[arg-type]
     assert c.status == "infeasible"
-    m = re.match(r"move previous point -> via 1 at \d+ %: (\S+) hits (\S+)", c.via_reason)
+    m = re.match(r"move A -> via 1 at \d+ %: (\S+) hits (\S+)", c.via_reason)
     assert m, c.via_reason
     assert m.group(2) == "stator_section"
 
@@ -198,3 +198,45 @@ def test_a_seven_joint_via_is_refused_by_the_writers(demo: Plan) -> None:
     for fmt in ("rapid", "krl", "urscript"):
         with pytest.raises(InputError, match=r"point B, via 1: 7 joint values"):
             export_program(plan, PLANS, fmt, run_check=False)
+
+
+# ---- the orders the programs probe in ------------------------------------------------------
+def test_probe_orders_follow_the_adaptive_rapid_program(demo: Plan) -> None:
+    from planner.export.job import probe_orders
+
+    ids = [p.id for p in demo.points]
+    role = {p.role: i for i, p in enumerate(demo.points)}
+    orders = probe_orders(demo)
+    assert orders[0] == list(range(len(ids)))
+    adaptive = [role[r] for r in "ABCDEFGH"] + [role["C"], role["D"]]  # C and D retaken
+    assert adaptive in orders
+    # the RAPID main really calls the probes in that order
+    main = export_program(demo, PLANS, "rapid", run_check=False).files[".mod"]
+    main = main[main.index("PROC main") :]
+    called = re.findall(r"^\s*Probe_p(\w+) \d+", main, re.M)
+    assert called == [ids[i] for i in adaptive]
+
+
+def test_vias_are_checked_from_every_point_a_program_comes_from(
+    demo: Plan, demo_cell: object, poses: dict[str, np.ndarray], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """C is probed after B (plan order) and after H (the RAPID program's retake): both legs
+    into its vias are checked, and a problem on the retake's leg only is reported with H."""
+    import planner.cell.moves as moves
+
+    seen: list[str] = []
+
+    def only_from_h(*args: object) -> moves.ViaPath:
+        name = str(args[-1])
+        seen.append(name)
+        return moves.ViaPath(
+            (), "move H -> via 1 at 50 %: link_4 hits table" if name == "H" else ""
+        )
+
+    monkeypatch.setattr(moves, "check_via_path", only_from_h)
+    plan = with_vias(demo, 2, [(poses["C"] + LIFT).tolist()])
+    c = check_plan(plan, cell=demo_cell).points[2]  # type: ignore[arg-type]
+    assert seen == ["B", "H"], seen
+    assert c.status == "infeasible"
+    assert c.via_reason == "move H -> via 1 at 50 %: link_4 hits table"
+    assert "vias: move H -> via 1" in c.reason

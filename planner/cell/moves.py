@@ -121,6 +121,7 @@ def check_via_path(
     vias_q: Sequence[ArrayLike],
     q_point: ArrayLike | None,
     tcp: str,
+    prev_name: str = "previous point",
 ) -> ViaPath:
     """Check the moves from ``q_prev`` through ``vias_q`` to ``q_point`` (rad).
 
@@ -132,6 +133,7 @@ def check_via_path(
         q_point: joint values at this point's probe pose, or ``None`` (no pose found): the path
             ends at the last via.
         tcp: the probing TCP (for the drawn path).
+        prev_name: what the messages call the previous pose (e.g. the point's id).
     """
     for k, q in enumerate(vias_q, start=1):
         why = joint_limit_problem(cell.chain, q)
@@ -142,7 +144,7 @@ def check_via_path(
         (n, np.asarray(q, dtype=np.float64)) for n, q in zip(names, vias_q, strict=True)
     ]
     if q_prev is not None:
-        stops.insert(0, ("previous point", np.asarray(q_prev, dtype=np.float64)))
+        stops.insert(0, (prev_name, np.asarray(q_prev, dtype=np.float64)))
     if q_point is not None:
         stops.append(("point", np.asarray(q_point, dtype=np.float64)))
     legs = []

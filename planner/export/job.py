@@ -320,6 +320,27 @@ def adaptive_spec(plan: Plan) -> AdaptiveSpec | None:
     )
 
 
+#: The order the adaptive RAPID program (``rapid_adaptive.adaptive_main``) probes the roles.
+ADAPTIVE_ORDER = ("A", "B", "C", "D", "E", "F", "G", "H")
+
+
+def probe_orders(plan: Plan) -> list[list[int]]:
+    """Every order (point indices, plan order numbering) in which an exported program probes the
+    plan's points: plan order (every format), and for an adaptive A-H plan the RAPID program's
+    A..H then, with ``retake_c_d``, C and D again. The moves into a point's vias come from the
+    point before it in each of these orders (``wobjcal check`` checks them all).
+    """
+    orders = [list(range(len(plan.points)))]
+    a = adaptive_spec(plan)
+    if a is not None:
+        order = [a.index[r] for r in ADAPTIVE_ORDER]
+        if a.settings.retake_c_d:
+            order += [a.index["C"], a.index["D"]]
+        if order not in orders:
+            orders.append(order)
+    return orders
+
+
 def safety_header(job: ExportJob, prefix: str, width: int = 92) -> list[str]:
     """Header comment lines of a program that runs every search in the nominal frame."""
     import textwrap
