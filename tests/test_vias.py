@@ -240,3 +240,16 @@ def test_vias_are_checked_from_every_point_a_program_comes_from(
     assert c.status == "infeasible"
     assert c.via_reason == "move H -> via 1 at 50 %: link_4 hits table"
     assert "vias: move H -> via 1" in c.reason
+
+
+def test_vias_on_a_robot_with_a_prismatic_joint_are_refused() -> None:
+    """The programs write via joint targets in degrees: a sliding joint would be written as
+    metres x 57.3, so the check refuses the vias and names the joint."""
+    from types import SimpleNamespace
+
+    from planner.cell.moves import check_via_path
+
+    chain = SimpleNamespace(joint_names=("j1", "rail"), joint_types=("revolute", "prismatic"))
+    path = check_via_path(SimpleNamespace(chain=chain), None, [[0.0, 0.1]], None, "tcp")  # type: ignore[arg-type]
+    assert path.problem == "vias need a robot of rotary joints; rail is prismatic"
+    assert check_via_path(SimpleNamespace(chain=chain), None, [], None, "tcp").problem == ""  # type: ignore[arg-type]

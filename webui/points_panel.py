@@ -198,7 +198,8 @@ class PointsPanel:
         """
         scene = self._app.server.scene
         picker = self._app.picker
-        sel = self._app.selected
+        # the point the gizmo is drawn on (another tab may have selected another since)
+        sel = None if self._gizmo_for is None else self._gizmo_for[0]
         if sel is None or picker is None or sel not in self._app.state.doc.ids:
             return
         start = self._gizmo_pose(sel)

@@ -180,13 +180,17 @@ class Selections:
         self._app = app
         self._folder = folder
         self._lock = threading.RLock()
+        self._build_lock = threading.Lock()
         self._tabs: dict[int, TabSelection] = {}
         #: The latest point selected anywhere (a tab or a script), or ``None``.
         self.latest: str | None = None
 
     def add_client(self, client: viser.ClientHandle) -> TabSelection:
         """Build a newly connected tab's widgets (nothing selected)."""
-        tab = TabSelection(self._app, client, self._folder)
+        # viser runs connect handlers on a thread pool, and a GUI container may be entered by
+        # one thread at a time: tabs that connect together take turns
+        with self._build_lock:
+            tab = TabSelection(self._app, client, self._folder)
         with self._lock:
             self._tabs[client.client_id] = tab
         return tab

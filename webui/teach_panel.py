@@ -84,8 +84,8 @@ class TeachPanel:
         self.from_point.on_click(lambda ev: self._guard(ev, self.jog_to_selected, ev.client))
         self.drag_tcp.on_update(lambda ev: self._guard(ev, self._update_gizmo))
         self.teach_button.on_click(lambda ev: self._guard(ev, self.teach, str(self.target.value)))
-        self.via_button.on_click(lambda ev: self._guard(ev, self.teach_via))
-        self.unvia_button.on_click(lambda ev: self._guard(ev, self.remove_via))
+        self.via_button.on_click(lambda ev: self._guard(ev, self.teach_via, ev.client))
+        self.unvia_button.on_click(lambda ev: self._guard(ev, self.remove_via, ev.client))
         self.show_moves.on_update(lambda ev: self._guard(ev, self.draw_moves))
         self.via_view = ViaView(app)
         app.state.subscribe(lambda _c: self._on_change())
@@ -250,14 +250,18 @@ class TeachPanel:
         return self.moves
 
     # ---- teach -----------------------------------------------------------------------------
-    def teach_via(self) -> int:
-        """Add the jogged joint values as the last via before the selected point (one undo
-        step, autosaved); return how many vias the point has now.
+    def teach_via(self, client: Any = None) -> int:
+        """Add the jogged joint values as the last via before the point the tab of ``client``
+        has selected (``None``: the latest selected anywhere); one undo step, autosaved; return
+        how many vias the point has now.
 
         Raises:
             InputError: no robot, or no point selected.
         """
-        view, pid = self._app.view, self._app.selected
+        view, pid = (
+            self._app.view,
+            self._app.selection.of(None if client is None else client.client_id),
+        )
         if view is None or len(self.q) == 0:
             raise InputError("load a plan with a robot first")
         if pid is None:
@@ -271,14 +275,14 @@ class TeachPanel:
         )  # fmt: skip
         return len(change.doc.get(pid).vias)
 
-    def remove_via(self) -> int:
-        """Remove the selected point's last via (one undo step, autosaved); return how many
-        vias it has left.
+    def remove_via(self, client: Any = None) -> int:
+        """Remove the last via of the point the tab of ``client`` has selected (``None``: the
+        latest selected anywhere); one undo step, autosaved; return how many vias it has left.
 
         Raises:
             InputError: no point selected, or it has no via.
         """
-        pid = self._app.selected
+        pid = self._app.selection.of(None if client is None else client.client_id)
         if pid is None:
             raise InputError("select the point whose via to remove (click its marker or row)")
         change = self._app.state.update(

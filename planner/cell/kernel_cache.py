@@ -117,7 +117,10 @@ def start_background(cache_dir: Path | None) -> bool:
         env["PYTHONPATH"] = os.pathsep.join(p for p in (src, env.get("PYTHONPATH")) if p)
         try:
             proc = subprocess.Popen(
-                [sys.executable, "-m", "planner.cell.warmup", "--reverse"],
+                # -P: never the current directory on sys.path (a user's folder could shadow
+                # a module); cwd: the source tree, whose planner is the one imported here
+                [sys.executable, "-P", "-m", "planner.cell.warmup", "--reverse"],
+                cwd=src,
                 env=env,
                 stdin=subprocess.DEVNULL,
                 stdout=subprocess.DEVNULL,

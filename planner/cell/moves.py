@@ -135,6 +135,12 @@ def check_via_path(
         tcp: the probing TCP (for the drawn path).
         prev_name: what the messages call the previous pose (e.g. the point's id).
     """
+    chain = cell.chain
+    sliding = [
+        n for n, t in zip(chain.joint_names, chain.joint_types, strict=True) if t == "prismatic"
+    ]
+    if vias_q and sliding:  # the programs write via joint targets in degrees (rad: URScript)
+        return ViaPath((), f"vias need a robot of rotary joints; {sliding[0]} is prismatic")
     for k, q in enumerate(vias_q, start=1):
         why = joint_limit_problem(cell.chain, q)
         if why:
