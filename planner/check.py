@@ -194,6 +194,8 @@ def check_via_moves(cell: Cell, plan: Plan, checks: Sequence[PointCheck]) -> tup
     from planner.cell.moves import check_via_path
     from planner.export.job import probe_orders
 
+    if not any(p.via_points for p in plan.points):
+        return tuple(checks)
     ids = [p.id for p in plan.points]
     before: dict[int, list[int | None]] = {}
     for order in probe_orders(plan):

@@ -253,3 +253,16 @@ def test_vias_on_a_robot_with_a_prismatic_joint_are_refused() -> None:
     path = check_via_path(SimpleNamespace(chain=chain), None, [[0.0, 0.1]], None, "tcp")  # type: ignore[arg-type]
     assert path.problem == "vias need a robot of rotary joints; rail is prismatic"
     assert check_via_path(SimpleNamespace(chain=chain), None, [], None, "tcp").problem == ""  # type: ignore[arg-type]
+
+
+def test_a_layout_the_adaptive_program_refuses_leaves_the_plan_order(demo: Plan) -> None:
+    """H moved 5 m: the adaptive RAPID program refuses the layout, so no program probes in its
+    order; the vias are checked in plan order and nothing raises."""
+    from planner.export.job import probe_orders
+
+    raw = json.loads(plan_to_json(demo))
+    for p in raw["points"]:
+        if p["id"] == "H":
+            p["position_m"] = [p["position_m"][0] + 5.0, *p["position_m"][1:]]
+    moved = plan_from_json(json.dumps(raw))
+    assert probe_orders(moved) == [list(range(len(moved.points)))]

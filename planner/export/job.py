@@ -331,7 +331,10 @@ def probe_orders(plan: Plan) -> list[list[int]]:
     point before it in each of these orders (``wobjcal check`` checks them all).
     """
     orders = [list(range(len(plan.points)))]
-    a = adaptive_spec(plan)
+    try:
+        a = adaptive_spec(plan)
+    except InputError:  # a layout the adaptive program refuses: no program probes in its order
+        a = None
     if a is not None:
         order = [a.index[r] for r in ADAPTIVE_ORDER]
         if a.settings.retake_c_d:
