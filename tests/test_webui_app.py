@@ -199,6 +199,36 @@ def test_play_search_path_ends_at_its_last_pose(app: WobjcalApp) -> None:
     np.testing.assert_allclose(app.robot.q, check.q_path[-1])
 
 
+def test_plays_started_together_leave_one_animation_that_stops(app: WobjcalApp) -> None:
+    """Eight plays of a long path started at once from eight threads (as button clicks of a
+    thread pool), five rounds: one animation is left registered, and ``stop`` ends every one
+    of them (before, a play could replace another's entry and leave it running for good)."""
+    import threading
+
+    assert app.robot is not None
+    robot = app.robot
+    path = np.repeat(robot.q[None, :], 400, axis=0)  # 400 poses over 60 s: runs until stopped
+    for _ in range(5):
+        go = threading.Event()
+
+        def start(go: threading.Event = go) -> None:
+            go.wait()
+            robot.play(path, duration_s=60.0)
+
+        starters = [threading.Thread(target=start) for _ in range(8)]
+        for t in starters:
+            t.start()
+        go.set()
+        for t in starters:
+            t.join(30.0)
+        players = [t for t in threading.enumerate() if t.name == "wobjcal-play" and t.is_alive()]
+        assert len(robot._players) == 1
+        robot.stop()
+        for t in players:
+            t.join(5.0)
+        assert not any(t.is_alive() for t in players), "an animation nobody can stop"
+
+
 def test_gizmo_drag_previews_then_projects_onto_surface(app: WobjcalApp) -> None:
     from types import SimpleNamespace
 

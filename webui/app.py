@@ -142,6 +142,9 @@ class WobjcalApp:
             self.robot = None
         if view.robot_urdf is not None:
             self.robot, why = tab_robots_or_reason(self.server, view)
+            if self.robot is not None:  # tabs that connected while it was being built
+                for client in list(self.server.get_clients().values()):
+                    self.robot.add_client(client)
             if why:
                 logger.warning("%s", why)
                 self.notify("Robot not drawn", why, error=True)

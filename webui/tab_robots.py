@@ -151,9 +151,8 @@ class TabRobots:
         client_id: int | None = None,
     ) -> None:
         """Animate ``q_path (M, n)`` in one tab (or every tab) on a background thread; a
-        running animation of the same tab stops first."""
+        running animation of the same tab (for every tab: of any tab) stops first."""
         path = np.asarray(q_path, dtype=np.float64)
-        self._stop(client_id)
         stop = threading.Event()
 
         def run() -> None:
@@ -166,9 +165,15 @@ class TabRobots:
                     time.sleep(dt)
 
         thread = threading.Thread(target=run, name="wobjcal-play", daemon=True)
-        with self._lock:
+        with self._lock:  # one step: two plays at once never leave one running unstoppable
+            keys = list(self._players) if client_id is None else [client_id]
+            old = [self._players.pop(k) for k in keys if k in self._players]
             self._players[client_id] = (stop, thread)
-        thread.start()
+            thread.start()  # registered threads are started ones (join needs that)
+        for old_stop, old_thread in old:  # every tab's, for an animation in every tab
+            old_stop.set()
+            if old_thread is not threading.current_thread():
+                old_thread.join(1.0)
 
     def wait(self, timeout: float | None = None) -> bool:
         """Wait for running animations to end; True when none is running any more."""
