@@ -102,6 +102,9 @@ class AppContext(Protocol):
     def selected(self) -> str | None:
         """The latest point selected in any tab or by a script."""
 
+    def selection_of(self, client: viser.ClientHandle | None) -> str | None:
+        """The point the tab of ``client`` has selected (``None``: the latest anywhere)."""
+
     def select(self, point_id: str | None, client: viser.ClientHandle | None = None) -> None:
         """Select a point (or none) in the tab of ``client``, or in every tab (``None``)."""
 

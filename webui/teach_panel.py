@@ -187,7 +187,7 @@ class TeachPanel:
     def jog_to_selected(self, client: Any = None) -> JogStatus:
         """Jog to the probe pose (from its check) of the point the tab of ``client`` has
         selected (``None``: the latest selected anywhere)."""
-        sel = self._app.selection.of(None if client is None else client.client_id)
+        sel = self._app.selection_of(client)
         check = None if sel is None else self._app.check_of(sel)
         if check is None or check.q is None:
             raise InputError("select a point whose probe pose was found (a reachable point)")
@@ -258,10 +258,7 @@ class TeachPanel:
         Raises:
             InputError: no robot, or no point selected.
         """
-        view, pid = (
-            self._app.view,
-            self._app.selection.of(None if client is None else client.client_id),
-        )
+        view, pid = self._app.view, self._app.selection_of(client)
         if view is None or len(self.q) == 0:
             raise InputError("load a plan with a robot first")
         if pid is None:
@@ -282,7 +279,7 @@ class TeachPanel:
         Raises:
             InputError: no point selected, or it has no via.
         """
-        pid = self._app.selection.of(None if client is None else client.client_id)
+        pid = self._app.selection_of(client)
         if pid is None:
             raise InputError("select the point whose via to remove (click its marker or row)")
         change = self._app.state.update(
