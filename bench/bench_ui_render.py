@@ -132,9 +132,7 @@ def _scene_first(app: Any) -> Callable[..., None]:
         if point_ids is not None:
             moved = set(before.by_point) ^ set(app.flags.by_point)
             point_ids = [*point_ids, *(i for i in moved if i not in point_ids and i in doc.ids)]
-        app.scene.draw_points(
-            doc, app.checks(), None, only=point_ids, flags=app.flags.by_point
-        )
+        app.scene.draw_points(doc, app.checks(), None, only=point_ids, flags=app.flags.by_point)
         app.points_panel.refresh()
         app.server.flush()
 

@@ -15,7 +15,8 @@ Owns:
       :mod:`~planner.cell.broad_parts`), its compiled kernels (:mod:`~planner.cell.broad_kernels`,
       :mod:`~planner.cell.mesh_kernels`, :mod:`~planner.cell.field_kernels`,
       :mod:`~planner.cell.gjk_kernels`, :mod:`~planner.cell.bound_kernels`; cached where
-      :mod:`~planner.cell.kernel_cache` says), :mod:`~planner.cell.sphere_tree`,
+      :mod:`~planner.cell.kernel_cache` says, typed helpers compiled on first use by
+      :mod:`~planner.cell.lazy_kernel`), :mod:`~planner.cell.sphere_tree`,
       :mod:`~planner.cell.link_geometry`, :mod:`~planner.cell.distance_field` (cached on disk by
       :mod:`~planner.cell.disk_cache`);
     - queries: :mod:`~planner.cell.feasibility` (probe poses, ``check_probes``) with

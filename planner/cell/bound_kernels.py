@@ -24,6 +24,7 @@ import numpy as np
 from planner.cell import gjk_kernels as G
 from planner.cell.broad_kernels import _compose
 from planner.cell.kernel_cache import configure
+from planner.cell.lazy_kernel import lazy_njit
 
 configure()  # before the first @njit: numba picks the cache directory then
 
@@ -33,7 +34,7 @@ _V = "float64[::1]"
 _SHAPE = f"int64, {_M}, {_V}, {_M}, int64, int64"
 
 
-@nb.njit(f"float64({_SHAPE}, {_SHAPE}, float64)", cache=True)
+@lazy_njit(f"float64({_SHAPE}, {_SHAPE}, float64)")
 def gjk_upper(
     kA: int, TA: np.ndarray, dA: np.ndarray, vA: np.ndarray, sA: int, cA: int,
     kB: int, TB: np.ndarray, dB: np.ndarray, vB: np.ndarray, sB: int, cB: int,
@@ -126,7 +127,7 @@ def _depth_lower(kA, TA, dA, verts, sA, cA, kB, TB, dB):  # fmt: skip
 
 
 # Explicit: the constant arguments of one call site would otherwise get a literal-typed copy
-# (1.4 s more of compile on first use).
+# (1.4 s more of compile on first use); compiled on first use (planner.cell.lazy_kernel).
 _I = "int64[::1]"
 _LINK = (
     f"float64({G._M}, int64, int64, {G._M}, {G._V}, int64, int64, {_I}, float64[:, :, ::1], "
@@ -134,7 +135,7 @@ _LINK = (
 )
 
 
-@nb.njit(_LINK, cache=True)
+@lazy_njit(_LINK)
 def _link_upper(
     Tl, k, kind, T, dims, vs, vc, sh_kind, sh_T, sh_dims, sh_vs, sh_vc, verts, link_sh0,
     link_shn, TA,

@@ -27,13 +27,15 @@ import numba as nb
 import numpy as np
 
 from planner.cell.kernel_cache import configure
+from planner.cell.lazy_kernel import lazy_njit
 
 configure()  # before the first @njit: numba picks the cache directory then
 
 BOX, CYLINDER, SPHERE, CAPSULE, HULL = 0, 1, 2, 3, 4
 _MAX_ITER = 40
 # Explicit signatures: every caller shares one compiled version (constant arguments would
-# otherwise make numba compile a literal-typed copy per call site, seconds each).
+# otherwise make numba compile a literal-typed copy per call site, seconds each); compiled on
+# first use, not at import (planner.cell.lazy_kernel).
 _M = "float64[:, ::1]"
 _V = "float64[::1]"
 _SUPPORT = f"UniTuple(float64, 3)(int64, {_M}, {_V}, {_M}, int64, int64, float64, float64, float64)"
@@ -41,7 +43,7 @@ _SHAPE = f"int64, {_M}, {_V}, {_M}, int64, int64"
 _CLASSIFY = f"int64({_SHAPE}, {_SHAPE}, float64, float64)"
 
 
-@nb.njit(_SUPPORT, cache=True)
+@lazy_njit(_SUPPORT)
 def support(
     kind: int,
     T: np.ndarray,
@@ -99,7 +101,7 @@ def support(
     )
 
 
-@nb.njit(f"void({_M}, int64, float64, float64, float64)", cache=True)
+@lazy_njit(f"void({_M}, int64, float64, float64, float64)")
 def _set(W: np.ndarray, i: int, x: float, y: float, z: float) -> None:
     W[i, 0], W[i, 1], W[i, 2] = x, y, z
 
@@ -122,7 +124,7 @@ def _closest_segment(W: np.ndarray, v: np.ndarray) -> int:
     return 2
 
 
-@nb.njit(f"int64({_M}, int64, int64, int64, {_M}, {_V})", cache=True)
+@lazy_njit(f"int64({_M}, int64, int64, int64, {_M}, {_V})")
 def _closest_triangle(
     W: np.ndarray, i0: int, i1: int, i2: int, out: np.ndarray, v: np.ndarray
 ) -> int:
@@ -236,7 +238,7 @@ def start_direction(TA: np.ndarray, TB: np.ndarray, v: np.ndarray) -> None:
         v[0] = 1.0
 
 
-@nb.njit(f"int64({_M}, int64, float64, float64, float64, {_M}, {_V})", cache=True)
+@lazy_njit(f"int64({_M}, int64, float64, float64, float64, {_M}, {_V})")
 def add_point(
     W: np.ndarray, n: int, wx: float, wy: float, wz: float, scratch: np.ndarray, v: np.ndarray
 ) -> int:
@@ -258,7 +260,7 @@ def add_point(
     return n
 
 
-@nb.njit(_CLASSIFY, cache=True)
+@lazy_njit(_CLASSIFY)
 def gjk_classify(
     kA: int, TA: np.ndarray, dA: np.ndarray, vA: np.ndarray, sA: int, cA: int,
     kB: int, TB: np.ndarray, dB: np.ndarray, vB: np.ndarray, sB: int, cB: int,
@@ -295,7 +297,7 @@ def gjk_classify(
     return 0
 
 
-@nb.njit(f"boolean({_SHAPE}, {_SHAPE}, float64)", cache=True)
+@lazy_njit(f"boolean({_SHAPE}, {_SHAPE}, float64)")
 def gjk_separated(
     kA: int, TA: np.ndarray, dA: np.ndarray, vA: np.ndarray, sA: int, cA: int,
     kB: int, TB: np.ndarray, dB: np.ndarray, vB: np.ndarray, sB: int, cB: int,

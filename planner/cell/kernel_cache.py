@@ -76,6 +76,7 @@ SOURCES = (
     "field_kernels",
     "mesh_kernels",
     "kernel_cache",
+    "lazy_kernel",
     "warmup",
 )
 _ENV_OFF = "WOBJCAL_BACKGROUND_COMPILE"
