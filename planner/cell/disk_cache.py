@@ -4,10 +4,16 @@ Files live in ``$WOBJCAL_CACHE_DIR/<kind>`` (default ``~/.cache/wobjcal/<kind>``
 allowed-collision lists use too) as ``<key>.npz``. Writes are atomic (temporary file and
 rename); a reader that finds a missing, partial, corrupt or foreign file (its stored key or
 version differ) gets ``None`` and the caller rebuilds: a cache can cost time, never an answer.
+
+Each kind is bounded: after a write, the least recently used files of that kind (a load
+refreshes a file's time) are deleted until the kind holds at most ``$WOBJCAL_CACHE_MAX_MB``
+(default 1,000 MB; a distance field is 2-30 MB), never the file just written. A user who
+opens many parts keeps the recent ones and does not fill the disk.
 """
 
 from __future__ import annotations
 
+import contextlib
 import io
 import logging
 import os
@@ -21,6 +27,8 @@ from numpy.typing import NDArray
 from calib.atomic_io import write_bytes_atomic
 
 log = logging.getLogger(__name__)
+#: The default bound of one kind's files, MB (``WOBJCAL_CACHE_MAX_MB`` overrides).
+DEFAULT_MAX_MB = 1000.0
 
 
 def cache_root() -> Path:
@@ -44,10 +52,12 @@ def load_arrays(kind: str, key: str, version: int) -> dict[str, NDArray] | None:
         if str(arrays.pop("_key", "")) != key or int(arrays.pop("_version", -1)) != version:
             log.warning("ignoring cache file %s: written for another key or version", path)
             return None
-        return arrays
     except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
         log.warning("ignoring unreadable cache file %s: %s", path, exc)
         return None
+    with contextlib.suppress(OSError):
+        os.utime(path)  # recently used: the last to be evicted
+    return arrays
 
 
 def save_arrays(kind: str, key: str, version: int, arrays: dict[str, NDArray]) -> None:
@@ -62,3 +72,49 @@ def save_arrays(kind: str, key: str, version: int, arrays: dict[str, NDArray]) -
         write_bytes_atomic(path, buf.getvalue())
     except OSError as exc:
         log.warning("cannot write cache file %s: %s", path, exc)
+        return
+    evict(kind, keep=path)
+
+
+def max_bytes() -> float:
+    """The bound of one kind's files in bytes (``$WOBJCAL_CACHE_MAX_MB``, default
+    :data:`DEFAULT_MAX_MB`); an unreadable setting is logged and the default used."""
+    text = os.environ.get("WOBJCAL_CACHE_MAX_MB", "")
+    try:
+        mb = float(text) if text else DEFAULT_MAX_MB
+        if not mb >= 0.0:
+            raise ValueError(text)
+    except ValueError:
+        log.warning("WOBJCAL_CACHE_MAX_MB=%r is not a size in MB; using %g", text, DEFAULT_MAX_MB)
+        mb = DEFAULT_MAX_MB
+    return mb * 1e6
+
+
+def evict(kind: str, keep: Path | None = None) -> list[Path]:
+    """Delete the least recently used ``.npz`` files of ``kind`` (never ``keep``) until the
+    rest fit in :func:`max_bytes`; returns the deleted paths. Files that vanish or cannot be
+    deleted meanwhile (another process) are skipped."""
+    entries = []
+    for p in (cache_root() / kind).glob("*.npz"):
+        try:
+            st = p.stat()
+        except OSError:
+            continue
+        entries.append((st.st_mtime, st.st_size, p))
+    total = sum(size for _, size, _ in entries)
+    limit = max_bytes()
+    removed: list[Path] = []
+    for _, size, p in sorted(entries, key=lambda e: e[0]):
+        if total <= limit:
+            break
+        if keep is not None and p == keep:
+            continue
+        try:
+            p.unlink()
+        except OSError:
+            continue
+        total -= size
+        removed.append(p)
+    if removed:
+        log.info("cache %s: removed %d least recently used files", kind, len(removed))
+    return removed
