@@ -9,8 +9,9 @@ Per point, three checks:
 
 1. the probe pose (:func:`planner.cell.feasibility.check_probes`): IK, joint limits, wrist
    singularity, collisions with clearance; ``marginal`` when little clearance or near a limit;
-2. the search path (:func:`planner.cell.search_paths.check_search`) from start to end of
-   travel, started from the pose's IK solution, in the nominal work-object frame;
+2. the search path (:func:`planner.check_paths.check_program_path`): the searches the exported
+   program runs, from the point's safe start to the end of travel, with the pose's orientation
+   and IK branch (what the program writes), in the nominal work-object frame;
 3. the planar face (:func:`planner.faces.checks.plan_face_reasons`): the point lies on a planar
    face with the plan's sensor footprint on it.
 
@@ -18,12 +19,12 @@ A point is ``infeasible`` when any of the three fails, ``marginal`` when only th
 marginal, else ``feasible``.
 
 A point with via points (``points[i].vias``) has a fourth check in :func:`check_plan`
-(:func:`check_via_moves`): every via within the joint limits, and the joint moves from the
-previous point's pose (none for the first point, or after a point without a pose) through the
-vias, in order, to the point's pose clear of collisions (:func:`planner.cell.moves.check_via_path`,
-the move check the Teach tab draws). A via that fails makes the point ``infeasible`` and names
-the via and the clearance pair. :func:`check_points` (one edited point, in the UI) leaves the
-vias out: their moves depend on the neighbours' poses.
+(:func:`check_via_moves`): every via within the joint limits, and the joint moves from the previous
+point's safe start (none for the first point, or after a point without a pose) through the vias, in
+order, to the point's safe start clear of collisions (:func:`planner.cell.moves.check_via_path`, the
+move check the Teach tab draws). A via that fails makes the point ``infeasible`` and names the via
+and the clearance pair. :func:`check_points` (one edited point, in the UI) leaves the vias out:
+their moves depend on the neighbours' poses.
 
 Per plan, the procedure's own preconditions (:func:`layout_problem`): the plan has points, every
 role the procedure needs, and the procedure computes the nominal frame from exact measurements
@@ -38,7 +39,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -46,10 +47,11 @@ from numpy.typing import NDArray
 from calib.errors import InputError, ProbeFailedError
 from calib.frames import transform_points
 from calib.plan.file import Plan, PlanPoint
-from calib.probing import SearchCommand
 from calib.procedures import procedure_kind
 from calib.tolerances import FACE_MAX_DEVIATION_M
+from planner.check_paths import ProgramPath, check_program_path
 from planner.check_results import ConfData, PlanCheck, PointCheck, Status
+from planner.export.job import safety_spec
 from planner.plan_cell import nominal_T_base_wobj, open_cell
 
 if TYPE_CHECKING:
@@ -184,12 +186,13 @@ def check_points(cell: Cell, plan: Plan, points: Sequence[PlanPoint]) -> tuple[P
 def check_via_moves(cell: Cell, plan: Plan, checks: Sequence[PointCheck]) -> tuple[PointCheck, ...]:
     """``checks`` (of all of ``plan``'s points, in plan order) with their via moves checked.
 
-    For each point with vias: the moves through the vias to the point's pose (when found),
-    joint space, in the open ``cell``, from the pose of every point an exported program probes
-    just before it (:func:`planner.export.job.probe_orders`: plan order, and the adaptive RAPID
-    program's A-H order with the C and D retakes); the first point of a program has no
-    previous pose and its first leg is not checked. A problem makes the point ``infeasible``,
-    with ``via_reason`` (and ``reason``) naming the previous point, the via and the pair.
+    For each point with vias: the moves through the vias to the point's safe start (when it has
+    one), joint space, in the open ``cell``, from the safe start (where the program leaves a point)
+    of every point an exported program probes just before it
+    (:func:`planner.export.job.probe_orders`: plan order, and the adaptive RAPID program's A-H order
+    with the C and D retakes); the first point of a program has no previous pose and its first leg
+    is not checked. A problem makes the point ``infeasible``, with ``via_reason`` (and ``reason``)
+    naming the previous point, the via and the pair.
     """
     from planner.cell.moves import check_via_path
     from planner.export.job import probe_orders
@@ -212,10 +215,10 @@ def check_via_moves(cell: Cell, plan: Plan, checks: Sequence[PointCheck]) -> tup
         for prev in before.get(i, [None]):
             q_prev = None
             if prev is not None and checks[prev].pose_status != "infeasible":
-                q_prev = checks[prev].q
+                q_prev = checks[prev].q_safe
             name = "previous point" if prev is None else ids[prev]
             qs = [v.q_rad for v in vias]
-            path = check_via_path(cell, q_prev, qs, c.q, plan.cell.tool.tcp, name)
+            path = check_via_path(cell, q_prev, qs, c.q_safe, plan.cell.tool.tcp, name)
             if path.problem:
                 problem = path.problem
                 break
@@ -256,8 +259,10 @@ def _check(plan: Plan, points: list[PlanPoint], cell: Cell) -> tuple[tuple[Point
     out = []
     T_flange_tcp = cell.T_flange_tcp(plan.cell.tool.tcp)
     part = f"work object {wo.name}: {wo.report.size_text}"
+    safety = safety_spec(plan)
+    tcp = plan.cell.tool.tcp
     for p, probe, pose, face in zip(points, probes, poses, faces, strict=True):
-        path = cell.check_search(SearchCommand.from_point(probe, T_nom), q_ref=pose.q)
+        path = check_program_path(cell, probe, pose, T_nom, safety, T_flange_tcp, tcp)
         check = _point_check(cell, p, pose, path, face, ik_kind, t0, T_flange_tcp)
         out.append(_with_part_size(check, wo.name, part))
         t0 = time.perf_counter()
@@ -268,7 +273,7 @@ def _point_check(
     cell: Cell,
     p: PlanPoint,
     pose: ProbeFeasibility,
-    path: Any,
+    path: ProgramPath,
     face: str,
     ik_kind: str,
     t0: float,
@@ -301,7 +306,8 @@ def _point_check(
         confdata=_confdata(cell, pose.q) if pose.feasible else None,
         ik_kind=ik_kind,
         q=None if pose.q is None else np.asarray(pose.q, dtype=float),
-        q_path=None if path.q_path is None else np.asarray(path.q_path, dtype=float),
+        q_path=np.asarray(path.q_path, dtype=float),
+        q_safe=path.q_safe,
         T_base_flange=None if pose.T_base_flange is None else np.asarray(pose.T_base_flange),
         elapsed_s=time.perf_counter() - t0,
         T_base_tcp=None

@@ -37,8 +37,8 @@ class PointCheck:
         pose_reason: why the pose is marginal or infeasible (``""`` when feasible).
         path_feasible: the whole search path can be run.
         path_reason: why not, with the distance along the path (``""`` when feasible).
-        path_fail_at_m: distance from the search start of the first failing sample, m (NaN
-            when the path is feasible).
+        path_fail_at_m: distance of the first failing sample from the start of its search (the
+            program's: from the safe start), m (NaN when the path is feasible).
         face_reason: why the point is not on a planar face with the sensor footprint on it
             (``""`` when it is).
         clearance_m: clearance of the limiting pair at the chosen pose, m (NaN: no pose);
@@ -49,11 +49,14 @@ class PointCheck:
             marginal pose), else ``None``.
         ik_kind: the cell's IK: ``"opw"`` (analytic) or ``"numeric"``.
         q: ``(n,)`` joint values of the chosen (or least-bad) pose, rad; ``None`` when no IK.
-        q_path: ``(M, n)`` joint values along the path samples that passed, rad, or ``None``.
+        q_path: ``(M, n)`` joint values along the path samples that passed, rad, or ``None``:
+            the program's searches in order (:mod:`planner.check_paths`).
         T_base_flange: ``(4, 4)`` flange pose of ``q``, robot base frame, m, or ``None``.
         elapsed_s: time this point's check took, s.
         T_base_tcp: ``(4, 4)`` the probing TCP at ``q`` (through the tool's mount), robot base
             frame, m, or ``None``.
+        q_safe: ``(n,)`` joint values at the point's safe start (where the program arrives
+            and leaves from), rad; ``None`` when it has none.
         n_vias: how many via points the plan gives the point (``points[i].vias``).
         via_reason: why the moves from the previous point through the vias to this point
             cannot be run (a via outside the joint limits, a leg that collides, naming the via
@@ -82,6 +85,7 @@ class PointCheck:
     T_base_flange: FloatArray | None
     elapsed_s: float = 0.0
     T_base_tcp: FloatArray | None = None
+    q_safe: FloatArray | None = None
     n_vias: int = 0
     via_reason: str = ""
 

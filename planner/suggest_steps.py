@@ -24,7 +24,7 @@ from calib.estimators.layout import (
 )
 from calib.plan.file import Plan, PlanPoint
 from calib.plan.report_spec import PointOfInterest, ReportSpec
-from calib.probing import ProbePoint, SearchCommand, SearchSpec
+from calib.probing import ProbePoint, SearchSpec
 from calib.procedures import BestFit, ThreeTwoOne
 from planner.export.safety import SafetySpec
 from planner.faces.candidates import Candidates, FaceTried
@@ -181,16 +181,20 @@ class Context:
 
     def paths_ok(self, chosen: tuple[int, ...]) -> bool:
         """Check the search paths of the chosen candidates not yet checked."""
+        from planner.check_paths import check_program_path
+
         T = nominal_T_base_wobj(self.plan)
         tcp = self.plan.cell.tool.tcp
+        T_ft = self.cell.T_flange_tcp(tcp)
         for i in chosen:
             if i in self.path_ok:
                 continue
             pose = self.cell.check_probes(
                 self.pool.positions_m[i : i + 1], self.pool.normals[i : i + 1], tcp=tcp
             )[0]
-            path = self.cell.check_search(
-                SearchCommand.from_point(self.probe(i, "c"), T), q_ref=pose.q
+            # the program's searches, as ``wobjcal check`` walks them
+            path = check_program_path(
+                self.cell, self.probe(i, "c"), pose, T, self.safety, T_ft, tcp
             )
             self.path_ok[i] = bool(pose.feasible and path.feasible)
             self.path_why[i] = str(path.reason or pose.reason)

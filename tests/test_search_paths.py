@@ -147,3 +147,27 @@ def test_numeric_ik_robot_runs_a_search(reference_dir) -> None:
     )
     np.testing.assert_allclose(pos[:, 2], 0.2 + 0.05 - res.s_m, atol=1e-5)
     assert np.abs(np.diff(res.q_path, axis=0)).max() < np.radians(5)
+
+
+def test_a_given_sensor_x_and_branch_fix_the_rotation_and_the_configuration(cell: Cell) -> None:
+    """The program runs the probe pose's orientation and configuration: with ``sensor_x`` and
+    ``branch`` the path keeps that x axis (any axial component ignored) on that branch."""
+    cmd = SearchCommand.from_point(TOP_APPROACH, cell.T_base_wobj)
+    free = cell.check_search(cmd)
+    x = np.array([np.cos(0.1), np.sin(0.1), 0.0])  # off the 15-deg grid
+    res = cell.check_search(cmd, sensor_x=x + 0.3 * cmd.sensor_axis, branch=free.branch)
+    assert res.feasible and res.branch == free.branch
+    T = cell.chain.fk(res.q_path) @ cell.T_flange_tcp("sensor")
+    np.testing.assert_allclose(T[:, :3, 0], np.repeat(x[None], len(T), axis=0), atol=1e-6)
+    other = next(b for b in range(8) if b != free.branch)
+    res_other = cell.check_search(cmd, sensor_x=x, branch=other, max_starts=1)
+    if res_other.feasible:  # reachable on that branch too: then it is that branch
+        assert res_other.branch == other
+    with pytest.raises(DegenerateGeometryError, match="sensor_x"):
+        cell.check_search(cmd, sensor_x=cmd.sensor_axis)
+
+
+def test_a_branch_the_start_does_not_have_is_named(cell: Cell) -> None:
+    cmd = SearchCommand.from_point(TOP_APPROACH, cell.T_base_wobj)
+    res = cell.check_search(cmd, branch=99)
+    assert not res.feasible and "no solution on IK branch 99" in res.reason

@@ -7,8 +7,9 @@ and from their size), and a thin near-black polyline from the via(s) to the poin
 their points change (a click that edits no via sends nothing).
 
 :func:`draw_moves` (the Teach tab's "Show moves between points") draws the joint moves from each
-point's pose through the next point's vias to its pose, green when clear and red when they
-collide, checked by :func:`planner.cell.moves.check_via_path` as ``wobjcal check`` does.
+point's safe start through the next point's vias to its safe start (the program's moves), green when
+clear and red when they collide, checked by :func:`planner.cell.moves.check_via_path` as ``wobjcal
+check`` does.
 """
 
 from __future__ import annotations
@@ -104,18 +105,18 @@ class ViaView:
 
 
 def draw_moves(app: AppContext, tcp: str) -> tuple[dict[str, str], str]:
-    """Draw and check the joint moves between consecutive points with a feasible pose (through
-    the vias of the later point), under ``/moves``.
+    """Draw and check the joint moves between the safe starts of consecutive points with a
+    feasible pose (through the vias of the later point), under ``/moves``.
 
     Returns:
         ``({"A->B": problem}, markdown)``: ``""`` for a clear move; the lines for the panel.
     """
     scene = app.server.scene
     doc, checks = app.state.doc, app.checks()
-    posed = [
-        (p.id, c.q)
+    posed = [  # where the program arrives at and leaves each point: its safe start
+        (p.id, c.q_safe)
         for p in doc.points
-        if (c := checks.get(p.id)) is not None and c.q is not None and c.status != "infeasible"
+        if (c := checks.get(p.id)) is not None and c.q_safe is not None and c.status != "infeasible"
     ]
     moves: dict[str, str] = {}
     lines = []

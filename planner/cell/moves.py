@@ -102,7 +102,8 @@ def check_joint_move(
 
 @dataclass(frozen=True)
 class ViaPath:
-    """The moves of one point's via path: previous pose, vias in order, the point's pose.
+    """The moves of one point's via path: previous pose, vias in order, the point's pose
+    (``wobjcal check`` and the Teach tab pass the points' safe starts).
 
     Attributes:
         legs: ``(from, to, check)`` per move checked, named ``"start"``, ``"via 1"``, ...,
@@ -127,11 +128,12 @@ def check_via_path(
 
     Args:
         cell: the plan's open cell.
-        q_prev: joint values at the previous point's probe pose, or ``None`` (the first point,
-            or a previous point without a pose): the path starts at the first via.
+        q_prev: joint values where the robot leaves the previous point (its safe start), or
+            ``None`` (the first point, or a previous point without a pose): the path starts
+            at the first via.
         vias_q: the vias' joint values, in order.
-        q_point: joint values at this point's probe pose, or ``None`` (no pose found): the path
-            ends at the last via.
+        q_point: joint values where the robot arrives at this point (its safe start), or
+            ``None`` (no pose found): the path ends at the last via.
         tcp: the probing TCP (for the drawn path).
         prev_name: what the messages call the previous pose (e.g. the point's id).
     """

@@ -79,6 +79,8 @@ def check_search(
     rotation_step_deg: float = 15.0,
     q_ref: ArrayLike | None = None,
     max_starts: int = 6,
+    sensor_x: ArrayLike | None = None,
+    branch: int | None = None,
 ) -> PathFeasibility:
     """Check the search ``command`` in ``cell`` (see the module docstring).
 
@@ -92,6 +94,11 @@ def check_search(
         rotation_step_deg: step of the rotations about the sensor axis tried at the start.
         q_ref: ``(n,)`` reference configuration for the start choice (default home).
         max_starts: start candidates (rotation, branch) tried before giving up.
+        sensor_x: ``(3,)`` the sensor TCP's x axis, base frame: only that rotation about the
+            sensor axis is tried (the probe pose's, which the exported program runs; its
+            component along the axis is ignored). ``None``: every ``rotation_step_deg``.
+        branch: only start solutions of this IK branch (the probe pose's: the program's
+            configuration); ``None`` or ``-1``: any branch.
 
     Returns:
         The first start candidate whose whole path passes, else the one that got farthest.
@@ -115,8 +122,11 @@ def check_search(
     s = np.linspace(0.0, length, math.ceil(length / step - 1e-9) + 1)
     s_nominal = float((nominal - start) @ direction)
     skip_from = s_nominal + 1e-9 if command.kind == "approach" else np.inf
-    rot_step = math.radians(check_positive(rotation_step_deg, "rotation_step_deg"))
-    angles = np.arange(0.0, 2 * np.pi - 1e-9, rot_step)
+    if sensor_x is None:
+        rot_step = math.radians(check_positive(rotation_step_deg, "rotation_step_deg"))
+        angles = np.arange(0.0, 2 * np.pi - 1e-9, rot_step)
+    else:
+        angles = np.array([_angle_of(check_vector3(sensor_x, "sensor_x"), start, axis)])
     # T_base_tcp of every (rotation, sample): normals are -axis, points along the path
     points = start + s[:, None] * direction
     T_start = tcp_frames(start[None], -axis[None], angles)[0]  # (R, 4, 4)
@@ -125,16 +135,20 @@ def check_search(
     K = starts.valid.shape[1]
     q0 = starts.q
     ok0 = starts.valid.copy()
+    if branch is not None and branch >= 0:
+        ok0 &= starts.branch == branch
     if ok0.any():
         sing, _ = singular(cell, q0[ok0])
         ok0[ok0] = ~sing
     empty = np.zeros((0, cell.chain.n_joints))
     if not ok0.any():
-        reason = (
-            no_ik_reason(cell.reach_model, cell.solver, cell.chain, T_start @ T_tcp_flange)
-            if not starts.valid.any()
-            else ("singular at the start")
-        )
+        if not starts.valid.any():
+            reason = no_ik_reason(cell.reach_model, cell.solver, cell.chain, T_start @ T_tcp_flange)
+        elif branch is not None and branch >= 0 and not (starts.branch == branch).any():
+            reason = f"no solution on IK branch {branch} (the probe pose's)"
+        else:
+            reason = "singular at the start"
+
         return PathFeasibility(False, f"at 0.0 mm: {reason}", 0.0, s, empty, math.nan, -1, math.nan)
     motion = np.where(ok0, np.linalg.norm(np.nan_to_num(q0 - ref), axis=-1), np.inf)
     near = limit_margin(cell.chain, np.nan_to_num(q0)) < MARGINAL_LIMIT_RAD
@@ -228,6 +242,16 @@ def _walk(
         branch,
         min_cl,
     )
+
+
+def _angle_of(x: FloatArray, start: FloatArray, axis: FloatArray) -> float:
+    """The rotation about the sensor ``axis`` (:func:`tcp_frames`' angle) whose TCP x axis
+    is ``x`` projected off the axis, rad."""
+    T0 = tcp_frames(start[None], -axis[None], np.zeros(1))[0, 0]
+    u, v = float(x @ T0[:3, 0]), float(x @ T0[:3, 1])
+    if math.hypot(u, v) < 1e-9 * max(1.0, float(np.linalg.norm(x))):
+        raise DegenerateGeometryError("sensor_x must not be along the sensor axis")
+    return math.atan2(v, u)
 
 
 def _unit(v: ArrayLike, name: str) -> FloatArray:

@@ -22,6 +22,7 @@ from calib.plan.file import Plan
 from calib.probing import SearchCommand
 from calib.procedures import procedure_kind
 from planner.export.safety import SafetySpec
+from planner.export.searches import safe_and_face_wobj
 from planner.export.text import module_name
 
 FloatArray = NDArray[np.float64]
@@ -254,15 +255,7 @@ def build_job(
         R = np.asarray(R, dtype=float)
         end = cmd.start_m + cmd.length_m * cmd.direction
         n = np.asarray(p.normal, dtype=float)
-        # the face point the first approach search looks for: the point, or the edge start
-        face = np.asarray(p.position_m, float) if p.search.kind == "approach" else cmd.start_m
-        clear = safety.start_clearance_m(face)
-        if p.search.kind == "approach":
-            safe = face + max(clear, p.search.start_offset_m) * n
-            face_end = end
-        else:
-            safe = face + clear * n
-            face_end = face - safety.overtravel_m(face) * n
+        safe, face_end = safe_and_face_wobj(p.to_probe_point(), safety)
         targets.append(
             TargetPair(
                 point_id=p.id,

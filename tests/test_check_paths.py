@@ -1,0 +1,80 @@
+"""``wobjcal check`` walks the searches the exported program runs (:mod:`planner.check_paths`):
+from the safe start, with the probe pose's orientation and configuration."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import msgspec
+import numpy as np
+import pytest
+
+from calib.frames import transform_points
+from calib.plan import Plan, load_plan
+from planner.check import check_plan
+from planner.export.job import safety_spec
+from planner.export.searches import program_searches, safe_and_face_wobj
+from planner.export_plan import export_job_for, with_arm_poses
+from planner.plan_cell import nominal_T_base_wobj, open_cell
+
+ROOT = Path(__file__).resolve().parent.parent
+DEMO = ROOT / "assets/plans/stator_section_ah.json"
+
+
+@pytest.fixture(scope="module")
+def demo() -> Plan:
+    return load_plan(DEMO)
+
+
+@pytest.fixture(scope="module")
+def demo_cell(demo: Plan) -> Iterator[object]:
+    with open_cell(demo, DEMO.parent) as cell:
+        yield cell
+
+
+def test_the_checked_path_is_the_programs(demo: Plan, demo_cell) -> None:  # type: ignore[no-untyped-def]
+    """Every demo point: the checked path starts at the program's safe start, keeps the probe
+    pose's sensor orientation all along, and its first joint values are the exported program's
+    safe-start joint values."""
+    check = check_plan(demo, DEMO.parent, cell=demo_cell)
+    T_nom = nominal_T_base_wobj(demo)
+    safety = safety_spec(demo)
+    job, _ = export_job_for(demo, DEMO.parent, check)
+    job = with_arm_poses(job, demo_cell, check, demo.cell.tool.tcp)
+    arms = {t.point_id: t.arm for t in job.targets}
+    T_ft = demo_cell.T_flange_tcp(demo.cell.tool.tcp)
+    for p, c in zip(demo.points, check.points, strict=True):
+        assert c.feasible and c.q_safe is not None and c.q_path is not None, c.reason
+        T = demo_cell.chain.fk(c.q_path) @ T_ft
+        safe_base = transform_points(T_nom, safe_and_face_wobj(p.to_probe_point(), safety)[0])
+        np.testing.assert_allclose(T[0, :3, 3], safe_base, atol=1e-6)
+        np.testing.assert_allclose(c.q_safe, c.q_path[0])
+        assert c.T_base_tcp is not None
+        R_pose = c.T_base_tcp[:3, :3]
+        assert np.abs(T[:, :3, :3] - R_pose).max() < 1e-6, p.id  # the pose's orientation
+        assert arms[p.id] is not None
+        np.testing.assert_allclose(arms[p.id]["safe"].q_rad, c.q_safe, atol=1e-6)
+        kinds = [cmd.kind for cmd in program_searches(p.to_probe_point(), T_nom, safety)]
+        assert kinds == (["approach", "edge"] if p.search.kind == "edge" else ["approach"])
+
+
+def test_a_safe_start_out_of_reach_makes_the_point_infeasible(demo: Plan, demo_cell) -> None:  # type: ignore[no-untyped-def]
+    """A misplacement tolerance of 0.6 m puts every safe start more than half a metre off the
+    part: the plan's own searches (5 cm out) are reachable, the program's are not, and the
+    check says so naming the safe start (it used to pass: the program was never checked)."""
+    v = demo.validation
+    loose = msgspec.structs.replace(
+        v, misplacement=msgspec.structs.replace(v.misplacement, max_translation_m=0.6)
+    )
+    plan = msgspec.structs.replace(demo, validation=loose)
+    check = check_plan(plan, DEMO.parent, cell=demo_cell)
+    bad = [c for c in check.points if not c.path_feasible]
+    assert bad, "no search from a safe start 0.6 m out failed"
+    for c in bad:
+        assert c.status == "infeasible"
+        assert "from the safe start" in c.path_reason, c.path_reason
+    # the poses themselves are untouched by the tolerance
+    assert [c.pose_status for c in check.points] == [
+        c.pose_status for c in check_plan(demo, DEMO.parent, cell=demo_cell).points
+    ]
