@@ -39,7 +39,8 @@ class ProgramPath:
         reason: why not, naming the search and the distance from its start (``""``).
         fail_at_m: distance of the first failing sample from the start of its search, m (NaN
             when feasible).
-        q_path: ``(M, n)`` joint values of the samples that passed, all searches in order, rad.
+        q_path: ``(M, n)`` joint values of the samples that passed, all searches in order, rad
+            (an edge point's face approach up to the nominal face, where the program stops).
         q_safe: ``(n,)`` joint values at the safe start (the program's first target of the
             point, where it leaves from too), rad; ``None`` when that start has no solution.
     """
@@ -92,6 +93,9 @@ def check_program_path(
             q_path = np.concatenate(parts) if parts else np.zeros((0, n))
             q_safe = q_path[0].copy() if len(q_path) else None
             return ProgramPath(False, reason, res.fail_at_m, q_path, q_safe)
-        q_ref = res.q_path[-1]
+        if k == 0 and len(searches) == 2:  # the face approach stops at the face (nominally)
+            at_face = float((cmd.nominal_m - cmd.start_m) @ cmd.direction)
+            parts[-1] = res.q_path[res.s_m <= at_face + 1e-9]
+        q_ref = parts[-1][-1] if len(parts[-1]) else res.q_path[-1]
     q_path = np.concatenate(parts)
     return ProgramPath(True, "", math.nan, q_path, q_path[0].copy())

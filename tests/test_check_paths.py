@@ -78,3 +78,18 @@ def test_a_safe_start_out_of_reach_makes_the_point_infeasible(demo: Plan, demo_c
     assert [c.pose_status for c in check.points] == [
         c.pose_status for c in check_plan(demo, DEMO.parent, cell=demo_cell).points
     ]
+
+
+def test_an_edge_points_path_stops_at_the_face_then_runs_the_edge(demo: Plan, demo_cell) -> None:  # type: ignore[no-untyped-def]
+    """F: the face approach from the safe start down to the nominal face (not its overtravel
+    into the part), then the edge search from the edge start: no jump between them."""
+    check = check_plan(demo, DEMO.parent, cell=demo_cell)
+    T_nom = nominal_T_base_wobj(demo)
+    (p,) = [p for p in demo.points if p.id == "F"]
+    (c,) = [c for c in check.points if c.point_id == "F"]
+    approach, edge = program_searches(p.to_probe_point(), T_nom, safety_spec(demo))
+    tcp = (demo_cell.chain.fk(c.q_path) @ demo_cell.T_flange_tcp(demo.cell.tool.tcp))[:, :3, 3]
+    depth = (tcp - edge.start_m) @ (-approach.direction)  # height over the nominal face
+    assert depth.min() > -1e-6  # never into the part
+    assert np.linalg.norm(np.diff(tcp, axis=0), axis=1).max() < 1.5e-3  # 1 mm samples, no jump
+    np.testing.assert_allclose(tcp[-1], edge.start_m + edge.length_m * edge.direction, atol=1e-6)
