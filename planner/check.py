@@ -48,9 +48,11 @@ from calib.errors import InputError, ProbeFailedError
 from calib.frames import transform_points
 from calib.plan.file import Plan, PlanPoint
 from calib.procedures import procedure_kind
+from calib.procedures.base import edge_offset_of
 from calib.tolerances import FACE_MAX_DEVIATION_M
-from planner.check_paths import ProgramPath, check_program_path
+from planner.check_paths import ProgramPath, check_program_path, measured_starts_wobj
 from planner.check_results import ConfData, PlanCheck, PointCheck, Status
+from planner.dry_run import nominal_part_probe
 from planner.export.job import safety_spec
 from planner.plan_cell import nominal_T_base_wobj, open_cell
 
@@ -141,8 +143,11 @@ def plan_quality(plan: Plan, mesh: trimesh.Trimesh) -> tuple[LayoutQuality | Non
 def layout_problem(plan: Plan) -> str:
     """Why the plan's procedure would refuse its points, ``""`` when it would not.
 
-    A dry run of ``wobjcal calibrate``: the procedure (:data:`calib.procedures.PROCEDURES`)
-    estimates the frame from exact measurements of the nominal points, in the nominal frame.
+    A dry run of the procedure (:data:`calib.procedures.PROCEDURES`) on the nominal part with
+    an exact sensor (:func:`planner.dry_run.nominal_part_probe`): every search commanded as the
+    program and ``wobjcal calibrate`` would, step by step, in the frame estimated so far, and
+    answered where it meets the nominal face or edge (an edge search started off the face by
+    ``edge_start_offset_m`` switches that far off it; the sensor's edge-event offset is added).
     It must accept them (roles, faces, observability) and give back the nominal frame: a
     layout that breaks the procedure's assumptions (e.g. A and B of the A-H procedure not at
     one height) shows as the distance, at the worst point, between the two frames; more than
@@ -155,9 +160,9 @@ def layout_problem(plan: Plan) -> str:
     if problem:
         return problem
     T = nominal_T_base_wobj(plan)
-    exact = {p.id: transform_points(T, p.position_m)[None] for p in plan.points}
+    probe = nominal_part_probe(T, edge_offset_of(plan.procedure))
     try:
-        T_est = kind.estimate(plan.role_points(), exact, T, plan.procedure).T_base_wobj
+        T_est = kind.run(plan.role_points(), T, probe, plan.procedure).T_base_wobj
     except (InputError, ProbeFailedError) as exc:
         return f"{plan.method}: {exc}"
     positions = np.array([p.position_m for p in plan.points], dtype=np.float64)
@@ -218,7 +223,8 @@ def check_via_moves(cell: Cell, plan: Plan, checks: Sequence[PointCheck]) -> tup
                 q_prev = checks[prev].q_safe
             name = "previous point" if prev is None else ids[prev]
             qs = [v.q_rad for v in vias]
-            path = check_via_path(cell, q_prev, qs, c.q_safe, plan.cell.tool.tcp, name)
+            q_point = c.q_safe if c.pose_status != "infeasible" else None
+            path = check_via_path(cell, q_prev, qs, q_point, plan.cell.tool.tcp, name)
             if path.problem:
                 problem = path.problem
                 break
@@ -261,8 +267,11 @@ def _check(plan: Plan, points: list[PlanPoint], cell: Cell) -> tuple[tuple[Point
     part = f"work object {wo.name}: {wo.report.size_text}"
     safety = safety_spec(plan)
     tcp = plan.cell.tool.tcp
+    measured = measured_starts_wobj(plan)
     for p, probe, pose, face in zip(points, probes, poses, faces, strict=True):
-        path = check_program_path(cell, probe, pose, T_nom, safety, T_flange_tcp, tcp)
+        path = check_program_path(
+            cell, probe, pose, T_nom, safety, T_flange_tcp, tcp, measured.get(p.id)
+        )
         check = _point_check(cell, p, pose, path, face, ik_kind, t0, T_flange_tcp)
         out.append(_with_part_size(check, wo.name, part))
         t0 = time.perf_counter()

@@ -17,11 +17,12 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
+from calib.plan.file import Plan
 from calib.probing import ProbePoint, SearchCommand
 from planner.export.safety import SafetySpec
-from planner.export.searches import program_searches
+from planner.export.searches import ProgramSearch, program_searches
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
@@ -60,6 +61,7 @@ def check_program_path(
     safety: SafetySpec,
     T_flange_tcp: FloatArray,
     tcp: str,
+    measured_start_wobj: ArrayLike | None = None,
 ) -> ProgramPath:
     """Walk ``point``'s searches in ``cell`` (module docstring).
 
@@ -71,31 +73,78 @@ def check_program_path(
         safety: the misplacement tolerance of the safe starts.
         T_flange_tcp: ``(4, 4)`` the probing TCP on the flange, m.
         tcp: the probing TCP's name.
+        measured_start_wobj: for an edge point the adaptive RAPID program starts at an already
+            measured point (``edge_start_from_measured``): that start, wobj frame, m. Both
+            programs are walked (the other formats approach the face); the path returned is
+            the face approach's, a failure of either is the point's.
     """
-    n = cell.chain.n_joints
     if pose.q is None or pose.T_base_flange is None or pose.status == "infeasible":
         cmd = SearchCommand.from_point(point, T_base_wobj)
         res = cell.check_search(cmd, q_ref=pose.q, tcp=tcp)
-        q_safe = res.q_path[0].copy() if len(res.q_path) else None
-        return ProgramPath(res.feasible, res.reason, res.fail_at_m, res.q_path, q_safe)
-    sensor_x = (np.asarray(pose.T_base_flange) @ T_flange_tcp)[:3, 0]
-    q_ref = np.asarray(pose.q, dtype=float)
-    parts: list[FloatArray] = []
-    searches = program_searches(point, T_base_wobj, safety)
-    for k, cmd in enumerate(searches):
-        res = cell.check_search(
-            cmd, q_ref=q_ref, tcp=tcp, sensor_x=sensor_x, branch=int(pose.branch), max_starts=1
-        )
-        parts.append(res.q_path)
-        if not res.feasible:
-            what = "approach to the face" if len(searches) == 2 and k == 0 else "search"
-            reason = f"{what} from the safe start {res.reason}" if k == 0 else res.reason
-            q_path = np.concatenate(parts) if parts else np.zeros((0, n))
-            q_safe = q_path[0].copy() if len(q_path) else None
-            return ProgramPath(False, reason, res.fail_at_m, q_path, q_safe)
-        if k == 0 and len(searches) == 2:  # the face approach stops at the face (nominally)
-            at_face = float((cmd.nominal_m - cmd.start_m) @ cmd.direction)
-            parts[-1] = res.q_path[res.s_m <= at_face + 1e-9]
-        q_ref = parts[-1][-1] if len(parts[-1]) else res.q_path[-1]
-    q_path = np.concatenate(parts)
-    return ProgramPath(True, "", math.nan, q_path, q_path[0].copy())
+        return ProgramPath(res.feasible, res.reason, res.fail_at_m, res.q_path, None)
+    walk = _Walk(cell, pose, T_flange_tcp, tcp)
+    path = walk.run(program_searches(point, T_base_wobj, safety))
+    if path.feasible and measured_start_wobj is not None:
+        other = walk.run(program_searches(point, T_base_wobj, safety, measured_start_wobj))
+        if not other.feasible:
+            why = f"adaptive RAPID program (edge search from the measured point): {other.reason}"
+            return ProgramPath(False, why, other.fail_at_m, path.q_path, path.q_safe)
+    return path
+
+
+class _Walk:
+    """Walks searches with one probe pose's orientation and branch, in order."""
+
+    def __init__(
+        self, cell: Cell, pose: ProbeFeasibility, T_flange_tcp: FloatArray, tcp: str
+    ) -> None:
+        self.cell, self.pose, self.tcp = cell, pose, tcp
+        self.sensor_x = (np.asarray(pose.T_base_flange) @ T_flange_tcp)[:3, 0]
+
+    def run(self, searches: tuple[ProgramSearch, ...]) -> ProgramPath:
+        """The searches in order, each from where the previous one ended (nominally)."""
+        q_ref = np.asarray(self.pose.q, dtype=float)
+        parts: list[FloatArray] = []
+        for k, (name, cmd) in enumerate(searches):
+            res = self.cell.check_search(
+                cmd,
+                q_ref=q_ref,
+                tcp=self.tcp,
+                sensor_x=self.sensor_x,
+                branch=int(self.pose.branch),
+                max_starts=1,
+            )
+            parts.append(res.q_path)
+            if not res.feasible:
+                q_path = np.concatenate(parts)
+                q_safe = q_path[0].copy() if len(q_path) else None
+                why = f"{name} {res.reason}"
+                return ProgramPath(False, why, res.fail_at_m, q_path, q_safe)
+            if k < len(searches) - 1:  # an approach stops at its nominal point
+                at = float((cmd.nominal_m - cmd.start_m) @ cmd.direction)
+                parts[-1] = res.q_path[res.s_m <= at + 1e-9]
+            q_ref = parts[-1][-1] if len(parts[-1]) else res.q_path[-1]
+        q_path = np.concatenate(parts)
+        return ProgramPath(True, "", math.nan, q_path, q_path[0].copy())
+
+
+def measured_starts_wobj(plan: Plan) -> dict[str, FloatArray]:
+    """``{point id: start}`` of the edge searches the adaptive RAPID program starts at an
+    already measured point (``edge_start_from_measured``: F at E, H at G, plus
+    ``edge_start_offset_m`` along the edge point's normal), wobj frame, m; ``{}`` when the
+    plan's program is not adaptive or does not."""
+    from calib.errors import InputError
+    from planner.export.job import adaptive_spec
+
+    try:
+        a = adaptive_spec(plan)
+    except InputError:  # a layout the adaptive program refuses: it is not exported adaptive
+        return {}
+    if a is None or not a.settings.edge_start_from_measured:
+        return {}
+    out = {}
+    for edge, source in (("F", "E"), ("H", "G")):
+        p, q = plan.points[a.index[edge]], plan.points[a.index[source]]
+        n = np.asarray(p.normal, dtype=float)
+        out[p.id] = np.asarray(q.position_m, dtype=float) + a.settings.edge_start_offset_m * n
+    return out

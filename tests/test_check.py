@@ -110,3 +110,24 @@ def test_a_part_in_the_wrong_units_is_named_with_its_size(reference_dir: Path) -
     about_part = [p.reason for p in result.points if "work object plate_holes" in p.reason]
     assert about_part, [p.reason for p in result.points]
     assert all("203 x 305 x 12.7 m (file units 'm', given)" in r for r in about_part)
+
+
+@pytest.mark.parametrize(
+    ("from_measured", "start_offset", "event_offset"),
+    [(True, 0.004, None), (True, 0.004, 0.002), (False, 0.0, 0.003)],
+)
+def test_the_dry_run_measures_edges_as_the_robot_does(
+    from_measured: bool, start_offset: float, event_offset: float | None
+) -> None:
+    """An edge search started off the face (``edge_start_offset_m``) switches off the face, and
+    a sensor that reports edges late (``edge_event_offset_m``) reports them late; the procedure
+    removes both, so the dry run gives back the nominal frame. (It used to feed the nominal
+    points unchanged, and refused these plans: "moves point C by 15.2 mm".)"""
+    plan = load_plan(STATOR)
+    proc = msgspec.structs.replace(
+        plan.procedure,
+        edge_start_from_measured=from_measured,
+        edge_start_offset_m=start_offset,
+        edge_event_offset_m=event_offset,
+    )
+    assert layout_problem(msgspec.structs.replace(plan, procedure=proc)) == ""

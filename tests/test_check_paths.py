@@ -13,6 +13,7 @@ import pytest
 from calib.frames import transform_points
 from calib.plan import Plan, load_plan
 from planner.check import check_plan
+from planner.check_paths import check_program_path, measured_starts_wobj
 from planner.export.job import safety_spec
 from planner.export.searches import program_searches, safe_and_face_wobj
 from planner.export_plan import export_job_for, with_arm_poses
@@ -55,7 +56,7 @@ def test_the_checked_path_is_the_programs(demo: Plan, demo_cell) -> None:  # typ
         assert np.abs(T[:, :3, :3] - R_pose).max() < 1e-6, p.id  # the pose's orientation
         assert arms[p.id] is not None
         np.testing.assert_allclose(arms[p.id]["safe"].q_rad, c.q_safe, atol=1e-6)
-        kinds = [cmd.kind for cmd in program_searches(p.to_probe_point(), T_nom, safety)]
+        kinds = [s.command.kind for s in program_searches(p.to_probe_point(), T_nom, safety)]
         assert kinds == (["approach", "edge"] if p.search.kind == "edge" else ["approach"])
 
 
@@ -87,9 +88,57 @@ def test_an_edge_points_path_stops_at_the_face_then_runs_the_edge(demo: Plan, de
     T_nom = nominal_T_base_wobj(demo)
     (p,) = [p for p in demo.points if p.id == "F"]
     (c,) = [c for c in check.points if c.point_id == "F"]
-    approach, edge = program_searches(p.to_probe_point(), T_nom, safety_spec(demo))
+    approach, edge = (
+        s.command for s in program_searches(p.to_probe_point(), T_nom, safety_spec(demo))
+    )
     tcp = (demo_cell.chain.fk(c.q_path) @ demo_cell.T_flange_tcp(demo.cell.tool.tcp))[:, :3, 3]
     depth = (tcp - edge.start_m) @ (-approach.direction)  # height over the nominal face
     assert depth.min() > -1e-6  # never into the part
     assert np.linalg.norm(np.diff(tcp, axis=0), axis=1).max() < 1.5e-3  # 1 mm samples, no jump
     np.testing.assert_allclose(tcp[-1], edge.start_m + edge.length_m * edge.direction, atol=1e-6)
+
+
+def test_the_adaptive_programs_edge_start_at_the_measured_point_is_walked_too(
+    demo: Plan,
+    demo_cell,  # type: ignore[no-untyped-def]
+) -> None:
+    """With ``edge_start_from_measured`` the adaptive RAPID program moves F from its safe start
+    straight to the measured E (plus the offset) and searches from there; the check walks that
+    too, and names it when it fails (here: a start put out of reach)."""
+    proc = msgspec.structs.replace(
+        demo.procedure, edge_start_from_measured=True, edge_start_offset_m=0.004
+    )
+    plan = msgspec.structs.replace(demo, procedure=proc)
+    starts = measured_starts_wobj(plan)
+    pts = {p.id: p for p in plan.points}
+    assert set(starts) == {"F", "H"}
+    np.testing.assert_allclose(
+        starts["F"], np.add(pts["E"].position_m, 0.004 * np.asarray(pts["F"].normal))
+    )
+    check = check_plan(plan, DEMO.parent, cell=demo_cell)
+    assert check.feasible, [(c.point_id, c.reason) for c in check.points if not c.feasible]
+    T_nom = nominal_T_base_wobj(plan)
+    safety = safety_spec(plan)
+    F = pts["F"].to_probe_point()
+    move, edge = (s.command for s in program_searches(F, T_nom, safety, starts["F"]))
+    np.testing.assert_allclose(move.start_m + move.length_m * move.direction, edge.start_m)
+    np.testing.assert_allclose(edge.start_m, transform_points(T_nom, starts["F"]))
+    pose = demo_cell.check_probes(
+        np.array([F.position_m]), np.array([F.normal]), tcp=plan.cell.tool.tcp
+    )[0]
+    T_ft = demo_cell.T_flange_tcp(plan.cell.tool.tcp)
+    tcp = plan.cell.tool.tcp
+    far = starts["F"] + 0.25 * np.asarray(F.normal) - 0.9 * np.asarray(F.search.edge_direction)
+    path = check_program_path(demo_cell, F, pose, T_nom, safety, T_ft, tcp, far)
+    assert not path.feasible
+    assert path.reason.startswith(
+        "adaptive RAPID program (edge search from the measured point): move from the safe start"
+    ), path.reason
+    assert path.q_safe is not None  # the face-approach program's, which passes
+
+
+def test_a_point_without_a_usable_pose_has_no_safe_start(demo: Plan, demo_cell) -> None:  # type: ignore[no-untyped-def]
+    far = msgspec.structs.replace(demo.points[0], position_m=(3.0, 3.0, 3.0))
+    plan = msgspec.structs.replace(demo, points=[far, *demo.points[1:]])
+    c = check_plan(plan, DEMO.parent, cell=demo_cell).points[0]
+    assert c.pose_status == "infeasible" and c.q_safe is None

@@ -190,7 +190,7 @@ def test_every_format_moves_through_the_vias_first(via_plan: Plan, demo_cell: ob
     proc = rapid[rapid.index("PROC Probe_pB") :]
     assert proc.index("MoveAbsJ pB_via1") < proc.index("MoveAbsJ pB_via2") < proc.index("MoveJ")
     urs = export_program(via_plan, PLANS, "urscript", cell=demo_cell).files[".script"]  # type: ignore[arg-type]
-    assert urs.index('probe("A"') < urs.index("movej(") < urs.index('probe("B"')
+    assert urs.index('probe("A"') < urs.index("movej([") < urs.index('probe("B"')
 
 
 def test_a_seven_joint_via_is_refused_by_the_writers(demo: Plan) -> None:

@@ -229,8 +229,10 @@ class PointsPanel:
         sel = self._app.selection.of(cid)
         check = None if sel is None else self._app.check_of(sel)
         robot = self._app.robot
-        if check is None or check.q_path is None or robot is None:
+        if check is None or check.q_path is None or len(check.q_path) == 0 or robot is None:
             why = "select a point whose search path was computed" if robot else "no robot loaded"
+            if robot and check is not None and check.path_reason:
+                why = f"no sample of its search path passed: {check.path_reason}"
             self._app.notify("Nothing to play", why, client=client)
             return
         robot.play(check.q_path, client_id=cid)

@@ -96,7 +96,9 @@ def check_search(
         max_starts: start candidates (rotation, branch) tried before giving up.
         sensor_x: ``(3,)`` the sensor TCP's x axis, base frame: only that rotation about the
             sensor axis is tried (the probe pose's, which the exported program runs; its
-            component along the axis is ignored). ``None``: every ``rotation_step_deg``.
+            component along the axis is ignored), start solutions nearest ``q_ref`` first
+            (max-abs joint distance, as the export picks a target's joint values).
+            ``None``: every ``rotation_step_deg``, least motion away from the limits first.
         branch: only start solutions of this IK branch (the probe pose's: the program's
             configuration); ``None`` or ``-1``: any branch.
 
@@ -150,8 +152,12 @@ def check_search(
             reason = "singular at the start"
 
         return PathFeasibility(False, f"at 0.0 mm: {reason}", 0.0, s, empty, math.nan, -1, math.nan)
-    motion = np.where(ok0, np.linalg.norm(np.nan_to_num(q0 - ref), axis=-1), np.inf)
-    near = limit_margin(cell.chain, np.nan_to_num(q0)) < MARGINAL_LIMIT_RAD
+    if sensor_x is None:  # free choice: least motion, away from the limits first
+        motion = np.where(ok0, np.linalg.norm(np.nan_to_num(q0 - ref), axis=-1), np.inf)
+        near = limit_margin(cell.chain, np.nan_to_num(q0)) < MARGINAL_LIMIT_RAD
+    else:  # the program's start: the solution nearest the pose (export's rule, max-abs)
+        motion = np.where(ok0, np.abs(np.nan_to_num(q0 - ref)).max(axis=-1), np.inf)
+        near = np.zeros_like(ok0)
     order = np.lexsort((motion.ravel(), near.ravel(), ~ok0.ravel()))[: int(ok0.sum())]
     order = order[:max_starts]
     best: PathFeasibility | None = None

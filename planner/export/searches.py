@@ -18,10 +18,12 @@ the one the program runs; :func:`safe_and_face_wobj` gives the two targets for
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.errors import InputError
 from calib.frames import transform_directions, transform_points
 from calib.probing import ProbePoint, SearchCommand
 from planner.export.safety import SafetySpec
@@ -49,38 +51,85 @@ def safe_and_face_wobj(point: ProbePoint, safety: SafetySpec) -> tuple[FloatArra
     return safe, face_end
 
 
+class ProgramSearch(NamedTuple):
+    """One search of a program: what a message calls it, and the command (base frame)."""
+
+    name: str
+    command: SearchCommand
+
+
 def program_searches(
-    point: ProbePoint, T_base_wobj: ArrayLike, safety: SafetySpec
-) -> tuple[SearchCommand, ...]:
+    point: ProbePoint,
+    T_base_wobj: ArrayLike,
+    safety: SafetySpec,
+    measured_start_wobj: ArrayLike | None = None,
+) -> tuple[ProgramSearch, ...]:
     """The searches the program runs for ``point`` (module docstring), base frame.
 
     Args:
         point: the point (a plan's: ``PlanPoint.to_probe_point()``).
         T_base_wobj: ``(4, 4)`` the (nominal) work object in the robot base frame.
         safety: the misplacement tolerance the safe starts are computed for.
+        measured_start_wobj: for an edge point, where the adaptive RAPID program starts the
+            edge search instead of approaching the face (``edge_start_from_measured``: the
+            measured E or G plus the offset along the normal), wobj frame, m; the program
+            then moves there in a straight line from the safe start.
 
     Returns:
-        One command (approach point) or two (edge point: the face approach, then the edge
-        search); each starts where the program starts it.
+        One search (approach point) or two (edge point: the face approach, or the move to the
+        measured start, then the edge search); each starts where the program starts it.
+
+    Raises:
+        InputError: the measured start lies past the end of the plan's edge search.
     """
     T = np.asarray(T_base_wobj, dtype=np.float64)
     cmd = SearchCommand.from_point(point, T)
     safe_w, face_end_w = safe_and_face_wobj(point, safety)
     safe = transform_points(T, safe_w)
+    end = cmd.start_m + cmd.length_m * cmd.direction
     if point.search.kind == "approach":
-        end = cmd.start_m + cmd.length_m * cmd.direction
-        return (replace(cmd, start_m=safe, length_m=float(np.linalg.norm(end - safe))),)
+        length = float(np.linalg.norm(end - safe))
+        return (
+            ProgramSearch(
+                "search from the safe start", replace(cmd, start_m=safe, length_m=length)
+            ),
+        )
     n = transform_directions(T, np.asarray(point.normal, dtype=float))
-    face = cmd.start_m  # the edge search's start: on the face
-    approach = SearchCommand(
+    if measured_start_wobj is None:
+        to, name = cmd.start_m, "approach to the face from the safe start"
+        first = SearchCommand(
+            point_id=point.id,
+            kind="approach",
+            start_m=safe,
+            direction=-n,
+            length_m=float(np.linalg.norm(transform_points(T, face_end_w) - safe)),
+            sensor_axis=cmd.sensor_axis,
+            T_base_wobj_estimate=T.copy(),
+            nominal_m=to.copy(),
+            stop_normal=n,
+        )
+        return ProgramSearch(name, first), ProgramSearch("edge search", cmd)
+    to = transform_points(T, np.asarray(measured_start_wobj, dtype=float))
+    run = float((end - to) @ cmd.direction)
+    if run <= 0.0:
+        raise InputError(
+            f"point {point.id}: the edge search from the measured start (edge_start_from_"
+            f"measured) would start {-run * 1e3:.1f} mm past the end of the plan's search"
+        )
+    gap = float(np.linalg.norm(to - safe))
+    move = SearchCommand(
         point_id=point.id,
         kind="approach",
         start_m=safe,
-        direction=-n,
-        length_m=float(np.linalg.norm(transform_points(T, face_end_w) - safe)),
+        direction=(to - safe) / gap if gap > 0.0 else -n,
+        length_m=max(gap, 1e-6),
         sensor_axis=cmd.sensor_axis,
         T_base_wobj_estimate=T.copy(),
-        nominal_m=face.copy(),
+        nominal_m=to,
         stop_normal=n,
     )
-    return approach, cmd
+    edge = replace(cmd, start_m=to, length_m=run)
+    return (
+        ProgramSearch("move from the safe start to the measured start", move),
+        ProgramSearch("edge search from the measured start", edge),
+    )

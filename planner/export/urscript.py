@@ -4,7 +4,8 @@ Conventions: metres and rotation vectors, poses ``p[x, y, z, rx, ry, rz]``. The 
 object is the pose ``wobj`` (robot base frame); each target is written in the work-object frame
 and moved to the base with ``pose_trans(wobj, target)``, so replacing ``wobj`` with the
 calibrated frame is a one-line change. Every search runs in that nominal frame (not adaptive)
-and starts at the safe start of :mod:`planner.export.safety`; an edge point first approaches
+and starts at the safe start of :mod:`planner.export.safety` (reached with a joint move,
+``movej`` of the pose); an edge point first approaches
 its face and runs the edge search from the measured face point (``probe``'s ``safe_wobj`` and
 ``face_wobj``). A search runs ``movel`` to the end point in a thread
 while the main loop polls ``get_standard_digital_in(SENSOR_IN)`` every control cycle; at the
@@ -83,7 +84,9 @@ def export_urscript(job: ExportJob) -> str:
         "  # along the plan's direction from the measured face point up to the plan's end",
         "  def probe(name, start_wobj, end_wobj, want, speed, safe_wobj, face_wobj):",
         "    safe = pose_trans(wobj, safe_wobj)",
-        "    movel(safe, a=0.5, v=0.1)",
+        "    # a joint move into the safe start (IK nearest the current joints), as the vias and",
+        "    # the other formats, and as wobjcal check walks it; the searches are linear",
+        "    movej(safe, a=1.4, v=1.05)",
         "    if want:",
         "      result = run_search(pose_trans(wobj, end_wobj), True, speed)",
         "    else:",
