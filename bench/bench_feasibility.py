@@ -85,7 +85,7 @@ def _cold(samples: int, seed: int, fresh_kernels: bool, helper: bool = True) -> 
         numba_dir = Path(tmp) / "cache" / "numba"
         deadline = time.monotonic() + 300
         while fresh_kernels and helper and time.monotonic() < deadline:
-            if any(numba_dir.glob("warm-*")):  # the helper is done
+            if any(numba_dir.rglob("warm-*")):  # the helper is done
                 break
             time.sleep(0.2)
     row = json.loads(out.stdout.strip().splitlines()[-1])

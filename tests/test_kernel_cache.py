@@ -7,9 +7,12 @@ runs in a fresh interpreter.
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
+
+from planner.cell.kernel_cache import SOURCES, source_key
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -29,10 +32,31 @@ def _run(env_extra: dict[str, str]) -> list[str]:
     return out.stdout.strip().splitlines()
 
 
-def test_kernels_cached_under_wobjcal_cache_root(tmp_path: Path) -> None:
+def test_kernels_cached_under_wobjcal_cache_root_by_source_key(tmp_path: Path) -> None:
+    stale = tmp_path / "numba" / ("0" * 16)  # another version's kernels
+    stale.mkdir(parents=True)
+    (stale / "x.nbi").write_text("old")
+    keep = tmp_path / "numba" / "notes"  # not a version's directory
+    keep.mkdir()
     lines = _run({"WOBJCAL_CACHE_DIR": str(tmp_path)})
-    assert lines[0] == lines[1] == str(tmp_path / "numba")
-    assert (tmp_path / "numba").is_dir()
+    assert lines[0] == lines[1] == str(tmp_path / "numba" / source_key())
+    assert (tmp_path / "numba" / source_key()).is_dir()
+    assert not stale.exists() and keep.is_dir()
+
+
+def test_the_key_follows_every_kernel_source(tmp_path: Path) -> None:
+    """A cached caller holds its callees' code, and numba checks only the caller's own file:
+    a change to any kernel module must change the directory (a fresh compile)."""
+    here = ROOT / "planner" / "cell"
+    for name in SOURCES:
+        shutil.copy(here / f"{name}.py", tmp_path / f"{name}.py")
+    assert source_key(tmp_path) == source_key()
+    for name in ("gjk_kernels", "lazy_kernel"):
+        path = tmp_path / f"{name}.py"
+        text = path.read_text()
+        path.write_text(text + "\n# changed\n")
+        assert source_key(tmp_path) != source_key()
+        path.write_text(text)
 
 
 def test_numba_cache_dir_wins(tmp_path: Path) -> None:

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from planner.cell.kernel_cache import configure, marker_path, start_background
+from planner.cell.kernel_cache import configure, marker_path, source_key, start_background
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -41,11 +41,16 @@ print("compiled:", sorted(set(compiled)))
 """
 
 
+def _cache(tmp_path: Path) -> Path:
+    """Where a process with ``WOBJCAL_CACHE_DIR=tmp_path/cache`` keeps its kernels."""
+    return tmp_path / "cache" / "numba" / source_key()
+
+
 def _env(tmp_path: Path, **extra: str) -> dict[str, str]:
     warm = configure()
     if warm is None or not warm.is_dir():
         pytest.skip("no writable kernel cache to copy")
-    shutil.copytree(warm, tmp_path / "cache" / "numba", ignore=shutil.ignore_patterns("warm-*"))
+    shutil.copytree(warm, _cache(tmp_path), ignore=shutil.ignore_patterns("warm-*"))
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
     env.update(WOBJCAL_CACHE_DIR=str(tmp_path / "cache"), **extra)
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")])
@@ -65,7 +70,7 @@ def test_a_check_after_the_warm_up_compiles_nothing(tmp_path: Path) -> None:
 
 def test_the_warm_up_command_and_the_background_helper_write_the_marker(tmp_path: Path) -> None:
     env = _env(tmp_path, WOBJCAL_BACKGROUND_COMPILE="0")
-    cache = tmp_path / "cache" / "numba"
+    cache = _cache(tmp_path)
     out = subprocess.run(
         [sys.executable, "-m", "planner.cell.warmup"],
         capture_output=True,

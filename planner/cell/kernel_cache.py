@@ -7,9 +7,14 @@ read-only install cannot. :func:`configure` points numba at ``<cache root>/numba
 (``$WOBJCAL_CACHE_DIR/numba``, default ``~/.cache/wobjcal/numba``), beside the distance fields
 and allowed-collision lists, so one directory holds every derived file and emptying it is a
 true cold start. ``NUMBA_CACHE_DIR``, when set, wins. When the directory cannot be created or
-written, numba's own fallbacks apply (next to the source, then its user-wide directory); a
-cache only ever costs time, never an answer: numba checks each entry against the source file's
-stamp and the CPU before it loads it.
+written, numba's own fallbacks apply (next to the source, then its user-wide directory).
+
+The kernels live in a subdirectory named by a hash of all the kernel modules' sources
+(:func:`source_key`), and other versions' subdirectories are deleted: numba checks a cached
+kernel only against its *own* file's stamp, but a cached caller contains the machine code of
+the helpers it calls from other files (``broad_kernels`` calls ``gjk_kernels``), so a change to
+a helper alone would otherwise leave its callers running the old code. With the key, a changed
+source costs a compile, never an answer.
 
 Each kernel module calls :func:`configure` before its first ``@njit``: numba picks the
 directory when a function is decorated. The first call also starts the background compile of
@@ -21,6 +26,7 @@ from __future__ import annotations
 import hashlib
 import logging
 import os
+import shutil
 import subprocess
 import sys
 import threading
@@ -49,12 +55,26 @@ def configure() -> Path | None:
     """
     if _CONFIG.CACHE_DIR:  # NUMBA_CACHE_DIR or an earlier call
         return Path(_CONFIG.CACHE_DIR)
-    path = cache_root() / "numba"
+    key = source_key()
+    path = cache_root() / "numba" / key
     if _writable(path):
         _CONFIG.CACHE_DIR = str(path)
+        _remove_other_versions(path.parent, key)
         start_background(path)
         return path
     return None
+
+
+def _remove_other_versions(root: Path, key: str) -> None:
+    """Delete the kernels of other sources (best effort: another process of another version
+    that loses its cache only compiles again)."""
+    for d in root.iterdir():
+        if d.is_dir() and d.name != key and len(d.name) == len(key) and _is_hex(d.name):
+            shutil.rmtree(d, ignore_errors=True)
+
+
+def _is_hex(name: str) -> bool:
+    return all(c in "0123456789abcdef" for c in name)
 
 
 def _writable(path: Path) -> bool:
@@ -86,8 +106,10 @@ _started = threading.Lock()
 _helper: list[subprocess.Popen[bytes]] = []
 
 
-def _key() -> str:
-    here = Path(__file__).resolve().parent
+def source_key(here: Path | None = None) -> str:
+    """16 hex digits of the kernels' sources (:data:`SOURCES` in ``here``, default this
+    package), numba's and Python's versions: the name of the cache directory."""
+    here = Path(__file__).resolve().parent if here is None else here
     h = hashlib.sha256(f"{numba.__version__} {sys.version}".encode())
     for name in SOURCES:
         h.update((here / f"{name}.py").read_bytes())
@@ -96,7 +118,7 @@ def _key() -> str:
 
 def marker_path(cache_dir: Path) -> Path:
     """The file that says ``cache_dir`` holds the kernels of this source and numba."""
-    return cache_dir / f"warm-{_key()}"
+    return cache_dir / f"warm-{source_key()}"
 
 
 def start_background(cache_dir: Path | None) -> bool:
