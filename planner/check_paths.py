@@ -1,13 +1,13 @@
 """The search paths ``wobjcal check`` walks: the ones the exported program runs.
 
 A program moves to a point's safe start and searches from there with the orientation and
-configuration of the probe pose the check chose (``wobjcal export`` writes that pose's rotation
-and ``confdata`` into every target of the point). So, for a point with a pose, the check walks
+configuration of the probe pose the check chose (``wobjcal export`` writes that pose's rotation and
+``confdata`` into every target of the point). So, for a point with a pose, the check walks
 :func:`planner.export.searches.program_searches` (from the safe start; for an edge point the
-approach to the face, then the edge search) with the pose's sensor x axis and IK branch only:
-a path that would pass only with the sensor turned another way, or on another branch, is not
-the program's path and does not count. A point without a usable pose is infeasible anyway; its
-plan search is walked with any rotation, for the reason it gives.
+approach to the face, the edge search and the straight retreat to the safe start) with the pose's
+sensor x axis and IK branch only: a path that would pass only with the sensor turned another way, or
+on another branch, is not the program's path and does not count. A point without a usable pose is
+infeasible anyway; its plan search is walked with any rotation, for the reason it gives.
 """
 
 from __future__ import annotations

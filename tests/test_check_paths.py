@@ -57,7 +57,8 @@ def test_the_checked_path_is_the_programs(demo: Plan, demo_cell) -> None:  # typ
         assert arms[p.id] is not None
         np.testing.assert_allclose(arms[p.id]["safe"].q_rad, c.q_safe, atol=1e-6)
         kinds = [s.command.kind for s in program_searches(p.to_probe_point(), T_nom, safety)]
-        assert kinds == (["approach", "edge"] if p.search.kind == "edge" else ["approach"])
+        edge = ["approach", "edge", "approach"]  # face approach, edge search, retreat
+        assert kinds == (edge if p.search.kind == "edge" else ["approach"])
 
 
 def test_a_safe_start_out_of_reach_makes_the_point_infeasible(demo: Plan, demo_cell) -> None:  # type: ignore[no-untyped-def]
@@ -81,21 +82,28 @@ def test_a_safe_start_out_of_reach_makes_the_point_infeasible(demo: Plan, demo_c
     ]
 
 
-def test_an_edge_points_path_stops_at_the_face_then_runs_the_edge(demo: Plan, demo_cell) -> None:  # type: ignore[no-untyped-def]
+def test_an_edge_points_path_is_approach_edge_and_retreat(demo: Plan, demo_cell) -> None:  # type: ignore[no-untyped-def]
     """F: the face approach from the safe start down to the nominal face (not its overtravel
-    into the part), then the edge search from the edge start: no jump between them."""
+    into the part), the edge search from the edge start up to the edge (where it stops), and
+    the straight retreat back to the safe start: never into the part, no jump."""
     check = check_plan(demo, DEMO.parent, cell=demo_cell)
     T_nom = nominal_T_base_wobj(demo)
     (p,) = [p for p in demo.points if p.id == "F"]
     (c,) = [c for c in check.points if c.point_id == "F"]
-    approach, edge = (
+    approach, edge, retreat = (
         s.command for s in program_searches(p.to_probe_point(), T_nom, safety_spec(demo))
     )
     tcp = (demo_cell.chain.fk(c.q_path) @ demo_cell.T_flange_tcp(demo.cell.tool.tcp))[:, :3, 3]
     depth = (tcp - edge.start_m) @ (-approach.direction)  # height over the nominal face
     assert depth.min() > -1e-6  # never into the part
     assert np.linalg.norm(np.diff(tcp, axis=0), axis=1).max() < 1.5e-3  # 1 mm samples, no jump
-    np.testing.assert_allclose(tcp[-1], edge.start_m + edge.length_m * edge.direction, atol=1e-6)
+    np.testing.assert_allclose(tcp[0], approach.start_m, atol=1e-6)
+    np.testing.assert_allclose(tcp[-1], approach.start_m, atol=1e-6)  # back at the safe start
+    np.testing.assert_allclose(retreat.start_m, edge.nominal_m, atol=1e-9)  # from the edge
+    run = (tcp - edge.start_m) @ edge.direction
+    assert run.max() == pytest.approx(
+        float((edge.nominal_m - edge.start_m) @ edge.direction), abs=1e-3
+    )
 
 
 def test_the_adaptive_programs_edge_start_at_the_measured_point_is_walked_too(
@@ -120,7 +128,7 @@ def test_the_adaptive_programs_edge_start_at_the_measured_point_is_walked_too(
     T_nom = nominal_T_base_wobj(plan)
     safety = safety_spec(plan)
     F = pts["F"].to_probe_point()
-    move, edge = (s.command for s in program_searches(F, T_nom, safety, starts["F"]))
+    move, edge, _ = (s.command for s in program_searches(F, T_nom, safety, starts["F"]))
     np.testing.assert_allclose(move.start_m + move.length_m * move.direction, edge.start_m)
     np.testing.assert_allclose(edge.start_m, transform_points(T_nom, starts["F"]))
     pose = demo_cell.check_probes(

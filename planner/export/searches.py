@@ -7,7 +7,8 @@ there, which is not the plan's search start when the safe clearance is the large
   normal`` along ``-normal`` to the plan's search end (``SearchL`` to ``_end``);
 - an **edge** point: an approach to the face the edge search runs along, from ``edge start +
   clearance * normal`` down to ``overtravel`` past the nominal face (``_face``), then the edge
-  search from the (measured) face point along the plan's direction.
+  search from the (measured) face point along the plan's direction, then a straight retreat
+  from where it stopped back to the safe start.
 
 :func:`program_searches` gives these as :class:`calib.probing.SearchCommand` (base frame), which
 ``wobjcal check`` walks with the probe pose's orientation and branch, so the motion it checks is
@@ -76,8 +77,10 @@ def program_searches(
             then moves there in a straight line from the safe start.
 
     Returns:
-        One search (approach point) or two (edge point: the face approach, or the move to the
-        measured start, then the edge search); each starts where the program starts it.
+        One search (approach point: its retreat runs back along it) or three (edge point: the
+        face approach, or the move to the measured start; the edge search; the straight
+        retreat from where it stops to the safe start); each starts where the program starts
+        it.
 
     Raises:
         InputError: the measured start lies past the end of the plan's edge search.
@@ -96,40 +99,52 @@ def program_searches(
         )
     n = transform_directions(T, np.asarray(point.normal, dtype=float))
     if measured_start_wobj is None:
-        to, name = cmd.start_m, "approach to the face from the safe start"
-        first = SearchCommand(
-            point_id=point.id,
-            kind="approach",
-            start_m=safe,
-            direction=-n,
-            length_m=float(np.linalg.norm(transform_points(T, face_end_w) - safe)),
-            sensor_axis=cmd.sensor_axis,
-            T_base_wobj_estimate=T.copy(),
-            nominal_m=to.copy(),
-            stop_normal=n,
+        face_end = transform_points(T, face_end_w)
+        first = _line(cmd, safe, cmd.start_m, n, length_m=float(np.linalg.norm(face_end - safe)))
+        edge = cmd
+        names = ("approach to the face from the safe start", "edge search")
+    else:
+        to = transform_points(T, np.asarray(measured_start_wobj, dtype=float))
+        run = float((end - to) @ cmd.direction)
+        if run <= 0.0:
+            raise InputError(
+                f"point {point.id}: the edge search from the measured start (edge_start_from_"
+                f"measured) would start {-run * 1e3:.1f} mm past the end of the plan's search"
+            )
+        first = _line(cmd, safe, to, n)
+        edge = replace(cmd, start_m=to, length_m=run)
+        names = (
+            "move from the safe start to the measured start",
+            "edge search from the measured start",
         )
-        return ProgramSearch(name, first), ProgramSearch("edge search", cmd)
-    to = transform_points(T, np.asarray(measured_start_wobj, dtype=float))
-    run = float((end - to) @ cmd.direction)
-    if run <= 0.0:
-        raise InputError(
-            f"point {point.id}: the edge search from the measured start (edge_start_from_"
-            f"measured) would start {-run * 1e3:.1f} mm past the end of the plan's search"
-        )
-    gap = float(np.linalg.norm(to - safe))
-    move = SearchCommand(
-        point_id=point.id,
-        kind="approach",
-        start_m=safe,
-        direction=(to - safe) / gap if gap > 0.0 else -n,
-        length_m=max(gap, 1e-6),
-        sensor_axis=cmd.sensor_axis,
-        T_base_wobj_estimate=T.copy(),
-        nominal_m=to,
-        stop_normal=n,
-    )
-    edge = replace(cmd, start_m=to, length_m=run)
+    # where the edge search stops (nominally), then the straight retreat to the safe start
+    stop = edge.start_m + float((edge.nominal_m - edge.start_m) @ edge.direction) * edge.direction
     return (
-        ProgramSearch("move from the safe start to the measured start", move),
-        ProgramSearch("edge search from the measured start", edge),
+        ProgramSearch(names[0], first),
+        ProgramSearch(names[1], edge),
+        ProgramSearch("retreat to the safe start", _line(cmd, stop, safe, n)),
+    )
+
+
+def _line(
+    cmd: SearchCommand,
+    a: FloatArray,
+    b: FloatArray,
+    n: FloatArray,
+    length_m: float | None = None,
+) -> SearchCommand:
+    """A straight move of ``cmd``'s sensor from ``a`` towards ``b`` (base frame), walked as an
+    approach whose nominal point is ``b`` (checked against the part up to there, the sensor
+    allowed to touch it); ``length_m`` runs it past ``b`` (a search's overtravel)."""
+    gap = float(np.linalg.norm(b - a))
+    return SearchCommand(
+        point_id=cmd.point_id,
+        kind="approach",
+        start_m=a,
+        direction=(b - a) / gap if gap > 0.0 else -n,
+        length_m=max(gap if length_m is None else length_m, 1e-6),
+        sensor_axis=cmd.sensor_axis,
+        T_base_wobj_estimate=cmd.T_base_wobj_estimate.copy(),
+        nominal_m=np.asarray(b, dtype=float).copy(),
+        stop_normal=n,
     )
