@@ -189,33 +189,28 @@ def check_points(cell: Cell, plan: Plan, points: Sequence[PlanPoint]) -> tuple[P
 
 
 def check_via_moves(cell: Cell, plan: Plan, checks: Sequence[PointCheck]) -> tuple[PointCheck, ...]:
-    """``checks`` (of all of ``plan``'s points, in plan order) with their via moves checked.
+    """``checks`` (of all of ``plan``'s points, in plan order) with the moves between points
+    checked.
 
-    For each point with vias: the moves through the vias to the point's safe start (when it has
-    one), joint space, in the open ``cell``, from the safe start (where the program leaves a point)
-    of every point an exported program probes just before it
-    (:func:`planner.export.job.probe_orders`: plan order, and the adaptive RAPID program's A-H order
-    with the C and D retakes); the first point of a program has no previous pose and its first leg
-    is not checked. A problem makes the point ``infeasible``, with ``via_reason`` (and ``reason``)
-    naming the previous point, the via and the pair.
+    For each point: the joint moves into it, from the safe start (where the program leaves a
+    point) of every point an exported program probes just before it
+    (:func:`planner.export.job.probe_orders`: plan order, and the adaptive RAPID program's A-H
+    order with the C and D retakes), through the point's vias if it has any, to its safe start;
+    in the open ``cell``. Every exporter moves between points this way (joint moves, fine
+    points). The first point of a program has no previous pose and its first leg is not
+    checked. A problem makes the point ``infeasible``, with ``via_reason`` (and ``reason``)
+    naming the previous point, the via and the pair; a point without vias is told to get one.
     """
     from planner.cell.moves import check_via_path
-    from planner.export.job import probe_orders
+    from planner.export.job import predecessors
 
-    if not any(p.via_points for p in plan.points):
-        return tuple(checks)
     ids = [p.id for p in plan.points]
-    before: dict[int, list[int | None]] = {}
-    for order in probe_orders(plan):
-        for k, i in enumerate(order):
-            prev = order[k - 1] if k else None
-            if prev not in before.setdefault(i, []):
-                before[i].append(prev)
+    before = predecessors(plan)
     out = list(checks)
+    tcp = plan.cell.tool.tcp
     for i, (p, c) in enumerate(zip(plan.points, checks, strict=True)):
         vias = p.via_points
-        if not vias:
-            continue
+        q_point = c.q_safe if c.pose_status != "infeasible" else None
         problem = ""
         for prev in before.get(i, [None]):
             q_prev = None
@@ -223,12 +218,19 @@ def check_via_moves(cell: Cell, plan: Plan, checks: Sequence[PointCheck]) -> tup
                 q_prev = checks[prev].q_safe
             name = "previous point" if prev is None else ids[prev]
             qs = [v.q_rad for v in vias]
-            q_point = c.q_safe if c.pose_status != "infeasible" else None
-            path = check_via_path(cell, q_prev, qs, q_point, plan.cell.tool.tcp, name)
+            path = check_via_path(cell, q_prev, qs, q_point, tcp, name, point_name=p.id)
             if path.problem:
                 problem = path.problem
                 break
-        why = f"vias: {problem}" if problem else ""
+        if not vias and not problem:
+            continue
+        why = ""
+        if problem:
+            why = (
+                f"vias: {problem}"
+                if vias
+                else f"{problem} (add via points: Teach tab, or `wobjcal check --add-vias`)"
+            )
         out[i] = replace(
             c,
             n_vias=len(vias),

@@ -114,7 +114,11 @@ class PointCheck:
             "confdata": list(self.confdata) if self.confdata else None,
             "ik_kind": self.ik_kind,
             "feasible": self.feasible,
-        } | ({"vias": {"count": self.n_vias, "reason": self.via_reason}} if self.n_vias else {})
+        } | (
+            {"vias": {"count": self.n_vias, "reason": self.via_reason}}
+            if self.n_vias or self.via_reason
+            else {}
+        )
 
 
 @dataclass(frozen=True)

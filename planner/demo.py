@@ -65,8 +65,15 @@ def stator_plan() -> Plan:
 
 
 def stator_plan_text() -> str:
-    """The canonical JSON of :func:`stator_plan`."""
-    return plan_to_json(stator_plan())
+    """The canonical JSON of :func:`stator_plan` with the via points its moves between points
+    need in the demo cell (:func:`planner.move_vias.plan_with_vias`; opens the cell)."""
+    from planner.move_vias import plan_with_vias
+    from planner.plan_cell import open_cell
+
+    plan = stator_plan()
+    with open_cell(plan, DEMO_PLAN.parent) as cell:
+        plan, _ = plan_with_vias(plan, DEMO_PLAN.parent, cell)
+    return plan_to_json(plan)
 
 
 def make_demo_cell(geom: StatorGeometry | None = None, **cell_kwargs: Any) -> Cell:

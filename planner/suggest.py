@@ -23,7 +23,9 @@ points of interest) and proposes the points:
    face; points that fit in no order are set aside and the design redone), growing the number of
    points until the predicted error at every point of interest holds ``target_m`` at the
    confidence, or ``max_points`` is reached (3-2-1: six points, every ordered triple of faces);
-4. the written plan's quality predicted exactly (:func:`planner.check.plan_quality`: the
+4. via points where a joint move between two of the points would collide
+   (:func:`planner.move_vias.plan_with_vias`: retract, or turn the shoulder or elbow);
+5. the written plan's quality predicted exactly (:func:`planner.check.plan_quality`: the
    procedure linearised), which is what the result reports.
 
 ``add=N`` keeps the plan's points and adds the ``N`` best (best fit only).
@@ -52,6 +54,7 @@ from planner.faces.candidates import Candidates, FaceTried, face_candidates
 from planner.faces.detection import find_planar_faces
 from planner.faces.edges import edge_candidates
 from planner.faces.outline import FaceOutlines
+from planner.move_vias import plan_with_vias
 from planner.plan_cell import open_cell
 from planner.sim.report_points import poi_rows
 from planner.sim.rows import RowSpec, z_values
@@ -297,6 +300,8 @@ def suggest_plan(
             "first points): " + faces_text(tried, pool, ctx)
         )
     new_plan = suggested_plan(plan, ctx, design, procedure, add, at_m)
+    say("moves between points", 0, 1)
+    new_plan, via_notes = plan_with_vias(new_plan, plan_dir or Path.cwd(), cell)
     say("prediction", 0, 1)
     quality, note = plan_quality(new_plan, mesh)
     worst = quality.worst_poi_m(level) if quality is not None else math.nan
@@ -316,6 +321,9 @@ def suggest_plan(
         )
     if note:
         msg += f" ({note})"
+    stuck = [f"{pid}: {what}" for pid, what in via_notes.items() if "added" not in what]
+    if stuck:
+        msg += "; moves between points not cleared: " + "; ".join(stuck)
     return SuggestResult(
         plan=new_plan,
         quality=quality,

@@ -9,7 +9,8 @@ handlers, ``RETURN``/``RAISE``/``EXIT``/``Stop`` and the functions ``PoseVect``,
 ``PoseMult``, ``CrossProd``, ``DotProd``, ``VectMagn``, ``NOrient``, ``OrientZYX``, ``ATan2``,
 ``Sqrt``, ``Sin``, ``Cos``, ``Tan``, ``Abs``, ``NumToStr`` (angles in degrees, as RAPID).
 
-Motion: ``MoveJ``/``MoveL`` put the sensor TCP at the target; ``SearchL`` asks a callback
+Motion: ``MoveJ``/``MoveL`` put the sensor TCP at the target (``MoveAbsJ``, a via, is recorded
+and leaves it: no FK here); ``SearchL`` asks a callback
 ``search(start_m, end_m, sensor_axis, neg_flank) -> (3,) hit or "ERR_..."`` (base frame,
 metres) and stores the hit in the result robtarget in the work object, as the controller does.
 The world frame is the robot base. One statement per line, as the generator writes.
@@ -639,6 +640,9 @@ class Machine:
             T = self._target_m(self.eval(pos[0], scopes), self.eval(sw["WObj"], scopes))
             self.motions.append(Motion(name, self.tcp_m, T[:3, 3]))
             self.tcp_m = T[:3, 3]
+        elif name == "MoveAbsJ":  # a via: joint values (no FK here); the TCP is unknown until
+            self.eval(pos[0], scopes)  # the next Cartesian move, which every via precedes
+            self.motions.append(Motion(name, self.tcp_m, self.tcp_m))
         elif name == "SearchL":
             self._searchl(pos, sw, scopes)
         elif name in ("ConfJ", "ConfL"):

@@ -6,7 +6,7 @@ from __future__ import annotations
 import itertools
 import re
 import warnings
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -52,6 +52,13 @@ POS = re.compile(
     rf"\tX = ({NUM})  mm,\tY = ({NUM})  mm,\tZ = ({NUM})  mm,\n"
     rf"\tW = ({NUM}) deg,\tP = ({NUM}) deg,\tR = ({NUM}) deg\n}};"
 )
+#: A via: joint representation (``J1= ... deg``), no configuration.
+JPOS = re.compile(
+    r'P\[(\d+):"([A-Za-z0-9_ ]{0,16})"\]\{\n   GP1:\n'
+    r"\tUF : (\d+), UT : (\d+),\n"
+    rf"\tJ1= ({NUM}) deg,\tJ2= ({NUM}) deg,\tJ3= ({NUM}) deg,\n"
+    rf"\tJ4= ({NUM}) deg,\tJ5= ({NUM}) deg,\tJ6= ({NUM}) deg\n}};"
+)
 
 
 # ------------------------------------------------------------------ parsing the .ls back
@@ -94,6 +101,17 @@ class Program:
     attr: str
     lines: list[str]  # /MN instructions without line number and " ;"
     positions: dict[int, Position]
+    joints: dict[int, Position] = field(default_factory=dict)  # vias: J1..J6, deg
+
+
+def _no_vias(plan: Plan) -> Plan:
+    """The plan without via points: the program's structure checked here is each point's own
+    moves (the vias' joint moves before them: tests/test_vias.py)."""
+    import msgspec
+
+    return msgspec.structs.replace(
+        plan, points=[msgspec.structs.replace(p, vias=msgspec.UNSET) for p in plan.points]
+    )
 
 
 def parse_ls(text: str) -> Program:
@@ -116,10 +134,16 @@ def parse_ls(text: str) -> Program:
         assert n not in positions
         vals = np.array([float(pm.group(k)) for k in range(6, 12)])
         positions[n] = Position(pm.group(2), int(pm.group(3)), int(pm.group(4)), pm.group(5), vals)
-    assert not POS.sub("", pos).strip(), "text in /POS that is no position"
+    joints = {}
+    for jm in JPOS.finditer(pos):
+        n = int(jm.group(1))
+        assert n not in positions and n not in joints
+        vals = np.array([float(jm.group(k)) for k in range(5, 11)])
+        joints[n] = Position(jm.group(2), int(jm.group(3)), int(jm.group(4)), "", vals)
+    assert not JPOS.sub("", POS.sub("", pos)).strip(), "text in /POS that is no position"
     lc = re.search(r"^LINE_COUNT\t= (\d+);$", attr, re.M)
     assert lc and int(lc.group(1)) == len(lines)
-    return Program(m.group(1), attr, lines, positions)
+    return Program(m.group(1), attr, lines, positions, joints)
 
 
 def frame_constants(lines: list[str], pr: int) -> np.ndarray:
@@ -375,7 +399,7 @@ def test_wpr_convention_round_trips_with_scipy(rng: np.random.Generator) -> None
 
 @pytest.mark.parametrize("path", [VALID, STATOR], ids=["three_two_one", "stator_ah"])
 def test_poses_and_frames_parse_back(path: Path, rng: np.random.Generator) -> None:
-    plan = load_plan(path)
+    plan = _no_vias(load_plan(path))
     job = random_job(plan, rng)
     prog = parse_ls(ls_of(job))
     # frames: UFRAME[9] = PR[1] = T_base_wobj, UTOOL[9] = PR[2] = the sensor TCP
@@ -445,7 +469,7 @@ def test_program_run_against_a_misplaced_part(path: Path, seed: int) -> None:
     starts within the sensing distance of it, the edge searches start on its face, every
     approach point is found on the true part (the test plan's 20 mm edge search may end before
     the moved edge, code 1)."""
-    plan = load_plan(path)
+    plan = _no_vias(load_plan(path))
     rng = np.random.default_rng(seed)
     T_nom = make_transform(matrix_from_rotvec([0.0, 0.2, 0.1]), [1.4, -0.3, 0.8])
     T_true = T_nom @ full_misplacement(plan, rng)
@@ -480,7 +504,7 @@ def test_program_run_against_a_misplaced_part(path: Path, seed: int) -> None:
 @pytest.mark.parametrize("path", [VALID, STATOR], ids=["three_two_one", "stator_ah"])
 def test_nominal_part_gives_the_plan_points(path: Path, rng: np.random.Generator) -> None:
     """On the part at its nominal pose every PR[10 + i] is the plan's point i (user frame)."""
-    plan = load_plan(path)
+    plan = _no_vias(load_plan(path))
     job = random_job(plan, rng)
     tp = TPRun(ls_of(job), job.T_base_wobj).run()
     for p in plan.points:
@@ -509,7 +533,7 @@ def test_failure_codes() -> None:
 
 
 def test_structure_labels_registers_and_name() -> None:
-    plan = load_plan(STATOR)
+    plan = _no_vias(load_plan(STATOR))
     job = build_job(plan, np.eye(4), ToolData(T_flange_tcp=np.eye(4)))
     prog = parse_ls(ls_of(job))
     assert prog.name == "WOBJCALSTATORSECTIONAH" == F.program_name(job.name)
@@ -598,7 +622,10 @@ def test_cli_export_and_help(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     job, _ = export_job_for(plan, STATOR.parent, None)  # frames, tool, positions
     assert_pose(pose_matrix(frame_constants(prog.lines, F.PR_UFRAME)), job.T_base_wobj, "uf")
     assert_pose(pose_matrix(frame_constants(prog.lines, F.PR_UTOOL)), job.tool.T_flange_tcp, "ut")
-    for b, t in zip(point_blocks(prog.lines), job.targets, strict=True):
+    vias = sum(len(p.via_points) for p in plan.points)
+    assert vias and len(prog.joints) == vias  # the shipped plan's vias, as joint positions
+    blocks = [b for b in point_blocks(prog.lines) if b["safe"] in prog.positions]  # not vias
+    for b, t in zip(blocks, job.targets, strict=True):
         got = prog.positions[b["safe"]].values[:3] / 1000.0
         assert np.abs(got - t.safe_start[:3, 3]).max() < 1e-8  # orientations come from check
 
@@ -666,7 +693,7 @@ def test_fanuc_config_comes_from_the_checked_pose(tmp_path: Path) -> None:
     from planner.check import check_plan
     from planner.export_plan import export_program
 
-    plan = load_plan(STATOR)
+    plan = _no_vias(load_plan(STATOR))
     result = export_program(plan, STATOR.parent, "fanuc")
     check = check_plan(plan, STATOR.parent)
     prog = parse_ls(result.files[".ls"])
@@ -685,7 +712,7 @@ def test_fanuc_refuses_a_configuration_it_cannot_derive(
 ) -> None:
     """Before: 'N U T, 0, 0, 0' on every position whatever the pose. Without a checked pose
     there is nothing to derive it from: refused, naming the point."""
-    plan = load_plan(STATOR)
+    plan = _no_vias(load_plan(STATOR))
     job = build_job(plan, np.eye(4), ToolData(T_flange_tcp=np.eye(4)))
     with pytest.raises(InputError, match=r"FANUC export: point A: no checked robot pose"):
         export_files(job, "fanuc")

@@ -39,6 +39,7 @@ ADDED = {
     "clearance_pair",
     "layout_status",  # issue 13: the layout quality
     "quality",
+    "vias",  # the moves between points (the shipped plan got vias for its colliding moves)
 }
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")

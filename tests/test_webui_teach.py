@@ -11,6 +11,8 @@ import pytest
 
 from calib.errors import InputError
 from calib.frames import transform_points
+from calib.plan.file import load_plan
+from planner.demo import DEMO_PLAN
 from webui.app import WobjcalApp
 from webui.teach_panel import NEW_POINT
 
@@ -142,7 +144,10 @@ def test_teach_as_via_point_adds_one_undoable_autosaved_via(demo_app: WobjcalApp
     saved = json.loads(demo_app.state._autosave_path.read_text())
     b = next(p for p in saved["points"] if p["id"] == "B")
     np.testing.assert_allclose(b["vias"][0]["q_rad"], lifted, atol=1e-12)
-    assert all("vias" not in p for p in saved["points"] if p["id"] != "B")
+    shipped = {p.id: [list(v.q_rad) for v in p.via_points] for p in load_plan(DEMO_PLAN).points}
+    for p in saved["points"]:  # the others keep the vias they had (the shipped plan's)
+        if p["id"] != "B":
+            assert [v["q_rad"] for v in p.get("vias", [])] == shipped[p["id"]], p["id"]
     # drawn: a marker at the via's TCP and the path to B
     marker = demo_app.server.scene.get_handle_by_name("/vias/B/v1")
     assert marker is not None
@@ -156,7 +161,8 @@ def test_teach_as_via_point_adds_one_undoable_autosaved_via(demo_app: WobjcalApp
         panel.show_moves.value = False
     state.undo()
     assert state.doc.get("B").vias == ()
-    assert demo_app.server.scene.get_handle_by_name("/vias") is None
+    assert demo_app.server.scene.get_handle_by_name("/vias/B/v1") is None
+    assert demo_app.server.scene.get_handle_by_name("/vias/C/v1") is not None  # shipped vias
 
 
 def test_remove_last_via_keeps_the_others(demo_app: WobjcalApp) -> None:

@@ -8,7 +8,9 @@ part, the points and the report's points stay where they are in the world:
 - ``T_world_wobj_new = T_world_wobj_old @ T_old_new``;
 - ``T_wobj_mesh_new = inv(T_old_new) @ T_wobj_mesh_old`` (the mesh file is unchanged);
 - points (position, normal, edge direction, edge normal), points of interest and the report's
-  face points: ``p_new = inv(T_old_new) @ p_old``.
+  face points: ``p_new = inv(T_old_new) @ p_old``;
+- via points keep their joint values (the robot moves as before); their informative TCP pose
+  is re-expressed.
 
 The misplacement bound (a ball and an angle) and the procedure's settings do not depend on
 the frame's orientation and are kept.
@@ -24,6 +26,7 @@ from calib.frames import check_transform, invert_transform, transform_points
 from calib.plan.cell import Pose
 from calib.plan.file import Plan, PlanPoint
 from calib.plan.report_spec import ReportSpec
+from calib.plan.vias import ViaPoint
 from calib.user_frame import probe_point_in
 
 __all__ = ["plan_in_frame"]
@@ -51,6 +54,14 @@ def _report_in(T_new_old: np.ndarray, report: ReportSpec) -> ReportSpec:
     return replace(report, points_of_interest=pois, regions=regions)
 
 
+def _via_in(T_new_old: np.ndarray, via: ViaPoint) -> ViaPoint:
+    """A via in the new frame: the same joint values (the part has not moved, so neither does
+    the robot); its informative TCP pose re-expressed."""
+    if via.tcp_wobj is None:
+        return via
+    return replace(via, tcp_wobj=Pose.from_matrix(T_new_old @ via.tcp_wobj.matrix()))
+
+
 def plan_in_frame(plan: Plan, T_old_new: ArrayLike) -> Plan:
     """``plan`` with its work-object frame replaced by ``T_old_new`` (the new frame in the old
     one, 4x4, metres); see the module docstring.
@@ -68,7 +79,10 @@ def plan_in_frame(plan: Plan, T_old_new: ArrayLike) -> Plan:
     )
     points = [
         PlanPoint.from_probe_point(
-            probe_point_in(T_new_old, p.to_probe_point()), p.role, p.search.speed_m_s
+            probe_point_in(T_new_old, p.to_probe_point()),
+            p.role,
+            p.search.speed_m_s,
+            tuple(_via_in(T_new_old, v) for v in p.via_points),
         )
         for p in plan.points
     ]

@@ -123,6 +123,7 @@ def check_via_path(
     q_point: ArrayLike | None,
     tcp: str,
     prev_name: str = "previous point",
+    point_name: str = "point",
 ) -> ViaPath:
     """Check the moves from ``q_prev`` through ``vias_q`` to ``q_point`` (rad).
 
@@ -136,6 +137,7 @@ def check_via_path(
             ``None`` (no pose found): the path ends at the last via.
         tcp: the probing TCP (for the drawn path).
         prev_name: what the messages call the previous pose (e.g. the point's id).
+        point_name: what they call this point's pose.
     """
     chain = cell.chain
     sliding = [
@@ -154,7 +156,7 @@ def check_via_path(
     if q_prev is not None:
         stops.insert(0, (prev_name, np.asarray(q_prev, dtype=np.float64)))
     if q_point is not None:
-        stops.append(("point", np.asarray(q_point, dtype=np.float64)))
+        stops.append((point_name, np.asarray(q_point, dtype=np.float64)))
     legs = []
     for (na, qa), (nb, qb) in itertools.pairwise(stops):
         move = check_joint_move(cell, qa, qb, tcp)

@@ -9,6 +9,7 @@ import argparse
 import math
 import sys
 from collections.abc import Callable
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rich.table import Table
@@ -16,6 +17,7 @@ from rich.table import Table
 from planner.cli.common import print_json, read_plan, stdout
 
 if TYPE_CHECKING:
+    from calib.plan.file import Plan
     from planner.check import PlanCheck, PointCheck
     from planner.sim.quality import LayoutQuality
 
@@ -42,11 +44,40 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "1 any point or path infeasible or the layout refused (each named with the reason),\n"
         "2 bad input",
         "wobjcal check assets/plans/stator_section_ah.json\n"
-        "wobjcal check plan.json --json > check.json",
+        "wobjcal check plan.json --json > check.json\n"
+        "wobjcal check plan.json --add-vias plan_vias.json",
     )
     p.add_argument("plan", metavar="PLAN", help="plan file (wobjcal.plan/1)")
     p.add_argument("--json", action="store_true", help="print the results as JSON")
+    p.add_argument(
+        "--add-vias",
+        metavar="OUT",
+        help="where a joint move between points collides and the point has no vias, search via "
+        "points that clear it (retract along the sensor axis, or turn the shoulder or elbow), "
+        "write the plan with them to OUT (atomically) and check that plan",
+    )
     p.set_defaults(handler=cmd_check)
+
+
+def _with_vias(plan: Plan, plan_dir: Path, target: Path) -> tuple[Plan, Path, str]:
+    """The plan with vias added (:func:`planner.move_vias.plan_with_vias`), written to
+    ``target``; what was done is printed on stderr."""
+    from calib.plan.file import save_plan
+    from planner.move_vias import plan_with_vias
+    from planner.plan_cell import open_cell
+    from planner.suggest import moved_plan
+
+    with open_cell(plan, plan_dir) as cell:
+        new, done = plan_with_vias(plan, plan_dir, cell)
+    for pid, what in done.items():
+        print(f"wobjcal check: point {pid}: {what}", file=sys.stderr)
+    if not done:
+        print("wobjcal check: no move between points collides: nothing to add", file=sys.stderr)
+    out_dir = target.resolve().parent
+    written = new if out_dir == plan_dir.resolve() else moved_plan(new, plan_dir, out_dir)
+    save_plan(written, target)
+    print(f"wobjcal check: wrote {target}; checking it", file=sys.stderr)
+    return written, out_dir, str(target)
 
 
 def _clearance_text(p: PointCheck) -> str:
@@ -110,6 +141,9 @@ def cmd_check(args: argparse.Namespace) -> int:
     from planner.check import check_plan  # PyBullet: not for ``wobjcal --help``
 
     plan, plan_dir = read_plan(args.plan)
+    if args.add_vias:
+        plan, plan_dir, shown = _with_vias(plan, plan_dir, Path(args.add_vias))
+        args.plan = shown
     check = check_plan(plan, plan_dir)
     if check.error:
         print(f"wobjcal check: {check.error}", file=sys.stderr)

@@ -317,6 +317,18 @@ def adaptive_spec(plan: Plan) -> AdaptiveSpec | None:
 ADAPTIVE_ORDER = ("A", "B", "C", "D", "E", "F", "G", "H")
 
 
+def predecessors(plan: Plan) -> dict[int, list[int | None]]:
+    """``{point index: [the index of each point a program probes just before it]}`` over
+    :func:`probe_orders` (``None``: the point starts a program)."""
+    before: dict[int, list[int | None]] = {}
+    for order in probe_orders(plan):
+        for k, i in enumerate(order):
+            prev = order[k - 1] if k else None
+            if prev not in before.setdefault(i, []):
+                before[i].append(prev)
+    return before
+
+
 def probe_orders(plan: Plan) -> list[list[int]]:
     """Every order (point indices, plan order numbering) in which an exported program probes the
     plan's points: plan order (every format), and for an adaptive A-H plan the RAPID program's

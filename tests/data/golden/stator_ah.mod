@@ -46,11 +46,14 @@ MODULE WobjcalStatorSectionAh
     CONST robtarget pC_end:=[[-30,-60,-153.75],[0.560985527,0.560985527,-0.430459335,0.430459335],[-1,0,0,0],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
     CONST robtarget pC_safe:=[[-30,50,-153.75],[0.560985527,0.560985527,-0.430459335,0.430459335],[-1,0,0,0],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
     CONST speeddata vSearch_pC:=[10,30,5000,1000];
+    CONST jointtarget pC_via1:=[[-28.2909,-23.0846,55.4153,-50.1995,-36.5751,6.0153],[9E9,9E9,9E9,9E9,9E9,9E9]];
+    CONST jointtarget pC_via2:=[[-41.1167,37.5765,-1.8266,57.9849,117.3139,36.2752],[9E9,9E9,9E9,9E9,9E9,9E9]];
     ! D (approach search, role D, 110 mm at 10 mm/s)
     CONST robtarget pD_start:=[[50,-100,-32.5],[0.27059805,-0.653281482,-0.27059805,0.653281482],[-1,-1,-1,1],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
     CONST robtarget pD_end:=[[-60,-100,-32.5],[0.27059805,-0.653281482,-0.27059805,0.653281482],[-1,-1,-1,1],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
     CONST robtarget pD_safe:=[[50,-100,-32.5],[0.27059805,-0.653281482,-0.27059805,0.653281482],[-1,-1,-1,1],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
     CONST speeddata vSearch_pD:=[10,30,5000,1000];
+    CONST jointtarget pD_via1:=[[-41.1167,37.5765,-1.8266,57.9849,117.3139,36.2752],[9E9,9E9,9E9,9E9,9E9,9E9]];
     ! E (approach search, role E, 110 mm at 10 mm/s)
     CONST robtarget pE_start:=[[50,-100,-92.5],[0.27059805,-0.653281482,-0.27059805,0.653281482],[-1,-1,-1,1],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
     CONST robtarget pE_end:=[[-60,-100,-92.5],[0.27059805,-0.653281482,-0.27059805,0.653281482],[-1,-1,-1,1],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
@@ -328,6 +331,8 @@ MODULE WobjcalStatorSectionAh
     ENDPROC
 
     PROC Probe_pC(num i)
+        MoveAbsJ pC_via1,vApproach,fine,tSensor;
+        MoveAbsJ pC_via2,vApproach,fine,tSensor;
         MoveJ pC_safe,vApproach,fine,tSensor\WObj:=wobjCal;
         SearchL\SStop,diSensor,pMeas,pC_end,vSearch_pC,tSensor\WObj:=wobjCal;
         measured{i}:=PoseVect(wobjCal.uframe,PoseVect(wobjCal.oframe,pMeas.trans));
@@ -350,6 +355,7 @@ MODULE WobjcalStatorSectionAh
     ENDPROC
 
     PROC Probe_pD(num i)
+        MoveAbsJ pD_via1,vApproach,fine,tSensor;
         MoveJ pD_safe,vApproach,fine,tSensor\WObj:=wobjCal;
         SearchL\SStop,diSensor,pMeas,pD_end,vSearch_pD,tSensor\WObj:=wobjCal;
         measured{i}:=PoseVect(wobjCal.uframe,PoseVect(wobjCal.oframe,pMeas.trans));

@@ -126,7 +126,17 @@ def plate_plans() -> dict[str, Plan]:
         procedure=BestFit(),
         **common,
     )
-    return {"plate_holes_321.json": p321, "plate_holes_best_fit.json": best}
+    return {"plate_holes_321.json": _with_vias(p321), "plate_holes_best_fit.json": _with_vias(best)}
+
+
+def _with_vias(plan: Plan) -> Plan:
+    """The plan with the via points its moves between points need in its cell
+    (:func:`planner.move_vias.plan_with_vias`)."""
+    from planner.move_vias import plan_with_vias
+    from planner.plan_cell import open_cell
+
+    with open_cell(plan, PLANS) as cell:
+        return plan_with_vias(plan, PLANS, cell)[0]
 
 
 def main() -> None:
