@@ -50,3 +50,25 @@ def test_bad_edits_name_the_problem() -> None:
         )
     with pytest.raises(InputError, match="start_offset_m"):
         edit_search(plan, "A", kind="approach", start_offset_m=-1, overtravel_m=0.01)
+
+
+def test_the_plan_as_edited_carries_every_edited_point_or_is_none() -> None:
+    """The UI checks one edited point against the plan as edited now (the safe starts' pivot
+    is the centroid of all the points); edits that make no plan fall back to ``None``."""
+    from dataclasses import replace as dc_replace
+
+    from calib.plan.file import load_plan
+    from planner.demo import DEMO_PLAN
+    from webui.plan_adapter import plan_as_edited, ui_plan_from_plan
+
+    ui = ui_plan_from_plan(load_plan(DEMO_PLAN))
+    moved = dc_replace(
+        ui.points[0], probe=dc_replace(ui.points[0].probe, position_m=(0.01, -0.6, 0.05))
+    )
+    edited = dc_replace(ui, points=(moved, *ui.points[1:]))
+    plan = plan_as_edited(edited)
+    assert plan is not None and plan.points[0].position_m == (0.01, -0.6, 0.05)
+    assert plan.points[2].via_points == load_plan(DEMO_PLAN).points[2].via_points  # vias kept
+    twice = dc_replace(ui, points=(*ui.points, ui.points[0]))  # a duplicate id: no plan
+    assert plan_as_edited(twice) is None
+    assert plan_as_edited(dc_replace(ui, source=None)) is None

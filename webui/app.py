@@ -26,7 +26,7 @@ from webui.autosave import AutosaveLock
 from webui.backend import CellSession, CellView
 from webui.busy import BusyIndicator
 from webui.heatmap import HeatMap
-from webui.plan_adapter import autosave_bytes, plan_point, with_source
+from webui.plan_adapter import autosave_bytes, plan_as_edited, plan_point, with_source
 from webui.plan_doc import UiPlan
 from webui.role_check import RoleFlags, role_flags
 from webui.scene import PlanScene
@@ -180,8 +180,11 @@ class WobjcalApp:
         if not points:
             return []
         edited = [plan_point(p) for p in points]
+        as_edited = plan_as_edited(doc)
         with self.busy(f"checking {', '.join(p.id for p in points[:6])}"):
-            results = self.worker.call(lambda s: [] if s is None else s.check_points(edited))
+            results = self.worker.call(
+                lambda s: [] if s is None else s.check_points(edited, as_edited)
+            )
         current = self.state.doc
         with self._lock:
             for point, check in zip(points, results, strict=False):

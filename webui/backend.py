@@ -159,13 +159,14 @@ class CellSession:
             out[f.name] = (mesh, f.T_world_fixture.matrix())
         return out
 
-    def check_points(self, points: list[PlanPoint]) -> list[PointCheck]:
+    def check_points(self, points: list[PlanPoint], plan: Plan | None = None) -> list[PointCheck]:
         """Check the probe poses, search paths and planar faces of ``points`` (the session
         plan's, possibly edited) in the cell: :func:`planner.check.check_points`, the check
-        ``wobjcal check`` runs."""
+        ``wobjcal check`` runs. ``plan``: the plan as edited now (its points set the safe
+        starts' pivot; default the session's)."""
         if not points or self.cell is None:
             return []
-        return list(check_points(self.cell, self.plan, points))
+        return list(check_points(self.cell, plan or self.plan, points))
 
     # ---- jogging ---------------------------------------------------------------------------
     def T_world_tcp(self, q: ArrayLike, tcp: str) -> NDArray[np.float64]:

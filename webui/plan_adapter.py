@@ -15,6 +15,7 @@ from typing import Any
 
 import msgspec
 
+from calib.errors import WobjcalError
 from calib.plan.file import Plan, PlanError, PlanPoint, load_plan, plan_from_json, plan_to_json
 from calib.plan.json_io import canonical_json
 from calib.procedures import PROCEDURES, RolePoint, method_of, procedure_kind
@@ -81,6 +82,18 @@ def plan_from_ui(ui: UiPlan) -> Plan:
     if refusal:
         raise PlanError(refusal)
     return msgspec.structs.replace(ui.source, points=_plan_points(ui))
+
+
+def plan_as_edited(ui: UiPlan) -> Plan | None:
+    """The loaded plan with the points as edited now, without the procedure's role rules (the
+    check of one edited point needs all of them: their centroid is the pivot of the safe
+    starts), or ``None`` when they do not make a plan (the session's plan is used then)."""
+    if not isinstance(ui.source, Plan):
+        return None
+    try:
+        return msgspec.structs.replace(ui.source, points=_plan_points(ui))
+    except (WobjcalError, ValueError, TypeError):  # e.g. an edit that breaks a plan rule
+        return None
 
 
 def plan_json_from_ui(ui: UiPlan) -> str:

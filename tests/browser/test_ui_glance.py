@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from ui_helpers import (
     UiSession,
+    act_until,
     canvas_point,
     choose,
     open_tab,
@@ -114,8 +115,11 @@ def test_a_click_on_empty_space_says_why(demo: UiSession) -> None:
     demo.page.get_by_role("button", name="Top", exact=True).click()  # look down: sky is floor
     demo.page.get_by_role("button", name="Front", exact=True).click()
     wait_for(lambda: _camera_direction(demo)[1] > 0.9, what="the front view")
-    demo.page.mouse.click(box["x"] + 15, box["y"] + 15)  # the sky above the cell
-    wait_for(lambda: "nothing placed" in demo.notifications(), what="the notification")
+    act_until(  # the sky above the cell: clicking it again places nothing either
+        lambda: demo.page.mouse.click(box["x"] + 15, box["y"] + 15),
+        lambda: "nothing placed" in demo.notifications(),
+        what="the notification",
+    )
     assert demo.app.state.doc is before
 
 

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ui_helpers import UiSession, open_tab, save_screenshot, set_camera, wait_for
+from ui_helpers import UiSession, act_until, open_tab, save_screenshot, set_camera, wait_for
 
 from calib.frames import transform_points
 from webui.cell_edits import WORK_OBJECT, pose_of
@@ -55,7 +55,6 @@ def test_snap_button_rests_the_part_on_the_table(demo: UiSession) -> None:
     app, page = demo.app, demo.page
     open_tab(page, "Cell")
     T0 = pose_of(app.state.doc.source, WORK_OBJECT)
-    page.get_by_role("button", name="Snap part onto fixture").click()
     mesh, T_table = app.view.fixtures["table"]
     top = transform_points(T_table, mesh.vertices)[:, 2].max()
 
@@ -63,7 +62,8 @@ def test_snap_button_rests_the_part_on_the_table(demo: UiSession) -> None:
         low = transform_points(app.view.T_world_wobj, app.view.wobj_mesh.vertices)[:, 2].min()
         return abs(low - top) < 1e-9
 
-    wait_for(resting, what="the part on the table")
+    snap = page.get_by_role("button", name="Snap part onto fixture")
+    act_until(snap.click, resting, what="the part on the table")  # snapping again: no change
     # the cell is rebuilt before the plan changes: undo only once the change is in the plan
     wait_for(lambda: not np.allclose(pose_of(app.state.doc.source, WORK_OBJECT), T0), what="plan")
     app.state.undo()
@@ -76,19 +76,21 @@ def test_jog_slider_and_teach_in_the_page(demo: UiSession, tmp_path: Path) -> No
     app.select("D")
     check = wait_for(lambda: app.check_of("D"), what="D's check")
     open_tab(page, "Teach")
-    page.get_by_role("button", name="Jog to selected point").click()
-    wait_for(lambda: np.allclose(panel.q, check.q), what="the robot at D's pose")
+    to_point = page.get_by_role("button", name="Jog to selected point")
+    act_until(to_point.click, lambda: np.allclose(panel.q, check.q), what="the robot at D's pose")
     j1 = _input_of(page, panel.sliders[0])
     want = round(float(np.degrees(check.q[0])) + 2.0, 1)  # the slider step: 0.1 deg
-    j1.fill(f"{want}")
-    j1.press("Tab")
-    wait_for(lambda: abs(np.degrees(panel.q[0]) - want) < 1e-3, what="J1 jogged on the server")
+
+    def jog_j1() -> None:
+        j1.fill(f"{want}")
+        j1.press("Tab")
+
+    act_until(jog_j1, lambda: abs(np.degrees(panel.q[0]) - want) < 1e-3, what="J1 jogged")
     np.testing.assert_allclose(app.robot.q, panel.q)
     wait_for(
         lambda: panel.last_status is not None and "**" in panel.status_md.content, what="status"
     )
-    page.get_by_role("button", name="Jog to selected point").click()
-    wait_for(lambda: np.allclose(panel.q, check.q), what="back at D")
+    act_until(to_point.click, lambda: np.allclose(panel.q, check.q), what="back at D")
     T = panel.T_world_tcp()
     T[:3, 3] -= 0.05 * T[:3, 2]  # 50 mm back along the sensor axis, through the IK
     assert panel.move_tcp(T) is not None

@@ -46,6 +46,29 @@ def wait_for(pred: Callable[[], Any], timeout: float = TIMEOUT_S, what: str = "c
     pytest.fail(f"timed out after {timeout} s waiting for {what}")
 
 
+def act_until(
+    act: Callable[[], Any],
+    pred: Callable[[], Any],
+    what: str,
+    timeout: float = TIMEOUT_S,
+    retry_s: float = 10.0,
+) -> Any:
+    """Do ``act`` (a click, a fill: idempotent) until ``pred`` holds: on a loaded machine a
+    click can land while the panel is re-rendered by a server update and be lost; it is done
+    again after ``retry_s`` without the effect, never in less. Fails after ``timeout`` s."""
+    deadline = time.monotonic() + timeout
+    while True:
+        act()
+        again = min(deadline, time.monotonic() + retry_s)
+        while time.monotonic() < again:
+            value = pred()
+            if value:
+                return value
+            time.sleep(0.05)
+        if time.monotonic() >= deadline:
+            pytest.fail(f"timed out after {timeout} s waiting for {what}")
+
+
 class UiSession:
     """A running UI server and one connected browser page."""
 
