@@ -12,7 +12,6 @@ Run: ``python bench/bench_ui_latency.py [--clicks 40] [--browser]``; writes
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 import platform
 import statistics
@@ -25,7 +24,7 @@ from typing import Any
 import numpy as np
 import trimesh
 
-from calib.atomic_io import write_text_atomic
+from bench.result_file import write_result
 from calib.frames import transform_points
 from webui.server import run
 from webui.testing import BOX_EXTENTS, T_WORLD_WOBJ_BOX, box_plan, free_port, project_to_screen
@@ -296,9 +295,7 @@ def main(argv: list[str] | None = None) -> int:
     rng = np.random.default_rng(7)
     if args.demo_browser:
         result = {"benchmark": "ui_latency_demo_browser"} | bench_demo_browser(args.clicks, rng)
-        out = RESULTS.with_name("ui_latency_demo_browser.json")
-        write_text_atomic(out, json.dumps(result, indent=2) + "\n")
-        logging.getLogger(__name__).warning("%s", json.dumps(result, indent=2))
+        write_result(RESULTS.with_name("ui_latency_demo_browser.json"), result)
         return 0
     with tempfile.TemporaryDirectory() as tmp:
         plan = box_plan(Path(tmp), n_triangles=args.triangles, name="bench_box")
@@ -332,9 +329,7 @@ def main(argv: list[str] | None = None) -> int:
             }
         finally:
             app.stop()
-    RESULTS.parent.mkdir(parents=True, exist_ok=True)
-    write_text_atomic(RESULTS, json.dumps(result, indent=2) + "\n")
-    logging.getLogger(__name__).warning("%s", json.dumps(result, indent=2))
+    write_result(RESULTS, result)
     return 0
 
 

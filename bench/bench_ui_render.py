@@ -17,7 +17,6 @@ Run: ``python bench/bench_ui_render.py [--clicks 8]``; writes
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 import statistics
 import tempfile
@@ -29,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from bench.bench_ui_latency import page_targets
-from calib.atomic_io import write_text_atomic
+from bench.result_file import write_result
 from webui.server import run
 from webui.testing import free_port
 
@@ -271,9 +270,7 @@ def main(argv: list[str] | None = None) -> int:
         for row in result["settings"].values():
             row["click_over_baseline"] = row["click_median_ms"] / click0
             row["frame_over_baseline"] = row["frame_ms"] / frame0
-    RESULTS.parent.mkdir(parents=True, exist_ok=True)
-    write_text_atomic(RESULTS, json.dumps(result, indent=2) + "\n")
-    logging.getLogger(__name__).warning("%s", json.dumps(result, indent=2))
+    write_result(RESULTS, result)
     return 0
 
 

@@ -82,50 +82,40 @@ def check_program_path(
         cmd = SearchCommand.from_point(point, T_base_wobj)
         res = cell.check_search(cmd, q_ref=pose.q, tcp=tcp)
         return ProgramPath(res.feasible, res.reason, res.fail_at_m, res.q_path, None)
-    walk = _Walk(cell, pose, T_flange_tcp, tcp)
-    path = walk.run(program_searches(point, T_base_wobj, safety))
+    sensor_x = (np.asarray(pose.T_base_flange) @ T_flange_tcp)[:3, 0]
+    path = _walk(cell, pose, sensor_x, tcp, program_searches(point, T_base_wobj, safety))
     if path.feasible and measured_start_wobj is not None:
-        other = walk.run(program_searches(point, T_base_wobj, safety, measured_start_wobj))
+        measured = program_searches(point, T_base_wobj, safety, measured_start_wobj)
+        other = _walk(cell, pose, sensor_x, tcp, measured)
         if not other.feasible:
             why = f"adaptive RAPID program (edge search from the measured point): {other.reason}"
             return ProgramPath(False, why, other.fail_at_m, path.q_path, path.q_safe)
     return path
 
 
-class _Walk:
-    """Walks searches with one probe pose's orientation and branch, in order."""
-
-    def __init__(
-        self, cell: Cell, pose: ProbeFeasibility, T_flange_tcp: FloatArray, tcp: str
-    ) -> None:
-        self.cell, self.pose, self.tcp = cell, pose, tcp
-        self.sensor_x = (np.asarray(pose.T_base_flange) @ T_flange_tcp)[:3, 0]
-
-    def run(self, searches: tuple[ProgramSearch, ...]) -> ProgramPath:
-        """The searches in order, each from where the previous one ended (nominally)."""
-        q_ref = np.asarray(self.pose.q, dtype=float)
-        parts: list[FloatArray] = []
-        for k, (name, cmd) in enumerate(searches):
-            res = self.cell.check_search(
-                cmd,
-                q_ref=q_ref,
-                tcp=self.tcp,
-                sensor_x=self.sensor_x,
-                branch=int(self.pose.branch),
-                max_starts=1,
-            )
-            parts.append(res.q_path)
-            if not res.feasible:
-                q_path = np.concatenate(parts)
-                q_safe = q_path[0].copy() if len(q_path) else None
-                why = f"{name} {res.reason}"
-                return ProgramPath(False, why, res.fail_at_m, q_path, q_safe)
-            if k < len(searches) - 1:  # an approach stops at its nominal point
-                at = float((cmd.nominal_m - cmd.start_m) @ cmd.direction)
-                parts[-1] = res.q_path[res.s_m <= at + 1e-9]
-            q_ref = parts[-1][-1] if len(parts[-1]) else res.q_path[-1]
-        q_path = np.concatenate(parts)
-        return ProgramPath(True, "", math.nan, q_path, q_path[0].copy())
+def _walk(
+    cell: Cell, pose: ProbeFeasibility, sensor_x: FloatArray, tcp: str,
+    searches: tuple[ProgramSearch, ...],
+) -> ProgramPath:  # fmt: skip
+    """Walk ``searches`` in order with ``pose``'s sensor x axis and branch, each from where
+    the previous one ended (nominally)."""
+    q_ref = np.asarray(pose.q, dtype=float)
+    parts: list[FloatArray] = []
+    for k, (name, cmd) in enumerate(searches):
+        res = cell.check_search(
+            cmd, q_ref=q_ref, tcp=tcp, sensor_x=sensor_x, branch=int(pose.branch), max_starts=1
+        )
+        parts.append(res.q_path)
+        if not res.feasible:
+            q_path = np.concatenate(parts)
+            q_safe = q_path[0].copy() if len(q_path) else None
+            return ProgramPath(False, f"{name} {res.reason}", res.fail_at_m, q_path, q_safe)
+        if k < len(searches) - 1:  # an approach stops at its nominal point
+            at = float((cmd.nominal_m - cmd.start_m) @ cmd.direction)
+            parts[-1] = res.q_path[res.s_m <= at + 1e-9]
+        q_ref = parts[-1][-1] if len(parts[-1]) else res.q_path[-1]
+    q_path = np.concatenate(parts)
+    return ProgramPath(True, "", math.nan, q_path, q_path[0].copy())
 
 
 def measured_starts_wobj(plan: Plan) -> dict[str, FloatArray]:

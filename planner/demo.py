@@ -72,7 +72,7 @@ def stator_plan_text() -> str:
 
     plan = stator_plan()
     with open_cell(plan, DEMO_PLAN.parent) as cell:
-        plan, _ = plan_with_vias(plan, DEMO_PLAN.parent, cell)
+        plan, _ = plan_with_vias(plan, cell)
     return plan_to_json(plan)
 
 

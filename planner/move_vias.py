@@ -1,55 +1,53 @@
 """Via points for a plan's colliding moves between points (``wobjcal check --add-vias``).
 
-:func:`plan_with_vias` checks the plan, and for every point whose move in collides
-(:func:`planner.check.check_via_moves`) and that has no vias yet, asks
-:func:`planner.cell.via_search.suggest_vias` for vias clearing the moves from every point a
+:func:`plan_with_vias` checks the plan's points and the moves between them, and for every
+point whose move in collides (:func:`planner.check.check_via_moves`) and that has no vias yet,
+asks :func:`planner.cell.via_search.suggest_vias` for vias clearing the moves from every point a
 program may come from (:func:`planner.export.job.predecessors`), and returns the plan with
 them. Vias the engineer taught are never replaced; a point the search cannot clear is named.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import msgspec
 
 from calib.plan.file import Plan, ViaPoint
 from planner.cell.via_search import suggest_vias
-from planner.check import check_plan
+from planner.check import check_points, check_via_moves
 from planner.export.job import predecessors
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
 
 
-def plan_with_vias(plan: Plan, plan_dir: Path, cell: Cell) -> tuple[Plan, dict[str, str]]:
+def plan_with_vias(plan: Plan, cell: Cell) -> tuple[Plan, dict[str, str]]:
     """``plan`` with vias added where a move into a point collides (module docstring).
 
     Args:
         plan: the plan.
-        plan_dir: folder its relative file references resolve against.
         cell: the plan's open cell.
 
     Returns:
         The plan (unchanged when nothing was added) and ``{point id: what was done}`` for every
         point whose move in collided.
     """
-    check = check_plan(plan, plan_dir, cell=cell)
+    checks = check_via_moves(cell, plan, check_points(cell, plan, plan.points))
     before = predecessors(plan)
     tcp = plan.cell.tool.tcp
     points = list(plan.points)
     done: dict[str, str] = {}
-    for i, (p, c) in enumerate(zip(plan.points, check.points, strict=True)):
+    for i, (p, c) in enumerate(zip(plan.points, checks, strict=True)):
         if not c.via_reason:
             continue
         if p.via_points:
             done[p.id] = "has taught vias: left as they are (edit them in the Teach tab)"
             continue
         froms = [
-            check.points[k].q_safe
+            checks[k].q_safe
             for k in before.get(i, [])
-            if k is not None and check.points[k].pose_status != "infeasible"
+            if k is not None and checks[k].pose_status != "infeasible"
         ]
         if c.q_safe is None or c.pose_status == "infeasible":
             done[p.id] = "no pose to move to: fix the point first"

@@ -301,7 +301,7 @@ def suggest_plan(
         )
     new_plan = suggested_plan(plan, ctx, design, procedure, add, at_m)
     say("moves between points", 0, 1)
-    new_plan, via_notes = plan_with_vias(new_plan, plan_dir or Path.cwd(), cell)
+    new_plan, via_notes = plan_with_vias(new_plan, cell)
     say("prediction", 0, 1)
     quality, note = plan_quality(new_plan, mesh)
     worst = quality.worst_poi_m(level) if quality is not None else math.nan

@@ -70,7 +70,7 @@ def test_add_vias_writes_a_plan_that_passes_and_keeps_taught_vias(
     cell,  # type: ignore[no-untyped-def]
     tmp_path: Path,
 ) -> None:
-    new, done = plan_with_vias(bare, PLANS, cell)
+    new, done = plan_with_vias(bare, cell)
     assert set(done) == {"C", "D"} and all("added" in v for v in done.values())
     assert check_plan(new, PLANS, cell=cell).feasible
     assert all(not p.via_points for p in new.points if p.id not in done)
@@ -78,7 +78,7 @@ def test_add_vias_writes_a_plan_that_passes_and_keeps_taught_vias(
     q = np.asarray(check_plan(bare, PLANS, cell=cell).points[3].q_safe)
     taught = list(bare.points)
     taught[3] = taught[3].with_vias([ViaPoint(q_rad=[float(v) for v in q])])
-    again, said = plan_with_vias(msgspec.structs.replace(bare, points=taught), PLANS, cell)
+    again, said = plan_with_vias(msgspec.structs.replace(bare, points=taught), cell)
     assert again.points[3].via_points == taught[3].via_points
     assert said["D"].startswith("has taught vias")  # the move C -> D still collides
     # the command line: writes the plan (relative references kept) and checks it

@@ -68,7 +68,7 @@ def _with_vias(plan: Plan, plan_dir: Path, target: Path) -> tuple[Plan, Path, st
     from planner.suggest import moved_plan
 
     with open_cell(plan, plan_dir) as cell:
-        new, done = plan_with_vias(plan, plan_dir, cell)
+        new, done = plan_with_vias(plan, cell)
     for pid, what in done.items():
         print(f"wobjcal check: point {pid}: {what}", file=sys.stderr)
     if not done:

@@ -136,7 +136,7 @@ def _with_vias(plan: Plan) -> Plan:
     from planner.plan_cell import open_cell
 
     with open_cell(plan, PLANS) as cell:
-        return plan_with_vias(plan, PLANS, cell)[0]
+        return plan_with_vias(plan, cell)[0]
 
 
 def main() -> None:
