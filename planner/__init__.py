@@ -5,6 +5,8 @@ Subpackages, from the bottom up (each imports only the ones before it; a test ch
     - :mod:`planner.parts`: built-in work objects (the stator);
     - :mod:`planner.faces`: planar faces and sensor footprints;
     - :mod:`planner.cell`: the PyBullet cell, feasibility of probe poses and search paths;
+    - :mod:`planner.program`: the measuring program a controller runs for a plan (its steps,
+      safe starts and searches, and its execution against a probe), which every job judges;
     - :mod:`planner.sim`: sensors against the mesh, error models in use, the Monte Carlo;
     - :mod:`planner.export`: robot programs (RAPID, KRL, URScript, FANUC TP);
     - :mod:`planner.cli`: the ``wobjcal`` command.

@@ -53,8 +53,8 @@ from calib.tolerances import FACE_MAX_DEVIATION_M
 from planner.check_paths import ProgramPath, check_program_path, measured_starts_wobj
 from planner.check_results import ConfData, PlanCheck, PointCheck, Status
 from planner.dry_run import nominal_part_probe
-from planner.export.job import safety_spec
 from planner.plan_cell import nominal_T_base_wobj, open_cell
+from planner.program.build import safety_spec
 
 if TYPE_CHECKING:
     import trimesh
@@ -107,10 +107,13 @@ def check_plan(plan: Plan, plan_dir: Path | None = None, *, cell: Cell | None = 
     )
 
 
-def plan_quality(plan: Plan, mesh: trimesh.Trimesh) -> tuple[LayoutQuality | None, str]:
+def plan_quality(
+    plan: Plan, mesh: trimesh.Trimesh, fmt: str | None = None
+) -> tuple[LayoutQuality | None, str]:
     """The predicted quality of ``plan``'s layout (:mod:`planner.sim.quality`), or why none.
 
-    The plan's procedure linearised with its noise figures, its points of interest on the
+    The measuring program of the controller ``fmt`` (``None``: the default) linearised with the
+    plan's noise figures (the program validate executes), its points of interest on the
     work object ``mesh`` (wobj, metres; the default point is the farthest surface point).
     The check and the UI's live panel call this.
 
@@ -133,8 +136,8 @@ def plan_quality(plan: Plan, mesh: trimesh.Trimesh) -> tuple[LayoutQuality | Non
         models = check_simulatable(plan)
     except InputError as exc:  # PlanError included
         return None, str(exc)
-    setup = prediction_setup(plan, models)
     try:
+        setup = prediction_setup(plan, models, fmt)
         return layout_quality(setup, poi_rows(plan.validation.report, mesh)), ""
     except (InputError, ProbeFailedError) as exc:
         return None, f"{plan.method}: {exc}"
@@ -194,7 +197,7 @@ def check_via_moves(cell: Cell, plan: Plan, checks: Sequence[PointCheck]) -> tup
 
     For each point: the joint moves into it, from the safe start (where the program leaves a
     point) of every point an exported program probes just before it
-    (:func:`planner.export.job.probe_orders`: plan order, and the adaptive RAPID program's A-H
+    (:func:`planner.program.build.probe_orders`: plan order, and the adaptive RAPID program's A-H
     order with the C and D retakes), through the point's vias if it has any, to its safe start;
     in the open ``cell``. Every exporter moves between points this way (joint moves, fine
     points). The first point of a program has no previous pose and its first leg is not
@@ -202,7 +205,7 @@ def check_via_moves(cell: Cell, plan: Plan, checks: Sequence[PointCheck]) -> tup
     naming the previous point, the via and the pair; a point without vias is told to get one.
     """
     from planner.cell.moves import check_via_path
-    from planner.export.job import predecessors
+    from planner.program.build import predecessors
 
     ids = [p.id for p in plan.points]
     before = predecessors(plan)

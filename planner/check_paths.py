@@ -3,7 +3,7 @@
 A program moves to a point's safe start and searches from there with the orientation and
 configuration of the probe pose the check chose (``wobjcal export`` writes that pose's rotation and
 ``confdata`` into every target of the point). So, for a point with a pose, the check walks
-:func:`planner.export.searches.program_searches` (from the safe start; for an edge point the
+:func:`planner.program.searches.program_searches` (from the safe start; for an edge point the
 approach to the face, the edge search and the straight retreat to the safe start) with the pose's
 sensor x axis and IK branch only: a path that would pass only with the sensor turned another way, or
 on another branch, is not the program's path and does not count. A point without a usable pose is
@@ -21,8 +21,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from calib.plan.file import Plan
 from calib.probing import ProbePoint, SearchCommand
-from planner.export.safety import SafetySpec
-from planner.export.searches import ProgramSearch, program_searches
+from planner.program.safety import SafetySpec
+from planner.program.searches import ProgramSearch, program_searches
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
@@ -124,7 +124,7 @@ def measured_starts_wobj(plan: Plan) -> dict[str, FloatArray]:
     ``edge_start_offset_m`` along the edge point's normal), wobj frame, m; ``{}`` when the
     plan's program is not adaptive or does not."""
     from calib.errors import InputError
-    from planner.export.job import adaptive_spec
+    from planner.program.build import adaptive_spec
 
     try:
         a = adaptive_spec(plan)

@@ -3,7 +3,7 @@
 :func:`plan_with_vias` checks the plan's points and the moves between them, and for every
 point whose move in collides (:func:`planner.check.check_via_moves`) and that has no vias yet,
 asks :func:`planner.cell.via_search.suggest_vias` for vias clearing the moves from every point a
-program may come from (:func:`planner.export.job.predecessors`), and returns the plan with
+program may come from (:func:`planner.program.build.predecessors`), and returns the plan with
 them. Vias the engineer taught are never replaced; a point the search cannot clear is named.
 """
 
@@ -16,7 +16,7 @@ import msgspec
 from calib.plan.file import Plan, ViaPoint
 from planner.cell.via_search import suggest_vias
 from planner.check import check_points, check_via_moves
-from planner.export.job import predecessors
+from planner.program.build import predecessors
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell

@@ -6,7 +6,7 @@ points of interest) and proposes the points:
 1. candidates on the part's planar faces whose sensor footprint lies on the face with a
    floor of margin (:mod:`planner.faces.candidates`); approach
    searches started and run long enough for the misplacement
-   (:class:`planner.export.safety.SafetySpec`, as the exported programs and the validation's
+   (:class:`planner.program.safety.SafetySpec`, as the exported programs and the validation's
    preflight size them), so they still hit their face;
    with a sensor that runs edge searches, when the approach candidates together leave a
    motion free or weak, also edge searches toward the straight outer edges of those faces
@@ -49,13 +49,14 @@ from calib.plan.file import Plan, PlanError
 from calib.plan.report_spec import PointOfInterest
 from calib.probing import ProbePoint, SearchSpec
 from planner.check import plan_quality
-from planner.export.safety import SafetySpec
 from planner.faces.candidates import Candidates, FaceTried, face_candidates
 from planner.faces.detection import find_planar_faces
 from planner.faces.edges import edge_candidates
 from planner.faces.outline import FaceOutlines
 from planner.move_vias import plan_with_vias
 from planner.plan_cell import open_cell
+from planner.program.controllers import controller
+from planner.program.safety import SafetySpec
 from planner.sim.report_points import poi_rows
 from planner.sim.rows import RowSpec, z_values
 from planner.suggest_order import FLOOR_M, Sequencer
@@ -168,6 +169,7 @@ def suggest_plan(
     progress: SuggestProgress | None = None,
     cell: Cell | None = None,
     per_face: int = PER_FACE,
+    fmt: str | None = None,
 ) -> SuggestResult:
     """Suggest the probe points of ``plan`` (see the module docstring).
 
@@ -184,6 +186,10 @@ def suggest_plan(
         progress: ``progress(stage, done, total)``.
         cell: the plan's open cell (the UI's); ``None`` opens one.
         per_face: candidates per planar face.
+        fmt: the controller whose program the layout is designed for (``None``: the
+            default): a program that runs every search in the nominal frame lands each one
+            anywhere the whole misplacement allows, so every footprint is grown by all of it;
+            an adaptive one by what the earlier searches leave.
 
     Raises:
         SuggestError: no layout can be had (the message names faces and reasons).
@@ -215,7 +221,10 @@ def suggest_plan(
                 progress=progress,
                 cell=own,
                 per_face=per_face,
+                fmt=fmt,
             )
+    target_controller = controller(fmt)
+    steered = procedure in target_controller.adaptive_methods
     t0 = time.perf_counter()
     say = progress or (lambda stage, done, total: None)
     wo = cell.work_object
@@ -284,6 +293,7 @@ def suggest_plan(
         np.array([p.position_m for p in old]).reshape(-1, 3),
         np.array([p.normal for p in old]).reshape(-1, 3),
         pool.is_edge,
+        steered=steered,
     )
     ctx = Context(cell, plan, pool, safety, rows_poi, z, r, corners, sequencer, tuple(old))
     ctx.edge_start_m, ctx.edge_overtravel_m = edge_start, 2.0 * worst_shift + 0.02
@@ -296,14 +306,21 @@ def suggest_plan(
             "no layout fixes all 6 degrees of freedom with the feasible candidates (each "
             "footprint grown by the in-plane shift it has when measured: the whole "
             f"misplacement, {plan.validation.misplacement.max_translation_m * 1e3:.1f} mm and "
-            f"{math.degrees(plan.validation.misplacement.max_angle_rad):.2f} deg, for the "
-            "first points): " + faces_text(tried, pool, ctx)
+            f"{math.degrees(plan.validation.misplacement.max_angle_rad):.2f} deg, for "
+            + (
+                "the first points"
+                if steered
+                else f"every point, as the {target_controller.label} "
+                "program runs every search in the nominal frame"
+            )
+            + "): "
+            + faces_text(tried, pool, ctx)
         )
     new_plan = suggested_plan(plan, ctx, design, procedure, add, at_m)
     say("moves between points", 0, 1)
     new_plan, via_notes = plan_with_vias(new_plan, cell)
     say("prediction", 0, 1)
-    quality, note = plan_quality(new_plan, mesh)
+    quality, note = plan_quality(new_plan, mesh, fmt)
     worst = quality.worst_poi_m(level) if quality is not None else math.nan
     met = target_m is None or (math.isfinite(worst) and worst <= target_m)
     n = len(new_plan.points)

@@ -9,6 +9,8 @@ shift it will really have (the misplacement the earlier points leave times :data
 plus :data:`NOISE_SIGMAS` of what their noise leaves, plus :data:`FLOOR_M`; the whole
 misplacement, plus the floor, for a point measured first), stays on its face
 (:class:`planner.faces.outline.FaceOutlines`), and names the points that fit in no order.
+That holds for an adaptive program; a nominal one (``steered=False``) commands every search in
+the nominal frame, so every point is grown by the whole misplacement and the order is free.
 
 Best fit (progressive, one point after another): greedy; of the points that fit now, the one
 after which most of the others fit. 3-2-1: the order of the roles (primary, secondary,
@@ -70,6 +72,10 @@ class Sequencer:
         var_m2: the event variance of one search, m^2 (sensor and robot repeatability).
         fixed_m: ``(F, 3)`` points measured before any candidate (``--add``), with
             ``fixed_normals`` ``(F, 3)``.
+        edge: ``(C,)`` which candidates are edge searches.
+        steered: the program commands each search in the frame estimated from the searches
+            before it (an adaptive program); ``False``: every search in the nominal frame, so
+            every point lands anywhere the whole misplacement allows, whatever the order.
     """
 
     def __init__(
@@ -83,7 +89,9 @@ class Sequencer:
         fixed_m: FloatArray | None = None,
         fixed_normals: FloatArray | None = None,
         edge: NDArray[np.bool_] | None = None,
+        steered: bool = True,
     ) -> None:
+        self.steered = steered
         self.edge = np.zeros(len(positions_m), dtype=bool) if edge is None else edge
         self.outlines = outlines
         self.P = positions_m
@@ -106,6 +114,8 @@ class Sequencer:
         L = max(float(np.sqrt(np.mean(np.sum((allp - c) ** 2, axis=1)))), MIN_SCALE_M)
         X = np.concatenate([self.fixed_m, self.P[list(earlier)]])
         Nn = np.concatenate([self.fixed_n, self.N[list(earlier)]])
+        if not self.steered:  # a nominal program: nothing measured before steers the search
+            X, Nn = X[:0], Nn[:0]
         G_t, G_w = inplane_shift_maps(self.P[i], self.N[i], X, Nn, c, L, c)
         factor = SAFETY if len(X) else 1.0
         cov = inplane_noise_cov(self.P[i], self.N[i], X, Nn, c, L, np.full(len(X), self.var))

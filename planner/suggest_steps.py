@@ -26,9 +26,9 @@ from calib.plan.file import Plan, PlanPoint
 from calib.plan.report_spec import PointOfInterest, ReportSpec
 from calib.probing import ProbePoint, SearchSpec
 from calib.procedures import BestFit, ThreeTwoOne
-from planner.export.safety import SafetySpec
 from planner.faces.candidates import Candidates, FaceTried
 from planner.plan_cell import nominal_T_base_wobj
+from planner.program.safety import SafetySpec
 from planner.sim.rows import RowSpec, predicted_sigma
 from planner.suggest_order import Ordered, Sequencer
 

@@ -36,6 +36,8 @@ import trimesh
 from calib.plan.file import Plan, PlanError
 from calib.procedures import RolePoint
 from planner.plan_cell import nominal_T_base_wobj, open_cell
+from planner.program.build import build_program, safety_spec
+from planner.program.controllers import controller
 from planner.sim.montecarlo import simulate
 from planner.sim.report import PAPER_TABLE1, ValidationReport
 from planner.sim.report_points import report_rows
@@ -77,6 +79,7 @@ def validate_plan(
     plan_dir: Path | None = None,
     protocol: tuple[int, int] | None = None,
     mesh: trimesh.Trimesh | None = None,
+    fmt: str | None = None,
 ) -> ValidationReport:
     """Simulate the calibration of ``plan`` many times and report it, simulated beside predicted.
 
@@ -96,6 +99,8 @@ def validate_plan(
         protocol: ``(positions, repeats)``: also run the paper's protocol beside the default.
         mesh: the work object's mesh (wobj, metres) when the caller has it loaded already
             (the UI); default: loaded from the plan.
+        fmt: the controller whose measuring program is simulated (a key of
+            :data:`planner.program.controllers.CONTROLLERS`; ``None``: the default, RAPID).
 
     Returns:
         The :class:`planner.sim.report.ValidationReport`.
@@ -108,7 +113,7 @@ def validate_plan(
     folder = plan_dir or Path.cwd()
     part = work_object_mesh(plan, folder, models) if mesh is None else mesh
     preflight(plan, models, part)
-    setup = simulation_setup(plan, models, part)
+    setup = simulation_setup(plan, models, part, fmt)
     rows = report_rows(plan.validation.report, part, models.geometry, setup.xoffset)
     paper = PAPER_TABLE1 if models.geometry is not None and models.method == "hultman2013" else None
     n = plan.validation.trials if trials is None else int(trials)
@@ -136,6 +141,7 @@ def sensitivity_plan(
     progress: ProgressCallback | None = None,
     plan_dir: Path | None = None,
     mesh: trimesh.Trimesh | None = None,
+    fmt: str | None = None,
 ) -> SensitivityTable:
     """The sensitivity table of ``plan``: its rows with each noise term off in turn
     (:mod:`planner.sim.sensitivity`), ``trials`` trials per column (default the plan's).
@@ -146,7 +152,7 @@ def sensitivity_plan(
     models = check_simulatable(plan)
     part = work_object_mesh(plan, plan_dir or Path.cwd(), models) if mesh is None else mesh
     preflight(plan, models, part)
-    setup = simulation_setup(plan, models, part)
+    setup = simulation_setup(plan, models, part, fmt)
     rows = report_rows(plan.validation.report, part, models.geometry, setup.xoffset)
     n = plan.validation.trials if trials is None else int(trials)
     return sensitivity(
@@ -161,10 +167,11 @@ def sensitivity_plan(
 
 
 def simulation_setup(
-    plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh
+    plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh, fmt: str | None = None
 ) -> SimulationSetup:
-    """What every trial of ``plan`` shares (the part ``mesh`` in wobj, metres), with the
-    x-offset run's targets on the stator's bulged slot holes when the plan has one."""
+    """What every trial of ``plan`` shares (the part ``mesh`` in wobj, metres) for the program
+    of the controller ``fmt`` (``None``: the default), with the x-offset run's targets on the
+    stator's bulged slot holes when the plan has one."""
     xo = getattr(models.settings, "xoffset", None)
     xs = None
     if xo is not None and models.geometry is not None:
@@ -179,19 +186,27 @@ def simulation_setup(
         xs = xoffset_setup(xo, np.stack([g.side_face_offset_m(y, z), y, z], axis=-1))
     px = tuple(RolePoint("xoffset", p) for row in (xs.points if xs else ()) for p in row)
     return dataclasses.replace(
-        prediction_setup(plan, models),
+        prediction_setup(plan, models, fmt),
         faces=face_lookup(mesh, models.points + px, models.sensor.footprint_radius_m),
         xoffset=xs,
     )
 
 
-def prediction_setup(plan: Plan, models: ValidationModels) -> SimulationSetup:
+def prediction_setup(
+    plan: Plan, models: ValidationModels, fmt: str | None = None
+) -> SimulationSetup:
     """What the prediction of ``plan`` needs (:func:`planner.sim.predict.predict`, the layout
-    quality): its points, procedure, nominal pose and models; no part faces, no x-offset run."""
+    quality): its points, procedure, nominal pose, models and the measuring program of the
+    controller ``fmt`` (``None``: the default); no part faces, no x-offset run.
+
+    Raises:
+        InputError: unknown controller.
+    """
+    vias = {p.id: len(p.via_points) for p in plan.points}
+    safety = safety_spec(plan)
+    program = build_program(models.points, models.settings, safety, controller(fmt), vias)
     return SimulationSetup(
-        points=models.points,
-        method=models.method,
-        settings=models.settings,
+        program=program,
         T_base_wobj_nominal=nominal_T_base_wobj(plan),
         sensor=models.sensor,
         robot_error=models.robot_error,

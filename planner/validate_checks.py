@@ -24,8 +24,8 @@ from calib.estimators.observability import analyze_layout
 from calib.models import Misplacement, RobotErrorModel
 from calib.plan.file import Plan, PlanError
 from calib.procedures import RolePoint, procedure_kind
-from planner.export.safety import SafetySpec
 from planner.parts.stator import StatorGeometry
+from planner.program.safety import SafetySpec
 from planner.sim.sensors import sensor_kind
 from planner.sim.setup import DEFAULT_EDGE_INSET_M, default_pivot, resolved_settings
 
@@ -165,7 +165,7 @@ def preflight(plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh) -> No
 
     Every point must lie on a planar face with the sensor's footprint on it
     (:func:`planner.faces.checks.plan_face_reasons`); every search must reach its face under
-    the plan's misplacement (the bound of :class:`planner.export.safety.SafetySpec`, the same
+    the plan's misplacement (the bound of :class:`planner.program.safety.SafetySpec`, the same
     the exported programs use): an approach must start at least the face's largest shift plus
     the sensor's standoff out, and run at least the shift past it; an edge search must start
     at least the shift before the edge and run at least the shift plus the sensor's edge-event

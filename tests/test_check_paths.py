@@ -14,10 +14,10 @@ from calib.frames import transform_points
 from calib.plan import Plan, load_plan
 from planner.check import check_plan
 from planner.check_paths import check_program_path, measured_starts_wobj
-from planner.export.job import safety_spec
-from planner.export.searches import program_searches, safe_and_face_wobj
 from planner.export_plan import export_job_for, with_arm_poses
 from planner.plan_cell import nominal_T_base_wobj, open_cell
+from planner.program.build import safety_spec
+from planner.program.searches import program_searches, safe_and_face_wobj
 
 ROOT = Path(__file__).resolve().parent.parent
 DEMO = ROOT / "assets/plans/stator_section_ah.json"

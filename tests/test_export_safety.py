@@ -1,4 +1,4 @@
-"""Safe search starts (planner.export.safety) in every exporter, and the nominal-frame RAPID
+"""Safe search starts (planner.program.safety) in every exporter, and the nominal-frame RAPID
 program run in the RAPID interpreter against a misplaced part."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from calib.plan.file import load_plan
 from planner.export import export_files
 from planner.export.job import ToolData, build_job
 from planner.export.rapid import export_rapid
-from planner.export.safety import SafetySpec
+from planner.program.safety import SafetySpec
 from tests.box_part import BoxProbe, distance_to_box
 from tests.rapid_interp import Machine
 from tests.test_export_rapid_adaptive import full_misplacement, rapid_search

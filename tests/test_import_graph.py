@@ -23,6 +23,7 @@ BELOW_JOBS = {
     "planner.parts",
     "planner.faces",
     "planner.cell",
+    "planner.program",
     "planner.sim",
     "planner.export",
 }
@@ -35,14 +36,15 @@ ALLOWED: dict[str, set[str]] = {
     "planner.parts": {"calib", "planner.errors"},
     "planner.faces": {"calib", "planner.errors"},
     "planner.cell": {"calib", "planner.errors", "planner.builtins", "planner.robot"},
-    "planner.sim": {"calib", "planner.errors", "planner.parts", "planner.faces"},
-    "planner.export": {"calib", "planner.errors"},
+    "planner.program": {"calib", "planner.errors"},
+    "planner.sim": {"calib", "planner.errors", "planner.parts", "planner.faces", "planner.program"},
+    "planner.export": {"calib", "planner.errors", "planner.program"},
     JOBS: BELOW_JOBS,
     "planner.cli": BELOW_JOBS | {JOBS},
     "planner.__main__": {"planner.cli"},
     "webui": BELOW_JOBS | {JOBS},
 }
-SUBPACKAGES = ("robot", "cell", "faces", "sim", "parts", "export", "cli")
+SUBPACKAGES = ("robot", "cell", "faces", "program", "sim", "parts", "export", "cli")
 #: The one allowed upward import: ``wobjcal ui`` starts the web app, lazily, in one function.
 LAZY_UI = ("planner.cli.misc", "webui", "cmd_ui")
 

@@ -50,9 +50,11 @@ def test_seeded_run_is_repeatable_across_workers_and_sane() -> None:
     assert np.array_equal(a.delta_best_fit, b.delta_best_fit)
     assert a.failures == b.failures and a.landings == b.landings
     assert a.n_ok >= 190
-    # sane: origin within a millimetre, rotations within 0.5 deg, epsilon within 2 mm
+    # sane: origin within a millimetre, rotations within 1 deg (about y, the weakest: F and H
+    # run their edge searches from their face approaches' measured points, as the RAPID
+    # program does, 0.37 deg at 95.5 %), epsilon within 2 mm
     assert np.abs(a.delta_procedure[:, :3]).max() < 1e-3
-    assert np.abs(a.delta_procedure[:, 3:]).max() < math.radians(0.5)
+    assert np.abs(a.delta_procedure[:, 3:]).max() < math.radians(1.0)
     eps = a.row("yz_epsilon", 95.5)
     assert 0.05 < eps.procedure < 2.0 and abs(eps.procedure_bias) < 1.0
     # errors scatter: a run with another seed differs
@@ -62,18 +64,24 @@ def test_seeded_run_is_repeatable_across_workers_and_sane() -> None:
     assert "WOCS yz-plane at epsilon" in text and "± 0.40 mm" in text
 
 
-def test_robustness_report_catches_a_start_too_close_for_20_mm() -> None:
+def test_the_program_starts_from_the_safe_start_not_the_plans_start() -> None:
+    """A plan start 8 mm out is inside the sensor's reach of a part misplaced by 20 mm; the
+    program starts every search at its safe start (``planner.program.safety``), so no search
+    starts detecting, and a search too short to reach the face from there is what fails."""
     near = SearchSpec("approach", start_offset_m=0.008, overtravel_m=0.060)
     points = stator_ah_points(GEOM, approach=near)
     report = validate(points, GEOM, T_NOM, 60, np.random.default_rng(5), workers=1)
-    started = {k: v for k, v in report.failures.items() if "already detecting at start" in k}
-    assert started, report.failures
-    assert sum(started.values()) >= 10
+    assert not any("already detecting at start" in k for k in report.failures), report.failures
     assert report.n_ok == 60 - sum(report.failures.values())
-    assert "already detecting at start" in report.to_markdown()
-    # the default plan starts 50 mm out and survives the same misplacements
-    ok = validate(POINTS, GEOM, T_NOM, 60, np.random.default_rng(5), workers=1)
-    assert not any("already detecting" in k for k in ok.failures)
+    # a search that ends only 1 mm past the nominal face misses a part misplaced away
+    short = SearchSpec("approach", start_offset_m=0.050, overtravel_m=0.001)
+    report = validate(
+        stator_ah_points(GEOM, approach=short), GEOM, T_NOM, 60, np.random.default_rng(5),
+        workers=1,
+    )  # fmt: skip
+    missed = {k: v for k, v in report.failures.items() if "no detection" in k}
+    assert sum(missed.values()) >= 10, report.failures
+    assert "no detection" in report.to_markdown()
 
 
 def test_bad_arguments_are_named() -> None:

@@ -14,6 +14,8 @@ from calib.procedures.three_two_one import pick_roles
 from planner.parts.stator import StatorGeometry
 from planner.parts.stator_demo import nominal_T_base_wobj, stator_ah_points
 from planner.parts.stator_mesh import build_stator_mesh
+from planner.program.build import build_program
+from planner.program.controllers import controller
 from planner.sim.montecarlo import stator_setup
 from planner.sim.setup import DEFAULT_EDGE_INSET_M, default_settings, resolved_settings
 from planner.sim.trial import TrialRunner
@@ -34,7 +36,10 @@ def test_same_seed_same_trial_and_errors_are_small() -> None:
     assert a.failure == "" and np.array_equal(a.delta_procedure, b.delta_procedure)
     assert np.abs(a.delta_procedure[:3]).max() < 1e-3  # within a millimetre
     assert np.abs(a.delta_best_fit[:3]).max() < 1e-3
-    assert a.searched == ("A", "B", "C", "D", "E", "F", "G", "H", "C2", "D2")
+    # the adaptive RAPID program: an edge point approaches its face before its edge search
+    assert a.searched == (
+        *("A", "B", "C", "D", "E", "F@face", "F", "G", "H@face", "H", "C2", "D2"),
+    )
     other = runner.run_trial(np.random.SeedSequence(43), None)
     assert not np.array_equal(other.delta_procedure, a.delta_procedure)
 
@@ -63,7 +68,7 @@ def test_failed_probe_is_recorded_with_point_and_reason() -> None:
 
 @pytest.mark.parametrize("method", list(PROCEDURES))
 def test_every_procedure_runs_in_the_same_trial(method: str) -> None:
-    """The trial calls ``ProcedureKind.run`` of the registry: each procedure calibrates the
+    """The trial executes the program of each procedure of the registry: each calibrates the
     misplaced stator to within a millimetre and half a degree (the stator's weakest rotation,
     about y, scatters by 0.07 deg). The fits use the approach points of A-H and two on the top
     face: measured all at once in the nominal frame, an edge search would start off the face."""
@@ -85,13 +90,9 @@ def test_every_procedure_runs_in_the_same_trial(method: str) -> None:
         plain = [p for p in ah.values() if p.search.kind == "approach"]
         pts = [RolePoint("fit", p) for p in plain + top]
     setup, mesh = stator_setup(stator_ah_points(G), G, nominal_T_base_wobj(), mesh=MESH)
-    sensor = setup.sensor
-    setup = dataclasses.replace(
-        setup,
-        points=tuple(pts),
-        method=method,
-        settings=resolved_settings(kind.settings_type(), sensor, DEFAULT_EDGE_INSET_M),
-    )
+    settings = resolved_settings(kind.settings_type(), setup.sensor, DEFAULT_EDGE_INSET_M)
+    program = build_program(pts, settings, setup.program.safety, controller(None))
+    setup = dataclasses.replace(setup, program=program)
     res = TrialRunner(setup, mesh).run_trial(np.random.SeedSequence(5), None)
     assert res.failure == "", res.failure
     assert np.abs(res.delta_procedure[:3]).max() < 1e-3

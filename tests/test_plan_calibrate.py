@@ -177,6 +177,8 @@ def test_simulated_calibrations_of_the_bulged_stator_are_trusted() -> None:
     from planner.validate import simulation_setup, validation_models, work_object_mesh
 
     plan = load_plan(STATOR)
+    from planner.program import execute
+
     m = validation_models(plan)
     part = work_object_mesh(plan, STATOR.parent, m)
     setup = simulation_setup(plan, m, part)
@@ -193,7 +195,7 @@ def test_simulated_calibrations_of_the_bulged_stator_are_trusted() -> None:
             runner.caster, T_true, r, sensor=m.sensor, robot_error=m.robot_error,
             faces=setup.faces, edge_inset_m=m.edge_inset_m,
         )  # fmt: skip
-        res = runner.kind.run(list(setup.points), T_nom, probe, setup.settings)
+        res = execute(setup.program, T_nom, probe)  # what the exported RAPID program runs
         first = {k: v for k, v in res.measured_m.items() if "#" not in k}
         meas = Measurements.from_points_m(first)
         retakes = {k[:-2]: [tuple(v)] for k, v in res.measured_m.items() if k.endswith("#2")}

@@ -75,6 +75,7 @@ def test_a_failed_x_offset_run_leaves_the_row_to_the_other_trials(
     setup = SimpleNamespace(
         xoffset=SimpleNamespace(targets_wobj=targets),
         method="hultman2013",
+        program=SimpleNamespace(describe=lambda: ["RAPID, adaptive A-H", "1. a step"]),
         sensor=ProximitySensor(),
         noise_figures=(),
     )

@@ -205,7 +205,7 @@ def test_a_seven_joint_via_is_refused_by_the_writers(demo: Plan) -> None:
 
 # ---- the orders the programs probe in ------------------------------------------------------
 def test_probe_orders_follow_the_adaptive_rapid_program(demo: Plan) -> None:
-    from planner.export.job import probe_orders
+    from planner.program.build import probe_orders
 
     ids = [p.id for p in demo.points]
     role = {p.role: i for i, p in enumerate(demo.points)}
@@ -263,7 +263,7 @@ def test_vias_on_a_robot_with_a_prismatic_joint_are_refused() -> None:
 def test_a_layout_the_adaptive_program_refuses_leaves_the_plan_order(demo: Plan) -> None:
     """H moved 5 m: the adaptive RAPID program refuses the layout, so no program probes in its
     order; the vias are checked in plan order and nothing raises."""
-    from planner.export.job import probe_orders
+    from planner.program.build import probe_orders
 
     raw = json.loads(plan_to_json(demo))
     for p in raw["points"]:

@@ -74,6 +74,8 @@ class ProcedureKind(Protocol):
         roles: the roles a point of this procedure may take.
         role_limits: how many points each role takes at most (``None``: any number); an
             editor gives a new point the first role not yet full.
+        label: the procedure's short name for humans, e.g. ``"best fit"``, ``"A-H"`` (a
+            measuring program is named after it: "RAPID, adaptive A-H").
         summary: one line for humans.
     """
 
@@ -81,6 +83,7 @@ class ProcedureKind(Protocol):
     settings_type: type
     roles: tuple[str, ...]
     role_limits: Mapping[str, int | None]
+    label: str
     summary: str
 
     def role_problem(self, roles: Sequence[str], complete: bool) -> str:

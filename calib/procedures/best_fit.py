@@ -66,6 +66,7 @@ class BestFitProcedure:
     settings_type: type = BestFit
     roles: tuple[str, ...] = (ROLE,)
     role_limits: Mapping[str, int | None] = MappingProxyType({ROLE: None})
+    label = "best fit"
     summary = "least-squares fit of every point to its face"
     #: Its linearised covariance is the least-squares one of its searches, ``(A^T W A)^-1``,
     #: for approach searches without a shared TCP error (a test checks it against the

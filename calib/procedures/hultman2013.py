@@ -48,6 +48,7 @@ class Hultman2013Procedure:
     settings_type: type = Hultman2013
     roles: tuple[str, ...] = ROLES
     role_limits: Mapping[str, int | None] = MappingProxyType(dict.fromkeys(ROLES, 1))
+    label = "A-H"
     summary = "the paper's A-H procedure: 3 points fix the plane, searches fix the origin"
 
     def role_problem(self, roles: Sequence[str], complete: bool) -> str:

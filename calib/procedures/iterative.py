@@ -75,6 +75,7 @@ class IterativeProcedure(BestFitProcedure):
 
     method = "iterative"
     settings_type: type = Iterative
+    label = "iterative best fit"
     summary = "measure all, fit, re-command every search in the new frame, until it settles"
 
     def run(

@@ -152,6 +152,7 @@ class ThreeTwoOneProcedure:
     settings_type: type = ThreeTwoOne
     roles: tuple[str, ...] = tuple(ROLE_COUNTS)
     role_limits: Mapping[str, int | None] = MappingProxyType(dict(ROLE_COUNTS))
+    label = "3-2-1"
     summary = "3 points on a primary face, 2 on a secondary, 1 on a tertiary"
     #: Six face constraints, solved exactly: its linearised covariance is the least-squares
     #: one of its searches (a test checks it against the linearisation to 1e-9).

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from planner.cli.common import count_arg, read_plan, stdout
+from planner.program.controllers import CONTROLLERS, DEFAULT_CONTROLLER
 
 
 def _points_mm(text: str) -> np.ndarray:
@@ -109,6 +110,14 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         metavar="N",
         help="keep the plan's points and add the N best (best fit)",
     )
+    p.add_argument(
+        "--format",
+        choices=list(CONTROLLERS),
+        default=DEFAULT_CONTROLLER,
+        help="design for the program this controller's export runs (default: "
+        f"{DEFAULT_CONTROLLER}; a nominal program lands every search anywhere the whole "
+        "misplacement allows)",
+    )
     p.add_argument("-o", "--output", metavar="OUT", required=True, help="plan file to write")
     p.set_defaults(handler=cmd_suggest)
 
@@ -130,6 +139,7 @@ def cmd_suggest(args: argparse.Namespace) -> int:
         max_points=args.max_points,
         procedure=args.procedure,
         add=args.add,
+        fmt=args.format,
         progress=lambda stage, done, total: print(
             f"wobjcal suggest: {stage} {done}/{total}", file=sys.stderr
         ),

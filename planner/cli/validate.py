@@ -15,6 +15,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from calib.atomic_io import write_text_atomic
 from calib.plan.models import MAX_SEED, MAX_TRIALS
 from planner.cli.common import count_arg, read_plan, stderr, stdout
+from planner.program.controllers import CONTROLLERS, DEFAULT_CONTROLLER
 
 #: Most worker processes a validation may start.
 MAX_WORKERS = 64
@@ -39,7 +40,10 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         sub,
         "validate",
         "simulate the calibration many times: confidence intervals, simulated and predicted",
-        "Simulate the whole calibration TRIALS times with the plan's procedure, sensor model\n"
+        "Simulate the whole calibration TRIALS times: the measuring program the controller\n"
+        "of --format runs for the plan (its searches from the safe starts, in the nominal\n"
+        "frame or, where that controller's program updates its frame, adaptively), with the\n"
+        "plan's sensor model\n"
         "(proximity or touch probe, against the real mesh where the part really lies), robot\n"
         "error model and part misplacement. Prints every row (origin x/y/z, rotations, the\n"
         "error at the points of interest and over the regions) at the plan's confidence\n"
@@ -51,9 +55,17 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "exit codes: 0 every trial calibrated, 1 some trials failed (listed), 2 bad input",
         "wobjcal validate assets/plans/stator_section_ah.json --trials 400 --seed 1\n"
         "wobjcal validate plan.json --json report.json --plots plots/\n"
+        "wobjcal validate plan.json --format krl   # the program the KUKA export runs\n"
         "wobjcal validate plan.json --protocol 20x20 --sensitivity",
     )
     p.add_argument("plan", metavar="PLAN", help="plan file (wobjcal.plan/1)")
+    p.add_argument(
+        "--format",
+        choices=list(CONTROLLERS),
+        default=DEFAULT_CONTROLLER,
+        help="the controller whose exported program is simulated (default: "
+        f"{DEFAULT_CONTROLLER}); the report names the program",
+    )
     p.add_argument(
         "--trials",
         type=count_arg(2, MAX_TRIALS),
@@ -106,6 +118,7 @@ def _num(x: float) -> float | None:
 def report_json(report: ValidationReport) -> dict[str, Any]:
     """The JSON of a ``ValidationReport``: rows (display units), outcomes, failures, landings."""
     return {
+        "program": {"name": report.program, "steps": list(report.program_steps)},
         "method": report.method,
         "sensor": report.sensor,
         "n_trials": report.n_trials,
@@ -178,6 +191,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
             reach_trials=min(args.reach_trials, trials),
             plan_dir=plan_dir,
             protocol=args.protocol,
+            fmt=args.format,
         )
     stdout().print(report.to_markdown(), markup=False)
     data = report_json(report) | {"plan": args.plan, "seed": seed}
@@ -191,6 +205,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
                 workers=args.workers,
                 progress=lambda done, total: bar.update(task, completed=done, total=total),
                 plan_dir=plan_dir,
+                fmt=args.format,
             )
         stdout().print(table.to_markdown(), markup=False)
         data["sensitivity"] = {

@@ -4,7 +4,7 @@ Owns:
     - :mod:`planner.export.job`: :class:`~planner.export.job.ExportJob` (what every writer
       formats: the nominal work object, the sensor tool, one :class:`TargetPair` per point,
       the safe starts and the adaptive A-H spec) and :func:`~planner.export.job.build_job`;
-    - :mod:`planner.export.safety`: safe search starts under the plan's misplacement;
+    - :mod:`planner.program.safety`: safe search starts under the plan's misplacement;
     - :mod:`planner.export.text`: identifiers, numbers, and names made safe for comments and
       string literals, shared by writers;
     - one module per language: ``rapid`` (+ ``rapid_probe``, ``rapid_adaptive``,
@@ -16,9 +16,8 @@ A writer is a function ``(ExportJob) -> {file suffix: text}`` (KRL writes a ``.s
 :data:`FORMATS`; the command line (``wobjcal export --format NAME``), the web UI's download
 buttons and the tests all look formats up here::
 
-    FORMATS["mylang"] = ExportFormat(
-        "mylang", "MyLang", "Maker", "planner.export.mylang:export_mylang", (".prg",)
-    )
+    CONTROLLERS["mylang"] = Controller("mylang", "MyLang", "Maker")  # planner.program
+    FORMATS["mylang"] = ExportFormat("mylang", "planner.export.mylang:export_mylang", (".prg",))
 
 Writers are imported when first used, so listing the formats imports no writer.
 """
@@ -31,6 +30,7 @@ from dataclasses import dataclass
 
 from calib.errors import InputError
 from planner.export.job import ExportJob, TargetPair, ToolData, build_job
+from planner.program.controllers import CONTROLLERS
 
 #: A writer: the program files of a job, ``{suffix: text}``.
 Writer = Callable[[ExportJob], dict[str, str]]
@@ -38,22 +38,30 @@ Writer = Callable[[ExportJob], dict[str, str]]
 
 @dataclass(frozen=True)
 class ExportFormat:
-    """One robot-program format.
+    """One robot-program format: the writer of one controller's programs.
 
     Attributes:
-        name: the format's name on the command line, e.g. ``"rapid"``.
-        label: the language's name, as the UI's download button shows it, e.g. ``"RAPID"``.
-        vendor: the robot maker, e.g. ``"ABB"``.
+        name: the format's name on the command line, e.g. ``"rapid"``: a controller of
+            :data:`planner.program.controllers.CONTROLLERS` (its language's name, its vendor and
+            what its programs compute are recorded there, once).
         writer: ``"module:function"`` of the writer ``(ExportJob) -> {suffix: text}``.
         suffixes: the suffixes of the files the writer returns, first one first (the first
             file is written to the output path, the others beside it with their suffix).
     """
 
     name: str
-    label: str
-    vendor: str
     writer: str
     suffixes: tuple[str, ...]
+
+    @property
+    def label(self) -> str:
+        """The language's name, as the UI's download button shows it, e.g. ``"RAPID"``."""
+        return CONTROLLERS[self.name].label
+
+    @property
+    def vendor(self) -> str:
+        """The robot maker, e.g. ``"ABB"``."""
+        return CONTROLLERS[self.name].vendor
 
     def load(self) -> Writer:
         """The writer function (imports its module)."""
@@ -66,16 +74,10 @@ class ExportFormat:
 FORMATS: dict[str, ExportFormat] = {
     f.name: f
     for f in (
-        ExportFormat("rapid", "RAPID", "ABB", "planner.export.rapid:rapid_files", (".mod",)),
-        ExportFormat("krl", "KRL", "KUKA", "planner.export.krl:export_krl", (".src", ".dat")),
-        ExportFormat(
-            "urscript",
-            "URScript",
-            "Universal Robots",
-            "planner.export.urscript:urscript_files",
-            (".script",),
-        ),
-        ExportFormat("fanuc", "TP", "FANUC", "planner.export.fanuc:export_fanuc", (".ls",)),
+        ExportFormat("rapid", "planner.export.rapid:rapid_files", (".mod",)),
+        ExportFormat("krl", "planner.export.krl:export_krl", (".src", ".dat")),
+        ExportFormat("urscript", "planner.export.urscript:urscript_files", (".script",)),
+        ExportFormat("fanuc", "planner.export.fanuc:export_fanuc", (".ls",)),
     )
 }
 #: What ``wobjcal export --format`` accepts: the robot formats and the plan's own JSON.

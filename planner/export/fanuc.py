@@ -14,7 +14,7 @@ turn numbers of :data:`TURN_AXES`, from the IK solution at that target next to t
 export is refused (:class:`calib.errors.InputError`), never written as a guess.
 
 Every search runs in the nominal user frame (not adaptive; the frame comes from ``wobjcal
-calibrate``) and starts at the safe start of :mod:`planner.export.safety`. A search is
+calibrate``) and starts at the safe start of :mod:`planner.program.safety`. A search is
 ``SKIP CONDITION DI[SENSOR_DI]=ON`` (approach) or ``=OFF`` (edge) and a linear move to the end
 point ``... FINE Skip,LBL[i],PR[k]=LPOS``: when the input switches, the robot stops, ``PR[k]``
 holds the TCP where the skip fired (user frame) and the next line runs; when it never switches,
@@ -246,7 +246,7 @@ def _header(prog: _Program, job: ExportJob, name: str) -> None:
         f"plan's robot base: check WORLD before the run. UTOOL[{UTOOL_NO}] = PR[{PR_UTOOL}] = "
         f"sensor TCP in the flange. Sensor on DI[{SENSOR_DI}]. Tool {fmt(tool.mass_kg, 3)} kg, "
         f"COG [{cog}] mm: set the payload schedule on the controller.",
-        " ".join(safety_header(job, "", 10_000)),
+        " ".join(safety_header(job, "fanuc", "", 10_000)),
         f"Results: PR[{first}]..PR[{last}] = point 1..{n}: TCP where the skip fired (LPOS), "
         f"UFRAME[{UFRAME_NO}], mm. R[{R_CODE_BASE + 1}]..R[{R_CODE_BASE + n}] = 0 measured, "
         "1 no detection, 2 input already at the searched level at the start, 3 not run. A PR "

@@ -17,13 +17,14 @@ from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import InputError
 from calib.frames import check_transform, make_transform
-from calib.paper.settings import Hultman2013
 from calib.plan.file import Plan
 from calib.probing import SearchCommand
-from calib.procedures import procedure_kind
-from planner.export.safety import SafetySpec
-from planner.export.searches import safe_and_face_wobj
 from planner.export.text import module_name
+from planner.program.build import AdaptiveSpec, adaptive_spec, measuring_program, safety_spec
+from planner.program.controllers import CONTROLLERS
+from planner.program.model import MeasuringProgram
+from planner.program.safety import SafetySpec
+from planner.program.searches import safe_and_face_wobj
 
 FloatArray = NDArray[np.float64]
 #: ABB ``confdata`` (cf1, cf4, cf6, cfx).
@@ -67,7 +68,7 @@ class TargetPair:
         normal_wobj: ``(3,)`` outward normal of the face the sensor looks at, wobj frame.
         T_wobj_safe: ``(4, 4)`` where the program starts the (first) approach search, wobj
             frame, m: the plan's start moved out along the normal to the safe clearance
-            (:class:`planner.export.safety.SafetySpec`); for an edge search, the edge start
+            (:class:`planner.program.safety.SafetySpec`); for an edge search, the edge start
             moved out along the normal (the approach to the face the edge search runs along).
         T_wobj_face: ``(4, 4)`` end of that approach search, wobj frame, m (for an approach
             point the plan's end, for an edge point past the face by the safe overtravel).
@@ -160,22 +161,6 @@ class ToolData:
 
 
 @dataclass(frozen=True)
-class AdaptiveSpec:
-    """A procedure the program runs adaptively: the paper's A-H (``hultman2013`` plans).
-
-    Attributes:
-        index: ``{role: i}`` the target index (0-based, plan order) of each role ``A``..``H``.
-        settings: the plan's A-H settings (an unset edge-event offset counts as 0, as
-            ``wobjcal calibrate`` does: :attr:`Hultman2013.edge_offset_m`).
-        face_coords_wobj: x of the side face, y of the short side, z of the top, wobj, m.
-    """
-
-    index: dict[str, int]
-    settings: Hultman2013
-    face_coords_wobj: tuple[float, float, float]
-
-
-@dataclass(frozen=True)
 class ExportJob:
     """Everything an exporter writes.
 
@@ -188,8 +173,13 @@ class ExportJob:
         targets: one :class:`TargetPair` per point, in plan order.
         sensor_input: name of the sensor's digital input (RAPID signal, KRL/UR input number).
         safety: the misplacement tolerance the safe starts are computed for.
-        adaptive: the A-H procedure for ``hultman2013`` plans (searches commanded in the frame
-            estimated so far), or ``None``: every search in the nominal frame.
+        adaptive: the A-H specifics the adaptive programs are written from (searches
+            commanded in the frame estimated so far), or ``None`` when no controller runs the
+            plan adaptively; a writer uses it only when its own program is adaptive.
+        programs: the measuring program of every controller, by controller name: what each
+            writer serialises (:meth:`program`).
+        program_errors: why a controller has no program (its adaptive procedure refuses the
+            layout), by controller name.
     """
 
     name: str
@@ -201,6 +191,19 @@ class ExportJob:
     sensor_input: str = "diSensor"
     safety: SafetySpec = field(default_factory=SafetySpec)
     adaptive: AdaptiveSpec | None = None
+    programs: Mapping[str, MeasuringProgram] = field(default_factory=dict)
+    program_errors: Mapping[str, str] = field(default_factory=dict)
+
+    def program(self, fmt: str) -> MeasuringProgram:
+        """The measuring program the controller ``fmt`` runs for this job's plan.
+
+        Raises:
+            InputError: the controller has no program for the plan (the message says why).
+        """
+        if fmt in self.programs:
+            return self.programs[fmt]
+        why = self.program_errors.get(fmt, "the job was built without it")
+        raise InputError(f"no {fmt} program for plan {self.plan_name!r}: {why}")
 
 
 def default_sensor_rotation(
@@ -246,6 +249,17 @@ def build_job(
     rotations = rotations_wobj or {}
     confs = confdata or {}
     safety = safety_spec(plan)
+    programs: dict[str, MeasuringProgram] = {}
+    errors: dict[str, str] = {}
+    for name in CONTROLLERS:
+        try:
+            programs[name] = measuring_program(plan, name)
+        except InputError as exc:  # an adaptive procedure that refuses the layout
+            errors[name] = str(exc)
+    try:
+        spec = adaptive_spec(plan) if any(p.adaptive for p in programs.values()) else None
+    except InputError:
+        spec = None
     targets = []
     for p in plan.points:
         cmd = SearchCommand.from_point(p.to_probe_point(), np.eye(4))
@@ -280,82 +294,21 @@ def build_job(
         targets=tuple(targets),
         sensor_input=sensor_input,
         safety=safety,
-        adaptive=adaptive_spec(plan),
+        adaptive=spec,
+        programs=programs,
+        program_errors=errors,
     )
 
 
-def safety_spec(plan: Plan) -> SafetySpec:
-    """The misplacement tolerance and sensing distance of ``plan``'s validation settings.
-
-    The rotation pivot is the centroid of the probe points, as in ``wobjcal validate``.
-    """
-    v = plan.validation
-    pivot = np.mean([p.position_m for p in plan.points], axis=0) if plan.points else np.zeros(3)
-    return SafetySpec(
-        max_translation_m=v.misplacement.max_translation_m,
-        max_angle_rad=v.misplacement.max_angle_rad,
-        pivot_wobj_m=(float(pivot[0]), float(pivot[1]), float(pivot[2])),
-        sensing_distance_m=v.sensor.standoff_m,
-    )
-
-
-def adaptive_spec(plan: Plan) -> AdaptiveSpec | None:
-    """How the program runs the plan's procedure adaptively, or ``None``: every search in the
-    nominal frame (the procedure has no adaptive layout, or the plan lacks a role)."""
-    layout = procedure_kind(plan.procedure).adaptive_layout(plan.role_points())
-    if layout is None or not isinstance(plan.procedure, Hultman2013):
-        return None
-    face = layout.face_coords_wobj
-    return AdaptiveSpec(
-        index={p.role: i for i, p in enumerate(plan.points)},
-        settings=plan.procedure,
-        face_coords_wobj=(float(face[0]), float(face[1]), float(face[2])),
-    )
-
-
-#: The order the adaptive RAPID program (``rapid_adaptive.adaptive_main``) probes the roles.
-ADAPTIVE_ORDER = ("A", "B", "C", "D", "E", "F", "G", "H")
-
-
-def predecessors(plan: Plan) -> dict[int, list[int | None]]:
-    """``{point index: [the index of each point a program probes just before it]}`` over
-    :func:`probe_orders` (``None``: the point starts a program)."""
-    before: dict[int, list[int | None]] = {}
-    for order in probe_orders(plan):
-        for k, i in enumerate(order):
-            prev = order[k - 1] if k else None
-            if prev not in before.setdefault(i, []):
-                before[i].append(prev)
-    return before
-
-
-def probe_orders(plan: Plan) -> list[list[int]]:
-    """Every order (point indices, plan order numbering) in which an exported program probes the
-    plan's points: plan order (every format), and for an adaptive A-H plan the RAPID program's
-    A..H then, with ``retake_c_d``, C and D again. The moves into a point's vias come from the
-    point before it in each of these orders (``wobjcal check`` checks them all).
-    """
-    orders = [list(range(len(plan.points)))]
-    try:
-        a = adaptive_spec(plan)
-    except InputError:  # a layout the adaptive program refuses: no program probes in its order
-        a = None
-    if a is not None:
-        order = [a.index[r] for r in ADAPTIVE_ORDER]
-        if a.settings.retake_c_d:
-            order += [a.index["C"], a.index["D"]]
-        if order not in orders:
-            orders.append(order)
-    return orders
-
-
-def safety_header(job: ExportJob, prefix: str, width: int = 92) -> list[str]:
-    """Header comment lines of a program that runs every search in the nominal frame."""
+def safety_header(job: ExportJob, fmt: str, prefix: str, width: int = 92) -> list[str]:
+    """Header comment lines of the controller ``fmt``'s program when it runs every search in
+    the nominal frame."""
     import textwrap
 
+    name = job.program(fmt).name
     text = (
-        "NOMINAL FRAME: every search is commanded in the nominal work object (not adaptive: "
-        "the A-H frame update runs only in the RAPID export); compute the frame afterwards with "
+        f"PROGRAM: {name}. NOMINAL FRAME: every search is commanded in the nominal work object "
+        "(not adaptive: this program runs no frame update); compute the frame afterwards with "
         "`wobjcal calibrate`. SAFE FOR: "
         + job.safety.describe()
         + ". Every search starts outside the nominal surface by at least the largest "

@@ -10,7 +10,7 @@ the targets are ``E6POS`` in that base with the status ``S`` and turn ``T`` of t
 checked pose); without a check they have no S and T (the controller keeps the current status
 and turn; check the first run in T1). Every search runs in the nominal base (not
 adaptive; the frame comes from ``wobjcal calibrate``) and starts at ``x<ID>_safe``, outside
-the nominal surface by the safe clearance of :mod:`planner.export.safety`; an edge point first
+the nominal surface by the safe clearance of :mod:`planner.program.safety`; an edge point first
 runs an approach search to ``x<ID>_face`` and then the edge search from the measured face point
 along the plan's direction. A search moves ``LIN`` to the end point with
 ``INTERRUPT ... WHEN diSensor==TRUE`` (approach) or ``==FALSE`` (edge); the interrupt routine
@@ -125,7 +125,7 @@ def _src(job: ExportJob, names: list[str]) -> str:
         f"(procedure {comment_text(job.method)}).",
         "  ; Probes each point with the proximity sensor on diSensor; see the .dat file.",
         _status_note(job),
-        *safety_header(job, "  ; "),
+        *safety_header(job, "krl", "  ; "),
         "  ; Results: xMeas[i] = point i in the robot base (mm), nFail[i] = 0 ok, 1 no detection,",
         "  ; 2 input already at the searched level at the start. Order of points:",
         "  ; "

@@ -1,6 +1,6 @@
 """The RAPID routines that run one probe point: ``Probe_<name>(num i)`` and its handler.
 
-An approach point: ``MoveJ`` to ``_safe`` (the safe start, :mod:`planner.export.safety`),
+An approach point: ``MoveJ`` to ``_safe`` (the safe start, :mod:`planner.program.safety`),
 ``SearchL \\SStop`` to ``_end``, store, retreat to ``_safe``. An edge point: ``MoveJ`` to
 ``_safe``, an approach ``SearchL`` to ``_face`` (the face the edge search runs along), then
 ``MoveL`` to the measured face point and ``SearchL \\SStop ... \\NegFlank`` along the plan's

@@ -40,6 +40,9 @@ from calib.procedures import RolePoint
 from planner.parts.stator import StatorGeometry
 from planner.parts.stator_demo import STATOR_REPORT
 from planner.parts.stator_mesh import build_stator_mesh
+from planner.program.build import build_program
+from planner.program.controllers import controller
+from planner.program.safety import SafetySpec
 from planner.sim.error_map import error_map
 from planner.sim.predict import predict
 from planner.sim.probe import ReachabilityHook, cell_search_hook
@@ -191,8 +194,10 @@ def stator_setup(
     pivot_wobj_m: ArrayLike | None = None,
     edge_inset_m: float = DEFAULT_EDGE_INSET_M,
     edge_tolerance_m: float = 2e-5,
+    program: str | None = None,
 ) -> tuple[SimulationSetup, trimesh.Trimesh]:
-    """The setup and mesh of the paper's A-H procedure on a stator (see :func:`validate`)."""
+    """The setup and mesh of the paper's A-H procedure on a stator (see :func:`validate`), with
+    the program the controller ``program`` runs (``None``: the default, adaptive RAPID)."""
     T_nom = check_transform(T_base_wobj_nominal, "T_base_wobj_nominal")
     check_stator_points(points)
     if misplacement is None:
@@ -205,17 +210,21 @@ def stator_setup(
     cfg = default_settings(sensor, edge_inset_m) if settings is None else settings
     part = build_stator_mesh(geometry) if mesh is None else mesh
     role_points = tuple(RolePoint(role, p) for role, p in points.items())
+    pivot = default_pivot(points) if pivot_wobj_m is None else np.asarray(pivot_wobj_m, float)
+    resolved = resolved_settings(cfg, sensor, edge_inset_m)
+    safety = SafetySpec(
+        max_translation_m=misplacement.max_translation_m,
+        max_angle_rad=misplacement.max_angle_rad,
+        pivot_wobj_m=(float(pivot[0]), float(pivot[1]), float(pivot[2])),
+        sensing_distance_m=sensor.sensing_distance_m,
+    )
     setup = SimulationSetup(
-        points=role_points,
-        method="hultman2013",
-        settings=resolved_settings(cfg, sensor, edge_inset_m),
+        program=build_program(role_points, resolved, safety, controller(program)),
         T_base_wobj_nominal=T_nom,
         sensor=sensor,
         robot_error=robot_error or RobotErrorModel(),
         misplacement=misplacement,
-        pivot_wobj_m=(
-            default_pivot(points) if pivot_wobj_m is None else np.asarray(pivot_wobj_m, float)
-        ),
+        pivot_wobj_m=pivot,
         faces=face_lookup(part, role_points, sensor.footprint_radius_m),
         edge_inset_m=edge_inset_m,
         edge_tolerance_m=edge_tolerance_m,
@@ -253,7 +262,8 @@ def validate(
         procedure: ``"hultman2013"`` (the only procedure of this form).
         reachability, cell, reach_trials, workers, progress: as :func:`simulate`.
         **kwargs: ``mesh``, ``sensor``, ``robot_error``, ``misplacement``, ``settings``,
-            ``pivot_wobj_m``, ``edge_inset_m``, ``edge_tolerance_m`` of :func:`stator_setup`
+            ``pivot_wobj_m``, ``edge_inset_m``, ``edge_tolerance_m``, ``program`` of
+            :func:`stator_setup`
             (settings default to the paper's with the sensor's analytic edge offset).
 
     Raises:

@@ -1,7 +1,7 @@
 """The accuracy of a plan predicted from the procedure's linearisation, with the same noise.
 
-:func:`predict` runs the plan's procedure (and the best fit fed as it is fed, and the x-offset
-run) against the ideal part at the nominal pose through
+:func:`predict` executes the plan's measuring program (the one the trials execute; and the
+best fit fed as it is fed, and the x-offset run) against the ideal part at the nominal pose through
 :func:`calib.procedures.linearize.linearize`, and combines the resulting Jacobians with the
 event covariance of every search (:func:`calib.procedures.linearize.event_covariance`: the
 sensor's own noise from :meth:`SensorModel.search_noise`, the robot's repeatability, the TCP
@@ -17,9 +17,9 @@ from numpy.typing import NDArray
 
 from calib.frames import motion_between
 from calib.probing import Probe
-from calib.procedures import procedure_kind
 from calib.procedures.comparison import FedFit
 from calib.procedures.linearize import event_covariance, linearize
+from planner.program.execute import execute
 from planner.sim.setup import SimulationSetup
 from planner.sim.xoffset import run_xoffset
 
@@ -59,13 +59,12 @@ def predict(setup: SimulationSetup, step_m: float = 1e-6, best_fit: bool = True)
         InputError: the ideal calibration fails (the plan cannot calibrate even without
             noise), or the procedure is not smooth around it.
     """
-    kind = procedure_kind(setup.method)
     fed = FedFit([rp.point for rp in setup.points], setup.edge_offset_m)
     T_nom = setup.T_base_wobj_nominal
     xs = setup.xoffset.with_holes(setup.xoffset.targets_wobj) if setup.xoffset else None
 
     def run(probe: Probe) -> dict[str, FloatArray]:
-        res = kind.run(list(setup.points), T_nom, probe, setup.settings)
+        res = execute(setup.program, T_nom, probe)
         out = {"procedure": motion_between(T_nom, res.T_base_wobj)}
         if best_fit:
             out["best_fit"] = motion_between(T_nom, fed(res).T_base_wobj)

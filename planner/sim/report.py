@@ -141,6 +141,9 @@ class ValidationReport:
         points_of_interest: per point row key, ``(3,)`` its point, wobj frame, metres.
         probe_points_wobj: ``(N, 3)`` the plan's probe points, wobj frame, metres.
         error_map: the procedure's error over the part (:mod:`planner.sim.error_map`), or None.
+        program: the measuring program every trial executed, by name (e.g. ``"RAPID,
+            adaptive A-H"``), and why it runs nominal when it does.
+        program_steps: its steps, one line each.
     """
 
     n_trials: int
@@ -166,6 +169,8 @@ class ValidationReport:
     points_of_interest: dict[str, FloatArray] = field(default_factory=dict)
     probe_points_wobj: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
     error_map: ErrorMap | None = None
+    program: str = ""
+    program_steps: tuple[str, ...] = ()
 
     def row(self, key: str, level_percent: float) -> IntervalRow:
         """The row ``key`` at ``level_percent``; raises KeyError when absent."""
@@ -229,6 +234,7 @@ def report_markdown(report: ValidationReport) -> str:
     head += ["paper protocol"] if protocol else []
     head += ["paper"] if paper else []
     lines = [
+        f"Program: {report.program}" if report.program else "Program: not given",
         f"Procedure: {report.method}, sensor: {report.sensor}. Trials: {report.n_trials}, "
         f"calibrated: {report.n_ok}, time: {report.elapsed_s:.2f} s on {report.workers} "
         "worker(s)" + (f"; paper protocol: {report.protocol}" if protocol else ""),

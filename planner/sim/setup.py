@@ -26,6 +26,7 @@ from calib.procedures import RolePoint
 from calib.procedures.base import edge_offset_of
 from planner.faces.checks import check_plan_faces
 from planner.faces.detection import find_planar_faces
+from planner.program.model import MeasuringProgram, search_keys
 from planner.sim.search_events import FaceLookup
 from planner.sim.xoffset import XOffsetSetup
 
@@ -68,19 +69,10 @@ def default_pivot(points: Sequence[RolePoint] | Mapping[str, ProbePoint]) -> Flo
 
 
 def search_aliases(points: Sequence[RolePoint]) -> dict[str, str]:
-    """``{search id: plan id}``: the ids a procedure may give a point's searches.
-
-    The plan id itself; a role held by exactly one point (the A-H procedure names its
-    searches by role); and either with ``"2"`` appended (its retakes ``"C2"``, ``"D2"``).
-    """
-    out: dict[str, str] = {}
-    roles = [rp.role for rp in points]
-    for rp in points:
-        names = [rp.point.id] + ([rp.role] if roles.count(rp.role) == 1 else [])
-        for name in names:
-            out.setdefault(name, rp.point.id)
-            out.setdefault(f"{name}2", rp.point.id)
-    return out
+    """``{search key: plan id}``: the keys a program gives a point's searches
+    (:func:`planner.program.model.search_keys`: the plan id, a role held by one point, the
+    retakes ``"C2"``, an edge point's ``"<id>@face"`` approach to its face)."""
+    return search_keys(points)
 
 
 def face_lookup(
@@ -103,11 +95,14 @@ def face_lookup(
 class SimulationSetup:
     """Everything a worker needs to run trials (picklable).
 
+    The program holds the plan's points with their roles, the procedure and its settings
+    (edge-event offset resolved, :func:`resolved_settings`): :attr:`points`, :attr:`method` and
+    :attr:`settings` read them from it, so a setup cannot simulate one procedure and predict
+    another.
+
     Attributes:
-        points: the plan's probe points with their roles, wobj frame.
-        method: the procedure's registry name (:data:`calib.procedures.PROCEDURES`).
-        settings: the procedure's settings, edge-event offset resolved
-            (:func:`resolved_settings`).
+        program: the measuring program each trial executes (the one a controller runs for
+            the plan: :func:`planner.program.build.measuring_program`).
         T_base_wobj_nominal: ``(4, 4)`` the nominal part pose, base frame.
         sensor: the sensor model (any kind of :data:`calib.models.SensorSettings`).
         robot_error: robot error model.
@@ -120,9 +115,7 @@ class SimulationSetup:
         edge_tolerance_m: edge bisection tolerance, m.
     """
 
-    points: tuple[RolePoint, ...]
-    method: str
-    settings: Any
+    program: MeasuringProgram
     T_base_wobj_nominal: FloatArray
     sensor: Any
     robot_error: RobotErrorModel
@@ -133,6 +126,21 @@ class SimulationSetup:
     xoffset: XOffsetSetup | None = None
     edge_inset_m: float = DEFAULT_EDGE_INSET_M
     edge_tolerance_m: float = 2e-5
+
+    @property
+    def points(self) -> tuple[RolePoint, ...]:
+        """The plan's probe points with their roles, wobj frame (the program's)."""
+        return self.program.points
+
+    @property
+    def method(self) -> str:
+        """The procedure's registry name (:data:`calib.procedures.PROCEDURES`)."""
+        return self.program.method
+
+    @property
+    def settings(self) -> Any:
+        """The procedure's settings, edge-event offset resolved (the program's)."""
+        return self.program.settings
 
     @property
     def edge_offset_m(self) -> float:

@@ -218,6 +218,8 @@ def build_report(
         workers=n_workers,
         reach_checked=n_reach,
         method=setup.method,
+        program=setup.program.describe()[0],
+        program_steps=tuple(setup.program.describe()[1:]),
         sensor=str(type(setup.sensor).KIND),
         outcomes=outcomes,
         predicted_cov_procedure=prediction.cov_procedure,

@@ -4,8 +4,9 @@
 A worker process holds one :class:`~planner.sim.setup.SimulationSetup` and one ray caster of
 the part (:func:`init_worker`); each trial draws its own misplacement and noise from its own
 seed (:meth:`TrialRunner.run_trial`), so results do not depend on which process runs which
-trial. A trial runs the plan's procedure from the registry (``ProcedureKind.run``) with the
-simulator registered for the plan's sensor, so every procedure validates the same way; then
+trial. A trial executes the plan's measuring program (:func:`planner.program.execute.execute`:
+the program a controller runs, nominal or adaptive) with the simulator registered for the plan's
+sensor, so every procedure validates the same way and as the robot runs it; then
 the best fit of the same measurements fed as the procedure is fed
 (:class:`calib.procedures.comparison.FedFit`), and the x-offset run when the plan has one.
 """
@@ -23,8 +24,8 @@ from numpy.typing import NDArray
 
 from calib.errors import InputError, ProbeFailedError
 from calib.frames import motion_between
-from calib.procedures import procedure_kind
 from calib.procedures.comparison import FedFit
+from planner.program.execute import execute
 from planner.sim.pool import kill_pool, open_pool
 from planner.sim.raycast import MeshRayCaster
 from planner.sim.search_events import ProbeEvent, ReachabilityHook, search_group
@@ -93,7 +94,6 @@ class TrialRunner:
     def __init__(self, setup: SimulationSetup, mesh: trimesh.Trimesh, cell: Any = None) -> None:
         self.setup = setup
         self.caster = MeshRayCaster(mesh)
-        self.kind = procedure_kind(setup.method)
         self.simulator = sensor_kind(setup.sensor).load()
         self.fed_fit = FedFit([rp.point for rp in setup.points], setup.edge_offset_m)
         self.cell = cell
@@ -133,7 +133,7 @@ class TrialRunner:
         d_proc = d_fit = nan6
         x_err: FloatArray | None = None
         try:
-            run = self.kind.run(list(setup.points), T_nom, probe, setup.settings)
+            run = execute(setup.program, T_nom, probe)
             d_proc = motion_between(T_true, run.T_base_wobj)
             d_fit = motion_between(T_true, self.fed_fit(run).T_base_wobj)
         except ProbeFailedError as exc:

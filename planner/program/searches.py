@@ -1,6 +1,6 @@
 """The searches an exported program runs for one point, from its safe start.
 
-Every exporter moves to a point's safe start (:mod:`planner.export.safety`) and searches from
+Every exporter moves to a point's safe start (:mod:`planner.program.safety`) and searches from
 there, which is not the plan's search start when the safe clearance is the larger:
 
 - an **approach** point: one search from the safe start ``face + max(clearance, start offset) *
@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 from calib.errors import InputError
 from calib.frames import transform_directions, transform_points
 from calib.probing import ProbePoint, SearchCommand
-from planner.export.safety import SafetySpec
+from planner.program.safety import SafetySpec
 
 FloatArray = NDArray[np.float64]
 

@@ -1,0 +1,259 @@
+"""A plan plus a controller gives exactly one measuring program: :func:`measuring_program`.
+
+The program is adaptive when the controller computes the plan's procedure's frame update
+(:attr:`planner.program.controllers.Controller.adaptive_methods`) and the plan has every role
+the procedure steers by; else every search runs once, in plan order, in the nominal frame, and
+``wobjcal calibrate`` computes the frame from the recorded points. An adaptive program's order
+(retakes included) and where it updates its estimate come from a dry run of the procedure itself
+on the ideal nominal part, never from a second copy of its logic.
+
+Also here, because every face needs them from the same place: the misplacement tolerance the
+safe starts are computed for (:func:`safety_spec`), the A-H specifics an adaptive RAPID program
+is written from (:func:`adaptive_spec`), and the orders in which any exported program probes the
+points (:func:`probe_orders`, :func:`predecessors`: the moves ``wobjcal check`` walks).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from calib.errors import InputError, ProbeFailedError
+from calib.paper.settings import Hultman2013
+from calib.plan.file import Plan
+from calib.probing import ProbeResult, SearchCommand
+from calib.procedures import RolePoint, procedure_kind
+from calib.procedures.base import edge_offset_of
+from calib.procedures.linearize import PlaneProbe
+from planner.program.controllers import CONTROLLERS, Controller, controller
+from planner.program.model import (
+    FACE_APPROACH,
+    FrameStep,
+    MeasuringProgram,
+    MoveStep,
+    SearchStep,
+    Step,
+    UpdateStep,
+    search_keys,
+)
+from planner.program.safety import SafetySpec
+
+
+def safety_spec(plan: Plan) -> SafetySpec:
+    """The misplacement tolerance and sensing distance of ``plan``'s validation settings.
+
+    The rotation pivot is the centroid of the probe points, as in ``wobjcal validate``.
+    """
+    v = plan.validation
+    pivot = np.mean([p.position_m for p in plan.points], axis=0) if plan.points else np.zeros(3)
+    return SafetySpec(
+        max_translation_m=v.misplacement.max_translation_m,
+        max_angle_rad=v.misplacement.max_angle_rad,
+        pivot_wobj_m=(float(pivot[0]), float(pivot[1]), float(pivot[2])),
+        sensing_distance_m=v.sensor.standoff_m,
+    )
+
+
+def measuring_program(plan: Plan, controller_name: str | None = None) -> MeasuringProgram:
+    """The program ``controller_name`` (default :data:`~planner.program.controllers.
+    DEFAULT_CONTROLLER`) runs for ``plan``.
+
+    Raises:
+        InputError: unknown controller; or an adaptive program whose procedure refuses the
+            plan's layout on the ideal part (the message says why).
+    """
+    vias = {p.id: len(p.via_points) for p in plan.points}
+    return build_program(
+        plan.role_points(),
+        plan.procedure,
+        safety_spec(plan),
+        controller(controller_name),
+        vias,
+    )
+
+
+def build_program(
+    points: Sequence[RolePoint],
+    settings: object,
+    safety: SafetySpec,
+    target: Controller,
+    vias: Mapping[str, int] | None = None,
+) -> MeasuringProgram:
+    """The program ``target`` runs for ``points`` with the procedure of ``settings``.
+
+    Args:
+        points: the plan's points with their roles, wobj frame.
+        settings: the procedure's settings struct (its type names the procedure).
+        safety: the misplacement tolerance the safe starts are computed for.
+        target: the controller.
+        vias: ``{point id: number of vias}``.
+    """
+    kind = procedure_kind(settings)  # type: ignore[arg-type]
+    steers = kind.method in target.adaptive_methods
+    adaptive = steers and kind.adaptive_layout(points) is not None
+    note = ""
+    if not adaptive:
+        why = target.why_nominal if not steers else "the plan lacks a role the update needs"
+        note = f"every search once, in the nominal frame: {why}"
+    if adaptive:
+        steps = _adaptive_steps(points, kind.method, settings, vias or {})
+    else:
+        steps = _nominal_steps(points, vias or {})
+    steps.append(FrameStep(on_controller=adaptive, method_label=kind.label))
+    return MeasuringProgram(
+        controller=target,
+        method=kind.method,
+        method_label=kind.label,
+        steering="adaptive" if adaptive else "nominal",
+        steps=tuple(steps),
+        safety=safety,
+        points=tuple(points),
+        settings=settings,
+        note=note,
+    )
+
+
+def _point_steps(
+    point_id: str, key: str, kind: str, frame: Literal["nominal", "estimate"], n_vias: int
+) -> list[Step]:
+    """The move into a point and its searches (an edge point approaches its face first)."""
+    f = frame
+    steps: list[Step] = [MoveStep(point_id, n_vias)]
+    if kind == "edge":
+        steps.append(
+            SearchStep(key + FACE_APPROACH, point_id, "approach", f, "safe start", recorded=False)
+        )
+        steps.append(SearchStep(key, point_id, "edge", f, "measured face point"))
+    else:
+        steps.append(SearchStep(key, point_id, "approach", f, "safe start"))
+    return steps
+
+
+def _nominal_steps(points: Sequence[RolePoint], vias: Mapping[str, int]) -> list[Step]:
+    steps: list[Step] = []
+    for rp in points:
+        p = rp.point
+        steps += _point_steps(p.id, p.id, p.search.kind, "nominal", vias.get(p.id, 0))
+    return steps
+
+
+@dataclass
+class _Recorder:
+    """A probe on the ideal nominal part that records each command (the dry run)."""
+
+    ideal: PlaneProbe
+    commands: list[SearchCommand]
+
+    def __call__(self, cmd: SearchCommand) -> ProbeResult:
+        self.commands.append(cmd)
+        return self.ideal(cmd)
+
+
+def _adaptive_steps(
+    points: Sequence[RolePoint], method: str, settings: object, vias: Mapping[str, int]
+) -> list[Step]:
+    """The steps of the procedure run adaptively: its own dry run on the ideal part, each
+    command a search (an estimate update wherever the commanded frame changed)."""
+    kind = procedure_kind(method)
+    T = np.eye(4)
+    rec = _Recorder(PlaneProbe(T, edge_offset_of(settings)), [])
+    try:
+        kind.run(list(points), T, rec, settings)
+    except (InputError, ProbeFailedError) as exc:
+        raise InputError(f"the adaptive {kind.label} program refuses the layout: {exc}") from exc
+    keys = search_keys(points)
+    by_id = {rp.point.id: rp.point for rp in points}
+    steps: list[Step] = []
+    since: list[str] = []
+    last = T
+    for cmd in rec.commands:
+        if not np.array_equal(cmd.T_base_wobj_estimate, last) and since:
+            steps.append(UpdateStep(tuple(since)))
+            since = []
+        last = cmd.T_base_wobj_estimate
+        pid = keys.get(cmd.point_id, cmd.point_id)
+        point = by_id[pid]
+        plan_start = SearchCommand.from_point(point, last).start_m
+        updated = any(isinstance(s, UpdateStep) for s in steps)
+        frame: Literal["nominal", "estimate"] = "estimate" if updated else "nominal"
+        if point.search.kind == "edge" and not np.allclose(cmd.start_m, plan_start, atol=1e-9):
+            steps += [
+                MoveStep(pid, vias.get(pid, 0)),
+                SearchStep(cmd.point_id, pid, "edge", frame, "measured point"),
+            ]
+        else:
+            steps += _point_steps(pid, cmd.point_id, point.search.kind, frame, vias.get(pid, 0))
+        since.append(cmd.point_id)
+    return steps
+
+
+def programs(plan: Plan) -> list[MeasuringProgram]:
+    """The program of every controller for ``plan`` (those whose procedure refuses the layout
+    left out: no program runs it)."""
+    out = []
+    for name in CONTROLLERS:
+        try:
+            out.append(measuring_program(plan, name))
+        except InputError:
+            continue
+    return out
+
+
+@dataclass(frozen=True)
+class AdaptiveSpec:
+    """A procedure the program runs adaptively: the paper's A-H (``hultman2013`` plans).
+
+    Attributes:
+        index: ``{role: i}`` the target index (0-based, plan order) of each role ``A``..``H``.
+        settings: the plan's A-H settings (an unset edge-event offset counts as 0, as
+            ``wobjcal calibrate`` does: :attr:`Hultman2013.edge_offset_m`).
+        face_coords_wobj: x of the side face, y of the short side, z of the top, wobj, m.
+    """
+
+    index: dict[str, int]
+    settings: Hultman2013
+    face_coords_wobj: tuple[float, float, float]
+
+
+def adaptive_spec(plan: Plan) -> AdaptiveSpec | None:
+    """The A-H specifics an adaptive program is written from, or ``None``: the procedure has
+    no adaptive layout, or the plan lacks a role."""
+    layout = procedure_kind(plan.procedure).adaptive_layout(plan.role_points())
+    if layout is None or not isinstance(plan.procedure, Hultman2013):
+        return None
+    face = layout.face_coords_wobj
+    return AdaptiveSpec(
+        index={p.role: i for i, p in enumerate(plan.points)},
+        settings=plan.procedure,
+        face_coords_wobj=(float(face[0]), float(face[1]), float(face[2])),
+    )
+
+
+def probe_orders(plan: Plan) -> list[list[int]]:
+    """Every order (point indices, plan order numbering) in which an exported program probes
+    the plan's points: the :attr:`~MeasuringProgram.probe_order` of every controller's program
+    (plan order for a nominal one; A-H with the C and D retakes for the adaptive RAPID one).
+    The moves into a point's vias come from the point before it in each of these orders
+    (``wobjcal check`` checks them all)."""
+    index = {p.id: i for i, p in enumerate(plan.points)}
+    orders = [list(range(len(plan.points)))]
+    for prog in programs(plan):
+        order = [index[i] for i in prog.probe_order]
+        if order not in orders:
+            orders.append(order)
+    return orders
+
+
+def predecessors(plan: Plan) -> dict[int, list[int | None]]:
+    """``{point index: [the index of each point a program probes just before it]}`` over
+    :func:`probe_orders` (``None``: the point starts a program)."""
+    before: dict[int, list[int | None]] = {}
+    for order in probe_orders(plan):
+        for k, i in enumerate(order):
+            prev = order[k - 1] if k else None
+            if prev not in before.setdefault(i, []):
+                before[i].append(prev)
+    return before

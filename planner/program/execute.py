@@ -1,0 +1,124 @@
+"""Execute a measuring program against a probe: what a validate trial and the prediction run.
+
+:func:`execute` runs a :class:`~planner.program.model.MeasuringProgram` the way its controller
+does, against any :data:`calib.probing.Probe` (the simulated sensor on the misplaced part, the
+ideal part of the linearisation):
+
+- a **nominal** program measures every point once, in program order, commanded in the nominal
+  work object, and the frame is the procedure's :meth:`~calib.procedures.base.ProcedureKind.
+  estimate` of the recorded points (what ``wobjcal calibrate`` computes from the program's
+  results file);
+- an **adaptive** program is the procedure's own step-by-step run
+  (:meth:`~calib.procedures.base.ProcedureKind.run`), each search commanded in the frame the
+  program estimated so far (the RAPID A-H program is proven equal to it in
+  ``tests/test_export_rapid_adaptive.py``).
+
+Either way every search goes through :class:`ProgramProbe`, which runs it as the exported program
+does (:mod:`planner.program.searches`): from the point's safe start, an edge point first
+approaching the face its edge search runs along and then searching from the measured face point.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from calib.errors import ProbeFailedError
+from calib.frames import invert_transform, transform_points
+from calib.probing import Probe, ProbePoint, ProbeResult, SearchCommand
+from calib.procedures import ProcedureRun, RolePoint, procedure_kind
+from planner.program.model import FACE_APPROACH, MeasuringProgram, search_keys
+from planner.program.safety import SafetySpec
+from planner.program.searches import program_searches
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass
+class ProgramProbe:
+    """A probe that runs each search a procedure commands as the exported program runs it.
+
+    The procedure commands a search from the plan's start (:meth:`SearchCommand.from_point` in
+    its estimate); the program starts it at the point's safe start in that estimate, and an
+    edge point approaches its face first (key ``"<key>@face"``) and runs the edge search from
+    the measured face point up to where the plan's search ends. An edge search the procedure
+    starts elsewhere (from an earlier measurement) is run from there, as commanded.
+
+    Args:
+        probe: the probe that runs the searches (simulated sensor, ideal part).
+        points: the plan's points with their roles.
+        safety: the misplacement tolerance the safe starts are computed for.
+    """
+
+    probe: Probe
+    points: Sequence[RolePoint]
+    safety: SafetySpec
+    _keys: Mapping[str, str] = field(init=False, repr=False)
+    _by_id: Mapping[str, ProbePoint] = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self._keys = search_keys(self.points)
+        self._by_id = {rp.point.id: rp.point for rp in self.points}
+
+    def __call__(self, cmd: SearchCommand) -> ProbeResult:
+        """Run ``cmd`` as the program does; the result is that of its last (recorded) search."""
+        point = self._by_id.get(self._keys.get(cmd.point_id, ""))
+        if point is None:  # not a plan point (e.g. the x-offset run): as commanded
+            return self.probe(cmd)
+        T = cmd.T_base_wobj_estimate
+        plan_start = SearchCommand.from_point(point, T).start_m
+        if not np.allclose(cmd.start_m, plan_start, rtol=0.0, atol=1e-9):
+            measured = transform_points(invert_transform(T), np.asarray(cmd.start_m))
+            searches = program_searches(point, T, self.safety, measured_start_wobj=measured)
+            return self.probe(replace(searches[1].command, point_id=cmd.point_id))
+        searches = program_searches(point, T, self.safety)
+        if point.search.kind == "approach":
+            return self.probe(replace(searches[0].command, point_id=cmd.point_id))
+        face = self.probe(replace(searches[0].command, point_id=cmd.point_id + FACE_APPROACH))
+        if face.point_m is None:
+            return ProbeResult(None, f"approach to the face: {face.reason}")
+        edge = searches[1].command
+        start = np.asarray(face.point_m, dtype=np.float64)
+        end = edge.start_m + edge.length_m * edge.direction
+        run = float((end - start) @ edge.direction)
+        if run <= 0.0:
+            return ProbeResult(None, "the measured face point lies past the end of the edge search")
+        return self.probe(replace(edge, point_id=cmd.point_id, start_m=start, length_m=run))
+
+
+def execute(
+    program: MeasuringProgram, T_base_wobj_nominal: FloatArray, probe: Probe
+) -> ProcedureRun:
+    """Run ``program`` with ``probe`` (see the module docstring) and compute its frame with
+    the program's procedure settings.
+
+    Args:
+        program: the program.
+        T_base_wobj_nominal: ``(4, 4)`` the nominal work object, base frame.
+        probe: runs one search.
+
+    Raises:
+        ProbeFailedError: a search failed (the program stops there).
+        InputError: the recorded points define no frame.
+    """
+    kind = procedure_kind(program.method)
+    points, settings = program.points, program.settings
+    run_as_program = ProgramProbe(probe, points, program.safety)
+    if program.adaptive:
+        return kind.run(list(points), T_base_wobj_nominal, run_as_program, settings)
+    by_id = {rp.point.id: rp.point for rp in points}
+    measured: dict[str, FloatArray] = {}
+    for step in program.searches:
+        if not step.recorded:
+            continue  # run inside its edge search's step by ProgramProbe
+        cmd = SearchCommand.from_point(by_id[step.point_id], T_base_wobj_nominal)
+        res = run_as_program(replace(cmd, point_id=step.key))
+        if res.point_m is None:
+            raise ProbeFailedError(step.key, res.reason or "no reason given")
+        q = np.asarray(res.point_m, dtype=np.float64)
+        prev = measured.get(step.point_id)
+        measured[step.point_id] = q[None] if prev is None else np.vstack([prev, q])
+    return kind.estimate(list(points), measured, T_base_wobj_nominal, settings)
