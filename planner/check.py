@@ -138,7 +138,8 @@ def plan_quality(
         return None, str(exc)
     try:
         setup = prediction_setup(plan, models, fmt)
-        return layout_quality(setup, poi_rows(plan.validation.report, mesh)), ""
+        quality = layout_quality(setup, poi_rows(plan.validation.report, mesh))
+        return replace(quality, program=setup.program.name), ""
     except (InputError, ProbeFailedError) as exc:
         return None, f"{plan.method}: {exc}"
 

@@ -264,6 +264,8 @@ def suggest_plan(
         for k, v in rej_e.items():
             rejected[k] = rejected.get(k, 0) + v
         pool = pool.joined(edges.subset(ok_e))
+    if steered and bool(pool.is_edge.any()):  # its frame update takes approach searches only
+        steered = False
     pivot = pool.positions_m.mean(axis=0)  # the probed region: the misplacement's pivot
     safety = SafetySpec(
         max_translation_m=m.max_translation_m,

@@ -40,8 +40,7 @@ Language (KSS 8, one statement a line, ``;`` comments, ``&`` header lines ignore
   ``RESUME``, which ends the routines down to the declaring level and goes on after the call
   (in the declaring routine) into the level below. KSS refuses a RESUME when the interrupted
   motion runs in the declaring routine itself ("impermissible program structure for RESUME"):
-  so does this interpreter, unless ``resume_in_declaring_level=True``, which ends the motion
-  and goes on after it.
+  so does this interpreter.
 
 Motion (mm and degrees; ``$WORLD`` = ``$ROBROOT`` = the robot base): ``PTP`` and ``LIN`` (also
 ``SPTP``, ``SLIN``; approximation ``C_PTP``/``C_DIS``/... ignored: every motion ends at its
@@ -1476,9 +1475,6 @@ class KrlMachine:
         sensor_input: the number of the input the sensor drives (``$IN[n]``).
         start_tcp_m: ``(4, 4)`` the TCP pose at the start, robot base, metres (``None``:
             unknown until the first Cartesian motion).
-        resume_in_declaring_level: accept a RESUME that KSS refuses, one whose interrupted
-            motion runs in the routine that declared the interrupt: end that motion there
-            and go on after it.
 
     Raises:
         KrlError: the module does not compile (the message names the line).
@@ -1492,7 +1488,6 @@ class KrlMachine:
         sensor: SensorFn | None = None,
         sensor_input: int = 1,
         start_tcp_m: np.ndarray | None = None,
-        resume_in_declaring_level: bool = False,
     ) -> None:
         if ".src" not in files:
             raise KrlError(f"no .src among {sorted(files)}")
@@ -1501,7 +1496,6 @@ class KrlMachine:
         self.search = search
         self.sensor = sensor
         self.sensor_input = sensor_input
-        self.resume_in_declaring_level = resume_in_declaring_level
         self.structs: dict[str, tuple[tuple[str, str], ...]] = dict(STRUCTS)
         self.enums: dict[str, tuple[str, ...]] = {}
         self.inputs: list[bool] = [False] * N_IO
@@ -2273,8 +2267,8 @@ class KrlMachine:
             else:
                 it.last = now
 
-    def _fire(self, it: _Interrupt, interrupted_depth: int, where: Src) -> bool:
-        """Run ``it``'s routine; True when a RESUME ended the interrupted statement here.
+    def _fire(self, it: _Interrupt, interrupted_depth: int, where: Src) -> None:
+        """Run ``it``'s routine (the interrupted statement goes on when it returns).
 
         Raises:
             _Unwind: RESUME goes back to the declaring routine, above the interrupted one.
@@ -2285,7 +2279,6 @@ class KrlMachine:
         self._isr.append(it)
         try:
             self._call(r, args)
-            return False
         except _Resume as res:
             if it.depth is None:
                 raise KrlError(
@@ -2294,8 +2287,6 @@ class KrlMachine:
                 ) from None
             if interrupted_depth > it.depth:
                 raise _Unwind(it.depth, res.where) from None
-            if self.resume_in_declaring_level:
-                return True
             raise KrlError(
                 f"RESUME for interrupt {it.prio} (declared at {it.decl.where}) while the "
                 f"interrupted statement {where} runs in the declaring routine itself: RESUME "
@@ -2458,8 +2449,7 @@ class KrlMachine:
                 break
             self._tcp = self._pose_on_line(start, goal, res * 1000.0)
             self.inputs[k] = not level
-            if self._interrupt_at(motion, frame):
-                return
+            self._interrupt_at(motion, frame)
         else:
             raise KrlError("the sensor input changed more than 8 times during one motion")
         self._tcp = goal
@@ -2488,9 +2478,9 @@ class KrlMachine:
         R = R0 @ matrix_from_rotvec(s * rotvec_from_matrix(R0.T @ goal[:3, :3]))
         return make_transform(R, p_mm)
 
-    def _interrupt_at(self, motion: Motion, frame: _Frame) -> bool:
-        """Fire the interrupts whose condition turned TRUE at the current pose; True when
-        one of them ended the motion there."""
+    def _interrupt_at(self, motion: Motion, frame: _Frame) -> None:
+        """Fire the interrupts whose condition turned TRUE at the current pose (a RESUME ends
+        the motion there: :class:`_Unwind`)."""
         assert self._tcp is not None
         self.system["$POS_INT"].value = self._pose_struct(self._tcp)
         for it in self._active():
@@ -2498,11 +2488,9 @@ class KrlMachine:
             if now and not it.last:
                 it.last = True
                 motion.interrupts.append(it.prio)
-                if self._fire(it, frame.depth, motion.where):
-                    return True
+                self._fire(it, frame.depth, motion.where)
             else:
                 it.last = now
-        return False
 
 
 def _mm(T_m: np.ndarray) -> np.ndarray:

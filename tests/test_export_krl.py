@@ -71,7 +71,7 @@ def test_program_structure() -> None:
     files = export_files(build_job(plan, np.eye(4), ToolData(T_flange_tcp=np.eye(4))), "krl")
     src, dat = files[".src"], files[".dat"]
     assert "DEF WobjcalThreeTwoOneSmall()" in src and "DEFDAT WobjcalThreeTwoOneSmall" in dat
-    assert len(re.findall(r"^DEF ", src, re.M)) == len(re.findall(r"^END$", src, re.M)) == 5
+    assert len(re.findall(r"^DEF ", src, re.M)) == len(re.findall(r"^END$", src, re.M)) == 6
     assert len(re.findall(r"^\s*IF .* THEN$", src, re.M)) == src.count("ENDIF")
     edge = [p.id for p in plan.points if p.search.kind == "edge"]
     assert len(re.findall(r"^ +SEARCH_FALL\(x", src, re.M)) == len(edge)
@@ -81,6 +81,39 @@ def test_program_structure() -> None:
     assert "INTERRUPT DECL 21 WHEN diSensor==FALSE" in src
     assert "xHit=$POS_INT" in src and "RESUME" in src
     assert "SIGNAL diSensor $IN[1]" in dat
+    # RESUME needs the search motion one level below the routine declaring the interrupt
+    search_move = re.search(r"^DEF SEARCH_MOVE\(xTo:IN\)\n(.*?)^END$", src, re.M | re.S)
+    assert search_move is not None and "  LIN xTo\n  WAIT SEC 0" in search_move.group(1)
+    for routine in ("SEARCH_RISE", "SEARCH_FALL"):
+        body = re.search(rf"^DEF {routine}\(.*?^END$", src, re.M | re.S)
+        assert body is not None and "INTERRUPT DECL" in body.group(0)
+        assert "  SEARCH_MOVE(xGoal)" in body.group(0) and "LIN" not in body.group(0)
+
+
+def test_krl_names_fit_24_characters_rapid_keeps_32() -> None:
+    """KRL's names have at most 24 characters; the RAPID module name keeps its 32."""
+    from dataclasses import replace
+
+    from planner.export.krl import _names, program_name
+
+    plan = load_plan(VALID)
+    job = build_job(plan, np.eye(4), ToolData(T_flange_tcp=np.eye(4)))
+    job = replace(job, name="WobjcalPlateHolesThreeTwoOne")
+    assert program_name(job.name) == "WobjcalPlateHolesThreeTw"
+    assert "DEF WobjcalPlateHolesThreeTw()" in export_files(job, "krl")[".src"]
+    assert "MODULE WobjcalPlateHolesThreeTwoOne" in export_files(job, "rapid")[".mod"]
+    ids = ["A", "a", "A_2", "x" * 32, "X" * 32, "x" * 31 + "y", "_"]
+    targets = tuple(replace(job.targets[0], point_id=i) for i in ids)
+    names = _names(targets)
+    assert names == [
+        "xA",
+        "xa_2",
+        "xA_2_2",
+        "x" * 18,
+        "x" + "X" * 15 + "_2",
+        "x" * 16 + "_3",
+        "x",
+    ]
 
 
 # ---- status and turn from the checked pose (issue 10) ----------------------------------------

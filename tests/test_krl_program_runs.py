@@ -9,12 +9,15 @@ A search that finds nothing, or an input already at its level, takes the program
 The ideal part is :class:`tests.box_part.BoxProbe` for plans on the stator box, else
 :class:`PlaneWorld`.
 
-Found while writing these: three things the KRL compiler or controller refuses (the ``xfail``
-tests at the end, strict so that they fail once the writer is fixed).
+The interpreter runs KSS's semantics strictly: ``RESUME`` only where the interrupted motion runs
+below the routine that declared the interrupt, names of at most 24 characters, unique ignoring
+case. The tests at the end pin what the writer once got wrong there: a search ``LIN`` in the
+declaring routine, point ids differing only in case, long point ids and plan names.
 """
 
 from __future__ import annotations
 
+import re
 import typing
 from collections.abc import Callable
 from dataclasses import replace
@@ -243,9 +246,8 @@ def variant_job(path: Path, variant: str) -> tuple[Plan, ExportJob, dict[str, st
 
 
 def run(files: dict[str, str], search: SearchFn, **kwargs: typing.Any) -> KrlMachine:
-    """The program run to its end, its RESUME taken as the writer means it (the strict
-    xfail test below)."""
-    m = KrlMachine(files, search, resume_in_declaring_level=True, **kwargs).run()
+    """The program run to its end (no HALT, no error)."""
+    m = KrlMachine(files, search, **kwargs).run()
     assert m.finished and m.halted is None
     return m
 
@@ -541,32 +543,44 @@ def test_interpreter_errors_name_the_line(body: str, message: str) -> None:
 
 
 # ------------------------------------------------------------------ the writer's KRL, strictly
-def _refused(call: Callable[[], object], because: str) -> None:
-    """Run ``call``; re-raise its KrlError if it says ``because`` (the expected failure of a
-    strict xfail), fail otherwise (a KrlError for another reason is a new problem)."""
-    try:
-        call()
-    except KrlError as err:
-        assert because in str(err), err
-        raise
-
-
-@pytest.mark.xfail(
-    strict=True,
-    raises=KrlError,
-    reason="writer bug: SEARCH_RISE/SEARCH_FALL declare their interrupt in the routine that runs "
-    "the search LIN, so HIT_20/HIT_21's RESUME has no lower level to end (KSS: impermissible "
-    "program structure for RESUME)",
-)
-def test_the_search_routines_resume_as_krl_allows() -> None:
+def _stator_files() -> tuple[Plan, dict[str, str]]:
     plan = load_plan(STATOR)
-    T_nom = nominal_T_base_wobj(plan)
-    job = build_job(plan, T_nom, ToolData(T_flange_tcp=np.eye(4)))
-    files = export_files(job, "krl")
-    _refused(
-        lambda: KrlMachine(files, ideal_part(plan, T_nom)).run(),
-        "impermissible program structure for RESUME",
-    )
+    job = build_job(plan, nominal_T_base_wobj(plan), ToolData(T_flange_tcp=np.eye(4)))
+    return plan, export_files(job, "krl")
+
+
+def test_the_search_routines_resume_as_krl_allows() -> None:
+    """SEARCH_RISE/SEARCH_FALL declare the interrupt and run the search ``LIN`` one level
+    below, in SEARCH_MOVE: HIT_20/HIT_21's RESUME ends SEARCH_MOVE where the input switched
+    and the program goes on in the search routine. (The writer once ran the ``LIN`` in the
+    declaring routine: KSS stops with "impermissible program structure for RESUME".)"""
+    plan, files = _stator_files()
+    m = run(files, ideal_part(plan, nominal_T_base_wobj(plan)))
+    assert len(m.searches) == 10
+    for s in m.searches:
+        assert s.where.text.strip() == "LIN xTo" and s.interrupts in ([20], [21])
+        assert s.end_m is not None and s.target_m is not None
+        hit = s.events[-1]
+        assert not isinstance(hit, str) and np.abs(s.end_m[:3, 3] - hit).max() < 1e-12
+        assert np.abs(s.end_m[:3, 3] - s.target_m[:3, 3]).max() > 1e-3  # stopped on the way
+
+
+def test_negative_edge_directions_are_written_in_parentheses() -> None:
+    """``fDot*(-0.5)``, never ``fDot*-0.5`` (a sign right after ``*``, which KRL may refuse)."""
+    plan = with_edges(load_plan(PLATE))
+    job = build_job(plan, nominal_T_base_wobj(plan), ToolData(T_flange_tcp=np.eye(4)))
+    src = export_files(job, "krl")[".src"]
+    assert "*(-" in src and not re.search(r"\*\s*-", src)
+
+
+def test_no_routine_parameter_shadows_module_data() -> None:
+    """A routine's parameters and local data are not also names of the module's data list
+    (KRL allows it, but which one a statement means is then a question)."""
+    _, files = _stator_files()
+    module, local = _krl_names(files)
+    params = re.findall(r"^DEF \w+\((.*)\)", files[".src"], re.M)
+    names = local + [a.split(":")[0] for ps in params for a in ps.split(",") if a]
+    assert names and not {n.upper() for n in names} & {n.upper() for n in module}
 
 
 def _renamed(plan: Plan, ids: list[str]) -> Plan:
@@ -575,34 +589,76 @@ def _renamed(plan: Plan, ids: list[str]) -> Plan:
     return msgspec.structs.replace(plan, points=points + plan.points[len(ids) :])
 
 
-@pytest.mark.xfail(strict=True, raises=KrlError, reason="writer bug: names KRL refuses")
+def _krl_names(files: dict[str, str]) -> tuple[list[str], list[str]]:
+    """The names the module declares: the data list's and the routines' (one scope), and the
+    routines' parameters and local data (each routine's own)."""
+    dat, src = files[".dat"], files[".src"]
+    module = re.findall(r"^(?:DEFDAT|DECL \w+|SIGNAL) (\w+)", dat, re.M)
+    module += re.findall(r"^DEF (\w+)", src, re.M)[1:]  # the main DEF is the DEFDAT's name
+    return module, re.findall(r"^  DECL \w+ (\w+)", src, re.M)
+
+
+def assert_legal_names(files: dict[str, str]) -> list[str]:
+    """At most 24 characters each, the module's unique ignoring case; returns them."""
+    module, local = _krl_names(files)
+    assert all(len(n) <= 24 for n in module + local), module + local
+    assert len({n.upper() for n in module}) == len(module), module
+    return module
+
+
 @pytest.mark.parametrize(
-    ("change", "because"),
+    ("change", "names"),
     [
         pytest.param(
             lambda plan: _renamed(plan, ["P1", "p1"]),
-            "XP1_START declared twice",
+            ["xP1_start", "xp1_2_start"],
             id="ids_differing_in_case",
         ),
         pytest.param(
             lambda plan: _renamed(plan, ["Point_number_one_long"]),
-            "has 26 characters, KRL allows 24",
+            ["xPoint_number_one_start"],
             id="long_point_id",
         ),
         pytest.param(
+            lambda plan: _renamed(plan, ["Point_number_one_long", "POINT_NUMBER_ONE_LONGER"]),
+            ["xPoint_number_one_start", "xPOINT_NUMBER_ON_2_start"],
+            id="long_ids_cut_alike",
+        ),
+        pytest.param(
             lambda plan: msgspec.structs.replace(plan, name="plate holes three two one"),
-            "WOBJCALPLATEHOLESTHREETWOONE has 28 characters",
+            ["WobjcalPlateHolesThreeTw"],
             id="long_plan_name",
         ),
     ],
 )
-def test_names_are_legal_krl(change: Callable[[Plan], Plan], because: str) -> None:
-    """Point ids differing only in case give one KRL name twice (KRL is case-insensitive);
+def test_names_are_legal_krl(change: Callable[[Plan], Plan], names: list[str]) -> None:
+    """Point ids differing only in case get different KRL names (KRL is case-insensitive);
     ids over 17 characters (``x<id>_start``) and plan names whose words join to over 17
-    characters (``Wobjcal<Words>``) give names over KRL's 24 characters. The plan model
-    accepts all three."""
+    characters (``Wobjcal<Words>``) are cut to KRL's 24 characters. The plan model accepts all
+    of them; the program compiles and measures as computed."""
     plan = load_plan(PLATE)
     plan = change(msgspec.structs.replace(plan, points=plan.points[:2]))
     job = build_job(plan, nominal_T_base_wobj(plan), ToolData(T_flange_tcp=np.eye(4)))
     files = export_files(job, "krl")
-    _refused(lambda: KrlMachine(files, PlaneWorld(plan, job.T_base_wobj)), because)
+    m = run(files, PlaneWorld(plan, job.T_base_wobj))
+    assert_runs_as_computed(m, job, Expected(job, PlaneWorld(plan, job.T_base_wobj)))
+    assert set(names) <= set(assert_legal_names(files))
+
+
+def test_random_long_ids_and_names_make_legal_krl() -> None:
+    """Point ids of up to 32 characters (the plan's limit) differing in case or only after
+    their 17th character, with vias, and a long plan name: the module compiles, runs and
+    measures every point as computed."""
+    rng = np.random.default_rng(23)
+    plan = with_edges(load_plan(PLATE))
+    stem = "".join(rng.choice(list("abcXYZ_09"), 16))
+    ids = [f"{stem}{k}" for k in range(3)] + [f"{stem}0".upper(), f"{stem}0".lower(), "S" * 32]
+    plan = _renamed(plan, ids[: len(plan.points)])
+    plan = msgspec.structs.replace(plan, name="a very long plan name " * 3)
+    job = build_job(plan, nominal_T_base_wobj(plan), ToolData(T_flange_tcp=np.eye(4)))
+    files = export_files(job, "krl")
+    T_true = job.T_base_wobj @ full_misplacement(plan, rng)
+    m = run(files, PlaneWorld(plan, T_true))
+    assert_runs_as_computed(m, job, Expected(job, PlaneWorld(plan, T_true)))
+    per_point = [3 + (t.kind == "edge") + len(t.vias_q_rad) for t in job.targets]
+    assert len(assert_legal_names(files)) == 13 + 5 + sum(per_point)  # data, routines, targets

@@ -25,7 +25,7 @@ from planner.plan_cell import nominal_T_base_wobj
 from planner.program import CONTROLLERS, execute, measuring_program
 from planner.program.build import probe_orders
 from tests.box_part import BoxProbe
-from tests.rapid_interp import Machine
+from tests.rapid_interp import Machine, _vec
 from tests.test_export_rapid_adaptive import full_misplacement, rapid_search
 
 PLANS = Path(__file__).resolve().parents[1] / "assets" / "plans"
@@ -40,9 +40,17 @@ def test_a_plan_and_a_controller_give_one_named_program() -> None:
     assert measuring_program(stator, "krl").name == "KRL, nominal A-H"
     assert measuring_program(stator, "fanuc").name == "TP, nominal A-H"
     assert measuring_program(fit, "urscript").name == "URScript, nominal best fit"
-    assert measuring_program(three, None).name == "RAPID, nominal 3-2-1"
-    assert "nominal frame" in measuring_program(fit, "rapid").note
+    assert measuring_program(three, None).name == "RAPID, adaptive 3-2-1"
+    assert measuring_program(fit, "rapid").name == "RAPID, adaptive best fit"
+    assert "nominal frame" in measuring_program(fit, "krl").note
     assert measuring_program(stator, "rapid").note == ""
+    # an edge search: the RAPID best-fit update takes approach searches only
+    edge = next(p for p in stator.points if p.search.kind == "edge")
+    with_edge = msgspec.structs.replace(
+        fit, points=(*fit.points, msgspec.structs.replace(edge, id="E9", role="fit"))
+    )
+    prog = measuring_program(with_edge, "rapid")
+    assert prog.name == "RAPID, nominal best fit" and "approach searches only" in prog.note
     with pytest.raises(InputError, match="format must be one of"):
         measuring_program(stator, "kawasaki")
 
@@ -174,3 +182,55 @@ def test_a_validate_trial_executes_the_program_of_the_chosen_controller() -> Non
     assert "Program: URScript, nominal best fit" in report.to_markdown()
     # one search per point: no second round, no re-aimed search
     assert {o.point_id: o.searches for o in report.outcomes} == {p.id: 4 for p in plan.points}
+
+
+def _world_probe(world):  # type: ignore[no-untyped-def]
+    """The same ideal part as a :data:`calib.probing.Probe` (what the executor calls)."""
+
+    def probe(cmd: SearchCommand) -> ProbeResult:
+        end = cmd.start_m + cmd.length_m * cmd.direction
+        hit = world(cmd.start_m, end, cmd.sensor_axis, cmd.kind == "edge")
+        if isinstance(hit, str):
+            return ProbeResult(None, hit)
+        return ProbeResult(np.asarray(hit, dtype=float))
+
+    return probe
+
+
+@pytest.mark.parametrize("path", [PLATE_FIT, PLATE_321])
+@pytest.mark.parametrize("seed", range(3))
+def test_the_adaptive_rapid_fit_programs_compute_what_the_executor_computes(
+    path: Path, seed: int
+) -> None:
+    """RAPID's best-fit and 3-2-1 programs steer themselves (``Steer``: Gauss-Newton with
+    the update's basis as constants): run in the RAPID interpreter on an ideal part misplaced
+    at the plan's full bound, every measured point and the final wobjCal equal the executed
+    program's (1e-6 mm), and the frame is the true part's (exact measurements)."""
+    from calib.plan.measurements import measurements_from_json
+    from tests.test_krl_program_runs import PlaneWorld
+
+    plan = load_plan(path)
+    T_nom = nominal_T_base_wobj(plan)
+    T_true = T_nom @ full_misplacement(plan, np.random.default_rng(200 + seed))
+    prog = measuring_program(plan, "rapid")
+    assert prog.steers_itself and prog.name.startswith("RAPID, adaptive")
+    job = build_job(plan, T_nom, ToolData(T_flange_tcp=np.eye(4)))
+    world = PlaneWorld(plan, T_true)
+    m = Machine(export_files(job, "rapid")[".mod"], world)
+    m.main()
+    assert m.tp[-2].startswith("wobjcal: done"), m.tp
+    run = execute(prog, T_nom, _world_probe(world))
+    meas = measurements_from_json(m.files["wobjcal_measured.json"], "program")
+    slot = {t.point_id: i for i, t in enumerate(job.targets)}
+    for pid, q in run.measured_m.items():  # the PERS array (the file has 0.001 mm)
+        assert np.abs(_vec(m.globals["measured"][slot[pid]]) / 1000.0 - q).max() < 1e-9, pid
+        assert np.abs(np.asarray(meas.points[pid]) / 1000.0 - q).max() < 1e-6, pid
+    T_prog = m.wobj_matrix_m("wobjCal")
+    assert np.abs(T_prog[:3, 3] - run.T_base_wobj[:3, 3]).max() < 1e-9
+    assert np.abs(T_prog[:3, :3] - run.T_base_wobj[:3, :3]).max() < 1e-9
+    assert np.abs(run.T_base_wobj - T_true).max() < 1e-9  # exact planes: the true part
+    # and it is the frame `wobjcal calibrate` computes from the program's file
+    kind = procedure_kind(plan.procedure)
+    table = {k: np.asarray(v)[None] for k, v in run.measured_m.items()}
+    ref = kind.estimate(plan.role_points(), table, T_nom, plan.procedure)
+    assert np.abs(ref.T_base_wobj - T_prog).max() < 1e-9

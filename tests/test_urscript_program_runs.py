@@ -9,20 +9,13 @@ measured face point), to 1e-6 mm. The sensor is :class:`tests.box_part.BoxProbe`
 plan's points lie on that box, else :class:`PlaneProbe` (each point's nominal face plane moved
 by the true pose).
 
-Known writer bugs (``planner/export/urscript.py``; the writer is not changed here). The runs
-below apply :func:`tolerate_known_writer_bugs` to the text; the ``as_exported`` tests are strict
-xfails that start to pass, and so fail, once the writer is fixed: then delete the workaround.
-
-1. ``def run_search(end, want, speed):`` names a parameter ``end``, the keyword that closes
-   every block: the program does not compile on a controller (the interpreter, like the
-   URScript grammar, reserves the block keywords).
-2. ``textmsg(name, " failed: ...", result[0])`` passes three arguments to ``textmsg(s1,
-   s2='')``: a call the controller refuses, on the path every failed point takes.
+The programs run as exported: the interpreter compiles them as the controller does (block
+keywords reserved, argument counts checked), so a parameter named ``end`` or a ``textmsg`` with
+three arguments, two bugs the writer once had, fail here (the ``as_exported`` tests).
 """
 
 from __future__ import annotations
 
-import re
 import typing
 from collections.abc import Callable
 from pathlib import Path
@@ -68,31 +61,6 @@ STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
 #: 1e-6 mm: the ideal probe and the interpreter are exact up to rounding.
 TOL_M = 1e-9
 NOT_FOUND = "ERR_WHLSEARCH"
-
-
-# ------------------------------------------------------------------ known writer bugs
-def rename_end_parameter(text: str) -> str:
-    """Writer bug 1: the parameter ``end`` of ``run_search`` renamed ``end_pose`` (every
-    ``end`` that is not a line of its own, comments left as they are)."""
-    out = []
-    for line in text.split("\n"):
-        code, hash_, comment = line.partition("#")
-        if code.strip() != "end":
-            code = re.sub(r"\bend\b", "end_pose", code)
-        out.append(code + hash_ + comment)
-    return "\n".join(out)
-
-
-def two_argument_textmsg(text: str) -> str:
-    """Writer bug 2: ``textmsg(a, "b", c)`` written ``textmsg(str_cat(a, "b"), c)``."""
-    return re.sub(
-        r'textmsg\(([^,()"]+), ("[^"]*"), ([^,()"]+)\)', r"textmsg(str_cat(\1, \2), \3)", text
-    )
-
-
-def tolerate_known_writer_bugs(text: str) -> str:
-    """The exported text with the two known writer bugs (module docstring) worked around."""
-    return two_argument_textmsg(rename_end_parameter(text))
 
 
 # ------------------------------------------------------------------ ideal sensors
@@ -280,7 +248,7 @@ def measured(machine: UrMachine, t: TargetPair) -> list[float]:
 def run_and_compare(job: ExportJob, text: str, search: SearchFn, **options: object) -> UrMachine:
     """Run the program against ``search`` and check every point against the reference."""
     program = Recorder(search)
-    machine = UrMachine(tolerate_known_writer_bugs(text), program, **options).run()  # type: ignore[arg-type]
+    machine = UrMachine(text, program, **options).run()  # type: ignore[arg-type]
     assert machine.finished and not machine.halted
     reference = Recorder(search)
     for t in job.targets:
@@ -498,7 +466,7 @@ def test_a_search_that_finds_nothing_takes_the_error_path(
     job, text = build(plan, T_nom)
     search = ideal_search(plan, misplaced(plan, T_nom, 11), T_nom)
     rec = failing_call(search, which)
-    machine = UrMachine(tolerate_known_writer_bugs(text), rec).run()
+    machine = UrMachine(text, rec).run()
     assert machine.finished
     failed = machine.searches[which - 1]
     assert failed.search is not None and failed.search.answer == NOT_FOUND
@@ -534,40 +502,41 @@ def test_input_already_on_at_the_safe_start_gives_code_2_and_no_search() -> None
         return bool(np.linalg.norm(T[:3, 3] - d_safe) < 1e-9)
 
     rec = Recorder(ideal_search(plan, T_nom, T_nom))
-    machine = UrMachine(tolerate_known_writer_bugs(text), rec, rest_level=rest_level).run()
+    machine = UrMachine(text, rec, rest_level=rest_level).run()
     assert measured(machine, d) == [2.0, 0.0, 0.0, 0.0]
     assert any(msg.startswith("D failed") and msg.endswith("2.0") for msg in machine.messages)
     assert len(rec.calls) == len(job.targets) + 2 - 1  # D's search never started
     assert all(np.linalg.norm(c[0] - d_safe) > 1e-6 for c in rec.calls)
 
 
-# ------------------------------------------------------------------ the writer bugs, as exported
+# ------------------------------------------------------------------ the program, as exported
 def _stator_text() -> str:
     plan = load_plan(STATOR)
     return build(plan, nominal_T_base_wobj(plan))[1]
 
 
-@pytest.mark.xfail(strict=True, raises=UrSyntaxError, reason="writer bug 1: parameter named end")
 def test_as_exported_the_program_compiles() -> None:
-    UrMachine(_stator_text(), lambda *a: NOT_FOUND)
-
-
-@pytest.mark.xfail(strict=True, raises=UrSyntaxError, reason="writer bug 2: textmsg, 3 arguments")
-def test_as_exported_the_failure_message_compiles() -> None:
-    UrMachine(rename_end_parameter(_stator_text()), lambda *a: NOT_FOUND)
-
-
-def test_the_writer_bugs_are_reported_with_their_line() -> None:
+    """No block keyword names a variable or a parameter (``run_search``'s goal was once
+    ``end``) and every call has the built-in's argument count (the failure message was once a
+    three-argument ``textmsg``: now ``textmsg(str_cat(name, text), code)``)."""
     text = _stator_text()
-    lines = text.split("\n")
-    with pytest.raises(UrSyntaxError, match=r"line (\d+): 'end' cannot be a parameter") as err:
-        UrMachine(text, lambda *a: NOT_FOUND)
-    k = int(re.search(r"line (\d+)", str(err.value)).group(1))  # type: ignore[union-attr]
-    assert lines[k - 1].strip().startswith("def run_search(end,")
-    with pytest.raises(UrSyntaxError, match=r"textmsg\(\) takes at most 2 arguments") as err:
-        UrMachine(rename_end_parameter(text), lambda *a: NOT_FOUND)
-    k = int(re.search(r"line (\d+)", str(err.value)).group(1))  # type: ignore[union-attr]
-    assert lines[k - 1].strip().startswith('textmsg(name, " failed')
+    UrMachine(text, lambda *a: NOT_FOUND)
+    assert "def run_search(goal, want, speed):" in text
+    assert 'textmsg(str_cat(name, " failed: ' in text
+
+
+def test_as_exported_the_failure_message_says_which_point_and_why() -> None:
+    """Every search finds nothing: each point logs ``<ID> failed: ... 1.0`` and records code 1."""
+    plan = load_plan(STATOR)
+    job, text = build(plan, nominal_T_base_wobj(plan))
+    machine = UrMachine(text, lambda *a: NOT_FOUND).run()
+    assert machine.finished and not machine.halted
+    for t in job.targets:
+        assert measured(machine, t) == [1.0, 0.0, 0.0, 0.0]
+    want = [
+        f"{t.point_id} failed: code (1 no detection, 2 at level at start) 1.0" for t in job.targets
+    ]
+    assert machine.messages == want
 
 
 # ------------------------------------------------------------------ the interpreter itself

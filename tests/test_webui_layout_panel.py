@@ -32,9 +32,12 @@ def test_quality_is_live_and_follows_an_edit(app: WobjcalApp) -> None:
     before = q.worst_poi_m(95.5)
     assert "Layout: ok" in panel.quality_md.content
     assert "WOCS yz-plane at epsilon" in panel.quality_md.content
-    # B (rotation about z with A: 500 mm apart) moved to 40 mm from A: weaker, seen live
-    a = app.state.doc.get("A").probe.position_m
-    app.move_point_to("B", [a[0], a[1] + 0.04, a[2]])
+    # E (the rotation the F and H searches are aimed by, with D: 60 mm apart) moved to 5 mm
+    # below D: their edge tracks tilt with its noise, weaker, seen live (not B towards A: the
+    # RAPID program runs F's and H's edge searches from their measured face points, and the
+    # final rotation is H, F, D's, so A and B no longer reach the frame)
+    d = app.state.doc.get("D").probe.position_m
+    app.move_point_to("E", [d[0], d[1], d[2] - 0.005])
     q2 = panel.refresh().result(60)
     assert q2 is not None and q2.worst_poi_m(95.5) > 1.5 * before
     app.state.undo()

@@ -34,6 +34,22 @@ class Misplacement(Strict, frozen=True, kw_only=True):
         check_positive(self.max_translation_m, "max_translation_m", allow_zero=True)
         check_positive(self.max_angle_rad, "max_angle_rad", allow_zero=True)
 
+    def motion_covariance(self, pivot_wobj_m: ArrayLike) -> FloatArray:
+        """``(6, 6)`` covariance of the small motion ``delta = (dt, dr)`` of the wobj frame
+        (its own axes, m and rad; :func:`calib.frames.small_motion`) that :meth:`sample`
+        draws, to first order.
+
+        The translation is uniform in a ball of radius ``a`` (``a^2 / 5`` per axis), the
+        rotation vector a uniform angle in ``[-b, b]`` about a uniform axis (``b^2 / 9`` per
+        axis); turning about the pivot ``c`` adds ``c x dr`` to the translation at the origin.
+        """
+        c = check_vector3(pivot_wobj_m, "pivot_wobj_m")
+        A = np.eye(6)
+        A[:3, 3:] = [[0.0, -c[2], c[1]], [c[2], 0.0, -c[0]], [-c[1], c[0], 0.0]]
+        S = np.diag([self.max_translation_m**2 / 5.0] * 3 + [self.max_angle_rad**2 / 9.0] * 3)
+        cov: FloatArray = A @ S @ A.T
+        return cov
+
     def sample(self, rng: np.random.Generator, pivot_wobj_m: ArrayLike) -> FloatArray:
         """``T_nominal_true`` ``(4, 4)``: the true part frame in the nominal one.
 

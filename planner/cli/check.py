@@ -116,7 +116,9 @@ def quality_table(q: LayoutQuality, status: str) -> Table:
     from planner.sim.quality import DOF_NAMES
 
     table = Table(
-        title="layout quality (predicted, the procedure linearised with the plan's noise)",
+        title="layout quality (predicted, "
+        + (f"the program {q.program}" if q.program else "the procedure")
+        + " linearised with the plan's noise)",
         caption=f"layout: [{_COLOUR[status]}]{status}[/]" + (f": {q.problem}" if q.problem else ""),
     )
     table.add_column("quantity")

@@ -35,6 +35,7 @@ from calib._version import __version__
 from calib.frames import quat_wxyz_from_matrix
 from planner.export.job import ExportJob
 from planner.export.rapid_probe import WOBJ, probe_proc
+from planner.export.rapid_steer import steer_main, steer_procs
 from planner.export.rapid_write import MEASURED_FILE, write_proc
 from planner.export.text import comment_text, fmt, identifier
 
@@ -148,7 +149,13 @@ def export_rapid(job: ExportJob) -> str:
         f"(procedure {comment_text(job.method)}).",
         f"    ! PROGRAM: {comment_text(program.name)}.",
         "    ! Probes each point with the proximity sensor on digital input diSensor.",
-        *(adaptive_header() if a is not None else _nominal_header()),
+        *(
+            adaptive_header()
+            if a is not None
+            else _steered_header()
+            if program.steers_itself
+            else _nominal_header()
+        ),
         *_comment(
             "SAFE FOR: "
             + job.safety.describe()
@@ -167,6 +174,7 @@ def export_rapid(job: ExportJob) -> str:
         f"    ! HOME:/{MEASURED_FILE} for `wobjcal calibrate PLAN MEASURED`.",
         *_declarations(job, names),
         *(adaptive_procs(job) if a is not None else []),
+        *(steer_procs(job, program) if program.steers_itself else []),
         *xoffset_procs(job, names),
         "",
         "    PROC main()",
@@ -180,6 +188,8 @@ def export_rapid(job: ExportJob) -> str:
         *(
             adaptive_main(job, names)
             if a is not None
+            else steer_main(job, program, names)
+            if program.steers_itself
             else [f"        Probe_{name} {i};" for i, name in enumerate(names, start=1)]
         ),
         "        WriteMeasurements;",
@@ -201,6 +211,14 @@ def _comment(text: str, width: int = 92) -> list[str]:
     import textwrap
 
     return ["    ! " + line for line in textwrap.wrap(text, width - 6)]
+
+
+def _steered_header() -> list[str]:
+    return [
+        f"    ! ADAPTIVE: {WOBJ}.uframe is updated after the points its steps name (the smallest",
+        "    ! motion that puts them on their faces), so each search runs in the work-object",
+        f"    ! frame estimated so far. At the end {WOBJ} is the calibrated work object.",
+    ]
 
 
 def _nominal_header() -> list[str]:

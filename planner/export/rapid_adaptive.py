@@ -32,7 +32,7 @@ from calib.paper.settings import XOffsetRun
 from calib.paper.stator_layout import STATOR_POINT_IDS as ROLES
 from calib.paper.xoffset import xoffset_probe_points
 from planner.export.job import AdaptiveSpec, ExportJob
-from planner.export.rapid_probe import WOBJ
+from planner.export.rapid_probe import WOBJ, stop_procs
 from planner.export.text import fmt
 
 
@@ -69,18 +69,7 @@ def adaptive_procs(job: ExportJob) -> list[str]:
         "    VAR pos pP3;",
         "    VAR pos pF;",
         "    VAR pos pH;",
-        "",
-        "    ! Stop the procedure: report, write what was measured, end the program",
-        "    PROC Fail(string why)",
-        '        TPWrite "wobjcal: A-H stopped: "+why;',
-        "        WriteMeasurements;",
-        "        EXIT;",
-        "    ENDPROC",
-        "",
-        "    PROC Require(num i)",
-        '        IF NOT measuredOk{i} Fail "point "+measuredId{i}+": "+measuredErr{i};',
-        "    ENDPROC",
-        "",
+        *stop_procs("A-H"),
         "    ! Eq. 11-12: P3, nP3Height above B on the side face assumed inclined by beta1",
         "    FUNC pos EstimateP3(pos a,pos b)",
         "        VAR num alpha1;",

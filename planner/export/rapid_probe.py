@@ -141,3 +141,22 @@ def probe_proc(t: TargetPair, name: str, from_measured: float | None) -> list[st
         *_handler(t, safe, True),
     ]
     return lines
+
+
+def stop_procs(label: str) -> list[str]:
+    """``Fail`` (report, write what was measured, end the program) and ``Require`` (fail
+    unless point ``i`` was measured): an adaptive program cannot go on without a point."""
+    return [
+        "",
+        "    ! Stop the procedure: report, write what was measured, end the program",
+        "    PROC Fail(string why)",
+        f'        TPWrite "wobjcal: {label} stopped: "+why;',
+        "        WriteMeasurements;",
+        "        EXIT;",
+        "    ENDPROC",
+        "",
+        "    PROC Require(num i)",
+        '        IF NOT measuredOk{i} Fail "point "+measuredId{i}+": "+measuredErr{i};',
+        "    ENDPROC",
+        "",
+    ]

@@ -40,6 +40,7 @@ from planner.program.model import (
     search_keys,
 )
 from planner.program.safety import SafetySpec
+from planner.program.steering import STEERED_METHODS, layout_pivot_scale, update_groups
 
 
 def safety_spec(plan: Plan) -> SafetySpec:
@@ -93,14 +94,27 @@ def build_program(
     """
     kind = procedure_kind(settings)  # type: ignore[arg-type]
     steers = kind.method in target.adaptive_methods
-    adaptive = steers and kind.adaptive_layout(points) is not None
-    note = ""
-    if not adaptive:
-        why = target.why_nominal if not steers else "the plan lacks a role the update needs"
-        note = f"every search once, in the nominal frame: {why}"
-    if adaptive:
-        steps = _adaptive_steps(points, kind.method, settings, vias or {})
+    why = target.why_nominal
+    pivot: tuple[float, float, float] | None = None
+    scale = 0.0
+    if kind.method in STEERED_METHODS:
+        edges = [rp.point.id for rp in points if rp.point.search.kind == "edge"]
+        adaptive = steers and not edges
+        if steers and edges:
+            why = f"its frame update takes approach searches only (edge searches: {edges})"
+        if adaptive:
+            ordered = kind.assign(points)
+            c, scale = layout_pivot_scale([rp.point for rp in ordered])
+            pivot = (float(c[0]), float(c[1]), float(c[2]))
+            steps = _steered_steps(ordered, kind.method, vias or {})
     else:
+        adaptive = steers and kind.adaptive_layout(points) is not None
+        if steers and not adaptive:
+            why = "the plan lacks a role the update needs"
+        if adaptive:
+            steps = _adaptive_steps(points, kind.method, settings, vias or {})
+    note = "" if adaptive else f"every search once, in the nominal frame: {why}"
+    if not adaptive:
         steps = _nominal_steps(points, vias or {})
     steps.append(FrameStep(on_controller=adaptive, method_label=kind.label))
     return MeasuringProgram(
@@ -113,6 +127,8 @@ def build_program(
         points=tuple(points),
         settings=settings,
         note=note,
+        pivot_m=pivot,
+        scale_m=scale,
     )
 
 
@@ -129,6 +145,25 @@ def _point_steps(
         steps.append(SearchStep(key, point_id, "edge", f, "measured face point"))
     else:
         steps.append(SearchStep(key, point_id, "approach", f, "safe start"))
+    return steps
+
+
+def _steered_steps(
+    ordered: Sequence[RolePoint], method: str, vias: Mapping[str, int]
+) -> list[Step]:
+    """The program of a procedure it steers itself (:mod:`planner.program.steering`): the
+    points in ``ordered`` order, each search in the estimate so far, its updates between."""
+    ids = [rp.point.id for rp in ordered]
+    after = {len(g): g for g in update_groups(method, ids)}
+    steps: list[Step] = []
+    since: list[str] = []
+    for k, rp in enumerate(ordered, start=1):
+        frame: Literal["nominal", "estimate"] = "estimate" if len(since) < k - 1 else "nominal"
+        steps += _point_steps(rp.point.id, rp.point.id, "approach", frame, vias.get(rp.point.id, 0))
+        since.append(rp.point.id)
+        if k in after:
+            steps.append(UpdateStep(tuple(since), uses=after[k]))
+            since = []
     return steps
 
 

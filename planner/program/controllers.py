@@ -43,7 +43,9 @@ class Controller:
 CONTROLLERS: dict[str, Controller] = {
     c.name: c
     for c in (
-        Controller("rapid", "RAPID", "ABB", frozenset({"hultman2013"})),
+        Controller(
+            "rapid", "RAPID", "ABB", frozenset({"hultman2013", "best_fit", "three_two_one"})
+        ),
         Controller("krl", "KRL", "KUKA"),
         Controller("urscript", "URScript", "Universal Robots"),
         Controller(
@@ -55,8 +57,7 @@ CONTROLLERS: dict[str, Controller] = {
     )
 }
 #: The controller whose program ``wobjcal validate`` and ``wobjcal check`` judge by default: ABB
-#: RAPID, the paper's controller (an IRB 4400) and the only one that runs the A-H procedure
-#: adaptively today.
+#: RAPID, the paper's controller (an IRB 4400), which runs A-H, 3-2-1 and best fit adaptively.
 DEFAULT_CONTROLLER = "rapid"
 
 

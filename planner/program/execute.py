@@ -30,9 +30,16 @@ from calib.errors import ProbeFailedError
 from calib.frames import invert_transform, transform_points
 from calib.probing import Probe, ProbePoint, ProbeResult, SearchCommand
 from calib.procedures import ProcedureRun, RolePoint, procedure_kind
-from planner.program.model import FACE_APPROACH, MeasuringProgram, search_keys
+from planner.program.model import (
+    FACE_APPROACH,
+    MeasuringProgram,
+    SearchStep,
+    UpdateStep,
+    search_keys,
+)
 from planner.program.safety import SafetySpec
 from planner.program.searches import program_searches
+from planner.program.steering import steer
 
 FloatArray = NDArray[np.float64]
 
@@ -107,6 +114,8 @@ def execute(
     kind = procedure_kind(program.method)
     points, settings = program.points, program.settings
     run_as_program = ProgramProbe(probe, points, program.safety)
+    if program.steers_itself:
+        return _run_steered(program, T_base_wobj_nominal, run_as_program)
     if program.adaptive:
         return kind.run(list(points), T_base_wobj_nominal, run_as_program, settings)
     by_id = {rp.point.id: rp.point for rp in points}
@@ -122,3 +131,25 @@ def execute(
         prev = measured.get(step.point_id)
         measured[step.point_id] = q[None] if prev is None else np.vstack([prev, q])
     return kind.estimate(list(points), measured, T_base_wobj_nominal, settings)
+
+
+def _run_steered(program: MeasuringProgram, T_base_wobj: FloatArray, probe: Probe) -> ProcedureRun:
+    """A program that steers itself: each search in the estimate so far, each update
+    (:func:`planner.program.steering.steer`) from the points it names; the frame is the last
+    update's."""
+    assert program.pivot_m is not None  # set with every update that fits points
+    by_id = {rp.point.id: rp.point for rp in program.points}
+    pivot = np.asarray(program.pivot_m, dtype=np.float64)
+    T = np.asarray(T_base_wobj, dtype=np.float64).copy()
+    measured: dict[str, FloatArray] = {}
+    for step in program.steps:
+        if isinstance(step, SearchStep) and step.recorded:
+            cmd = SearchCommand.from_point(by_id[step.point_id], T)
+            res = probe(replace(cmd, point_id=step.key))
+            if res.point_m is None:
+                raise ProbeFailedError(step.key, res.reason or "no reason given")
+            measured[step.point_id] = np.asarray(res.point_m, dtype=np.float64)
+        elif isinstance(step, UpdateStep) and step.uses:
+            pts = [by_id[i] for i in step.uses]
+            T = steer(pts, measured, T, pivot, program.scale_m)
+    return ProcedureRun(T, tuple(measured), measured)

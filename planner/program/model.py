@@ -90,12 +90,23 @@ class UpdateStep:
 
     Attributes:
         after: the keys measured since the previous update.
+        uses: the point ids whose last measurements the update fits, in program order, when
+            the program computes it itself (:mod:`planner.program.steering`: the smallest
+            motion that puts them on their faces); ``()``: the procedure's own update (the
+            A-H steps), run by the procedure.
     """
 
     after: tuple[str, ...]
+    uses: tuple[str, ...] = ()
 
     def describe(self) -> str:
         """One line for people."""
+        if self.uses:
+            whose = "its face" if len(self.uses) == 1 else "their faces"
+            return (
+                f"frame estimate updated: the smallest motion that puts "
+                f"{', '.join(self.uses)} on {whose}"
+            )
         return f"frame estimate updated (after {', '.join(self.after)})"
 
 
@@ -142,6 +153,9 @@ class MeasuringProgram:
             computed with them).
         note: why a procedure that steers its searches runs nominal on this controller
             (``""`` otherwise).
+        pivot_m: ``(3,)`` the centroid of the layout the program's own updates turn about,
+            wobj frame, m (``None`` without such updates).
+        scale_m: the layout's RMS size those updates scale rotations by, m.
     """
 
     controller: Controller
@@ -153,6 +167,8 @@ class MeasuringProgram:
     points: tuple[RolePoint, ...]
     settings: Any
     note: str = ""
+    pivot_m: tuple[float, float, float] | None = None
+    scale_m: float = 0.0
 
     @property
     def name(self) -> str:
@@ -163,6 +179,17 @@ class MeasuringProgram:
     def adaptive(self) -> bool:
         """True when the program updates its frame between searches."""
         return self.steering == "adaptive"
+
+    @property
+    def updates(self) -> tuple[UpdateStep, ...]:
+        """The update steps, in order."""
+        return tuple(s for s in self.steps if isinstance(s, UpdateStep))
+
+    @property
+    def steers_itself(self) -> bool:
+        """The program's own frame updates (:mod:`planner.program.steering`) steer its
+        searches, rather than the procedure's steps."""
+        return any(u.uses for u in self.updates)
 
     @property
     def searches(self) -> tuple[SearchStep, ...]:

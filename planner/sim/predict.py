@@ -10,15 +10,16 @@ error). The report puts the resulting intervals beside the simulated ones.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
-from calib.frames import motion_between
+from calib.frames import motion_between, small_motion
 from calib.probing import Probe
 from calib.procedures.comparison import FedFit
-from calib.procedures.linearize import event_covariance, linearize
+from calib.procedures.linearize import PlaneProbe, event_covariance, linearize
 from planner.program.execute import execute
 from planner.sim.setup import SimulationSetup
 from planner.sim.xoffset import run_xoffset
@@ -63,13 +64,13 @@ def predict(setup: SimulationSetup, step_m: float = 1e-6, best_fit: bool = True)
     T_nom = setup.T_base_wobj_nominal
     xs = setup.xoffset.with_holes(setup.xoffset.targets_wobj) if setup.xoffset else None
 
-    def run(probe: Probe) -> dict[str, FloatArray]:
+    def run(probe: Probe, T_true: FloatArray = T_nom) -> dict[str, FloatArray]:
         res = execute(setup.program, T_nom, probe)
-        out = {"procedure": motion_between(T_nom, res.T_base_wobj)}
+        out = {"procedure": motion_between(T_true, res.T_base_wobj)}
         if best_fit:
-            out["best_fit"] = motion_between(T_nom, fed(res).T_base_wobj)
+            out["best_fit"] = motion_between(T_true, fed(res).T_base_wobj)
         if xs is not None:
-            out["xoffset"] = run_xoffset(xs, probe, res.T_base_wobj, T_nom)[:, 0]
+            out["xoffset"] = run_xoffset(xs, probe, res.T_base_wobj, T_true)[:, 0]
         return out
 
     gain = (
@@ -82,13 +83,56 @@ def predict(setup: SimulationSetup, step_m: float = 1e-6, best_fit: bool = True)
     C = event_covariance(
         lin.commands, noise, setup.robot_error.repeatability_sigma_m, setup.robot_error.tcp_sigma_m
     )
+    placed = misplacement_covariances(run, setup, gain)
     x_sigma = float("nan")
     if xs is not None:
-        var = np.diag(lin.covariance("xoffset", C))
+        var = np.diag(lin.covariance("xoffset", C) + placed["xoffset"])
         x_sigma = float(np.sqrt(max(float(np.mean(var)), 0.0)))
     return Prediction(
-        cov_procedure=lin.covariance("procedure", C),
-        cov_best_fit=lin.covariance("best_fit", C) if best_fit else np.full((6, 6), np.nan),
+        cov_procedure=lin.covariance("procedure", C) + placed["procedure"],
+        cov_best_fit=(
+            lin.covariance("best_fit", C) + placed["best_fit"]
+            if best_fit
+            else np.full((6, 6), np.nan)
+        ),
         xoffset_sigma_m=x_sigma,
         n_searches=len(lin.commands),
     )
+
+
+def misplacement_covariances(
+    run: Callable[[Probe, FloatArray], dict[str, FloatArray]],
+    setup: SimulationSetup,
+    edge_axis_gain: float,
+    step: float = 1e-5,
+) -> dict[str, FloatArray]:
+    """Per output of ``run``, the covariance the part's misplacement adds to first order.
+
+    The program is exact on the ideal part wherever it lies, except where a search commanded in
+    an estimate meets the true part otherwise than the estimate says: an edge search whose track
+    runs closer to or farther from the tilted face it slides over than commanded (its event moves
+    by the sensor's axis gain), or a nominal program's searches that cross a face off their
+    nominal spots. Central differences of ``run`` against the ideal part moved by each of the six
+    small motions (``step``, m and rad), with the misplacement's motion covariance
+    (:meth:`calib.models.Misplacement.motion_covariance`).
+    """
+    T_nom = setup.T_base_wobj_nominal
+    S = setup.misplacement.motion_covariance(setup.pivot_wobj_m)
+    cols: dict[str, list[FloatArray]] = {}
+    for i in range(6):
+        outs = []
+        for sign in (1.0, -1.0):
+            d = np.zeros(6)
+            d[i] = sign * step
+            T_true = T_nom @ small_motion(d)
+            outs.append(run(PlaneProbe(T_true, setup.edge_offset_m, edge_axis_gain), T_true))
+        for k in outs[0]:
+            plus = np.asarray(outs[0][k], dtype=np.float64).ravel()
+            minus = np.asarray(outs[1][k], dtype=np.float64).ravel()
+            cols.setdefault(k, []).append((plus - minus) / (2.0 * step))
+    out = {}
+    for k, c in cols.items():
+        J = np.stack(c, axis=1)
+        cov = J @ S @ J.T
+        out[k] = 0.5 * (cov + cov.T)
+    return out

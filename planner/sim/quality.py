@@ -102,6 +102,8 @@ class LayoutQuality:
         weakest_unit: ``"deg"`` or ``"mm"``.
         poi: the predicted error at each point of interest.
         free: the motions no measurement sees (unobservable layouts), in words.
+        program: the measuring program predicted (its name, e.g. ``"RAPID, adaptive A-H"``),
+            ``""`` when not known.
     """
 
     sigma: FloatArray = field(repr=False)
@@ -115,6 +117,7 @@ class LayoutQuality:
     weakest_unit: str
     poi: tuple[PoiError, ...]
     free: tuple[str, ...] = ()
+    program: str = ""
 
     @property
     def weakest_text(self) -> str:
@@ -144,6 +147,7 @@ class LayoutQuality:
         """JSON-ready (millimetres and degrees; infinities as ``null``)."""
         scale = np.array([1e3] * 3 + [math.degrees(1.0)] * 3)
         return {
+            "program": self.program,
             "rating": self.rating,
             "problem": self.problem,
             "sigma": {
