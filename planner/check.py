@@ -55,12 +55,16 @@ from planner.check_results import ConfData, PlanCheck, PointCheck, Status
 from planner.dry_run import nominal_part_probe
 from planner.plan_cell import nominal_T_base_wobj, open_cell
 from planner.program.build import safety_spec
+from planner.program.reach import search_problems
 
 if TYPE_CHECKING:
     import trimesh
 
     from planner.cell.cell import Cell
     from planner.cell.feasibility import ProbeFeasibility
+    from planner.faces.detection import PlanarFaces
+    from planner.faces.outline import FaceOutlines
+    from planner.sim.landing import LandingRisk
     from planner.sim.quality import LayoutQuality
 
 FloatArray = NDArray[np.float64]
@@ -78,7 +82,9 @@ __all__ = [
 ]
 
 
-def check_plan(plan: Plan, plan_dir: Path | None = None, *, cell: Cell | None = None) -> PlanCheck:
+def check_plan(
+    plan: Plan, plan_dir: Path | None = None, *, cell: Cell | None = None, fmt: str | None = None
+) -> PlanCheck:
     """Check every point and search path of ``plan`` (see the module docstring).
 
     Args:
@@ -87,24 +93,110 @@ def check_plan(plan: Plan, plan_dir: Path | None = None, *, cell: Cell | None = 
             current folder); used only when ``cell`` is ``None``.
         cell: an open cell of the plan (the UI's); ``None`` opens the plan's cell and closes
             it afterwards.
+        fmt: the controller whose program the quality and the landing risk judge (``None``:
+            the default, RAPID); the poses, paths and moves are those of every program.
 
     Raises:
         InputError: a file of the plan cannot be loaded (named in the message).
     """
     if cell is None:
         with open_cell(plan, plan_dir or Path.cwd()) as own:
-            return check_plan(plan, cell=own)
+            return check_plan(plan, cell=own, fmt=fmt)
     checks, error = _check(plan, list(plan.points), cell)
     checks = check_via_moves(cell, plan, checks)
     layout = layout_problem(plan)
     quality, note = None, ""
+    landing = None
     if not layout and cell.work_object is not None:
-        quality, note = plan_quality(plan, cell.work_object.mesh)
+        quality, note = plan_quality(plan, cell.work_object.mesh, fmt)
         if quality is not None and quality.rating == "unobservable":
             layout = quality.problem
+        if not layout:
+            landing = plan_landing_risk(plan, cell.work_object.mesh, fmt)
+    if landing is not None:
+        checks = _with_landing(checks, landing.point_problems())
     return PlanCheck(
-        checks, cell.solver.kind, cell.solver.why_not_opw or "", error, layout, quality, note
+        checks,
+        cell.solver.kind,
+        cell.solver.why_not_opw or "",
+        error,
+        layout,
+        quality,
+        note,
+        landing,
     )
+
+
+def plan_landing_risk(
+    plan: Plan, mesh: trimesh.Trimesh, fmt: str | None = None
+) -> LandingRisk | None:
+    """How often each search of the program of ``fmt`` (``None``: the default) misses, starts
+    too close or lands off its face under the plan's misplacement (:mod:`planner.sim.landing`),
+    on the work object ``mesh`` (wobj, metres); ``None`` when the plan cannot be simulated."""
+    from planner.faces.checks import check_plan_faces
+    from planner.faces.detection import NoPlanarFaceError, find_planar_faces
+    from planner.sim.landing import landing_risk
+    from planner.validate import prediction_setup
+    from planner.validate_checks import check_simulatable
+
+    try:
+        setup = prediction_setup(plan, check_simulatable(plan), fmt)
+        r = max(float(plan.validation.sensor.footprint_radius_m), 1e-4)
+        faces = find_planar_faces(mesh, min_area_m2=math.pi * r**2, footprint_radius_m=r)
+    except (InputError, NoPlanarFaceError):
+        return None
+    probes = [rp.point for rp in setup.points]
+    face_of = {
+        p.id: int(c.face_id)
+        for p, c in zip(probes, check_plan_faces(faces, probes, footprint_radius_m=r), strict=True)
+        if c.ok
+    }
+    return landing_risk(
+        setup.program,
+        setup.T_base_wobj_nominal,
+        setup.misplacement,
+        setup.pivot_wobj_m,
+        _outlines(faces, r),
+        face_of,
+    )
+
+
+#: The face outlines of recent parts (their unions take a second on a stator): ``{(id of the
+#: faces, radius): (faces, outlines)}``, the faces kept so the id stays theirs.
+_OUTLINES: dict[tuple[int, float], tuple[object, object]] = {}
+
+
+def _outlines(faces: PlanarFaces, radius_m: float) -> FaceOutlines:
+    """The outlines of ``faces`` with a footprint of ``radius_m`` (kept for the next check)."""
+    from planner.faces.outline import FaceOutlines
+
+    key = (id(faces), float(radius_m))
+    if key not in _OUTLINES:
+        if len(_OUTLINES) >= 8:
+            _OUTLINES.pop(next(iter(_OUTLINES)))
+        _OUTLINES[key] = (faces, FaceOutlines(faces, radius_m))
+    out = _OUTLINES[key][1]
+    assert isinstance(out, FaceOutlines)
+    return out
+
+
+def _with_landing(
+    checks: Sequence[PointCheck], problems: dict[str, str]
+) -> tuple[PointCheck, ...]:
+    """``checks`` with the points whose searches go wrong too often made infeasible."""
+    out = []
+    for c in checks:
+        why = problems.get(c.point_id, "")
+        if why:
+            search = "; ".join(x for x in (c.search_reason, why) if x)
+            c = replace(
+                c,
+                status="infeasible",
+                search_reason=search,
+                reason="; ".join(x for x in (c.reason, f"landing: {why}") if x),
+            )
+        out.append(c)
+    return tuple(out)
 
 
 def plan_quality(
@@ -274,14 +366,33 @@ def _check(plan: Plan, points: list[PlanPoint], cell: Cell) -> tuple[tuple[Point
     safety = safety_spec(plan)
     tcp = plan.cell.tool.tcp
     measured = measured_starts_wobj(plan)
+    reach = search_problems(probes, safety, _edge_event_offset_m(plan))
     for p, probe, pose, face in zip(points, probes, poses, faces, strict=True):
         path = check_program_path(
             cell, probe, pose, T_nom, safety, T_flange_tcp, tcp, measured.get(p.id)
         )
         check = _point_check(cell, p, pose, path, face, ik_kind, t0, T_flange_tcp)
+        if p.id in reach:
+            check = replace(
+                check,
+                status="infeasible",
+                search_reason=reach[p.id],
+                reason="; ".join(x for x in (check.reason, f"search: {reach[p.id]}") if x),
+            )
         out.append(_with_part_size(check, wo.name, part))
         t0 = time.perf_counter()
     return tuple(out), error
+
+
+def _edge_event_offset_m(plan: Plan) -> float:
+    """How far past an edge the sensor reports it, m: the plan's value, or, unset, the sensor
+    model's (as the validation fills it in), so check and validate size edge searches alike."""
+    from planner.validate_checks import check_simulatable
+
+    try:
+        return edge_offset_of(check_simulatable(plan).settings)
+    except InputError:  # a plan the validation refuses: its own value (unset: 0)
+        return edge_offset_of(plan.procedure)
 
 
 def _point_check(

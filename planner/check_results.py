@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 if TYPE_CHECKING:
+    from planner.sim.landing import LandingRisk
     from planner.sim.quality import LayoutQuality
 
 FloatArray = NDArray[np.float64]
@@ -62,6 +63,9 @@ class PointCheck:
             cannot be run (a via outside the joint limits, a leg that collides, naming the via
             and the clearance pair); ``""`` when clear or without vias
             (:func:`planner.cell.moves.check_via_path`).
+        search_reason: why the point's search cannot reach its face or edge wherever the
+            part may lie (:func:`planner.program.reach.search_problems`), or how likely it is
+            to fail or land off its face; ``""`` when it can.
     """
 
     point_id: str
@@ -88,6 +92,7 @@ class PointCheck:
     q_safe: FloatArray | None = None
     n_vias: int = 0
     via_reason: str = ""
+    search_reason: str = ""
 
     @property
     def feasible(self) -> bool:
@@ -108,6 +113,7 @@ class PointCheck:
             "path_reason": self.path_reason,
             "path_fail_at_m": _finite_or_none(self.path_fail_at_m),
             "face_reason": self.face_reason,
+            "search_reason": self.search_reason,
             "clearance_m": _finite_or_none(self.clearance_m),
             "clearance_pair": list(self.clearance_pair) if self.clearance_pair else None,
             "clearance_is_lower_bound": self.clearance_is_lower_bound,
@@ -137,6 +143,8 @@ class PlanCheck:
         quality: the layout's predicted quality (:mod:`planner.sim.quality`), ``None`` when
             it could not be predicted (``quality_note`` says why) or the layout is refused.
         quality_note: why there is no quality, ``""`` otherwise.
+        landing: how often each search of the program goes wrong under the plan's
+            misplacement (:mod:`planner.sim.landing`), ``None`` when not computed.
     """
 
     points: tuple[PointCheck, ...]
@@ -146,6 +154,7 @@ class PlanCheck:
     layout: str = ""
     quality: LayoutQuality | None = None
     quality_note: str = ""
+    landing: LandingRisk | None = None
 
     @property
     def layout_status(self) -> Status:
@@ -192,6 +201,8 @@ class PlanCheck:
         out["layout_status"] = self.layout_status
         if self.quality is not None:
             out["quality"] = self.quality.to_json()
+        if self.landing is not None:
+            out["landing"] = self.landing.to_json()
         return out
 
 

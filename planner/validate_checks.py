@@ -25,6 +25,7 @@ from calib.models import Misplacement, RobotErrorModel
 from calib.plan.file import Plan, PlanError
 from calib.procedures import RolePoint, procedure_kind
 from planner.parts.stator import StatorGeometry
+from planner.program.reach import search_problems
 from planner.program.safety import SafetySpec
 from planner.sim.sensors import sensor_kind
 from planner.sim.setup import DEFAULT_EDGE_INSET_M, default_pivot, resolved_settings
@@ -165,11 +166,11 @@ def preflight(plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh) -> No
 
     Every point must lie on a planar face with the sensor's footprint on it
     (:func:`planner.faces.checks.plan_face_reasons`); every search must reach its face under
-    the plan's misplacement (the bound of :class:`planner.program.safety.SafetySpec`, the same
-    the exported programs use): an approach must start at least the face's largest shift plus
-    the sensor's standoff out, and run at least the shift past it; an edge search must start
-    at least the shift before the edge and run at least the shift plus the sensor's edge-event
-    offset past it.
+    the plan's misplacement as the program runs it (:func:`planner.program.reach.search_problems`,
+    which ``wobjcal check`` runs too: an approach starts at the safe start and must run at least
+    the face's largest shift past the nominal face; an edge search must start at least the
+    shift before the edge and run at least the shift plus the sensor's edge-event offset past
+    it). Every problem of every point is named at once.
 
     Raises:
         PlanError: naming every point that fails, and why.
@@ -195,30 +196,8 @@ def preflight(plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh) -> No
         margin_m=0.0,
     )
     edge_offset = float(getattr(models.settings, "edge_event_offset_m", 0.0) or 0.0)
-    for p in probes:
-        if p.id in why:
-            continue
-        shift = safety.surface_shift_bound_m(p.position_m)
-        s = p.search
-        if s.kind == "approach":
-            start_needed = safety.start_clearance_m(p.position_m)
-            run_needed = shift
-        else:
-            start_needed = shift
-            run_needed = shift + edge_offset
-        if s.start_offset_m < start_needed:
-            why[p.id] = (
-                f"the search starts {s.start_offset_m * 1e3:.1f} mm "
-                f"{'out' if s.kind == 'approach' else 'before the edge'}, but the part may lie "
-                f"up to {shift * 1e3:.1f} mm closer; it needs at least "
-                f"{start_needed * 1e3:.1f} mm"
-            )
-        elif s.overtravel_m < run_needed:
-            why[p.id] = (
-                f"the search runs {s.overtravel_m * 1e3:.1f} mm past the nominal "
-                f"{'face' if s.kind == 'approach' else 'edge'}, but the part may lie up to "
-                f"{shift * 1e3:.1f} mm farther; it needs at least {run_needed * 1e3:.1f} mm"
-            )
+    reach = search_problems([p for p in probes if p.id not in why], safety, edge_offset)
+    why.update(reach)
     if why:
         lines = "; ".join(f"{_name(plan, pid)}: {w}" for pid, w in why.items())
         raise PlanError(f"cannot validate this plan: {lines}")

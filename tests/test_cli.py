@@ -278,11 +278,13 @@ def test_validate_small_run_writes_json(tmp_path: Path, capsys: pytest.CaptureFi
 def test_validate_refuses_a_plan_that_cannot_work_naming_its_points(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    """The 3-2-1 test plan's searches start 30 mm out, closer than the 20 mm, 3 deg
-    misplacement allows: refused before any trial, point by point."""
+    """The 3-2-1 test plan's searches end 20 mm past their faces, less than the 20 mm, 3 deg
+    misplacement may move them away (the program starts them at their safe starts, so their
+    30 mm start no longer matters): refused before any trial, every point and problem named."""
     code, _, err = run(capsys, "validate", str(DATA / "valid_three_two_one.json"), "--trials", "2")
     assert code == 2
-    assert "points[0] (P1): the search starts 30.0 mm out" in err
+    assert "points[0] (P1): the search ends 20.0 mm past the nominal face" in err
+    assert "overtravel at least" in err
     assert "points[2] (P3): not on a planar face" in err
 
 

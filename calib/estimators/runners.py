@@ -129,6 +129,7 @@ def min_norm_update(
     pivot_m: FloatArray | None = None,
     scale_m: float | None = None,
     iterations: int = 10,
+    basis: FloatArray | None = None,
 ) -> FloatArray:
     """Move ``T_base_wobj`` by the smallest motion that puts the measured points on their faces.
 
@@ -152,12 +153,14 @@ def min_norm_update(
         pivot_m: ``(3,)`` wobj point the rotations are taken about.
         scale_m: length that converts rotations to translations, metres.
         iterations: Gauss-Newton iterations (the step is min-norm in each).
+        basis: ``(6, r)`` :func:`fixed_motions` of ``cs`` about ``pivot_m`` and ``scale_m``
+            when the caller has it already (it depends on the nominal layout only).
     """
     T = check_transform(T_base_wobj, "T_base_wobj").copy()
     q = np.asarray(measured_base, dtype=np.float64)[cs.point_index]
     c = cs.centroid_m if pivot_m is None else pivot_m
     L = cs.scale_m if scale_m is None else scale_m
-    V = fixed_motions(cs, c, L)
+    V = fixed_motions(cs, c, L) if basis is None else basis
     for _ in range(iterations):
         x = (q - T[:3, 3]) @ T[:3, :3]
         r = np.einsum("ij,ij->i", cs.normals, x - cs.nominal_m)

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 from rich.table import Table
 
 from planner.cli.common import print_json, read_plan, stdout
+from planner.program.controllers import CONTROLLERS, DEFAULT_CONTROLLER
 
 if TYPE_CHECKING:
     from calib.plan.file import Plan
@@ -40,6 +41,11 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "the weakest motion in words and the predicted error at the points of interest at the\n"
         "plan's confidence levels; a weak layout is marginal, one that leaves a degree of\n"
         "freedom free fails.\n\n"
+        "Both judge the measuring program the controller of --format runs (default rapid):\n"
+        "every search from its safe start must reach its face wherever the part may lie, and\n"
+        "executed on the ideal part misplaced as the validation misplaces it, no search may\n"
+        "miss, start inside its face or land off it in more than 1 % of calibrations (each\n"
+        "point named with the share and what to change).\n\n"
         "exit codes: 0 all feasible (marginal points and a weak layout are reported but pass),\n"
         "1 any point or path infeasible or the layout refused (each named with the reason),\n"
         "2 bad input",
@@ -49,6 +55,12 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
     )
     p.add_argument("plan", metavar="PLAN", help="plan file (wobjcal.plan/1)")
     p.add_argument("--json", action="store_true", help="print the results as JSON")
+    p.add_argument(
+        "--format",
+        choices=list(CONTROLLERS),
+        default=DEFAULT_CONTROLLER,
+        help=f"the controller whose program is judged (default: {DEFAULT_CONTROLLER})",
+    )
     p.add_argument(
         "--add-vias",
         metavar="OUT",
@@ -146,7 +158,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     if args.add_vias:
         plan, plan_dir, shown = _with_vias(plan, plan_dir, Path(args.add_vias))
         args.plan = shown
-    check = check_plan(plan, plan_dir)
+    check = check_plan(plan, plan_dir, fmt=args.format)
     if check.error:
         print(f"wobjcal check: {check.error}", file=sys.stderr)
     if check.layout:
@@ -167,6 +179,20 @@ def cmd_check(args: argparse.Namespace) -> int:
         out.print(quality_table(check.quality, check.layout_status))
     elif check.quality_note:
         out.print(f"layout quality: not predicted: {check.quality_note}", markup=False)
+    if check.landing is not None:
+        L = check.landing
+        risky = [s for s in L.searches if s.worst > 0 or s.partly_off > 0]
+        out.print(
+            f"landing ({L.program}, {L.trials} misplaced calibrations): searches go wrong in "
+            f"{L.failed:.1%} of them"
+            + "".join(
+                f"; {s.key}: off its face {s.off_face:.0%}, partly {s.partly_off:.0%}, "
+                f"misses {s.miss:.0%}, starts inside {s.start_inside:.0%}"
+                for s in risky
+            ),
+            markup=False,
+            style="red" if L.failed > 0.01 else None,
+        )
     n = len(check.points)
     out.print(
         f"{n - len(bad)} of {n} points feasible"

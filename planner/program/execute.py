@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import NDArray
@@ -70,30 +71,68 @@ class ProgramProbe:
         self._keys = search_keys(self.points)
         self._by_id = {rp.point.id: rp.point for rp in self.points}
 
+    def _searches(self, point: ProbePoint, T: FloatArray) -> tuple[SearchCommand, ...]:
+        """The program's searches of ``point`` in the estimate ``T`` (built once in the wobj
+        frame, then moved: a rigid motion of every point and direction of them)."""
+        return tuple(_moved(c, T) for c in _searches_in_wobj(point, self.safety))
+
     def __call__(self, cmd: SearchCommand) -> ProbeResult:
         """Run ``cmd`` as the program does; the result is that of its last (recorded) search."""
         point = self._by_id.get(self._keys.get(cmd.point_id, ""))
         if point is None:  # not a plan point (e.g. the x-offset run): as commanded
             return self.probe(cmd)
-        T = cmd.T_base_wobj_estimate
-        plan_start = SearchCommand.from_point(point, T).start_m
+        T = np.asarray(cmd.T_base_wobj_estimate, dtype=np.float64)
+        plan_start = T[:3, :3] @ _plan_start_wobj(point) + T[:3, 3]
         if not np.allclose(cmd.start_m, plan_start, rtol=0.0, atol=1e-9):
             measured = transform_points(invert_transform(T), np.asarray(cmd.start_m))
             searches = program_searches(point, T, self.safety, measured_start_wobj=measured)
             return self.probe(replace(searches[1].command, point_id=cmd.point_id))
-        searches = program_searches(point, T, self.safety)
+        first, *rest = self._searches(point, T)
         if point.search.kind == "approach":
-            return self.probe(replace(searches[0].command, point_id=cmd.point_id))
-        face = self.probe(replace(searches[0].command, point_id=cmd.point_id + FACE_APPROACH))
+            return self.probe(replace(first, point_id=cmd.point_id))
+        face = self.probe(replace(first, point_id=cmd.point_id + FACE_APPROACH))
         if face.point_m is None:
             return ProbeResult(None, f"approach to the face: {face.reason}")
-        edge = searches[1].command
+        edge = rest[0]
         start = np.asarray(face.point_m, dtype=np.float64)
         end = edge.start_m + edge.length_m * edge.direction
         run = float((end - start) @ edge.direction)
         if run <= 0.0:
             return ProbeResult(None, "the measured face point lies past the end of the edge search")
         return self.probe(replace(edge, point_id=cmd.point_id, start_m=start, length_m=run))
+
+
+@lru_cache(maxsize=4096)
+def _searches_in_wobj(point: ProbePoint, safety: SafetySpec) -> tuple[SearchCommand, ...]:
+    """The program's searches of ``point`` built in the wobj frame (the estimate ``I``)."""
+    return tuple(s.command for s in program_searches(point, np.eye(4), safety))
+
+
+def _plan_start_wobj(point: ProbePoint) -> FloatArray:
+    """``(3,)`` where the plan's search of ``point`` starts, wobj frame, m."""
+    p = np.asarray(point.position_m, dtype=np.float64)
+    s = point.search
+    if s.kind == "approach":
+        return p + s.start_offset_m * np.asarray(point.normal, dtype=np.float64)
+    return p - s.start_offset_m * np.asarray(s.edge_direction, dtype=np.float64)
+
+
+def _moved(cmd: SearchCommand, T: FloatArray) -> SearchCommand:
+    """``cmd`` (built in the frame ``I``) as built in the frame ``T``: every point and
+    direction moved by ``T``, and ``T`` its estimate."""
+    R, t = T[:3, :3], T[:3, 3]
+    stop = None if cmd.stop_normal is None else R @ cmd.stop_normal
+    return SearchCommand(
+        point_id=cmd.point_id,
+        kind=cmd.kind,
+        start_m=R @ cmd.start_m + t,
+        direction=R @ cmd.direction,
+        length_m=cmd.length_m,
+        sensor_axis=R @ cmd.sensor_axis,
+        T_base_wobj_estimate=T @ cmd.T_base_wobj_estimate,
+        nominal_m=R @ cmd.nominal_m + t,
+        stop_normal=stop,
+    )
 
 
 def execute(

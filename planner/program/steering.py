@@ -19,11 +19,12 @@ coordinate, which the writers do not yet carry.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import NDArray
 
-from calib.estimators.layout import constraint_set
+from calib.estimators.layout import ConstraintSet, constraint_set
 from calib.estimators.runners import fixed_motions, min_norm_update
 from calib.probing import ProbePoint
 
@@ -69,6 +70,15 @@ def update_basis(points: Sequence[ProbePoint], pivot_m: FloatArray, scale_m: flo
     return fixed_motions(constraint_set(points), np.asarray(pivot_m, float), float(scale_m))
 
 
+@lru_cache(maxsize=1024)
+def _update_layout(
+    points: tuple[ProbePoint, ...], pivot_m: tuple[float, ...], scale_m: float
+) -> tuple[ConstraintSet, FloatArray]:
+    """The constraints of ``points`` and their update basis (nominal: computed once)."""
+    cs = constraint_set(points)
+    return cs, fixed_motions(cs, np.asarray(pivot_m, float), float(scale_m))
+
+
 def steer(
     points: Sequence[ProbePoint],
     measured_base: Mapping[str, FloatArray],
@@ -78,8 +88,9 @@ def steer(
 ) -> FloatArray:
     """``(4, 4)`` the estimate after an update from ``points`` (their last measurements in
     ``measured_base``, base frame, metres), starting at ``T_base_wobj``."""
-    cs = constraint_set(points)
+    pivot = tuple(float(v) for v in np.asarray(pivot_m, float))
+    cs, V = _update_layout(tuple(points), pivot, float(scale_m))
     q = np.array([measured_base[p.id] for p in points], dtype=np.float64)
     return min_norm_update(
-        cs, q, T_base_wobj, np.asarray(pivot_m, float), float(scale_m), ITERATIONS
+        cs, q, T_base_wobj, np.asarray(pivot), float(scale_m), ITERATIONS, basis=V
     )

@@ -1,0 +1,221 @@
+"""Landing risk: how often each search of a program misses, starts too close, or lands off its
+face, under the plan's misplacement.
+
+The program (:mod:`planner.program`) is executed against the ideal part (its faces' planes,
+:class:`calib.procedures.linearize.PlaneProbe`) misplaced as the validation misplaces it, a few
+hundred seeded times; no noise (micrometres against millimetres of misplacement). For every
+search it records the travel to its event against the search's length, and for every approach
+where it lands on the true part: the centre of the sensor's footprint must lie on the planar
+face the point is on (:class:`planner.faces.outline.FaceOutlines`; the footprint partly over a
+hole or past an edge is counted and shown, not failed: the reading is biased, not wrong).
+A nominal program lands every search anywhere the whole misplacement allows; an adaptive one
+lands a search near its nominal spot once the points before it have fixed its face.
+
+This is the same program ``wobjcal validate --format`` simulates on the real mesh (where the
+footprint's rays see holes and edges); here it is cheap enough for ``wobjcal check`` and export,
+which fail a plan whose searches go wrong in more than :data:`RISK_LIMIT` of calibrations.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+from numpy.typing import NDArray
+
+from calib.errors import InputError, ProbeFailedError
+from calib.frames import invert_transform, transform_points
+from calib.models import Misplacement
+from calib.probing import ProbeResult, SearchCommand
+from calib.procedures.base import edge_offset_of
+from calib.procedures.linearize import PlaneProbe
+from planner.faces.outline import FaceOutlines
+from planner.program.execute import execute
+from planner.program.model import FACE_APPROACH, MeasuringProgram, search_keys
+
+FloatArray = NDArray[np.float64]
+
+#: A plan fails when its searches go wrong in more than this share of calibrations.
+RISK_LIMIT = 0.01
+#: Misplaced calibrations executed (seeded).
+TRIALS = 200
+
+
+@dataclass(frozen=True)
+class SearchRisk:
+    """How often one search of the program goes wrong (shares of calibrations, 0 to 1).
+
+    Attributes:
+        key: the search's key (``"P1"``, ``"C2"``, ``"F@face"``).
+        point_id: the plan's point id.
+        miss: the search ends before it meets its face or edge.
+        start_inside: it starts at or past its face or edge (already detecting).
+        off_face: the centre of the sensor's footprint where it lands is off the point's planar
+            face (over a hole, past an edge: approach searches); the search measures another
+            surface.
+        partly_off: the footprint lies partly over a hole or past an edge (its centre on the
+            face): the reading is biased, not wrong (the paper's stator teeth are narrower
+            than its sensor), so it is shown, not failed.
+    """
+
+    key: str
+    point_id: str
+    miss: float
+    start_inside: float
+    off_face: float
+    partly_off: float = 0.0
+
+    @property
+    def worst(self) -> float:
+        """The largest share of the three failures (misses, starts inside, off its face)."""
+        return max(self.miss, self.start_inside, self.off_face)
+
+
+@dataclass(frozen=True)
+class LandingRisk:
+    """The landing risk of a program.
+
+    Attributes:
+        program: the program's name.
+        trials: misplaced calibrations executed.
+        searches: per search, in program order.
+        failed: the share of calibrations in which at least one search goes wrong.
+    """
+
+    program: str
+    trials: int
+    searches: tuple[SearchRisk, ...]
+    failed: float
+
+    def point_problems(self, limit: float = RISK_LIMIT) -> dict[str, str]:
+        """``{point id: why, and what to change}`` for the points whose searches go wrong in
+        more than ``limit`` of calibrations."""
+        out: dict[str, list[str]] = {}
+        for s in self.searches:
+            if s.worst <= limit:
+                continue
+            what = s.key if s.key != s.point_id else "the search"
+            if s.key.endswith(FACE_APPROACH):
+                what = "the approach to its face"
+            parts = []
+            if s.off_face > limit:
+                parts.append(
+                    f"{what} lands off its face (over a hole or past an edge) in "
+                    f"{s.off_face:.0%} of calibrations: move the point inward, away from its "
+                    "face's edges and holes, measure it after points that fix its face (an "
+                    "adaptive program), or give a smaller misplacement bound"
+                )
+            if s.miss > limit:
+                parts.append(
+                    f"{what} ends before it meets its face or edge in {s.miss:.0%} of "
+                    "calibrations: a longer search (overtravel), or a smaller misplacement bound"
+                )
+            if s.start_inside > limit:
+                parts.append(
+                    f"{what} starts at or past its face or edge in {s.start_inside:.0%} of "
+                    "calibrations: start it farther out, or a smaller misplacement bound"
+                )
+            out.setdefault(s.point_id, []).extend(parts)
+        return {pid: f"{self.program}: " + "; ".join(parts) for pid, parts in out.items() if parts}
+
+    def to_json(self) -> dict[str, object]:
+        """JSON-ready: shares per search."""
+        return {
+            "program": self.program,
+            "trials": self.trials,
+            "failed": self.failed,
+            "limit": RISK_LIMIT,
+            "searches": [
+                {
+                    "key": s.key,
+                    "point": s.point_id,
+                    "miss": s.miss,
+                    "start_inside": s.start_inside,
+                    "off_face": s.off_face,
+                    "partly_off": s.partly_off,
+                }
+                for s in self.searches
+            ],
+        }
+
+
+@dataclass
+class _Recorder:
+    """The ideal part at one pose; records each search's travel, length and landing."""
+
+    ideal: PlaneProbe
+    rows: list[tuple[str, float, float, FloatArray]]
+
+    def __call__(self, cmd: SearchCommand) -> ProbeResult:
+        res = self.ideal(cmd)
+        travel = float(res.travel_m) if res.point_m is not None else float("nan")
+        hit = np.asarray(res.point_m if res.point_m is not None else cmd.start_m, float)
+        self.rows.append((cmd.point_id, travel, float(cmd.length_m), hit))
+        return res
+
+
+def landing_risk(
+    program: MeasuringProgram,
+    T_base_wobj_nominal: FloatArray,
+    misplacement: Misplacement,
+    pivot_wobj_m: FloatArray,
+    outlines: FaceOutlines,
+    face_of: Mapping[str, int],
+    trials: int = TRIALS,
+    seed: int = 0,
+) -> LandingRisk:
+    """The landing risk of ``program`` (see the module docstring).
+
+    Args:
+        program: the program.
+        T_base_wobj_nominal: ``(4, 4)`` the nominal part, base frame.
+        misplacement: the plan's misplacement bound (drawn as the validation draws it).
+        pivot_wobj_m: ``(3,)`` the misplacement's pivot, wobj frame, m.
+        outlines: the part's planar faces with the sensor's footprint.
+        face_of: ``{point id: planar face id}`` (``-1`` or missing: not judged).
+        trials: misplaced calibrations to execute.
+        seed: seed of the misplacements.
+    """
+    rng = np.random.default_rng(seed)
+    keys = search_keys(program.points)
+    edge_ids = {rp.point.id for rp in program.points if rp.point.search.kind == "edge"}
+    edge_offset = edge_offset_of(program.settings)
+    runs: dict[str, list[tuple[int, bool, bool]]] = {}  # key -> (trial, miss, inside)
+    landed: dict[str, list[tuple[int, FloatArray]]] = {}  # key -> (trial, wobj point)
+    for trial in range(trials):
+        T_true = T_base_wobj_nominal @ misplacement.sample(rng, pivot_wobj_m)
+        rec = _Recorder(PlaneProbe(T_true, edge_offset), [])
+        # an update that fails on the way: the searches so far count
+        with contextlib.suppress(ProbeFailedError, InputError):
+            execute(program, T_base_wobj_nominal, rec)
+        T_wobj_base = invert_transform(T_true)
+        for key, travel, length, hit in rec.rows:
+            miss = not travel <= length  # NaN: no event at all
+            runs.setdefault(key, []).append((trial, miss, travel < 0.0))
+            judged = key.endswith(FACE_APPROACH) or keys.get(key) not in edge_ids
+            if judged:  # an approach: where its footprint lands
+                landed.setdefault(key, []).append((trial, transform_points(T_wobj_base, hit)))
+    bad_trials: set[int] = set()
+    off_of: dict[str, int] = {}
+    partly_of: dict[str, int] = {}
+    for key, at in landed.items():
+        face = face_of.get(keys.get(key, key), -1)
+        if face < 0:
+            continue
+        uv = np.array([q for _, q in at]) @ outlines.basis(face)
+        off = ~shapely.contains_xy(outlines.face(face), uv[:, 0], uv[:, 1])
+        partly = ~shapely.contains_xy(outlines.free(face), uv[:, 0], uv[:, 1]) & ~off
+        off_of[key], partly_of[key] = int(np.sum(off)), int(np.sum(partly))
+        bad_trials |= {trial for (trial, _), o in zip(at, off, strict=True) if o}
+    searches = []
+    for key, rows in runs.items():
+        n = len(rows)
+        n_miss = sum(row[1] for row in rows)
+        n_inside = sum(row[2] for row in rows)
+        bad_trials |= {trial for trial, m, i in rows if m or i}
+        pid = keys.get(key, key)
+        searches.append(SearchRisk(key, pid, n_miss / n, n_inside / n, off_of.get(key, 0) / n))
+    return LandingRisk(program.name, trials, tuple(searches), len(bad_trials) / max(trials, 1))
