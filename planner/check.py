@@ -66,6 +66,7 @@ if TYPE_CHECKING:
     from planner.faces.outline import FaceOutlines
     from planner.sim.landing import LandingRisk
     from planner.sim.quality import LayoutQuality
+    from planner.sim.raycast import MeshRayCaster
 
 FloatArray = NDArray[np.float64]
 
@@ -158,7 +159,27 @@ def plan_landing_risk(
         setup.pivot_wobj_m,
         _outlines(faces, r),
         face_of,
+        caster=_caster(mesh),
+        standoff_m=float(plan.validation.sensor.standoff_m),
+        footprint_radius_m=float(plan.validation.sensor.footprint_radius_m),
     )
+
+
+#: The ray casters of recent parts: ``{id of the mesh: (mesh, caster)}``.
+_CASTERS: dict[int, tuple[object, object]] = {}
+
+
+def _caster(mesh: trimesh.Trimesh) -> MeshRayCaster:
+    """The part's ray caster (kept for the next check of the same mesh)."""
+    from planner.sim.raycast import MeshRayCaster
+
+    if id(mesh) not in _CASTERS:
+        if len(_CASTERS) >= 4:
+            _CASTERS.pop(next(iter(_CASTERS)))
+        _CASTERS[id(mesh)] = (mesh, MeshRayCaster(mesh))
+    out = _CASTERS[id(mesh)][1]
+    assert isinstance(out, MeshRayCaster)
+    return out
 
 
 #: The face outlines of recent parts (their unions take a second on a stator): ``{(id of the

@@ -187,7 +187,8 @@ def cmd_check(args: argparse.Namespace) -> int:
             f"{L.failed:.1%} of them"
             + "".join(
                 f"; {s.key}: off its face {s.off_face:.0%}, partly {s.partly_off:.0%}, "
-                f"misses {s.miss:.0%}, starts inside {s.start_inside:.0%}"
+                f"another surface first {s.other_surface:.0%}, misses {s.miss:.0%}, starts "
+                f"inside {s.start_inside:.0%}"
                 for s in risky
             ),
             markup=False,

@@ -35,13 +35,14 @@ from calib.procedures.linearize import PlaneProbe
 from planner.faces.outline import FaceOutlines
 from planner.program.execute import execute
 from planner.program.model import FACE_APPROACH, MeasuringProgram, search_keys
+from planner.sim.raycast import MeshRayCaster
 
 FloatArray = NDArray[np.float64]
 
 #: A plan fails when its searches go wrong in more than this share of calibrations.
 RISK_LIMIT = 0.01
 #: Misplaced calibrations executed (seeded).
-TRIALS = 200
+TRIALS = 128
 
 
 @dataclass(frozen=True)
@@ -59,6 +60,9 @@ class SearchRisk:
         partly_off: the footprint lies partly over a hole or past an edge (its centre on the
             face): the reading is biased, not wrong (the paper's stator teeth are narrower
             than its sensor), so it is shown, not failed.
+        other_surface: the sensor's face meets another surface of the part before its own
+            face (or starts inside the part): it switches early, or runs into it (approach
+            searches, judged on the part's mesh).
     """
 
     key: str
@@ -67,11 +71,13 @@ class SearchRisk:
     start_inside: float
     off_face: float
     partly_off: float = 0.0
+    other_surface: float = 0.0
 
     @property
     def worst(self) -> float:
-        """The largest share of the three failures (misses, starts inside, off its face)."""
-        return max(self.miss, self.start_inside, self.off_face)
+        """The largest share of the failures (misses, starts inside, off its face, another
+        surface first)."""
+        return max(self.miss, self.start_inside, self.off_face, self.other_surface)
 
 
 @dataclass(frozen=True)
@@ -113,6 +119,13 @@ class LandingRisk:
                     f"{what} ends before it meets its face or edge in {s.miss:.0%} of "
                     "calibrations: a longer search (overtravel), or a smaller misplacement bound"
                 )
+            if s.other_surface > limit:
+                parts.append(
+                    f"{what} meets another surface of the part before its face (or starts "
+                    f"inside it) in {s.other_surface:.0%} of calibrations: move the point away "
+                    "from the walls beside it, start it from another side, or give a smaller "
+                    "misplacement bound"
+                )
             if s.start_inside > limit:
                 parts.append(
                     f"{what} starts at or past its face or edge in {s.start_inside:.0%} of "
@@ -136,6 +149,7 @@ class LandingRisk:
                     "start_inside": s.start_inside,
                     "off_face": s.off_face,
                     "partly_off": s.partly_off,
+                    "other_surface": s.other_surface,
                 }
                 for s in self.searches
             ],
@@ -144,17 +158,39 @@ class LandingRisk:
 
 @dataclass
 class _Recorder:
-    """The ideal part at one pose; records each search's travel, length and landing."""
+    """The ideal part at one pose; records each search's command, travel and landing."""
 
     ideal: PlaneProbe
-    rows: list[tuple[str, float, float, FloatArray]]
+    rows: list[tuple[SearchCommand, float, FloatArray]]
 
     def __call__(self, cmd: SearchCommand) -> ProbeResult:
         res = self.ideal(cmd)
         travel = float(res.travel_m) if res.point_m is not None else float("nan")
         hit = np.asarray(res.point_m if res.point_m is not None else cmd.start_m, float)
-        self.rows.append((cmd.point_id, travel, float(cmd.length_m), hit))
+        self.rows.append((cmd, travel, hit))
         return res
+
+
+#: Rays of the sensor face's bundle: its centre and this many around its rim.
+RIM_RAYS = 8
+#: A surface met this much before the search's own face counts as another surface, m.
+OTHER_SURFACE_TOL_M = 1e-3
+
+
+def _face_rays(
+    start_wobj: FloatArray, axis_wobj: FloatArray, standoff_m: float, radius_m: float
+) -> FloatArray:
+    """``(1 + RIM_RAYS, 3)`` origins on the sensor's face (``standoff_m`` behind the TCP at
+    ``start_wobj``, along ``axis_wobj``): its centre and its rim."""
+    a = axis_wobj / np.linalg.norm(axis_wobj)
+    helper = np.eye(3)[int(np.argmin(np.abs(a)))]
+    u = np.cross(a, helper)
+    u /= np.linalg.norm(u)
+    v = np.cross(a, u)
+    ang = np.linspace(0.0, 2.0 * np.pi, RIM_RAYS, endpoint=False)
+    rim = radius_m * (np.cos(ang)[:, None] * u + np.sin(ang)[:, None] * v)
+    centre = start_wobj - standoff_m * a
+    return np.vstack([centre, centre + rim])
 
 
 def landing_risk(
@@ -166,6 +202,9 @@ def landing_risk(
     face_of: Mapping[str, int],
     trials: int = TRIALS,
     seed: int = 0,
+    caster: MeshRayCaster | None = None,
+    standoff_m: float = 0.0,
+    footprint_radius_m: float = 0.0,
 ) -> LandingRisk:
     """The landing risk of ``program`` (see the module docstring).
 
@@ -178,6 +217,10 @@ def landing_risk(
         face_of: ``{point id: planar face id}`` (``-1`` or missing: not judged).
         trials: misplaced calibrations to execute.
         seed: seed of the misplacements.
+        caster: the part's mesh (wobj frame), to find the approaches whose sensor face meets
+            another surface before their own face; ``None``: not judged.
+        standoff_m: the sensor's sensing distance (its face lies that far behind the TCP), m.
+        footprint_radius_m: the sensor face's radius, m.
     """
     rng = np.random.default_rng(seed)
     keys = search_keys(program.points)
@@ -185,6 +228,8 @@ def landing_risk(
     edge_offset = edge_offset_of(program.settings)
     runs: dict[str, list[tuple[int, bool, bool]]] = {}  # key -> (trial, miss, inside)
     landed: dict[str, list[tuple[int, FloatArray]]] = {}  # key -> (trial, wobj point)
+    # key -> (trial, ray origins (R, 3), direction (3,), distance to the own face), wobj
+    rays: dict[str, list[tuple[int, FloatArray, FloatArray, float]]] = {}
     for trial in range(trials):
         T_true = T_base_wobj_nominal @ misplacement.sample(rng, pivot_wobj_m)
         rec = _Recorder(PlaneProbe(T_true, edge_offset), [])
@@ -192,12 +237,19 @@ def landing_risk(
         with contextlib.suppress(ProbeFailedError, InputError):
             execute(program, T_base_wobj_nominal, rec)
         T_wobj_base = invert_transform(T_true)
-        for key, travel, length, hit in rec.rows:
+        for cmd, travel, hit in rec.rows:
+            key, length = cmd.point_id, float(cmd.length_m)
             miss = not travel <= length  # NaN: no event at all
             runs.setdefault(key, []).append((trial, miss, travel < 0.0))
             judged = key.endswith(FACE_APPROACH) or keys.get(key) not in edge_ids
             if judged:  # an approach: where its footprint lands
                 landed.setdefault(key, []).append((trial, transform_points(T_wobj_base, hit)))
+            if judged and caster is not None and np.isfinite(travel):
+                R = T_wobj_base[:3, :3]
+                start = transform_points(T_wobj_base, np.asarray(cmd.start_m, float))
+                origins = _face_rays(start, R @ cmd.sensor_axis, standoff_m, footprint_radius_m)
+                d = R @ np.asarray(cmd.direction, float)
+                rays.setdefault(key, []).append((trial, origins, d, travel + standoff_m))
     bad_trials: set[int] = set()
     off_of: dict[str, int] = {}
     partly_of: dict[str, int] = {}
@@ -210,6 +262,16 @@ def landing_risk(
         partly = ~shapely.contains_xy(outlines.free(face), uv[:, 0], uv[:, 1]) & ~off
         off_of[key], partly_of[key] = int(np.sum(off)), int(np.sum(partly))
         bad_trials |= {trial for (trial, _), o in zip(at, off, strict=True) if o}
+    other_of: dict[str, int] = {}
+    if caster is not None:
+        for key, items in rays.items():
+            o = np.concatenate([it[1] for it in items])
+            d = np.repeat(np.array([it[2] for it in items]), 1 + RIM_RAYS, axis=0)
+            dist = caster.first_hits(o, d).reshape(len(items), 1 + RIM_RAYS)
+            own = np.array([it[3] for it in items])
+            early = np.any(dist < own[:, None] - OTHER_SURFACE_TOL_M, axis=1)
+            other_of[key] = int(np.sum(early))
+            bad_trials |= {it[0] for it, e in zip(items, early, strict=True) if e}
     searches = []
     for key, rows in runs.items():
         n = len(rows)
@@ -217,5 +279,7 @@ def landing_risk(
         n_inside = sum(row[2] for row in rows)
         bad_trials |= {trial for trial, m, i in rows if m or i}
         pid = keys.get(key, key)
-        searches.append(SearchRisk(key, pid, n_miss / n, n_inside / n, off_of.get(key, 0) / n))
+        off, partly = off_of.get(key, 0) / n, partly_of.get(key, 0) / n
+        other = other_of.get(key, 0) / n
+        searches.append(SearchRisk(key, pid, n_miss / n, n_inside / n, off, partly, other))
     return LandingRisk(program.name, trials, tuple(searches), len(bad_trials) / max(trials, 1))
