@@ -26,7 +26,10 @@ points of interest) and proposes the points:
 4. via points where a joint move between two of the points would collide
    (:func:`planner.move_vias.plan_with_vias`: retract, or turn the shoulder or elbow);
 5. the written plan's quality predicted exactly (:func:`planner.check.plan_quality`: the
-   procedure linearised), which is what the result reports.
+   program of the chosen format linearised), which is what the result reports;
+6. the written plan checked as ``wobjcal check --format`` checks it (poses, paths, moves, search
+   reach, landing risk): anything it refuses is named in the message and the result does not
+   count as met (``wobjcal suggest`` exits 1).
 
 ``add=N`` keeps the plan's points and adds the ``N`` best (best fit only).
 """
@@ -48,7 +51,7 @@ from calib.estimators.layout import search_constraint_set
 from calib.plan.file import Plan, PlanError
 from calib.plan.report_spec import PointOfInterest
 from calib.probing import ProbePoint, SearchSpec
-from planner.check import plan_quality
+from planner.check import check_plan, plan_quality
 from planner.faces.candidates import Candidates, FaceTried, face_candidates
 from planner.faces.detection import find_planar_faces
 from planner.faces.edges import edge_candidates
@@ -107,6 +110,9 @@ class SuggestResult:
         elapsed_s: wall time, s.
         pool: the candidates with a feasible probe pose (search paths checked only for the
             ones a design picked).
+        problems: what ``wobjcal check`` (of the program of the chosen format) refuses in the
+            written plan, one line per point: a move between points not cleared, a search that
+            lands off its face too often; ``()`` when it passes. ``met`` is False then.
     """
 
     plan: Plan
@@ -123,6 +129,7 @@ class SuggestResult:
     message: str
     elapsed_s: float
     pool: Candidates | None = field(default=None, repr=False)
+    problems: tuple[str, ...] = ()
 
 
 def _pois(plan: Plan, mesh: object, at_m: FloatArray | None) -> list[RowSpec]:
@@ -335,14 +342,26 @@ def suggest_plan(
         msg = (
             f"target {(target_m or 0.0) * 1e3:.3f} mm at {level:g} % not reached: the best "
             "layout of "
-            f"{n} points gives {worst * 1e3:.3f} mm (more points: --max-points; or a smaller "
-            "noise or misplacement)"
+            f"{n} points gives {worst * 1e3:.3f} mm ("
+            + ("more points: --max-points; or " if procedure != "three_two_one" else "")
+            + "a smaller noise or misplacement)"
         )
     if note:
         msg += f" ({note})"
     stuck = [f"{pid}: {what}" for pid, what in via_notes.items() if "added" not in what]
     if stuck:
         msg += "; moves between points not cleared: " + "; ".join(stuck)
+    say("check", 0, 1)
+    check = check_plan(new_plan, cell=cell, fmt=fmt)
+    problems = tuple(f"{p.point_id}: {p.reason}" for p in check.infeasible)
+    if check.layout:
+        problems += (f"layout: {check.layout}",)
+    if problems:
+        met = False
+        msg += (
+            f"; wobjcal check refuses it for the {target_controller.label} program: "
+            + "; ".join(problems)
+        )
     return SuggestResult(
         plan=new_plan,
         quality=quality,
@@ -358,6 +377,7 @@ def suggest_plan(
         message=msg,
         elapsed_s=time.perf_counter() - t0,
         pool=pool,
+        problems=problems,
     )
 
 

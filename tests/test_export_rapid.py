@@ -112,3 +112,18 @@ def test_unknown_confdata_turns_configuration_checks_off() -> None:
     text = export_rapid(build_job(plan, np.eye(4), ToolData(T_flange_tcp=np.eye(4))))
     assert "ConfJ\\Off;" in text and "ConfL\\Off;" in text
     assert "confdata unknown: run wobjcal check" in text
+
+
+def test_numbers_keep_the_zeros_of_their_integer_part() -> None:
+    """``fmt`` trims the trailing zeros of decimals only: a tenth point's index stays 10 (it
+    once became 1 in the adaptive best fit's ``nOrder``, and the last update refitted point 1
+    twice instead of point 10: found by replaying a validate trial through the module)."""
+    from planner.export.text import fmt
+
+    assert [fmt(10, 0), fmt(100.0, 4), fmt(1.2300, 4), fmt(-0.0, 3), fmt(-1e-9, 3)] == [
+        "10",
+        "100",
+        "1.23",
+        "0",
+        "0",
+    ]

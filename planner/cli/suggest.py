@@ -64,7 +64,8 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "information matrix), adding points until the target holds at the confidence or\n"
         "--max-points is reached. Writes the plan (atomically) and prints its predicted\n"
         "quality. With --add N the plan's points are kept and N are added (best fit).\n\n"
-        "exit codes: 0 target met (or none given), 1 target not reached (the best plan found\n"
+        "exit codes: 0 target met (or none given) and the plan passes 'wobjcal check' for\n"
+        "--format, 1 target not reached or check refuses the plan (named; the best plan found\n"
         "is still written), 2 bad input or no feasible layout (faces tried and why)",
         "wobjcal suggest plan.json --target 0.3 -o suggested.json\n"
         "wobjcal suggest plan.json --procedure three_two_one -o plan_321.json\n"

@@ -41,5 +41,7 @@ def module_name(plan_name: str) -> str:
 
 def fmt(x: float, decimals: int = 4) -> str:
     """A number for program text: fixed decimals, no ``-0``, trailing zeros trimmed."""
-    s = f"{x:.{decimals}f}".rstrip("0").rstrip(".")
+    s = f"{x:.{decimals}f}"
+    if "." in s:  # trailing zeros of the decimals only: 10 stays 10
+        s = s.rstrip("0").rstrip(".")
     return "0" if s in ("-0", "") else s
