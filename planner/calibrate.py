@@ -39,9 +39,11 @@ from calib.frames import invert_transform, rotvec_from_matrix, transform_points
 from calib.plan.file import Plan
 from calib.plan.measurements import Measurements
 from calib.procedures import PROCEDURES, procedure_kind
+from calib.procedures.base import edge_offset_of
 from calib.procedures.uncertainty import propagated_covariance
 from calib.tolerances import FACE_FLATNESS_RMS_M
 from planner.plan_cell import T_base_world, nominal_T_base_wobj
+from planner.program.settings import resolved_settings
 
 FloatArray = NDArray[np.float64]
 
@@ -150,7 +152,8 @@ def calibrate_plan(
             f"measurements: points {unknown} are not in the plan (its points: {sorted(known)})"
         )
     kind = procedure_kind(method)
-    settings = plan.procedure if kind.method == plan.method else None
+    # the program's settings: an unset edge-event offset as the exported program has it
+    settings = program_settings(plan) if kind.method == plan.method else None
     T_nom = nominal_T_base_wobj(plan)
     measured = MeasuredPoints(measurements, T_base_world(plan))
     points = plan.role_points()
@@ -199,10 +202,15 @@ def expected_sigma_m(plan: Plan) -> float:
     return float(np.sqrt(sum(x * x for x in parts)))
 
 
+def program_settings(plan: Plan) -> object:
+    """The plan's procedure settings as its programs compute with them (an unset edge-event
+    offset resolved from the sensor model: :func:`planner.program.settings.resolved_settings`)."""
+    return resolved_settings(plan.procedure, plan.validation.sensor)
+
+
 def edge_offset_m(plan: Plan) -> float:
-    """How far past the edge the sensor reports an edge, m: the plan procedure's
-    ``edge_event_offset_m`` where it has one (the A-H settings), else 0."""
-    return float(getattr(plan.procedure, "edge_offset_m", 0.0) or 0.0)
+    """How far past the edge the sensor reports an edge, m, as the programs take it."""
+    return edge_offset_of(program_settings(plan))
 
 
 def screen_plan_measurements(

@@ -54,7 +54,9 @@ from planner.check_paths import ProgramPath, check_program_path, measured_starts
 from planner.check_results import ConfData, PlanCheck, PointCheck, Status
 from planner.dry_run import nominal_part_probe
 from planner.plan_cell import nominal_T_base_wobj, open_cell
-from planner.program.build import safety_spec
+from planner.program.build import measuring_program, safety_spec
+from planner.program.controllers import controller
+from planner.program.execute import execute
 from planner.program.reach import search_problems
 
 if TYPE_CHECKING:
@@ -100,12 +102,13 @@ def check_plan(
     Raises:
         InputError: a file of the plan cannot be loaded (named in the message).
     """
+    controller(fmt)  # an unknown controller: one clear error, before any work
     if cell is None:
         with open_cell(plan, plan_dir or Path.cwd()) as own:
             return check_plan(plan, cell=own, fmt=fmt)
     checks, error = _check(plan, list(plan.points), cell)
     checks = check_via_moves(cell, plan, checks)
-    layout = layout_problem(plan)
+    layout = layout_problem(plan, fmt)
     quality, note = None, ""
     landing = None
     if not layout and cell.work_object is not None:
@@ -162,6 +165,7 @@ def plan_landing_risk(
         caster=_caster(mesh),
         standoff_m=float(plan.validation.sensor.standoff_m),
         footprint_radius_m=float(plan.validation.sensor.footprint_radius_m),
+        triangle_face=np.asarray(faces.face_id, dtype=np.int64),
     )
 
 
@@ -257,12 +261,12 @@ def plan_quality(
         return None, f"{plan.method}: {exc}"
 
 
-def layout_problem(plan: Plan) -> str:
+def layout_problem(plan: Plan, fmt: str | None = None) -> str:
     """Why the plan's procedure would refuse its points, ``""`` when it would not.
 
-    A dry run of the procedure (:data:`calib.procedures.PROCEDURES`) on the nominal part with
-    an exact sensor (:func:`planner.dry_run.nominal_part_probe`): every search commanded as the
-    program and ``wobjcal calibrate`` would, step by step, in the frame estimated so far, and
+    A dry run of the measuring program of the controller ``fmt`` (``None``: the default) on the
+    nominal part with an exact sensor (:func:`planner.dry_run.nominal_part_probe`): every search
+    commanded as the program does (nominal or in the frame estimated so far), and
     answered where it meets the nominal face or edge (an edge search started off the face by
     ``edge_start_offset_m`` switches that far off it; the sensor's edge-event offset is added).
     It must accept them (roles, faces, observability) and give back the nominal frame: a
@@ -277,9 +281,10 @@ def layout_problem(plan: Plan) -> str:
     if problem:
         return problem
     T = nominal_T_base_wobj(plan)
-    probe = nominal_part_probe(T, edge_offset_of(plan.procedure))
     try:
-        T_est = kind.run(plan.role_points(), T, probe, plan.procedure).T_base_wobj
+        program = measuring_program(plan, fmt)
+        probe = nominal_part_probe(T, edge_offset_of(program.settings))
+        T_est = execute(program, T, probe).T_base_wobj
     except (InputError, ProbeFailedError) as exc:
         return f"{plan.method}: {exc}"
     positions = np.array([p.position_m for p in plan.points], dtype=np.float64)
@@ -406,14 +411,11 @@ def _check(plan: Plan, points: list[PlanPoint], cell: Cell) -> tuple[tuple[Point
 
 
 def _edge_event_offset_m(plan: Plan) -> float:
-    """How far past an edge the sensor reports it, m: the plan's value, or, unset, the sensor
-    model's (as the validation fills it in), so check and validate size edge searches alike."""
-    from planner.validate_checks import check_simulatable
+    """How far past an edge the sensor reports it, m, as every program takes it (the plan's
+    value, or unset the sensor model's: :mod:`planner.program.settings`)."""
+    from planner.program.settings import resolved_settings
 
-    try:
-        return edge_offset_of(check_simulatable(plan).settings)
-    except InputError:  # a plan the validation refuses: its own value (unset: 0)
-        return edge_offset_of(plan.procedure)
+    return edge_offset_of(resolved_settings(plan.procedure, plan.validation.sensor))
 
 
 def _point_check(

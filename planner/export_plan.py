@@ -111,7 +111,7 @@ def export_program(
         with open_cell(plan, plan_dir) as own:
             return export_program(plan, plan_dir, fmt, run_check=True, cell=own)
     check = check_plan(plan, plan_dir, cell=cell, fmt=fmt) if run_check else None
-    layout = check.layout if check is not None else layout_problem(plan)
+    layout = check.layout if check is not None else layout_problem(plan, fmt)
     job, notes = export_job_for(plan, plan_dir, check)
     if check is not None and cell is not None:
         job = with_arm_poses(job, cell, check, plan.cell.tool.tcp)

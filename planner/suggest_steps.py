@@ -137,9 +137,13 @@ class Context:
         return ProbePoint(pid, tuple(float(c) for c in p), tuple(self.pool.normals[i]), search)  # type: ignore[arg-type]
 
     def size_searches(self, chosen: tuple[int, ...]) -> bool:
-        """Size the searches for the misplacement about the chosen points' centroid (the
-        validation's pivot); re-check the paths whose start moved. False: one is blocked."""
-        c = self.pool.positions_m[list(chosen)].mean(axis=0)
+        """Size the searches for the misplacement about the centroid of the written plan's
+        points (the plan's kept points with ``--add``, and the chosen ones: the pivot of the
+        program's safe starts and of the validation); re-check the paths whose start moved.
+        False: one is blocked."""
+        kept = np.array([p.position_m for p in self.fixed_points], dtype=np.float64)
+        every = np.concatenate([kept.reshape(-1, 3), self.pool.positions_m[list(chosen)]])
+        c = every.mean(axis=0)
         pivot = (float(c[0]), float(c[1]), float(c[2]))
         if pivot == self.safety.pivot_wobj_m:
             return True

@@ -27,8 +27,9 @@ from calib.procedures import RolePoint, procedure_kind
 from planner.parts.stator import StatorGeometry
 from planner.program.reach import search_problems
 from planner.program.safety import SafetySpec
+from planner.program.settings import DEFAULT_EDGE_INSET_M, resolved_settings
 from planner.sim.sensors import sensor_kind
-from planner.sim.setup import DEFAULT_EDGE_INSET_M, default_pivot, resolved_settings
+from planner.sim.setup import default_pivot
 
 __all__ = [
     "SIMULATED_PARTS",

@@ -75,7 +75,11 @@ def test_program_frame_equals_the_procedure(seed: int, variant: str) -> None:
     import msgspec
 
     plan = load_plan(PLAN)
-    proc = msgspec.structs.replace(plan.procedure, **VARIANTS[variant])
+    # the box's ideal sensor reports an edge at the edge: the plan says so (offset 0, measured),
+    # else every face takes the sensor model's 6.3 mm (planner.program.settings)
+    proc = msgspec.structs.replace(
+        plan.procedure, **{"edge_event_offset_m": 0.0, **VARIANTS[variant]}
+    )
     plan = msgspec.structs.replace(plan, procedure=proc)
     rng = np.random.default_rng(seed)
     T_nom = nominal_T_base_wobj(plan)

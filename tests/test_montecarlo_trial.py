@@ -16,8 +16,9 @@ from planner.parts.stator_demo import nominal_T_base_wobj, stator_ah_points
 from planner.parts.stator_mesh import build_stator_mesh
 from planner.program.build import build_program
 from planner.program.controllers import controller
+from planner.program.settings import DEFAULT_EDGE_INSET_M, resolved_settings
 from planner.sim.montecarlo import stator_setup
-from planner.sim.setup import DEFAULT_EDGE_INSET_M, default_settings, resolved_settings
+from planner.sim.setup import default_settings
 from planner.sim.trial import TrialRunner
 
 G = StatorGeometry.full_section()

@@ -14,7 +14,7 @@ from calib.plan.file import PlanError, PlanPoint, Search, load_plan
 from calib.procedures import BestFit, Iterative
 from planner.cli.main import main
 from planner.cli.validate import report_json
-from planner.sim.setup import DEFAULT_EDGE_INSET_M
+from planner.program.settings import DEFAULT_EDGE_INSET_M
 from planner.validate import check_simulatable, sensitivity_plan, validate_plan, validation_models
 
 REPO = Path(__file__).resolve().parent.parent
@@ -165,16 +165,19 @@ def test_a_layout_that_leaves_a_motion_free_is_refused(plate_fit) -> None:  # ty
 
 def test_points_off_their_face_or_with_short_searches_are_named(plate_fit) -> None:  # type: ignore[no-untyped-def]
     pts = list(plate_fit.points)
-    # T1 onto the centre of a hole; X2's search starting 2 mm out
+    # T1 onto the centre of a hole; X2's search starting 2 mm out (the program starts it at
+    # its safe start: no problem) and ending 1 mm past its face (too short for 3 mm / 1 deg)
     pts[0] = msgspec.structs.replace(pts[0], position_m=(0.1016, 0.1545, 0.0127))
     pts[5] = msgspec.structs.replace(
-        pts[5], search=msgspec.structs.replace(pts[5].search, start_offset_m=0.002)
+        pts[5],
+        search=msgspec.structs.replace(pts[5].search, start_offset_m=0.002, overtravel_m=0.001),
     )
     with pytest.raises(PlanError) as info:
         validate_plan(_with_points(plate_fit, pts), trials=2, plan_dir=PLATE_FIT.parent)
     msg = str(info.value)
     assert "points[0] (T1): not on a planar face" in msg
-    assert "points[5] (X2): the search starts 2.0 mm out, but the part may lie up to" in msg
+    assert "points[5] (X2): the search ends 1.0 mm past the nominal face" in msg
+    assert "starts 2.0 mm" not in msg
 
 
 def test_a_touch_probe_cannot_run_an_edge_search(plate_fit) -> None:  # type: ignore[no-untyped-def]
@@ -196,8 +199,12 @@ def test_the_stator_3_2_1_test_plan_is_refused_naming_its_points() -> None:
     with pytest.raises(PlanError) as info:
         validate_plan(load_plan(THREE_TWO_ONE), trials=2, seed=0)
     msg = str(info.value)
-    assert "points[0] (P1): the search starts 30.0 mm out" in msg
-    assert "points[5] (T1): the search starts 10.0 mm before the edge" in msg
+    # the approaches start at their safe starts (the plan's 30 mm is not judged) but end only
+    # 20 mm past their faces; the edge search is short at both ends: all named at once
+    assert "points[0] (P1): the search ends 20.0 mm past the nominal face" in msg
+    assert "starts 30.0 mm" not in msg
+    assert "points[5] (T1): the edge search starts 10.0 mm before the nominal edge" in msg
+    assert "the edge search ends 10.0 mm past the nominal edge" in msg
 
 
 def test_a_missing_mesh_file_is_named() -> None:

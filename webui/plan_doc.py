@@ -9,6 +9,7 @@ saving writes everything else back as it was.
 from __future__ import annotations
 
 import dataclasses
+import math
 import string
 from collections import Counter
 from dataclasses import dataclass, field
@@ -21,6 +22,7 @@ from calib.errors import InputError
 from calib.paper.stator_layout import STATOR_POINT_IDS
 from calib.plan.vias import ViaPoint
 from calib.probing import ProbePoint, SearchSpec
+from planner.program.safety import SAFETY_MARGIN_M
 
 if TYPE_CHECKING:
     from calib.plan.file import Plan
@@ -171,6 +173,28 @@ def _search_for_normal(search: SearchSpec, normal: ArrayLike) -> SearchSpec:
     return dataclasses.replace(search, edge_direction=_tuple3(d / norm))
 
 
+def _sized_search(plan: UiPlan, position_wobj: ArrayLike) -> SearchSpec:
+    """The approach search of a new point: the default, started and run far enough for the
+    plan's misplacement (``wobjcal check`` refuses a search that cannot reach its face wherever
+    the part may lie). The rotation's lever is taken to the farthest other point, at least the
+    lever to the points' centroid, the misplacement's pivot."""
+    default = SearchSpec()
+    src = plan.source
+    if src is None:
+        return default
+    m = src.validation.misplacement
+    p = np.asarray(position_wobj, dtype=np.float64).reshape(3)
+    others = [np.asarray(q.probe.position_m, dtype=np.float64) for q in plan.points]
+    lever = max((float(np.linalg.norm(q - p)) for q in others), default=0.0)
+    cos = math.cos(m.max_angle_rad)
+    shift = (m.max_translation_m + lever * m.max_angle_rad) / cos
+    standoff = float(src.validation.sensor.standoff_m) / cos
+    return SearchSpec(
+        start_offset_m=max(default.start_offset_m, shift + standoff + SAFETY_MARGIN_M),
+        overtravel_m=max(default.overtravel_m, shift + SAFETY_MARGIN_M),
+    )
+
+
 def place_point(
     plan: UiPlan,
     point_id: str,
@@ -181,7 +205,8 @@ def place_point(
     """Put point ``point_id`` at a surface point with that face's normal (add it if new).
 
     An existing point keeps its role and search settings (an edge direction is projected into the
-    new face); a new one gets an approach search and the role ``role`` (default: its id when the
+    new face); a new one gets an approach search sized for the plan's misplacement
+    (:func:`_sized_search`) and the role ``role`` (default: its id when the
     procedure has such a role and it is free, else the first role not yet full, else
     :data:`NO_ROLE`: never a duplicate, see :func:`next_free_role`).
     """
@@ -191,7 +216,11 @@ def place_point(
     n = n / np.linalg.norm(n)
     existing = {p.id: p for p in plan.points}
     old = existing.get(point_id)
-    search = SearchSpec() if old is None else _search_for_normal(old.probe.search, n)
+    search = (
+        _sized_search(plan, position_wobj)
+        if old is None
+        else _search_for_normal(old.probe.search, n)
+    )
     edge_normal = None if old is None or search.kind != "edge" else old.probe.edge_normal
     probe = ProbePoint(
         id=point_id,

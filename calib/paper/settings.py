@@ -81,8 +81,9 @@ class Hultman2013(
         edge_event_offset_m: how far past the true edge, along the search direction, the
             sensor reports it (a sensor characteristic measured once on a reference edge;
             footprint and hysteresis make it a few mm), metres; subtracted from F and H.
-            ``None``: not measured; ``wobjcal validate`` then uses the sensor model's analytic
-            value and ``wobjcal calibrate`` and the programs use 0 (:attr:`edge_offset_m`).
+            ``None``: not measured; every face (the programs, ``wobjcal calibrate``, check and
+            validate) then uses the sensor model's analytic value
+            (``planner.program.settings.resolved_settings``); :attr:`edge_offset_m` reads 0.
         xoffset: the x-offset run after the frame is fixed (eq. 13-14), or ``None``.
     """
 

@@ -47,8 +47,8 @@ class BestFit(
         tol: stop when the step is smaller than this (metres, and radians times the layout
             size).
         edge_event_offset_m: how far past a face's end the sensor reports it, removed from
-            edge searches, metres (``None``: not measured; the validation uses the sensor
-            model's value, ``wobjcal calibrate`` 0).
+            edge searches, metres (``None``: not measured; every face uses the sensor model's
+            value: ``planner.program.settings``).
     """
 
     max_iterations: int = 30

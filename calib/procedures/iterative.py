@@ -55,8 +55,8 @@ class Iterative(
             noise, or every round runs (0.5 mm by default).
         max_rounds: at most this many rounds of measurements.
         edge_event_offset_m: how far past a face's end the sensor reports it, removed from
-            edge searches, metres (``None``: not measured; the validation uses the sensor
-            model's value, ``wobjcal calibrate`` 0).
+            edge searches, metres (``None``: not measured; every face uses the sensor model's
+            value: ``planner.program.settings``).
     """
 
     tolerance_m: float = 5e-4

@@ -49,8 +49,8 @@ class ThreeTwoOne(
 
     Attributes:
         edge_event_offset_m: how far past a face's end the sensor reports it, removed from
-            edge searches, metres (``None``: not measured; the validation uses the sensor
-            model's value, ``wobjcal calibrate`` 0).
+            edge searches, metres (``None``: not measured; every face uses the sensor model's
+            value: ``planner.program.settings``).
     """
 
     edge_event_offset_m: float | None = None

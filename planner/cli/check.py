@@ -192,7 +192,7 @@ def cmd_check(args: argparse.Namespace) -> int:
                 for s in risky
             ),
             markup=False,
-            style="red" if L.failed > 0.01 else None,
+            style="red" if L.point_problems() else None,
         )
     n = len(check.points)
     out.print(

@@ -9,9 +9,10 @@ Layout of the module:
 - ``PERS wobjdata wobjNominal``: the nominal work object. ``uframe`` holds ``T_base_wobj`` (the
   controller's world frame is taken to be the robot base, ABB's default for one robot) and
   ``oframe`` is identity; ``PERS wobjdata wobjCal``: the frame every search is commanded in,
-  set to ``wobjNominal`` at the start. For ``hultman2013`` plans the program updates
-  ``wobjCal.uframe`` after every step of the A-H procedure (:mod:`planner.export.rapid_adaptive`)
-  and ends with the calibrated work object in it; otherwise it stays nominal;
+  set to ``wobjNominal`` at the start. The program updates ``wobjCal.uframe`` where its measuring
+  program does: after every step of the A-H procedure (:mod:`planner.export.rapid_adaptive`), or
+  between the searches of a best fit or a 3-2-1 (:mod:`planner.export.rapid_steer`), and ends
+  with the calibrated work object in it; a nominal program leaves it nominal;
 - per point ``_start``/``_end`` (the plan's search), ``_safe`` (the safe start) and for edge
   points ``_face``, ``_dir``, ``_normal``, all in ``wobjCal`` with the ``confdata``
   ``[cf1, cf4, cf6, cfx]`` of the IK branch ``wobjcal check`` chose (``[0, 0, 0, 0]`` and a

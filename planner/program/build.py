@@ -22,6 +22,7 @@ from typing import Literal
 import numpy as np
 
 from calib.errors import InputError, ProbeFailedError
+from calib.frames import small_motion
 from calib.paper.settings import Hultman2013
 from calib.plan.file import Plan
 from calib.probing import ProbeResult, SearchCommand
@@ -40,6 +41,7 @@ from planner.program.model import (
     search_keys,
 )
 from planner.program.safety import SafetySpec
+from planner.program.settings import resolved_settings
 from planner.program.steering import STEERED_METHODS, layout_pivot_scale, update_groups
 
 
@@ -69,7 +71,7 @@ def measuring_program(plan: Plan, controller_name: str | None = None) -> Measuri
     vias = {p.id: len(p.via_points) for p in plan.points}
     return build_program(
         plan.role_points(),
-        plan.procedure,
+        resolved_settings(plan.procedure, plan.validation.sensor),
         safety_spec(plan),
         controller(controller_name),
         vias,
@@ -175,6 +177,10 @@ def _nominal_steps(points: Sequence[RolePoint], vias: Mapping[str, int]) -> list
     return steps
 
 
+#: The small misplacement of the dry run (m, rad): well inside any plan's bound.
+_DRY_RUN_MOTION = np.array([4e-4, -3e-4, 5e-4, 2e-3, -1.5e-3, 1e-3])
+
+
 @dataclass
 class _Recorder:
     """A probe on the ideal nominal part that records each command (the dry run)."""
@@ -194,7 +200,9 @@ def _adaptive_steps(
     command a search (an estimate update wherever the commanded frame changed)."""
     kind = procedure_kind(method)
     T = np.eye(4)
-    rec = _Recorder(PlaneProbe(T, edge_offset_of(settings)), [])
+    # the part a little off its nominal pose: every update moves the estimate (on the nominal
+    # part some would leave it bit for bit where it was, and go unseen)
+    rec = _Recorder(PlaneProbe(small_motion(_DRY_RUN_MOTION), edge_offset_of(settings)), [])
     try:
         kind.run(list(points), T, rec, settings)
     except (InputError, ProbeFailedError) as exc:
@@ -243,8 +251,8 @@ class AdaptiveSpec:
 
     Attributes:
         index: ``{role: i}`` the target index (0-based, plan order) of each role ``A``..``H``.
-        settings: the plan's A-H settings (an unset edge-event offset counts as 0, as
-            ``wobjcal calibrate`` does: :attr:`Hultman2013.edge_offset_m`).
+        settings: the plan's A-H settings, an unset edge-event offset resolved
+            (:func:`planner.program.settings.resolved_settings`, as every face resolves it).
         face_coords_wobj: x of the side face, y of the short side, z of the top, wobj, m.
     """
 
@@ -262,7 +270,7 @@ def adaptive_spec(plan: Plan) -> AdaptiveSpec | None:
     face = layout.face_coords_wobj
     return AdaptiveSpec(
         index={p.role: i for i, p in enumerate(plan.points)},
-        settings=plan.procedure,
+        settings=resolved_settings(plan.procedure, plan.validation.sensor),
         face_coords_wobj=(float(face[0]), float(face[1]), float(face[2])),
     )
 

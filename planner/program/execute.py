@@ -8,10 +8,13 @@ ideal part of the linearisation):
   work object, and the frame is the procedure's :meth:`~calib.procedures.base.ProcedureKind.
   estimate` of the recorded points (what ``wobjcal calibrate`` computes from the program's
   results file);
-- an **adaptive** program is the procedure's own step-by-step run
+- an **adaptive** program that steers itself (best fit, 3-2-1: its update steps name the points
+  they fit, :mod:`planner.program.steering`) runs its steps: each search in the estimate so far,
+  each update between them; the frame is the last update's;
+- the adaptive A-H program is the procedure's own step-by-step run
   (:meth:`~calib.procedures.base.ProcedureKind.run`), each search commanded in the frame the
-  program estimated so far (the RAPID A-H program is proven equal to it in
-  ``tests/test_export_rapid_adaptive.py``).
+  program estimated so far (the RAPID module is proven equal to it in
+  ``tests/test_export_rapid_adaptive.py`` and ``tests/test_program.py``).
 
 Either way every search goes through :class:`ProgramProbe`, which runs it as the exported program
 does (:mod:`planner.program.searches`): from the point's safe start, an edge point first
@@ -83,7 +86,8 @@ class ProgramProbe:
             return self.probe(cmd)
         T = np.asarray(cmd.T_base_wobj_estimate, dtype=np.float64)
         plan_start = T[:3, :3] @ _plan_start_wobj(point) + T[:3, 3]
-        if not np.allclose(cmd.start_m, plan_start, rtol=0.0, atol=1e-9):
+        moved = not np.allclose(cmd.start_m, plan_start, rtol=0.0, atol=1e-9)
+        if moved and point.search.kind == "edge":  # an edge search from an earlier point
             measured = transform_points(invert_transform(T), np.asarray(cmd.start_m))
             searches = program_searches(point, T, self.safety, measured_start_wobj=measured)
             return self.probe(replace(searches[1].command, point_id=cmd.point_id))

@@ -14,6 +14,7 @@ export too) and the validation's preflight both call it, so they refuse the same
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 from calib.probing import ProbePoint
@@ -32,6 +33,10 @@ def search_problems(
         edge_offset_m: how far past an edge the sensor reports it, m.
     """
     out: dict[str, str] = {}
+    bound = (
+        f" (misplaced up to {safety.max_translation_m * 1e3:.1f} mm and "
+        f"{math.degrees(safety.max_angle_rad):.2f} deg)"
+    )
     for p in points:
         shift = safety.surface_shift_bound_m(p.position_m)
         s = p.search
@@ -40,9 +45,8 @@ def search_problems(
             if s.overtravel_m < shift:
                 why.append(
                     f"the search ends {s.overtravel_m * 1e3:.1f} mm past the nominal face, but "
-                    f"the part may lie up to {shift * 1e3:.1f} mm farther (misplacement "
-                    f"{safety.describe()}): overtravel at least {shift * 1e3:.1f} mm, or a "
-                    "smaller misplacement bound"
+                    f"the part may lie up to {shift * 1e3:.1f} mm farther{bound}: overtravel at "
+                    f"least {shift * 1e3:.1f} mm, or a smaller misplacement bound"
                 )
         else:
             if s.start_offset_m < shift:

@@ -2,8 +2,8 @@
 face, under the plan's misplacement.
 
 The program (:mod:`planner.program`) is executed against the ideal part (its faces' planes,
-:class:`calib.procedures.linearize.PlaneProbe`) misplaced as the validation misplaces it, a few
-hundred seeded times; no noise (micrometres against millimetres of misplacement). For every
+:class:`calib.procedures.linearize.PlaneProbe`) misplaced as the validation misplaces it,
+:data:`TRIALS` seeded times; no noise (micrometres against millimetres of misplacement). For every
 search it records the travel to its event against the search's length, and for every approach
 where it lands on the true part: the centre of the sensor's footprint must lie on the planar
 face the point is on (:class:`planner.faces.outline.FaceOutlines`; the footprint partly over a
@@ -205,6 +205,7 @@ def landing_risk(
     caster: MeshRayCaster | None = None,
     standoff_m: float = 0.0,
     footprint_radius_m: float = 0.0,
+    triangle_face: NDArray[np.int64] | None = None,
 ) -> LandingRisk:
     """The landing risk of ``program`` (see the module docstring).
 
@@ -221,6 +222,9 @@ def landing_risk(
             another surface before their own face; ``None``: not judged.
         standoff_m: the sensor's sensing distance (its face lies that far behind the TCP), m.
         footprint_radius_m: the sensor face's radius, m.
+        triangle_face: ``(T,)`` the planar face of each mesh triangle (``-1``: none), so a
+            ray that meets the point's own face (tilted, off its plane by the rim's lever)
+            does not count as another surface; ``None``: every early hit counts.
     """
     rng = np.random.default_rng(seed)
     keys = search_keys(program.points)
@@ -267,9 +271,15 @@ def landing_risk(
         for key, items in rays.items():
             o = np.concatenate([it[1] for it in items])
             d = np.repeat(np.array([it[2] for it in items]), 1 + RIM_RAYS, axis=0)
-            dist = caster.first_hits(o, d).reshape(len(items), 1 + RIM_RAYS)
+            dist, tri = caster.first_hits_ids(o, d)
+            dist = dist.reshape(len(items), 1 + RIM_RAYS)
             own = np.array([it[3] for it in items])
-            early = np.any(dist < own[:, None] - OTHER_SURFACE_TOL_M, axis=1)
+            hit_early = dist < own[:, None] - OTHER_SURFACE_TOL_M
+            if triangle_face is not None:  # the point's own planar face is not another surface
+                face = face_of.get(keys.get(key, key), -1)
+                same = (tri >= 0) & (triangle_face[np.maximum(tri, 0)] == face) & (face >= 0)
+                hit_early &= ~(same.reshape(hit_early.shape) & (dist > 0.0))
+            early = np.any(hit_early, axis=1)
             other_of[key] = int(np.sum(early))
             bad_trials |= {it[0] for it, e in zip(items, early, strict=True) if e}
     searches = []

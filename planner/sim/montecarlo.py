@@ -2,11 +2,12 @@
 
 :func:`simulate` runs any plan's setup (:class:`~planner.sim.setup.SimulationSetup`: any
 procedure of the registry, any sensor kind, any work-object mesh): each trial misplaces the true
-part by a random rigid motion within the tolerance, runs the procedure with the simulated
-sensor (each search commanded in the estimate so far, as on the robot), fits the same
+part by a random rigid motion within the tolerance, executes the plan's measuring program with
+the simulated sensor (each search as the controller's program commands it, in the nominal frame
+or the estimate so far), fits the same
 measurements by least squares fed as the procedure is fed, and runs the x-offset run if the plan
 has one (:mod:`planner.sim.trial`). The errors against the truth become the report's rows, each
-beside the interval predicted from the procedure's linearisation (:mod:`planner.sim.predict`).
+beside the interval predicted from the program's linearisation (:mod:`planner.sim.predict`).
 :func:`validate` is the same for the paper's A-H points on a stator geometry, as a script
 would call it.
 
@@ -43,20 +44,14 @@ from planner.parts.stator_mesh import build_stator_mesh
 from planner.program.build import build_program
 from planner.program.controllers import controller
 from planner.program.safety import SafetySpec
+from planner.program.settings import DEFAULT_EDGE_INSET_M, resolved_settings
 from planner.sim.error_map import error_map
 from planner.sim.predict import predict
 from planner.sim.probe import ReachabilityHook, cell_search_hook
 from planner.sim.report import PAPER_TABLE1, ValidationReport
 from planner.sim.report_points import report_rows
 from planner.sim.rows import RowSpec
-from planner.sim.setup import (
-    DEFAULT_EDGE_INSET_M,
-    SimulationSetup,
-    default_pivot,
-    default_settings,
-    face_lookup,
-    resolved_settings,
-)
+from planner.sim.setup import SimulationSetup, default_pivot, default_settings, face_lookup
 from planner.sim.summary import build_report
 from planner.sim.trial import TrialResult, TrialSeed, run_all
 

@@ -12,7 +12,6 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-import msgspec
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
@@ -27,27 +26,11 @@ from calib.procedures.base import edge_offset_of
 from planner.faces.checks import check_plan_faces
 from planner.faces.detection import find_planar_faces
 from planner.program.model import MeasuringProgram, search_keys
+from planner.program.settings import DEFAULT_EDGE_INSET_M
 from planner.sim.search_events import FaceLookup
 from planner.sim.xoffset import XOffsetSetup
 
 FloatArray = NDArray[np.float64]
-
-#: Edge searches run this far inside the face along the sensor axis by default, m.
-DEFAULT_EDGE_INSET_M = 0.003
-
-
-def resolved_settings(
-    settings: Any, sensor: SensorModel, edge_inset_m: float = DEFAULT_EDGE_INSET_M
-) -> Any:
-    """``settings`` with an unset edge-event offset replaced by the sensor's analytic
-    straight-edge offset at ``edge_inset_m`` (what a robot cell measures once on a reference
-    edge; see :meth:`calib.models.ProximitySensor.edge_event_offset_m`; 0 for a sensor without
-    edge searches)."""
-    if getattr(settings, "edge_event_offset_m", 0.0) is not None:
-        return settings
-    offset = sensor.edge_event_offset_m(edge_inset_m) if sensor.runs_edge_searches else 0.0
-    return msgspec.structs.replace(settings, edge_event_offset_m=offset)
-
 
 def default_settings(
     sensor: SensorModel, edge_inset_m: float = DEFAULT_EDGE_INSET_M, **kwargs: Any
@@ -96,9 +79,9 @@ class SimulationSetup:
     """Everything a worker needs to run trials (picklable).
 
     The program holds the plan's points with their roles, the procedure and its settings
-    (edge-event offset resolved, :func:`resolved_settings`): :attr:`points`, :attr:`method` and
-    :attr:`settings` read them from it, so a setup cannot simulate one procedure and predict
-    another.
+    (edge-event offset resolved, :func:`planner.program.settings.resolved_settings`):
+    :attr:`points`, :attr:`method` and :attr:`settings` read them from it, so a setup cannot
+    simulate one procedure and predict another.
 
     Attributes:
         program: the measuring program each trial executes (the one a controller runs for

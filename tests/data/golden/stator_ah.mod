@@ -85,7 +85,7 @@ MODULE WobjcalStatorSectionAh
     CONST num nTanBeta1:=0.267949192431;
     CONST num nP3Height:=50;
     CONST num nEdgeBack:=0;
-    CONST num nEdgeEvent:=0;
+    CONST num nEdgeEvent:=6.320734;
     CONST num nFaceX:=0;
     CONST num nFaceY:=0;
     CONST num nFaceZ:=0;
