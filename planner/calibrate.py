@@ -30,6 +30,7 @@ from __future__ import annotations
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 
+import msgspec
 import numpy as np
 from numpy.typing import NDArray
 
@@ -152,8 +153,19 @@ def calibrate_plan(
             f"measurements: points {unknown} are not in the plan (its points: {sorted(known)})"
         )
     kind = procedure_kind(method)
-    # the program's settings: an unset edge-event offset as the exported program has it
-    settings = program_settings(plan) if kind.method == plan.method else None
+    # the program's settings: an unset edge-event offset as the exported program has it (another
+    # procedure than the plan's: its defaults, with the same offset)
+    settings = (
+        program_settings(plan)
+        if kind.method == plan.method
+        else resolved_settings(
+            msgspec.structs.replace(
+                kind.settings_type(),
+                edge_event_offset_m=getattr(plan.procedure, "edge_event_offset_m", None),
+            ),
+            plan.validation.sensor,
+        )
+    )
     T_nom = nominal_T_base_wobj(plan)
     measured = MeasuredPoints(measurements, T_base_world(plan))
     points = plan.role_points()

@@ -353,6 +353,7 @@ def suggest_plan(
         msg += "; moves between points not cleared: " + "; ".join(stuck)
     say("check", 0, 1)
     check = check_plan(new_plan, cell=cell, fmt=fmt)
+    say("check", 1, 1)
     problems = tuple(f"{p.point_id}: {p.reason}" for p in check.infeasible)
     if check.layout:
         problems += (f"layout: {check.layout}",)

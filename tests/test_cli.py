@@ -122,6 +122,22 @@ def test_export_writes_files(fmt: str, tmp_path: Path, capsys: pytest.CaptureFix
         assert text.count(' = probe("') == 8
 
 
+def _ideal_stator(tmp_path: Path) -> Path:
+    """The shipped stator plan with an ideal sensor (edge-event offset measured as 0; unset,
+    every face would take the sensor model's 6.3 mm), written to ``tmp_path``."""
+    import msgspec
+
+    from calib.plan.file import save_plan
+    from planner.suggest import moved_plan
+
+    plan = load_plan(STATOR)
+    proc = msgspec.structs.replace(plan.procedure, edge_event_offset_m=0.0)
+    out = tmp_path / "stator_ideal.json"
+    ideal = msgspec.structs.replace(plan, procedure=proc)
+    save_plan(moved_plan(ideal, STATOR.parent, tmp_path), out)
+    return out
+
+
 def _synthetic(tmp_path: Path, rng: np.random.Generator) -> tuple[Path, np.ndarray]:
     plan = load_plan(STATOR)
     T_true = nominal_T_base_wobj(plan) @ random_transform(rng, 0.010, np.radians(2.0))
@@ -135,7 +151,8 @@ def test_calibrate_recovers_known_motion(
     method: str, tmp_path: Path, rng: np.random.Generator, capsys: pytest.CaptureFixture[str]
 ) -> None:
     meas, T_true = _synthetic(tmp_path, rng)
-    code, out, err = run(capsys, "calibrate", str(STATOR), str(meas), "--method", method, "--json")
+    ideal = str(_ideal_stator(tmp_path))
+    code, out, err = run(capsys, "calibrate", ideal, str(meas), "--method", method, "--json")
     assert code == 0, err
     res = json.loads(out)
     T = np.array(res["T_base_wobj"])
@@ -149,7 +166,7 @@ def test_calibrate_text_has_paste_lines(
     tmp_path: Path, rng: np.random.Generator, capsys: pytest.CaptureFixture[str]
 ) -> None:
     meas, T_true = _synthetic(tmp_path, rng)
-    code, out, _ = run(capsys, "calibrate", str(STATOR), str(meas))
+    code, out, _ = run(capsys, "calibrate", str(_ideal_stator(tmp_path)), str(meas))
     assert code == 0
     assert 'PERS wobjdata wobjCalibrated:=[FALSE,TRUE,"",[[' in out
     assert "BASE_DATA[10]={X " in out

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import msgspec
 import numpy as np
 import pytest
 
@@ -20,6 +21,23 @@ STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
 SMALL = REPO / "tests" / "data" / "plans" / "valid_three_two_one.json"
 
 
+def _ideal_stator():  # type: ignore[no-untyped-def]
+    """The shipped stator plan with an ideal sensor: its edge-event offset measured as 0 (unset,
+    every face would take the sensor model's 6.3 mm), so exact points recover the motion."""
+    plan = load_plan(STATOR)
+    return msgspec.structs.replace(
+        plan, procedure=msgspec.structs.replace(plan.procedure, edge_event_offset_m=0.0)
+    )
+
+
+def _ideal_small():  # type: ignore[no-untyped-def]
+    """The small 3-2-1 test plan (its tertiary point an edge search) with an ideal sensor."""
+    plan = load_plan(SMALL)
+    return msgspec.structs.replace(
+        plan, procedure=msgspec.structs.replace(plan.procedure, edge_event_offset_m=0.0)
+    )
+
+
 def _measure(plan, T_true, units="m"):  # type: ignore[no-untyped-def]
     pts = {p.id: transform_points(T_true, p.position_m) for p in plan.points}
     return Measurements.from_points_m(pts, units=units)
@@ -28,7 +46,7 @@ def _measure(plan, T_true, units="m"):  # type: ignore[no-untyped-def]
 @pytest.mark.parametrize("method", ["hultman2013", "three_two_one", "best_fit"])
 @pytest.mark.parametrize("units", ["m", "mm"])
 def test_known_motion_is_recovered(method: str, units: str, rng: np.random.Generator) -> None:
-    plan = load_plan(STATOR)
+    plan = _ideal_stator()
     T_nom = nominal_T_base_wobj(plan)
     for _ in range(5):
         T_true = T_nom @ random_transform(rng, 0.010, np.radians(2.0))
@@ -41,7 +59,7 @@ def test_known_motion_is_recovered(method: str, units: str, rng: np.random.Gener
 
 @pytest.mark.parametrize("method", ["three_two_one", "best_fit"])
 def test_small_plan_recovers_motion(method: str, rng: np.random.Generator) -> None:
-    plan = load_plan(SMALL)
+    plan = _ideal_small()
     T_true = nominal_T_base_wobj(plan) @ random_transform(rng, 0.02, np.radians(3.0))
     out = calibrate_plan(plan, _measure(plan, T_true), method)
     assert np.abs(motion_between(T_true, out.T_base_wobj)).max() < 1e-6
@@ -55,7 +73,7 @@ def test_hultman_needs_a_to_h_roles() -> None:
 
 
 def test_unknown_method_and_missing_point() -> None:
-    plan = load_plan(STATOR)
+    plan = _ideal_stator()
     m = _measure(plan, nominal_T_base_wobj(plan))
     with pytest.raises(InputError, match="method must be one of"):
         calibrate_plan(plan, m, "guess")
@@ -73,7 +91,7 @@ def test_world_frame_measurements_use_T_world_base(rng: np.random.Generator) -> 
 
     from calib.plan.file import Pose
 
-    plan = load_plan(STATOR)
+    plan = _ideal_stator()
     T_world_base = random_transform(rng, 1.0, 1.0)
     robot = msgspec.structs.replace(plan.cell.robot, T_world_base=Pose.from_matrix(T_world_base))
     plan = msgspec.structs.replace(plan, cell=msgspec.structs.replace(plan.cell, robot=robot))
@@ -90,7 +108,7 @@ def test_world_frame_measurements_use_T_world_base(rng: np.random.Generator) -> 
 
 def test_retakes_feed_c2_d2(rng: np.random.Generator) -> None:
     """The replay returns the retake for C2/D2: a retake off the face moves the result."""
-    plan = load_plan(STATOR)
+    plan = _ideal_stator()
     T_nom = nominal_T_base_wobj(plan)
     m = _measure(plan, T_nom)
     exact = calibrate_plan(plan, m, "hultman2013").T_base_wobj
@@ -112,7 +130,7 @@ def test_three_two_one_roles_are_picked_from_faces() -> None:
 
 
 def test_measured_point_not_in_plan_is_an_error() -> None:
-    plan = load_plan(STATOR)
+    plan = _ideal_stator()
     m = _measure(plan, nominal_T_base_wobj(plan))
     extra = Measurements(points={**m.points, "Z": (1.0, 2.0, 3.0)})
     with pytest.raises(InputError, match=r"points \['Z'\] are not in the plan"):
@@ -131,7 +149,7 @@ def _measure_off(plan, T, point_id: str, offset_wobj):  # type: ignore[no-untype
 
 def test_a_point_10_mm_off_is_flagged_and_named() -> None:
     """Item 1: D 10 mm off along wobj x gave a frame 17 deg off, trusted. Now: D is named."""
-    plan = load_plan(STATOR)
+    plan = _ideal_stator()
     out = calibrate_plan(plan, _measure_off(plan, nominal_T_base_wobj(plan), "D", (0.01, 0, 0)))
     assert not out.trusted
     assert out.screen is not None and out.screen.remeasure == ("D",)
@@ -142,7 +160,7 @@ def test_a_point_10_mm_off_is_flagged_and_named() -> None:
 
 
 def test_a_point_1_m_off_is_named_with_best_fit() -> None:
-    plan = load_plan(STATOR)
+    plan = _ideal_stator()
     out = calibrate_plan(
         plan, _measure_off(plan, nominal_T_base_wobj(plan), "G", (1.0, 0, 0)), "best_fit"
     )
@@ -156,7 +174,7 @@ def test_noise_the_plan_expects_is_not_flagged(method: str, rng: np.random.Gener
     sigma plus 0.1 mm of face flatness, part misplaced within the plan's bound."""
     from planner.calibrate import expected_sigma_m
 
-    plan = load_plan(STATOR)
+    plan = _ideal_stator()
     T_nom = nominal_T_base_wobj(plan)
     sigma = expected_sigma_m(plan)
     pivot = np.mean([p.position_m for p in plan.points], axis=0)
@@ -232,7 +250,7 @@ def test_propagated_covariance_matches_best_fit_and_monte_carlo(rng: np.random.G
     from calib.procedures import procedure_kind
     from calib.procedures.uncertainty import propagated_covariance
 
-    plan = load_plan(STATOR)
+    plan = _ideal_stator()
     T_nom = nominal_T_base_wobj(plan)
     points = plan.role_points()
     exact = {p.id: transform_points(T_nom, p.position_m)[None] for p in plan.points}

@@ -151,7 +151,7 @@ class LayoutQuality:
             "rating": self.rating,
             "problem": self.problem,
             "sigma": {
-                n.replace(" ", "_") + ("_mm" if i < 3 else "_deg"): float(v)
+                n.replace(" ", "_") + ("_mm" if i < 3 else "_deg"): _finite(float(v))
                 for i, (n, v) in enumerate(zip(DOF_NAMES, self.sigma * scale, strict=True))
             },
             "noise_sigma_mm": self.noise_sigma_m * 1e3,

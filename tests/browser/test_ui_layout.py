@@ -42,9 +42,10 @@ def test_layout_tab_shows_the_quality_and_follows_a_moved_point(demo: UiSession)
     wait_for(lambda: _shown(demo, q0), what=f"'{_poi_line(q0)}' in the page")
     assert "weakest:" in page.inner_text("body") and "noise gain" in page.inner_text("body")
     before = q0.worst_poi_m(LEVEL)
-    # B moved to 40 mm from A (A and B fix the rotation about z): weaker, live
-    a = app.state.doc.get("A").probe.position_m
-    app.move_point_to("B", [a[0], a[1] + 0.04, a[2]])
+    # E moved to 5 mm below D (D and E aim F's and H's edge tracks): weaker, live (the RAPID
+    # program runs F and H from their measured face points: A and B no longer reach the frame)
+    d = app.state.doc.get("D").probe.position_m
+    app.move_point_to("E", [d[0], d[1], d[2] - 0.005])
     try:
         q1 = wait_for(
             lambda: (
@@ -52,7 +53,7 @@ def test_layout_tab_shows_the_quality_and_follows_a_moved_point(demo: UiSession)
                 if panel.last is not None and panel.last.worst_poi_m(LEVEL) > 1.5 * before
                 else None
             ),
-            what="the server's quality after B moved",
+            what="the server's quality after E moved",
         )
         wait_for(lambda: _shown(demo, q1), what=f"'{_poi_line(q1)}' in the page")
         assert not _shown(demo, q0)
