@@ -149,13 +149,22 @@ def plan_landing_risk(
         faces = find_planar_faces(mesh, min_area_m2=math.pi * r**2, footprint_radius_m=r)
     except (InputError, NoPlanarFaceError):
         return None
+    key = (
+        setup.program,
+        setup.T_base_wobj_nominal.tobytes(),
+        setup.misplacement,
+        setup.pivot_wobj_m.tobytes(),
+        id(mesh),
+    )
+    if key in _RISKS:
+        return _RISKS[key][1]
     probes = [rp.point for rp in setup.points]
     face_of = {
         p.id: int(c.face_id)
         for p, c in zip(probes, check_plan_faces(faces, probes, footprint_radius_m=r), strict=True)
         if c.ok
     }
-    return landing_risk(
+    risk = landing_risk(
         setup.program,
         setup.T_base_wobj_nominal,
         setup.misplacement,
@@ -167,6 +176,16 @@ def plan_landing_risk(
         footprint_radius_m=float(plan.validation.sensor.footprint_radius_m),
         triangle_face=np.asarray(faces.face_id, dtype=np.int64),
     )
+    if len(_RISKS) >= 32:
+        _RISKS.pop(next(iter(_RISKS)))
+    _RISKS[key] = (mesh, risk)  # the mesh kept, so its id stays its own
+    return risk
+
+
+#: Landing risks of recent programs on recent parts (the same plan is checked again after
+#: every export and edit): ``{(program, nominal pose, misplacement, pivot, id of the mesh):
+#: (mesh, risk)}``; the risk is seeded, so a cached one is the one computed again.
+_RISKS: dict[tuple[object, ...], tuple[object, LandingRisk]] = {}
 
 
 #: The ray casters of recent parts: ``{id of the mesh: (mesh, caster)}``.
