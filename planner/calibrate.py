@@ -44,6 +44,7 @@ from calib.procedures.base import edge_offset_of
 from calib.procedures.uncertainty import propagated_covariance
 from calib.tolerances import FACE_FLATNESS_RMS_M
 from planner.plan_cell import T_base_world, nominal_T_base_wobj
+from planner.program.build import plan_settings
 from planner.program.settings import resolved_settings
 
 FloatArray = NDArray[np.float64]
@@ -156,7 +157,7 @@ def calibrate_plan(
     # the program's settings: an unset edge-event offset as the exported program has it (another
     # procedure than the plan's: its defaults, with the same offset)
     settings = (
-        program_settings(plan)
+        plan_settings(plan)
         if kind.method == plan.method
         else resolved_settings(
             msgspec.structs.replace(
@@ -214,15 +215,9 @@ def expected_sigma_m(plan: Plan) -> float:
     return float(np.sqrt(sum(x * x for x in parts)))
 
 
-def program_settings(plan: Plan) -> object:
-    """The plan's procedure settings as its programs compute with them (an unset edge-event
-    offset resolved from the sensor model: :func:`planner.program.settings.resolved_settings`)."""
-    return resolved_settings(plan.procedure, plan.validation.sensor)
-
-
 def edge_offset_m(plan: Plan) -> float:
     """How far past the edge the sensor reports an edge, m, as the programs take it."""
-    return edge_offset_of(program_settings(plan))
+    return edge_offset_of(plan_settings(plan))
 
 
 def screen_plan_measurements(

@@ -54,7 +54,7 @@ from planner.check_paths import ProgramPath, check_program_path, measured_starts
 from planner.check_results import ConfData, PlanCheck, PointCheck, Status
 from planner.dry_run import nominal_part_probe
 from planner.plan_cell import nominal_T_base_wobj, open_cell
-from planner.program.build import measuring_program, safety_spec
+from planner.program.build import measuring_program, plan_settings, safety_spec
 from planner.program.controllers import controller
 from planner.program.execute import execute
 from planner.program.reach import search_problems
@@ -411,7 +411,7 @@ def _check(plan: Plan, points: list[PlanPoint], cell: Cell) -> tuple[tuple[Point
     safety = safety_spec(plan)
     tcp = plan.cell.tool.tcp
     measured = measured_starts_wobj(plan)
-    reach = search_problems(probes, safety, _edge_event_offset_m(plan))
+    reach = search_problems(probes, safety, edge_offset_of(plan_settings(plan)))
     for p, probe, pose, face in zip(points, probes, poses, faces, strict=True):
         path = check_program_path(
             cell, probe, pose, T_nom, safety, T_flange_tcp, tcp, measured.get(p.id)
@@ -427,14 +427,6 @@ def _check(plan: Plan, points: list[PlanPoint], cell: Cell) -> tuple[tuple[Point
         out.append(_with_part_size(check, wo.name, part))
         t0 = time.perf_counter()
     return tuple(out), error
-
-
-def _edge_event_offset_m(plan: Plan) -> float:
-    """How far past an edge the sensor reports it, m, as every program takes it (the plan's
-    value, or unset the sensor model's: :mod:`planner.program.settings`)."""
-    from planner.program.settings import resolved_settings
-
-    return edge_offset_of(resolved_settings(plan.procedure, plan.validation.sensor))
 
 
 def _point_check(

@@ -25,11 +25,10 @@ from calib.models import Misplacement, RobotErrorModel
 from calib.plan.file import Plan, PlanError
 from calib.procedures import RolePoint, procedure_kind
 from planner.parts.stator import StatorGeometry
+from planner.program.build import safety_spec
 from planner.program.reach import search_problems
-from planner.program.safety import SafetySpec
 from planner.program.settings import DEFAULT_EDGE_INSET_M, resolved_settings
 from planner.sim.sensors import sensor_kind
-from planner.sim.setup import default_pivot
 
 __all__ = [
     "SIMULATED_PARTS",
@@ -187,17 +186,8 @@ def preflight(plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh) -> No
         )
         if reason
     }
-    m = models.misplacement
-    pivot = default_pivot(list(models.points))
-    safety = SafetySpec(
-        max_translation_m=m.max_translation_m,
-        max_angle_rad=m.max_angle_rad,
-        pivot_wobj_m=(float(pivot[0]), float(pivot[1]), float(pivot[2])),
-        sensing_distance_m=models.sensor.standoff_m,
-        margin_m=0.0,
-    )
     edge_offset = float(getattr(models.settings, "edge_event_offset_m", 0.0) or 0.0)
-    reach = search_problems([p for p in probes if p.id not in why], safety, edge_offset)
+    reach = search_problems([p for p in probes if p.id not in why], safety_spec(plan), edge_offset)
     why.update(reach)
     if why:
         lines = "; ".join(f"{_name(plan, pid)}: {w}" for pid, w in why.items())

@@ -13,6 +13,7 @@ from calib.probing import ProbePoint, SearchCommand
 from calib.procedures import RolePoint
 from planner.parts.stator import StatorGeometry
 from planner.parts.stator_mesh import build_stator_mesh
+from planner.program.model import search_keys
 from planner.sim.probe import SimulatedProbe
 from planner.sim.raycast import MeshRayCaster
 from planner.sim.search_events import (
@@ -22,7 +23,7 @@ from planner.sim.search_events import (
     cell_search_hook,
     search_group,
 )
-from planner.sim.setup import face_lookup, search_aliases
+from planner.sim.setup import face_lookup
 
 G = StatorGeometry.prototype()
 X = (1.0, 0.0, 0.0)
@@ -98,7 +99,7 @@ def test_search_ids_of_roles_and_retakes() -> None:
         RolePoint("fit", ProbePoint("P1", (0, 1, 0), X)),
         RolePoint("fit", ProbePoint("P2", (0, 2, 0), X)),
     ]
-    aliases = search_aliases(pts)
+    aliases = search_keys(pts)
     assert aliases["A"] == aliases["A2"] == aliases["yoke_left"] == "yoke_left"
     assert "fit" not in aliases and aliases["P2"] == "P2"
     assert search_group("PX1_3") == search_group("PX6_41") != search_group("P1")

@@ -9,7 +9,6 @@ saving writes everything else back as it was.
 from __future__ import annotations
 
 import dataclasses
-import math
 import string
 from collections import Counter
 from dataclasses import dataclass, field
@@ -22,7 +21,7 @@ from calib.errors import InputError
 from calib.paper.stator_layout import STATOR_POINT_IDS
 from calib.plan.vias import ViaPoint
 from calib.probing import ProbePoint, SearchSpec
-from planner.program.safety import SAFETY_MARGIN_M
+from planner.program.build import safety_spec
 
 if TYPE_CHECKING:
     from calib.plan.file import Plan
@@ -182,16 +181,15 @@ def _sized_search(plan: UiPlan, position_wobj: ArrayLike) -> SearchSpec:
     src = plan.source
     if src is None:
         return default
-    m = src.validation.misplacement
     p = np.asarray(position_wobj, dtype=np.float64).reshape(3)
     others = [np.asarray(q.probe.position_m, dtype=np.float64) for q in plan.points]
-    lever = max((float(np.linalg.norm(q - p)) for q in others), default=0.0)
-    cos = math.cos(m.max_angle_rad)
-    shift = (m.max_translation_m + lever * m.max_angle_rad) / cos
-    standoff = float(src.validation.sensor.standoff_m) / cos
+    far = max(others, key=lambda q: float(np.linalg.norm(q - p)), default=p)
+    safety = dataclasses.replace(
+        safety_spec(src), pivot_wobj_m=(float(far[0]), float(far[1]), float(far[2]))
+    )
     return SearchSpec(
-        start_offset_m=max(default.start_offset_m, shift + standoff + SAFETY_MARGIN_M),
-        overtravel_m=max(default.overtravel_m, shift + SAFETY_MARGIN_M),
+        start_offset_m=max(default.start_offset_m, safety.start_clearance_m(p)),
+        overtravel_m=max(default.overtravel_m, safety.overtravel_m(p)),
     )
 
 

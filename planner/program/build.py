@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 
@@ -60,6 +60,13 @@ def safety_spec(plan: Plan) -> SafetySpec:
     )
 
 
+def plan_settings(plan: Plan) -> Any:
+    """The plan's procedure settings as every program computes with them: an unset edge-event
+    offset resolved from the plan's sensor (:func:`planner.program.settings.resolved_settings`).
+    """
+    return resolved_settings(plan.procedure, plan.validation.sensor)
+
+
 def measuring_program(plan: Plan, controller_name: str | None = None) -> MeasuringProgram:
     """The program ``controller_name`` (default :data:`~planner.program.controllers.
     DEFAULT_CONTROLLER`) runs for ``plan``.
@@ -71,7 +78,7 @@ def measuring_program(plan: Plan, controller_name: str | None = None) -> Measuri
     vias = {p.id: len(p.via_points) for p in plan.points}
     return build_program(
         plan.role_points(),
-        resolved_settings(plan.procedure, plan.validation.sensor),
+        plan_settings(plan),
         safety_spec(plan),
         controller(controller_name),
         vias,
@@ -270,7 +277,7 @@ def adaptive_spec(plan: Plan) -> AdaptiveSpec | None:
     face = layout.face_coords_wobj
     return AdaptiveSpec(
         index={p.role: i for i, p in enumerate(plan.points)},
-        settings=resolved_settings(plan.procedure, plan.validation.sensor),
+        settings=plan_settings(plan),
         face_coords_wobj=(float(face[0]), float(face[1]), float(face[2])),
     )
 

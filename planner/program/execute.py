@@ -112,13 +112,10 @@ def _searches_in_wobj(point: ProbePoint, safety: SafetySpec) -> tuple[SearchComm
     return tuple(s.command for s in program_searches(point, np.eye(4), safety))
 
 
+@lru_cache(maxsize=4096)
 def _plan_start_wobj(point: ProbePoint) -> FloatArray:
     """``(3,)`` where the plan's search of ``point`` starts, wobj frame, m."""
-    p = np.asarray(point.position_m, dtype=np.float64)
-    s = point.search
-    if s.kind == "approach":
-        return p + s.start_offset_m * np.asarray(point.normal, dtype=np.float64)
-    return p - s.start_offset_m * np.asarray(s.edge_direction, dtype=np.float64)
+    return SearchCommand.from_point(point, np.eye(4)).start_m
 
 
 def _moved(cmd: SearchCommand, T: FloatArray) -> SearchCommand:

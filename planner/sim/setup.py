@@ -51,13 +51,6 @@ def default_pivot(points: Sequence[RolePoint] | Mapping[str, ProbePoint]) -> Flo
     return np.mean([p.position_m for p in pts], axis=0)
 
 
-def search_aliases(points: Sequence[RolePoint]) -> dict[str, str]:
-    """``{search key: plan id}``: the keys a program gives a point's searches
-    (:func:`planner.program.model.search_keys`: the plan id, a role held by one point, the
-    retakes ``"C2"``, an edge point's ``"<id>@face"`` approach to its face)."""
-    return search_keys(points)
-
-
 def face_lookup(
     mesh: trimesh.Trimesh, points: Sequence[RolePoint], footprint_radius_m: float
 ) -> FaceLookup:
@@ -70,7 +63,7 @@ def face_lookup(
     faces = find_planar_faces(mesh, min_area_m2=np.pi * radius**2, footprint_radius_m=radius)
     checks = check_plan_faces(faces, [rp.point for rp in points], footprint_radius_m=radius)
     by_id = {rp.point.id: c.face_id for rp, c in zip(points, checks, strict=True)}
-    intended = {alias: by_id[pid] for alias, pid in search_aliases(points).items()}
+    intended = {alias: by_id[pid] for alias, pid in search_keys(points).items()}
     return FaceLookup(np.asarray(faces.face_id, dtype=np.int64), intended)
 
 
