@@ -473,6 +473,7 @@ def _point_check(
         T_base_tcp=None
         if pose.T_base_flange is None
         else np.asarray(pose.T_base_flange) @ T_flange_tcp,
+        branch=int(pose.branch),
     )
 
 
@@ -487,7 +488,8 @@ def _with_part_size(check: PointCheck, name: str, part: str) -> PointCheck:
     pose, path, face = add(check.pose_reason), add(check.path_reason), add(check.face_reason)
     if (pose, path, face) == (check.pose_reason, check.path_reason, check.face_reason):
         return check
-    parts = [pose, f"search path: {path}" if path else "", face]
+    search = f"search: {check.search_reason}" if check.search_reason else ""
+    parts = [pose, f"search path: {path}" if path else "", face, search]
     return replace(
         check,
         pose_reason=pose,

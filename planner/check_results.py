@@ -66,6 +66,8 @@ class PointCheck:
         search_reason: why the point's search cannot reach its face or edge wherever the
             part may lie (:func:`planner.program.reach.search_problems`), or how likely it is
             to fail or land off its face; ``""`` when it can.
+        branch: the IK branch of ``q`` (OPW configuration 0-7; -1 unknown or none): the
+            configuration every program runs the point in (ABB ``confdata``, KUKA ``S``/``T``).
     """
 
     point_id: str
@@ -93,6 +95,7 @@ class PointCheck:
     n_vias: int = 0
     via_reason: str = ""
     search_reason: str = ""
+    branch: int = -1
 
     @property
     def feasible(self) -> bool:
@@ -175,6 +178,14 @@ class PlanCheck:
     def infeasible(self) -> tuple[PointCheck, ...]:
         """The points that fail."""
         return tuple(p for p in self.points if not p.feasible)
+
+    def problems(self) -> tuple[str, ...]:
+        """Every problem the check found, one line each: the plan's error, the layout's, then
+        ``"point <id>: <reason>"`` per infeasible point (``()`` when feasible)."""
+        out = [f"error: {self.error}"] if self.error else []
+        out += [f"layout: {self.layout}"] if self.layout else []
+        out += [f"point {p.point_id}: {p.reason or p.status}" for p in self.infeasible]
+        return tuple(out)
 
     def point(self, point_id: str) -> PointCheck:
         """The check of ``point_id``.

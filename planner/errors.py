@@ -24,3 +24,20 @@ class ToolMountError(InputError):
 
 class UnreachableError(WobjcalError):
     """A target cannot be reached by the robot; the message says why."""
+
+
+class PlanRefused(WobjcalError):
+    """``wobjcal check`` refuses the plan for the program a job would run, so the job stops
+    before it starts (``validate`` without ``--force``).
+
+    Attributes:
+        program: the measuring program's name, e.g. ``"RAPID, adaptive best fit"``.
+        problems: every problem check names, one line each (``"point T1: ..."``).
+    """
+
+    def __init__(self, program: str, problems: tuple[str, ...]) -> None:
+        self.program = program
+        self.problems = problems
+        super().__init__(
+            f"check refuses this plan for the program {program}: " + "; ".join(problems)
+        )

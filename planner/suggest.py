@@ -36,6 +36,8 @@ points of interest) and proposes the points:
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -48,17 +50,18 @@ from numpy.typing import NDArray
 
 from calib.errors import InputError
 from calib.estimators.layout import search_constraint_set
-from calib.plan.file import Plan, PlanError
+from calib.plan.file import Plan, PlanError, PlanPoint
 from calib.plan.report_spec import PointOfInterest
 from calib.probing import ProbePoint, SearchSpec
 from planner.check import check_plan, plan_quality
+from planner.check_results import PlanCheck
 from planner.faces.candidates import Candidates, FaceTried, face_candidates
 from planner.faces.detection import find_planar_faces
 from planner.faces.edges import edge_candidates
 from planner.faces.outline import FaceOutlines
 from planner.move_vias import plan_with_vias
 from planner.plan_cell import open_cell
-from planner.program.controllers import controller
+from planner.program.controllers import CONTROLLERS, controller
 from planner.program.safety import SafetySpec
 from planner.sim.report_points import poi_rows
 from planner.sim.rows import RowSpec, z_values
@@ -306,28 +309,9 @@ def suggest_plan(
     )
     ctx = Context(cell, plan, pool, safety, rows_poi, z, r, corners, sequencer, tuple(old))
     ctx.edge_start_m, ctx.edge_overtravel_m = edge_start, 2.0 * worst_shift + 0.02
-    if procedure == "three_two_one":
-        design, history = three_two_one_design(ctx, say)
-    else:
-        design, history = best_fit_design(ctx, target_m, max_points, add, fixed, say)
-    if design is None:
-        raise SuggestError(
-            "no layout fixes all 6 degrees of freedom with the feasible candidates (each "
-            "footprint grown by the in-plane shift it has when measured: the whole "
-            f"misplacement, {plan.validation.misplacement.max_translation_m * 1e3:.1f} mm and "
-            f"{math.degrees(plan.validation.misplacement.max_angle_rad):.2f} deg, for "
-            + (
-                "the first points"
-                if steered
-                else f"every point, as the {target_controller.label} "
-                "program runs every search in the nominal frame"
-            )
-            + "): "
-            + faces_text(tried, pool, ctx)
-        )
-    new_plan = suggested_plan(plan, ctx, design, procedure, add, at_m)
-    say("moves between points", 0, 1)
-    new_plan, via_notes = plan_with_vias(new_plan, cell)
+    new_plan, design_note, check, history = _design_until_checked(
+        ctx, plan, procedure, target_m, max_points, add, fixed, at_m, steered, fmt, tried, say
+    )
     say("prediction", 0, 1)
     quality, note = plan_quality(new_plan, mesh, fmt)
     worst = quality.worst_poi_m(level) if quality is not None else math.nan
@@ -348,12 +332,7 @@ def suggest_plan(
         )
     if note:
         msg += f" ({note})"
-    stuck = [f"{pid}: {what}" for pid, what in via_notes.items() if "added" not in what]
-    if stuck:
-        msg += "; moves between points not cleared: " + "; ".join(stuck)
-    say("check", 0, 1)
-    check = check_plan(new_plan, cell=cell, fmt=fmt)
-    say("check", 1, 1)
+    msg += design_note
     problems = tuple(f"{p.point_id}: {p.reason}" for p in check.infeasible)
     if check.layout:
         problems += (f"layout: {check.layout}",)
@@ -380,6 +359,201 @@ def suggest_plan(
         pool=pool,
         problems=problems,
     )
+
+
+#: Designs redone, at most, with the candidates ``wobjcal check`` refused in the written plan
+#: set aside (a search landing off its face, a move between points not cleared).
+REDESIGNS = 3
+
+
+def _design_until_checked(
+    ctx: Context,
+    plan: Plan,
+    procedure: str,
+    target_m: float | None,
+    max_points: int,
+    add: int,
+    fixed: tuple[FloatArray, FloatArray] | None,
+    at_m: FloatArray | None,
+    steered: bool,
+    fmt: str | None,
+    tried: tuple[FaceTried, ...],
+    say: SuggestProgress,
+) -> tuple[Plan, str, PlanCheck, list[tuple[int, float]]]:
+    """Design, add the vias, check the written plan as ``wobjcal check --format`` does; while
+    check refuses points of it, set their candidates aside and design again (at most
+    :data:`REDESIGNS` times), so a suggestion never proposes a point check refuses when another
+    layout exists.
+
+    Returns:
+        The last written plan, a note for the message (what was set aside, the moves not
+        cleared), its check, and the design history.
+
+    Raises:
+        SuggestError: no layout fixes all six degrees of freedom with the candidates left.
+    """
+    set_aside: dict[str, str] = {}
+    for attempt in range(REDESIGNS + 1):
+        if procedure == "three_two_one":
+            design, history = three_two_one_design(ctx, say)
+        else:
+            design, history = best_fit_design(ctx, target_m, max_points, add, fixed, say)
+        if design is None:
+            why = _no_layout(ctx, plan, steered, fmt, tried, set_aside)
+            change = _smallest_change(ctx, plan, procedure, max_points, add, fixed, fmt)
+            raise SuggestError(why + (f". {change}" if change else ""))
+        new_plan = suggested_plan(plan, ctx, design, procedure, add, at_m)
+        say("moves between points", 0, 1)
+        new_plan, via_notes = plan_with_vias(new_plan, ctx.cell)
+        say("check", 0, 1)
+        check = check_plan(new_plan, cell=ctx.cell, fmt=fmt)
+        say("check", 1, 1)
+        kept = {p.id for p in plan.points} if add else set()
+        refused = [c for c in check.infeasible if c.point_id not in kept]
+        if not refused or attempt == REDESIGNS:
+            break
+        by_id = {p.id: p for p in new_plan.points}
+        for c in refused:
+            i = _candidate_of(ctx.pool, by_id[c.point_id])
+            if i is None:  # not a candidate (a kept point): nothing to set aside
+                continue
+            ctx.path_ok[i] = False
+            ctx.path_why[i] = c.reason
+            set_aside[_where(ctx.pool, i)] = c.search_reason or c.reason
+    note = ""
+    if set_aside:
+        note = f"; {len(set_aside)} candidates check refused were set aside"
+    stuck = [f"{pid}: {what}" for pid, what in via_notes.items() if "added" not in what]
+    if stuck:
+        note += "; moves between points not cleared: " + "; ".join(stuck)
+    return new_plan, note, check, history
+
+
+#: Fractions of the plan's misplacement bound tried, largest first, to say at which bound a
+#: layout exists when none does at the plan's.
+BOUND_FRACTIONS = (0.75, 0.5, 0.35, 0.25, 0.15, 0.1)
+
+
+def _smallest_change(
+    ctx: Context,
+    plan: Plan,
+    procedure: str,
+    max_points: int,
+    add: int,
+    fixed: tuple[FloatArray, FloatArray] | None,
+    fmt: str | None,
+) -> str:
+    """What would make a layout exist when none does: an adaptive program where the chosen
+    controller's is nominal (another controller that steers the procedure), else the largest
+    misplacement bound (a fraction of the plan's, :data:`BOUND_FRACTIONS`) at which the same
+    candidates give one. Footprints and order are judged at that bound; the search paths keep
+    the verdicts already found (sized for the plan's bound: a smaller bound only shortens them)
+    and paths not yet walked count as clear, so a layout found there is the one to try, not yet
+    checked."""
+    assert ctx.sequencer is not None
+
+    def exists(sequencer: Sequencer) -> bool:
+        trial = dataclasses.replace(
+            ctx, sequencer=sequencer, path_ok=dict(ctx.path_ok), path_why=dict(ctx.path_why),
+            off_face=set(), check_paths=False,
+        )  # fmt: skip
+        quiet: SuggestProgress = lambda stage, done, total: None  # noqa: E731
+        if procedure == "three_two_one":
+            design, _ = three_two_one_design(trial, quiet)
+        else:
+            design, _ = best_fit_design(trial, None, max_points, add, fixed, quiet)
+        return design is not None
+
+    base = ctx.sequencer
+    m = plan.validation.misplacement
+    label = f"the {controller(fmt).label} program"
+    out = []
+    if not base.steered and not bool(ctx.pool.is_edge.any()):
+        adaptive = [c.name for c in CONTROLLERS.values() if procedure in c.adaptive_methods]
+        if adaptive and exists(_scaled(base, 1.0, steered=True)):
+            out.append(
+                f"An adaptive program has a layout at this bound: --format {adaptive[0]} "
+                f"(the {controller(fmt).label} program runs every search in the nominal frame)"
+            )
+    # the largest fraction with a layout, by bisection (a smaller bound only shrinks the
+    # footprints' growth): the smallest first, so a part with none costs one design
+    fractions = sorted(BOUND_FRACTIONS)
+    lo, hi = -1, len(fractions)  # fractions[lo] has a layout, fractions[hi] has none
+    if exists(_scaled(base, fractions[0], steered=base.steered)):
+        lo = 0
+        while hi - lo > 1:
+            mid = (lo + hi) // 2
+            if exists(_scaled(base, fractions[mid], steered=base.steered)):
+                lo = mid
+            else:
+                hi = mid
+    if lo >= 0:
+        f = fractions[lo]
+        out.append(
+            f"For {label} a layout exists at a misplacement bound of "
+            f"{f * m.max_translation_m * 1e3:.1f} mm and "
+            f"{math.degrees(f * m.max_angle_rad):.2f} deg ({f:.0%} of the plan's): "
+            "place the part more tightly, or measure it first coarsely (e.g. three touch-up "
+            "points) and give that bound"
+        )
+    else:
+        out.append(
+            f"For {label} no layout exists even at {fractions[0]:.0%} of the plan's "
+            "misplacement bound: the faces the sensor can reach are too small or too few for it"
+        )
+    return ". ".join(out)
+
+
+def _scaled(base: Sequencer, f: float, *, steered: bool) -> Sequencer:
+    """A copy of ``base`` for a misplacement bound ``f`` times its own."""
+    out = copy.copy(base)
+    out.a, out.b, out.steered = base.a * f, base.b * f, steered
+    return out
+
+
+def _candidate_of(pool: Candidates, point: PlanPoint) -> int | None:
+    """The pool index of the candidate ``point`` was written from (same position and normal)."""
+    d = np.linalg.norm(pool.positions_m - np.asarray(point.position_m), axis=1)
+    i = int(np.argmin(d)) if len(d) else -1
+    if i < 0 or d[i] > 1e-9 or float(pool.normals[i] @ np.asarray(point.normal)) < 1.0 - 1e-9:
+        return None
+    return i
+
+
+def _where(pool: Candidates, i: int) -> str:
+    p = pool.positions_m[i] * 1e3
+    return f"({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm"
+
+
+def _no_layout(
+    ctx: Context,
+    plan: Plan,
+    steered: bool,
+    fmt: str | None,
+    tried: tuple[FaceTried, ...],
+    set_aside: dict[str, str],
+) -> str:
+    """Why no layout exists: per face what removed its candidates, and what to change."""
+    m = plan.validation.misplacement
+    label = controller(fmt).label
+    text = (
+        "no layout fixes all 6 degrees of freedom with the feasible candidates (each "
+        "footprint grown by the in-plane shift it has when measured: the whole "
+        f"misplacement, {m.max_translation_m * 1e3:.1f} mm and "
+        f"{math.degrees(m.max_angle_rad):.2f} deg, for "
+        + (
+            "the first points"
+            if steered
+            else f"every point, as the {label} program runs every search in the nominal frame"
+        )
+        + "): "
+        + faces_text(tried, ctx.pool, ctx)
+    )
+    if set_aside:
+        text += "; set aside after wobjcal check refused them: " + "; ".join(
+            f"{where}: {why}" for where, why in set_aside.items()
+        )
+    return text
 
 
 def moved_plan(plan: Plan, from_dir: Path, to_dir: Path) -> Plan:

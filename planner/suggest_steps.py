@@ -76,6 +76,9 @@ class Context:
     #: edge searches: start inside the edge and travel past it, metres
     edge_start_m: float = 0.0
     edge_overtravel_m: float = 0.0
+    #: check the search paths of newly chosen candidates in the cell; ``False``: only the
+    #: verdicts already cached count (what-if designs, e.g. at a smaller misplacement bound)
+    check_paths: bool = True
 
     @property
     def poi(self) -> list[FloatArray]:
@@ -187,6 +190,8 @@ class Context:
         """Check the search paths of the chosen candidates not yet checked."""
         from planner.check_paths import check_program_path
 
+        if not self.check_paths:
+            return all(self.path_ok.get(i, True) for i in chosen)
         T = nominal_T_base_wobj(self.plan)
         tcp = self.plan.cell.tool.tcp
         T_ft = self.cell.T_flange_tcp(tcp)

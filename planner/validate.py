@@ -28,19 +28,23 @@ from __future__ import annotations
 
 import dataclasses
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import trimesh
 
+from calib.errors import InputError
 from calib.plan.file import Plan, PlanError
 from calib.procedures import RolePoint
+from planner.errors import PlanRefused
 from planner.plan_cell import nominal_T_base_wobj, open_cell
-from planner.program.build import build_program, safety_spec
+from planner.program.build import build_program, measuring_program, safety_spec
 from planner.program.controllers import controller
+from planner.program.model import search_keys
 from planner.sim.montecarlo import simulate
 from planner.sim.report import PAPER_TABLE1, ValidationReport
 from planner.sim.report_points import report_rows
+from planner.sim.search_events import ProgramPose, program_search_hook
 from planner.sim.sensitivity import SensitivityTable, sensitivity
 from planner.sim.setup import SimulationSetup, default_pivot, face_lookup
 from planner.sim.xoffset import xoffset_setup
@@ -80,6 +84,8 @@ def validate_plan(
     protocol: tuple[int, int] | None = None,
     mesh: trimesh.Trimesh | None = None,
     fmt: str | None = None,
+    check: Literal["refuse", "report", "off"] = "off",
+    cell: Any = None,
 ) -> ValidationReport:
     """Simulate the calibration of ``plan`` many times and report it, simulated beside predicted.
 
@@ -93,43 +99,116 @@ def validate_plan(
         progress: ``progress(done_trials, total_trials)``, called as trials finish.
         reach_trials: also vet every commanded search of the first ``reach_trials`` trials
             in the plan's cell (reachability, joint limits, collisions with the part where it
-            really lies), so searches that fail because the part moved are counted with their
-            reason; about 0.2 s a trial in the demo cell. 0: no cell check.
+            really lies) with the sensor rotation and IK branch ``wobjcal check`` chose for the
+            point (the exported programs' targets), so searches that fail because the part
+            moved are counted with their reason; about 0.2 s a trial in the demo cell. 0: no
+            cell check.
         plan_dir: folder the plan's relative file references resolve against.
         protocol: ``(positions, repeats)``: also run the paper's protocol beside the default.
         mesh: the work object's mesh (wobj, metres) when the caller has it loaded already
             (the UI); default: loaded from the plan.
         fmt: the controller whose measuring program is simulated (a key of
             :data:`planner.program.controllers.CONTROLLERS`; ``None``: the default, RAPID).
+        check: first check the plan as ``wobjcal check --format fmt`` does (in the cell the
+            vetting uses): ``"refuse"`` a plan check refuses, naming every problem (what
+            ``wobjcal validate`` does); ``"report"``: simulate it anyway, the report lists
+            check's problems (``check_problems``; ``validate --force``); ``"off"``: no
+            check, unless ``reach_trials`` opens the cell (then as ``"report"``).
+        cell: an open cell of the plan (a :class:`planner.cell.cell.Cell`) to check and vet
+            in; ``None`` opens the plan's cell when needed and closes it afterwards.
 
     Returns:
         The :class:`planner.sim.report.ValidationReport`.
 
     Raises:
+        PlanRefused: ``check="refuse"`` and check refuses the plan (every problem named).
         PlanError: the plan cannot be simulated (the message names the point or field).
         InputError: ``trials`` < 2, another argument out of range, or a mesh that cannot load.
     """
     models = check_simulatable(plan)
     folder = plan_dir or Path.cwd()
     part = work_object_mesh(plan, folder, models) if mesh is None else mesh
+    if check not in ("refuse", "report", "off"):
+        raise InputError(f"check must be 'refuse', 'report' or 'off', got {check!r}")
+    if check != "off" or reach_trials:
+        if cell is not None:
+            return _validate_in_cell(
+                plan, models, part, cell, trials, seed, workers, progress, reach_trials,
+                protocol, fmt, check == "refuse",
+            )  # fmt: skip
+        with open_cell(plan, folder) as own:
+            return _validate_in_cell(
+                plan, models, part, own, trials, seed, workers, progress, reach_trials,
+                protocol, fmt, check == "refuse",
+            )  # fmt: skip
+    return _simulate(plan, models, part, trials, seed, workers, progress, protocol, fmt)
+
+
+def _validate_in_cell(
+    plan: Plan,
+    models: ValidationModels,
+    part: trimesh.Trimesh,
+    cell: Any,
+    trials: int | None,
+    seed: int | None,
+    workers: int | None,
+    progress: ProgressCallback | None,
+    reach_trials: int,
+    protocol: tuple[int, int] | None,
+    fmt: str | None,
+    refuse: bool,
+) -> ValidationReport:
+    """Check the plan in its open ``cell`` (check's verdict, and the poses the vetting uses),
+    then simulate."""
+    from planner.check import check_plan
+
+    checked = check_plan(plan, cell=cell, fmt=fmt)
+    problems = checked.problems()
+    if problems and refuse:
+        raise PlanRefused(measuring_program(plan, fmt).name, problems)
+    hook = None
+    if reach_trials:
+        T_nom = nominal_T_base_wobj(plan)
+        poses = {
+            c.point_id: ProgramPose(
+                np.asarray(c.T_base_tcp)[:3, 0], c.branch, np.asarray(c.q, dtype=float)
+            )
+            for c in checked.points
+            if c.T_base_tcp is not None and c.q is not None
+        }
+        program = measuring_program(plan, fmt)
+        keys = search_keys(program.points)
+        hook = program_search_hook(cell, poses, keys, T_nom, plan.cell.tool.tcp)
+    report = _simulate(
+        plan, models, part, trials, seed, workers, progress, protocol, fmt,
+        cell=cell if reach_trials else None, reachability=hook, reach_trials=reach_trials,
+    )  # fmt: skip
+    return dataclasses.replace(report, check_problems=problems)
+
+
+def _simulate(
+    plan: Plan,
+    models: ValidationModels,
+    part: trimesh.Trimesh,
+    trials: int | None,
+    seed: int | None,
+    workers: int | None,
+    progress: ProgressCallback | None,
+    protocol: tuple[int, int] | None,
+    fmt: str | None,
+    **vetting: Any,
+) -> ValidationReport:
+    """The preflight and the Monte Carlo run of ``plan`` on ``part``."""
     preflight(plan, models, part)
     setup = simulation_setup(plan, models, part, fmt)
     rows = report_rows(plan.validation.report, part, models.geometry, setup.xoffset)
     paper = PAPER_TABLE1 if models.geometry is not None and models.method == "hultman2013" else None
     n = plan.validation.trials if trials is None else int(trials)
     rng = np.random.default_rng(plan.validation.seed if seed is None else seed)
-    kwargs: dict[str, Any] = {
-        "protocol": protocol,
-        "paper": paper,
-        "workers": workers,
-        "progress": progress,
-    }
-    if reach_trials:
-        with open_cell(plan, folder) as cell:
-            return simulate(
-                setup, part, rows, n, rng, cell=cell, reach_trials=reach_trials, **kwargs
-            )
-    return simulate(setup, part, rows, n, rng, **kwargs)
+    return simulate(
+        setup, part, rows, n, rng, protocol=protocol, paper=paper, workers=workers,
+        progress=progress, **vetting,
+    )  # fmt: skip
 
 
 def sensitivity_plan(

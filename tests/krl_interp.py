@@ -2,8 +2,10 @@
 
 :class:`KrlMachine` loads a ``.src``/``.dat`` pair (``planner.export.export_files(job, "krl")``)
 and runs the module's first ``DEF`` against a simulated robot, so tests can check what a program
-*does*, not only what it says. It checks what the KRL compiler and controller check, so that
-wrong KRL fails here too: names of at most 24 characters, case-insensitive (``xA`` is ``XA``),
+*does*, not only what it says (:meth:`KrlMachine.call` then calls one of its routines, as a
+statement of the main program would: e.g. a function the program offers but never calls). It
+checks what the KRL compiler and controller check, so that wrong KRL fails here too: names of
+at most 24 characters, case-insensitive (``xA`` is ``XA``),
 declared once; declarations before the first statement; every parameter declared; constant
 values in data lists; values invalid until assigned (reading one is an error); write-protected
 ``$IN``; types of assignments and operands. Anything it does not know is an error naming the
@@ -1532,6 +1534,31 @@ class KrlMachine:
             self.halted = h.where
         self.finished = True
         return self
+
+    def call(self, name: str, *args: Any) -> Any:
+        """Call the module's routine ``name`` (a ``DEF`` or ``DEFFCT``) as a statement of the
+        main program would, with ``args`` the values of its ``:IN`` parameters (INT, REAL,
+        BOOL, CHAR or a :class:`Struct`, converted to each parameter's declared type as KRL
+        converts them), on the data list and the robot as they are now (after :meth:`run`: as
+        the program left them). Returns a function's value (``None`` for a ``DEF``).
+
+        Raises:
+            KrlError: no such routine, a wrong number of arguments, an ``:OUT`` parameter (it
+                needs a variable of the caller), or a run-time error.
+        """
+        r = self.routines.get(name.upper())
+        if r is None:
+            raise KrlError(f"unknown routine {name}")
+        if len(args) != len(r.params):
+            raise KrlError(f"{r.name} takes {len(r.params)} arguments, got {len(args)}")
+        out = [p for p, mode, _ in r.params if mode == "OUT"]
+        if out:
+            raise KrlError(f"{r.name}: :OUT parameter(s) {', '.join(out)} need a variable")
+        try:
+            return self._call(r, [copy.deepcopy(a) for a in args])
+        except _Halt as h:
+            self.halted = h.where
+            return None
 
     def set_input(self, number: int, value: bool) -> None:
         """Set ``$IN[number]`` (as the cell would)."""

@@ -4,8 +4,8 @@ The plans are what a user makes (:mod:`tests.bracket_part`): the shipped plate p
 template, the bracket's STL in metres, an 18 mm proximity sensor, a 20 mm / 3 deg misplacement
 bound, hand-placed points (3-2-1: 3 on the base's top, 2 on the upright, 1 on an end face;
 best fit: 3 + 3 + 3), the vias ``wobjcal check --add-vias`` adds. For the RAPID program
-(adaptive: frame updated between searches) and the KRL one (every search in the nominal
-frame), what the issue promises:
+(adaptive: frame updated between searches) and the FANUC TP one (every search in the
+nominal frame), what the issue promises:
 
 - check rates the plan feasible for the program, or names the point and what to change;
 - the validation of that program agrees with its prediction within 1.25x on every row at
@@ -14,11 +14,12 @@ frame), what the issue promises:
   what stops it.
 
 What does not hold today is marked ``xfail(strict=True)`` with the gap or the bug named: the
-KRL programs cannot measure the 20 mm end strips under a 20 mm bound (check says so, rightly);
-suggest's best fit for RAPID refuses a part it has a layout for; the planar-face test depends on
-the STL's triangles. The hand-placed top points lie 25 mm in front of the upright: check names
-them (the sensor runs into the upright when the part lies towards them), as the validation's
-failures show. 200 trials, the plan's own seed: a half-width scatters by about 10 %.
+nominal FANUC programs cannot measure the 20 mm end strips under a 20 mm bound (check says so,
+rightly); suggest's best fit for RAPID refuses a part it has a layout for; the planar-face test
+depends on the STL's triangles. The hand-placed top points lie 25 mm in front of the upright:
+check names them (the sensor runs into the upright when the part lies towards them), as the
+validation's failures show. 200 trials, the plan's own seed: a half-width scatters by about
+10 %.
 """
 
 from __future__ import annotations
@@ -46,11 +47,11 @@ SEED = 20131023
 FAIL_SHARE = 0.02
 #: Suggest's target at the points of interest, m.
 TARGET_M = 0.3e-3
-#: How each controller's program is named: RAPID steers best fit and 3-2-1, KRL does not.
-PROGRAM = {"rapid": "RAPID, adaptive", "krl": "KRL, nominal"}
+#: How each controller's program is named: RAPID steers best fit and 3-2-1, FANUC TP does not.
+PROGRAM = {"rapid": "RAPID, adaptive", "fanuc": "TP, nominal"}
 
-KRL_NOMINAL = (
-    "KRL runs every search in the nominal frame (the KRL writer computes no frame update): the "
+TP_NOMINAL = (
+    "FANUC TP runs every search in the nominal frame (the TP writer computes no frame update): the "
     "end-face searches land off the 20 mm end strips in ~30 % of calibrations under the 20 mm "
     "bound; check refuses them (landing), rightly, and nothing in the plan can fix it short of "
     "a smaller bound"
@@ -140,15 +141,15 @@ def _failed_share(report: Any) -> float:
     return (report.n_trials - report.n_ok) / report.n_trials
 
 
-def _cases(xfail_krl: str | None) -> list[Any]:
-    """``(procedure, fmt)`` for both procedures and programs; the KRL ones marked xfail with
-    ``xfail_krl`` as the reason when given."""
+def _cases(xfail_nominal: str | None) -> list[Any]:
+    """``(procedure, fmt)`` for both procedures and programs; the nominal (FANUC) ones marked
+    xfail with ``xfail_nominal`` as the reason when given."""
     out = []
     for procedure in ("three_two_one", "best_fit"):
-        for fmt in ("rapid", "krl"):
+        for fmt in ("rapid", "fanuc"):
             marks = []
-            if fmt == "krl" and xfail_krl is not None:
-                marks = [pytest.mark.xfail(strict=True, reason=xfail_krl)]
+            if fmt == "fanuc" and xfail_nominal is not None:
+                marks = [pytest.mark.xfail(strict=True, reason=xfail_nominal)]
             out.append(pytest.param(procedure, fmt, marks=marks, id=f"{procedure}-{fmt}"))
     return out
 
@@ -234,12 +235,12 @@ def test_check_and_the_validation_give_one_verdict(runs: _Runs, procedure: str, 
 def test_check_refuses_the_nominal_program_naming_the_point_and_what_to_change(
     runs: _Runs, procedure: str, points: set[str]
 ) -> None:
-    check = runs.check(procedure, "krl")
+    check = runs.check(procedure, "fanuc")
     bad = {p.point_id: p.reason for p in check.points if not p.feasible}
     assert points <= set(bad), bad
     for pid in points:
         why = bad[pid]
-        assert "KRL, nominal" in why and "lands off its face" in why, why
+        assert "TP, nominal" in why and "lands off its face" in why, why
         assert "adaptive program" in why and "misplacement bound" in why, why
 
 
@@ -264,7 +265,7 @@ def test_check_sees_the_sensor_run_into_the_upright(
 @pytest.mark.parametrize(
     ("procedure", "fmt"),
     _cases(
-        KRL_NOMINAL + ": origin_x simulated 11-15x its prediction (the prediction leaves out "
+        TP_NOMINAL + ": origin_x simulated 11-15x its prediction (the prediction leaves out "
         "where a misplaced part puts a search), and the rows it drives with it"
     ),
 )
@@ -288,8 +289,12 @@ def test_suggest_gives_a_layout_that_validates_or_says_what_stops_it(
         msg = str(res)
         assert "misplacement, 20.0 mm and 3.00 deg" in msg, msg
         assert "normal -x" in msg and "footprint off the face" in msg, msg  # the end faces
-        if fmt == "krl":
+        if fmt == "fanuc":
             assert "nominal frame" in msg, msg
+            if procedure == "three_two_one":  # RAPID's adaptive 3-2-1 has one (the test above)
+                assert "An adaptive program has a layout at this bound: --format rapid" in msg, msg
+        # and what would make a layout exist: the bound at which one does, or that none does
+        assert "a layout exists at a misplacement bound of" in msg or "no layout exists" in msg
         return
     from planner.check import check_plan
 

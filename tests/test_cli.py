@@ -297,8 +297,20 @@ def test_validate_refuses_a_plan_that_cannot_work_naming_its_points(
 ) -> None:
     """The 3-2-1 test plan's searches end 20 mm past their faces, less than the 20 mm, 3 deg
     misplacement may move them away (the program starts them at their safe starts, so their
-    30 mm start no longer matters): refused before any trial, every point and problem named."""
-    code, _, err = run(capsys, "validate", str(DATA / "valid_three_two_one.json"), "--trials", "2")
+    30 mm start no longer matters): refused before any trial, every point and problem named:
+    by check first (exit 1, as ``wobjcal check``); with --force, by the simulation's own
+    preflight (exit 2: it cannot be simulated)."""
+    argv = ["validate", str(DATA / "valid_three_two_one.json"), "--trials", "2"]
+    code, _, err = run(capsys, *argv)
+    assert code == 1
+    assert "check refuses this plan for the program RAPID" in err
+    lines = [line for line in err.splitlines() if line.startswith("error: point ")]
+    assert [line.split(":")[1].strip() for line in lines] == [
+        "point P1", "point P2", "point P3", "point S1", "point S2", "point T1"
+    ]  # fmt: skip
+    assert all("the search ends 20.0 mm past the nominal face" in line for line in lines[:2])
+    assert "nothing simulated" in err
+    code, _, err = run(capsys, *argv, "--force")
     assert code == 2
     assert "points[0] (P1): the search ends 20.0 mm past the nominal face" in err
     assert "overtravel at least" in err

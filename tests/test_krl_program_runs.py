@@ -2,12 +2,15 @@
 part at a misplaced pose, runs to its end and records what its searches find.
 
 For every shipped plan and generated variants of it (other procedures, fewer points, edge
-searches, a tool offset, status and turn) the program's searches are exactly the ones computed
-here from the export job (safe start, face end, plan end, edge direction: the searches of
-``program_searches``), and each ``xMeas[i]`` is the point those searches find, to 1e-6 mm.
-A search that finds nothing, or an input already at its level, takes the program's error path.
-The ideal part is :class:`tests.box_part.BoxProbe` for plans on the stator box, else
-:class:`PlaneWorld`.
+searches, a tool offset, status and turn): a nominal program's searches are exactly the ones
+computed here from the export job (safe start, face end, plan end, edge direction: the searches
+of ``program_searches``), and each ``xMeas[i]`` is the point those searches find, to 1e-6 mm;
+an adaptive program's searches (each in the frame estimated so far), points and final
+``BASE_DATA[10]`` are those of the executed program (:func:`planner.program.execute`, what
+``wobjcal validate`` simulates) on the same part. A search that finds nothing, or an input
+already at its level, takes the nominal program's error path (the adaptive program's:
+:mod:`tests.test_krl_adaptive_replay`). The ideal part is :class:`tests.box_part.BoxProbe` for
+plans on the stator box, else :class:`PlaneWorld`.
 
 The interpreter runs KSS's semantics strictly: ``RESUME`` only where the interrupted motion runs
 below the routine that declared the interrupt, names of at most 24 characters, unique ignoring
@@ -34,11 +37,13 @@ from calib.frames import (
     matrix_from_rotvec,
     matrix_from_tait_bryan_zyx,
     random_transform,
+    rotvec_from_matrix,
     tait_bryan_zyx_from_matrix,
     transform_directions,
     transform_points,
 )
 from calib.plan.file import Plan, PlanPoint, Search, load_plan
+from calib.probing import ProbeResult, SearchCommand
 from calib.procedures import ProcedureSettings, method_of, procedure_kind
 from planner.export import export_files
 from planner.export.job import (
@@ -49,7 +54,9 @@ from planner.export.job import (
     build_job,
     default_sensor_rotation,
 )
+from planner.export.krl_adaptive import measured_slots
 from planner.plan_cell import nominal_T_base_wobj
+from planner.program import execute
 from tests.box_part import BOX_HI, BOX_LO, BoxProbe, distance_to_box
 from tests.krl_interp import KrlError, KrlMachine, SearchFn
 from tests.test_export_rapid_adaptive import full_misplacement, rapid_search
@@ -58,7 +65,11 @@ REPO = Path(__file__).resolve().parent.parent
 PLANS = sorted((REPO / "assets" / "plans").glob("*.json"))
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
 PLATE = REPO / "assets" / "plans" / "plate_holes_321.json"
+PLATE_BEST_FIT = REPO / "assets" / "plans" / "plate_holes_best_fit.json"
 TOL_M = 1e-9  # 1e-6 mm
+#: An adaptive program against the executed one: its targets written to 1e-6 mm and 1e-6 deg
+#: (a nominal frame turned by 1e-8 rad moves a search 1 m away by 1e-8 m), metres and radians.
+ADAPTIVE_TOL = 1e-7
 
 
 # ------------------------------------------------------------------ the ideal part
@@ -125,6 +136,38 @@ def failing(search: SearchFn, k: int) -> SearchFn:
         return "ERR_WHLSEARCH" if calls[0] == k else search(start, end, axis, neg)
 
     return fn
+
+
+def probe_of(search: SearchFn) -> typing.Callable[[SearchCommand], ProbeResult]:
+    """A probe (``SearchCommand`` -> ``ProbeResult``) answered by a search callback."""
+
+    def probe(cmd: SearchCommand) -> ProbeResult:
+        end = cmd.start_m + cmd.length_m * cmd.direction
+        res = search(cmd.start_m, end, cmd.sensor_axis, cmd.kind == "edge")
+        return ProbeResult(None, res) if isinstance(res, str) else ProbeResult(np.asarray(res))
+
+    return probe
+
+
+def base_m(m: KrlMachine) -> np.ndarray:
+    """``(4, 4)`` ``BASE_DATA[10]``, robot base, metres: the program's work object."""
+    return m.frame_m(m.value("BASE_DATA").data[9])
+
+
+def slot_of(job: ExportJob) -> dict[str, int]:
+    """``{measurement key: slot of xMeas}``: plan ids, and ``id#2`` for the A-H retakes."""
+    return {
+        f"{pid}#2" if retake else pid: i
+        for i, (pid, retake) in enumerate(measured_slots(job), start=1)
+    }
+
+
+def assert_same_frame(T: np.ndarray, want: np.ndarray, tol_m: float, tol_rad: float) -> None:
+    """Origins within ``tol_m``, rotations within ``tol_rad`` (the angle of the rotation
+    between them, from its rotation vector: ``arccos`` of the trace cannot resolve 1e-8)."""
+    assert np.abs(T[:3, 3] - want[:3, 3]).max() < tol_m, (T[:3, 3], want[:3, 3])
+    angle = float(np.linalg.norm(rotvec_from_matrix(T[:3, :3].T @ want[:3, :3])))
+    assert angle < tol_rad, angle
 
 
 # ------------------------------------------------------------------ the searches, computed here
@@ -252,8 +295,40 @@ def run(files: dict[str, str], search: SearchFn, **kwargs: typing.Any) -> KrlMac
     return m
 
 
+def assert_runs_as_executed(m: KrlMachine, job: ExportJob, search: SearchFn) -> None:
+    """An adaptive program: it ended calibrated, its searches (each commanded in the frame
+    estimated so far) are the executed program's on the same part, and so are its points and
+    its frame (``BASE_DATA[10]``, also ``$BASE``), to :data:`ADAPTIVE_TOL`."""
+    program = job.program("krl")
+    assert program.adaptive
+    commands: list[SearchCommand] = []
+    ideal = probe_of(search)
+
+    def recording(cmd: SearchCommand) -> ProbeResult:
+        commands.append(cmd)
+        return ideal(cmd)
+
+    run = execute(program, job.T_base_wobj, recording)
+    assert m.value("nResult") == 1
+    assert set(m.ints().values()) == {0}
+    for call, cmd in zip(m.search_calls, commands, strict=False):  # then the x-offset run's
+        assert call.neg_flank == (cmd.kind == "edge")
+        assert np.abs(call.start_m - cmd.start_m).max() < ADAPTIVE_TOL
+        end = cmd.start_m + cmd.length_m * cmd.direction
+        assert np.abs(call.end_m - end).max() < ADAPTIVE_TOL
+    assert len(m.search_calls) >= len(commands)
+    slots, got = slot_of(job), m.measured_m()
+    assert set(got) == {slots[k] for k in run.measured_m}
+    for key, q in run.measured_m.items():
+        assert np.abs(got[slots[key]] - np.asarray(q)).max() < ADAPTIVE_TOL, key
+    assert_same_frame(base_m(m), run.T_base_wobj, ADAPTIVE_TOL, ADAPTIVE_TOL)
+    assert np.abs(m.base_m() - base_m(m)).max() < 1e-12
+
+
 def assert_runs_as_computed(m: KrlMachine, job: ExportJob, want: Expected) -> None:
-    """The program's searches, results and codes are the ones computed from the job."""
+    """The program's searches, results and codes are the ones computed from the job (a
+    nominal program)."""
+    assert not job.program("krl").adaptive
     assert len(m.search_calls) == len(want.calls)
     for got, (start, end, neg) in zip(m.search_calls, want.calls, strict=True):
         assert got.neg_flank == neg
@@ -293,19 +368,26 @@ def test_exported_program_runs_and_measures_what_its_searches_find(
     plan, job, files = variant_job(path, variant)
     T_true = job.T_base_wobj @ full_misplacement(plan, np.random.default_rng(seed))
     m = run(files, ideal_part(plan, T_true))
-    want = Expected(job, ideal_part(plan, T_true))
-    assert_runs_as_computed(m, job, want)
-    assert want.codes == dict.fromkeys(range(1, len(job.targets) + 1), 0)  # all found
-    assert_on_own_face(plan, T_true, m.measured_m())
-    # the frames it sets, and the vias it passes, as the job says (to the written precision)
-    assert np.abs(m.base_m() - written(job.T_base_wobj)).max() < 1e-12
+    program = job.program("krl")
+    if program.adaptive:
+        assert_runs_as_executed(m, job, ideal_part(plan, T_true))
+    else:
+        want = Expected(job, ideal_part(plan, T_true))
+        assert_runs_as_computed(m, job, want)
+        assert want.codes == dict.fromkeys(range(1, len(job.targets) + 1), 0)  # all found
+        # the frame it sets, as the job says (to the written precision)
+        assert np.abs(m.base_m() - written(job.T_base_wobj)).max() < 1e-12
+        # and the robot ends at the last point's safe start
+        last_safe = written(job.T_base_wobj) @ written(job.targets[-1].safe_start)
+        assert np.abs(m.tcp_m() - last_safe).max() < TOL_M
+    measured = {i: x for i, x in m.measured_m().items() if i <= len(job.targets)}
+    assert_on_own_face(plan, T_true, measured)
+    # the tool it sets, and the vias it passes in the program's order, as the job says
     assert np.abs(m.tool_m() - written(job.tool.T_flange_tcp)).max() < 1e-12
     vias = [mo.axes_deg for mo in m.motions if mo.axes_deg is not None]
-    want_vias = [v for t in job.targets for v in t.vias_deg("KRL")]
+    target = {t.point_id: t for t in job.targets}
+    want_vias = [v for pid in program.probe_order for v in target[pid].vias_deg("KRL")]
     assert np.allclose(vias, want_vias, atol=1e-4) if want_vias else vias == []
-    # and the robot ends at the last point's safe start
-    last_safe = written(job.T_base_wobj) @ written(job.targets[-1].safe_start)
-    assert np.abs(m.tcp_m() - last_safe).max() < TOL_M
 
 
 def _with_arms(job: ExportJob) -> ExportJob:
@@ -326,17 +408,23 @@ def test_tool_offset_and_status_turn_change_nothing_measured(path: Path) -> None
     files = export_files(job, "krl")
     assert ",S 2,T 42}" in files[".dat"]
     m = run(files, ideal_part(plan, T_true))
-    assert_runs_as_computed(m, job, Expected(job, ideal_part(plan, T_true)))
+    if job.program("krl").adaptive:
+        assert_runs_as_executed(m, job, ideal_part(plan, T_true))
+    else:
+        assert_runs_as_computed(m, job, Expected(job, ideal_part(plan, T_true)))
     assert np.abs(m.tool_m() - tool.T_flange_tcp).max() < 1e-12
     hit = m.value("xHit")  # $POS_INT carries the status and turn of the search target
     assert (hit.type, hit.f["S"], hit.f["T"]) == ("E6POS", 2, 42)
 
 
-def test_a_nominal_frame_away_from_the_base_and_turned_sensors() -> None:
-    """A random nominal frame and sensor orientations: the program's base and targets compose
-    with the geometric operator as the job's transforms do (to the written precision)."""
+@pytest.mark.parametrize("adaptive", [False, True], ids=["nominal", "adaptive"])
+def test_a_nominal_frame_away_from_the_base_and_turned_sensors(adaptive: bool) -> None:
+    """A random nominal frame, sensor orientations and tool: the program's base and targets
+    compose with the geometric operator as the job's transforms do (to the written precision):
+    the nominal program (edge searches) as computed here, the adaptive 3-2-1 (its frame updates
+    with ``INV_POS`` and ``:``) as executed."""
     rng = np.random.default_rng(11)
-    plan = with_edges(load_plan(PLATE))
+    plan = load_plan(PLATE) if adaptive else with_edges(load_plan(PLATE))
     T_nom = random_transform(rng, 2.0, np.pi)
     T_true = T_nom @ full_misplacement(plan, rng)
     rotations = {
@@ -346,13 +434,24 @@ def test_a_nominal_frame_away_from_the_base_and_turned_sensors() -> None:
     }
     tool = ToolData(T_flange_tcp=random_transform(rng, 0.3, np.pi))
     job = build_job(plan, T_nom, tool, rotations)
+    assert job.program("krl").adaptive == adaptive
     m = run(export_files(job, "krl"), PlaneWorld(plan, T_true))
-    assert_runs_as_computed(m, job, Expected(job, PlaneWorld(plan, T_true)))
+    if adaptive:
+        assert_runs_as_executed(m, job, PlaneWorld(plan, T_true))
+        assert_same_frame(base_m(m), T_true, ADAPTIVE_TOL, ADAPTIVE_TOL)  # the true part
+    else:
+        assert_runs_as_computed(m, job, Expected(job, PlaneWorld(plan, T_true)))
     assert_on_own_face(plan, T_true, m.measured_m())
 
 
-#: ``{k: (point that fails, searches run)}`` on the stator plan, whose searches are A, B, C, D,
-#: E, F (face, then edge), G, H (face, then edge).
+def stator_nominal() -> Plan:
+    """The stator plan under best fit: its KRL program is nominal (the frame update takes
+    approach searches only, and F and H are edge searches)."""
+    return VARIANTS["procedure_best_fit"](load_plan(STATOR))
+
+
+#: ``{k: (point that fails, searches run)}`` on the nominal stator program, whose searches are
+#: A, B, C, D, E, F (face, then edge), G, H (face, then edge).
 FAILURES = {1: (1, 10), 3: (3, 10), 6: (6, 9), 7: (6, 10), 10: (8, 10)}
 
 
@@ -361,10 +460,11 @@ def test_a_search_that_finds_nothing_takes_the_error_path(k: int) -> None:
     """The ``k``-th search finds nothing: that point gets ``nFail = 1`` and no ``xMeas``, an
     edge point whose face approach failed runs no edge search, every other point is measured;
     the robot goes to the end of the failed search and back to the point's safe start."""
-    plan = load_plan(STATOR)
+    plan = stator_nominal()
     T_nom = nominal_T_base_wobj(plan)
     T_true = T_nom @ full_misplacement(plan, np.random.default_rng(3))
     job = build_job(plan, T_nom, ToolData(T_flange_tcp=np.eye(4)))
+    assert not job.program("krl").adaptive
     world = ideal_part(plan, T_true)
     m = run(export_files(job, "krl"), failing(world, k))
     point, n_searches = FAILURES[k]
@@ -383,8 +483,8 @@ def test_a_search_that_finds_nothing_takes_the_error_path(k: int) -> None:
 
 def test_an_input_already_on_at_the_safe_start_skips_the_point() -> None:
     """``nFail = 2``: the sensor already on at a point's safe start (no search for it), or off
-    at the face point an edge search starts from."""
-    plan = load_plan(STATOR)
+    at the face point an edge search starts from (the nominal program goes on)."""
+    plan = stator_nominal()
     T_nom = nominal_T_base_wobj(plan)
     job = build_job(plan, T_nom, ToolData(T_flange_tcp=np.eye(4)))
     files = export_files(job, "krl")
@@ -552,11 +652,13 @@ def _stator_files() -> tuple[Plan, dict[str, str]]:
 def test_the_search_routines_resume_as_krl_allows() -> None:
     """SEARCH_RISE/SEARCH_FALL declare the interrupt and run the search ``LIN`` one level
     below, in SEARCH_MOVE: HIT_20/HIT_21's RESUME ends SEARCH_MOVE where the input switched
-    and the program goes on in the search routine. (The writer once ran the ``LIN`` in the
-    declaring routine: KSS stops with "impermissible program structure for RESUME".)"""
+    and the program goes on in the search routine, here four levels below the main program
+    (the adaptive A-H program's MEASURE_ADAPT, x<ID>_probe, PROBE_PX). (The writer once ran the
+    ``LIN`` in the declaring routine: KSS stops with "impermissible program structure for
+    RESUME".)"""
     plan, files = _stator_files()
     m = run(files, ideal_part(plan, nominal_T_base_wobj(plan)))
-    assert len(m.searches) == 10
+    assert len(m.searches) == 12 + 2 * 21  # A-H with C and D retaken, the x-offset run
     for s in m.searches:
         assert s.where.text.strip() == "LIN xTo" and s.interrupts in ([20], [21])
         assert s.end_m is not None and s.target_m is not None
@@ -578,7 +680,7 @@ def test_no_routine_parameter_shadows_module_data() -> None:
     (KRL allows it, but which one a statement means is then a question)."""
     _, files = _stator_files()
     module, local = _krl_names(files)
-    params = re.findall(r"^DEF \w+\((.*)\)", files[".src"], re.M)
+    params = re.findall(r"^DEF(?:FCT \w+)? \w+\((.*)\)", files[".src"], re.M)
     names = local + [a.split(":")[0] for ps in params for a in ps.split(",") if a]
     assert names and not {n.upper() for n in names} & {n.upper() for n in module}
 
@@ -590,12 +692,19 @@ def _renamed(plan: Plan, ids: list[str]) -> Plan:
 
 
 def _krl_names(files: dict[str, str]) -> tuple[list[str], list[str]]:
-    """The names the module declares: the data list's and the routines' (one scope), and the
-    routines' parameters and local data (each routine's own)."""
+    """The names the module declares: the data list's and the routines' (``DEF`` and
+    ``DEFFCT``: one scope), and the routines' parameters and local data (each routine's
+    own)."""
     dat, src = files[".dat"], files[".src"]
     module = re.findall(r"^(?:DEFDAT|DECL \w+|SIGNAL) (\w+)", dat, re.M)
     module += re.findall(r"^DEF (\w+)", src, re.M)[1:]  # the main DEF is the DEFDAT's name
-    return module, re.findall(r"^  DECL \w+ (\w+)", src, re.M)
+    module += re.findall(r"^DEFFCT \w+ (\w+)", src, re.M)
+    local = [
+        re.sub(r"\[.*", "", name).strip()
+        for decl in re.findall(r"^  DECL \w+ (.*)$", src, re.M)
+        for name in decl.split(",")
+    ]
+    return module, local
 
 
 def assert_legal_names(files: dict[str, str]) -> list[str]:
@@ -633,16 +742,20 @@ def assert_legal_names(files: dict[str, str]) -> list[str]:
 )
 def test_names_are_legal_krl(change: Callable[[Plan], Plan], names: list[str]) -> None:
     """Point ids differing only in case get different KRL names (KRL is case-insensitive);
-    ids over 17 characters (``x<id>_start``) and plan names whose words join to over 17
-    characters (``Wobjcal<Words>``) are cut to KRL's 24 characters. The plan model accepts all
-    of them; the program compiles and measures as computed."""
-    plan = load_plan(PLATE)
-    plan = change(msgspec.structs.replace(plan, points=plan.points[:2]))
+    ids over 17 characters (``x<id>_start``, ``x<id>_probe``) and plan names whose words join
+    to over 17 characters (``Wobjcal<Words>``) are cut to KRL's 24 characters. The plan model
+    accepts all of them; the (adaptive best fit) program compiles and measures as executed."""
+    plan = load_plan(PLATE_BEST_FIT)
+    plan = change(msgspec.structs.replace(plan, points=plan.points[:3]))
     job = build_job(plan, nominal_T_base_wobj(plan), ToolData(T_flange_tcp=np.eye(4)))
+    assert job.program("krl").adaptive
     files = export_files(job, "krl")
     m = run(files, PlaneWorld(plan, job.T_base_wobj))
-    assert_runs_as_computed(m, job, Expected(job, PlaneWorld(plan, job.T_base_wobj)))
+    assert_runs_as_executed(m, job, PlaneWorld(plan, job.T_base_wobj))
     assert set(names) <= set(assert_legal_names(files))
+    assert {f"{n[: -len('_start')]}_probe" for n in names if n.endswith("_start")} <= set(
+        assert_legal_names(files)
+    )
 
 
 def test_random_long_ids_and_names_make_legal_krl() -> None:

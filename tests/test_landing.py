@@ -29,30 +29,30 @@ def _mesh(plan: Plan):  # type: ignore[no-untyped-def]
 def test_a_nominal_program_on_narrow_faces_is_flagged_the_adaptive_one_is_not() -> None:
     """The plate's 3-2-1: its secondary and tertiary points sit on 12.7 mm side faces. Measured
     after the primary face has fixed height and tilts (RAPID) they land on them; measured in
-    the nominal frame under 3 mm / 1 deg (KRL) some land off, and those points are named."""
+    the nominal frame under 3 mm / 1 deg (FANUC TP) some land off, and those points are named."""
     plan = load_plan(PLATE_321)
     mesh = _mesh(plan)
     rapid = plan_landing_risk(plan, mesh, "rapid")
-    krl = plan_landing_risk(plan, mesh, "krl")
-    assert rapid is not None and krl is not None
+    tp = plan_landing_risk(plan, mesh, "fanuc")
+    assert rapid is not None and tp is not None
     assert rapid.failed == 0.0 and rapid.point_problems() == {}
-    assert krl.program == "KRL, nominal 3-2-1" and krl.failed > 0.05
-    problems = krl.point_problems()
+    assert tp.program == "TP, nominal 3-2-1" and tp.failed > 0.05
+    problems = tp.point_problems()
     assert set(problems) == {"S1", "S2", "T1"}
     assert all("lands off its face" in w and "adaptive program" in w for w in problems.values())
     # deterministic: the same seed gives the same shares
-    again = plan_landing_risk(plan, mesh, "krl")
-    assert again is not None and again.searches == krl.searches
+    again = plan_landing_risk(plan, mesh, "fanuc")
+    assert again is not None and again.searches == tp.searches
 
 
 def test_the_risk_is_what_the_validation_simulates_on_the_real_mesh() -> None:
-    """The share of calibrations in which D, E and G of the stator's nominal (KRL) A-H program
+    """The share of calibrations in which D, E and G of the stator's nominal (FANUC TP) A-H program
     land over a slot hole, from the ideal part's planes and the faces' outlines, is the share
     the Monte Carlo on the real mesh counts as landed off its face (within sampling error)."""
     plan = load_plan(STATOR)
-    risk = plan_landing_risk(plan, _mesh(plan), "krl")
+    risk = plan_landing_risk(plan, _mesh(plan), "fanuc")
     assert risk is not None
-    report = validate_plan(plan, trials=120, seed=4, workers=1, plan_dir=PLANS, fmt="krl")
+    report = validate_plan(plan, trials=120, seed=4, workers=1, plan_dir=PLANS, fmt="fanuc")
     simulated = {o.point_id: o.landed_off / o.searches for o in report.outcomes}
     for s in risk.searches:
         if s.key in ("D", "E", "G"):

@@ -97,7 +97,7 @@ def test_plate_plans_validate_from_the_cli(
     """The machined plate (mm mesh) with a touch probe: 3-2-1 and a 10-point best fit, each
     validated end to end as the exported programs run them, simulated beside predicted. The
     3-2-1's secondary and tertiary points lie on the 12.7 mm side faces: the adaptive RAPID
-    program (the default) lands them on their faces; the KRL program, every search in the
+    program (the default) lands them on their faces; the FANUC TP program, every search in the
     nominal frame under the plan's 3 mm / 1 deg bound, lands some off them, which the prediction
     does not see (origin y)."""
     for plan in (PLATE_321, PLATE_FIT):
@@ -114,11 +114,11 @@ def test_plate_plans_validate_from_the_cli(
             assert r["procedure_predicted"] == pytest.approx(r["procedure"], rel=0.25), key
         assert any(k.startswith("xyz_farthest") for k, _ in rows)
         assert (tmp_path / plan.stem / "error_map.png").is_file()
-    out = tmp_path / "krl.json"
-    argv = ["validate", str(PLATE_321), "--format", "krl", "--trials", "120", "--seed", "1"]
-    assert main([*argv, "--reach-trials", "0", "--json", str(out)]) in (0, 1)
+    out = tmp_path / "fanuc.json"
+    argv = ["validate", str(PLATE_321), "--format", "fanuc", "--trials", "120", "--seed", "1"]
+    assert main([*argv, "--reach-trials", "0", "--force", "--json", str(out)]) in (0, 1)
     data = json.loads(out.read_text())
-    assert data["program"]["name"].startswith("KRL, nominal 3-2-1")
+    assert data["program"]["name"].startswith("TP, nominal 3-2-1")
     assert any("landed off its face" in k for k in data["landings"]), data["landings"]
     r = {(r["key"], r["level_percent"]): r for r in data["rows"]}[("origin_y", 95.5)]
     assert r["procedure"] > 2.0 * r["procedure_predicted"], r

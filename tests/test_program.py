@@ -37,12 +37,11 @@ PLATE_321 = PLANS / "plate_holes_321.json"
 def test_a_plan_and_a_controller_give_one_named_program() -> None:
     stator, fit, three = load_plan(STATOR), load_plan(PLATE_FIT), load_plan(PLATE_321)
     assert measuring_program(stator, "rapid").name == "RAPID, adaptive A-H"
-    assert measuring_program(stator, "krl").name == "KRL, nominal A-H"
     assert measuring_program(stator, "fanuc").name == "TP, nominal A-H"
-    assert measuring_program(fit, "urscript").name == "URScript, nominal best fit"
+    assert measuring_program(fit, "fanuc").name == "TP, nominal best fit"
     assert measuring_program(three, None).name == "RAPID, adaptive 3-2-1"
     assert measuring_program(fit, "rapid").name == "RAPID, adaptive best fit"
-    assert "nominal frame" in measuring_program(fit, "krl").note
+    assert "nominal frame" in measuring_program(fit, "fanuc").note
     assert measuring_program(stator, "rapid").note == ""
     # an edge search: the RAPID best-fit update takes approach searches only
     edge = next(p for p in stator.points if p.search.kind == "edge")
@@ -64,9 +63,9 @@ def test_the_adaptive_order_comes_from_the_procedure_itself() -> None:
     no_retake = msgspec.structs.replace(plan.procedure, retake_c_d=False)
     short = measuring_program(msgspec.structs.replace(plan, procedure=no_retake), "rapid")
     assert [role[i] for i in short.probe_order] == list("ABCDEFGH")
-    krl = measuring_program(plan, "krl")
-    assert krl.probe_order == tuple(p.id for p in plan.points)
-    assert all(s.frame == "nominal" for s in krl.searches)
+    tp = measuring_program(plan, "fanuc")
+    assert tp.probe_order == tuple(p.id for p in plan.points)
+    assert all(s.frame == "nominal" for s in tp.searches)
     # check walks the moves of every program: plan order and the RAPID order with retakes
     index = {p.id: i for i, p in enumerate(plan.points)}
     assert sorted(probe_orders(plan)) == sorted(
@@ -113,7 +112,7 @@ def test_a_nominal_program_searches_from_the_exported_safe_starts(path: Path, se
     plan = load_plan(path)
     T_nom = nominal_T_base_wobj(plan)
     T_true = T_nom @ full_misplacement(plan, np.random.default_rng(seed))
-    prog = measuring_program(plan, "krl")
+    prog = measuring_program(plan, "fanuc")
     log: list[SearchCommand] = []
     run = execute(prog, T_nom, _planes_probe(plan, T_true, log))
     job = build_job(plan, T_nom, ToolData(T_flange_tcp=np.eye(4)))
@@ -176,10 +175,10 @@ def test_a_validate_trial_executes_the_program_of_the_chosen_controller() -> Non
     from planner.validate import validate_plan
 
     plan = load_plan(PLATE_FIT)
-    report = validate_plan(plan, trials=4, seed=3, workers=1, plan_dir=PLANS, fmt="urscript")
-    assert report.program.startswith("URScript, nominal best fit")
+    report = validate_plan(plan, trials=4, seed=3, workers=1, plan_dir=PLANS, fmt="fanuc")
+    assert report.program.startswith("TP, nominal best fit")
     assert report.program_steps[0] == "1. joint move to the safe start of T1"
-    assert "Program: URScript, nominal best fit" in report.to_markdown()
+    assert "Program: TP, nominal best fit" in report.to_markdown()
     # one search per point: no second round, no re-aimed search
     assert {o.point_id: o.searches for o in report.outcomes} == {p.id: 4 for p in plan.points}
 

@@ -2,12 +2,17 @@
 
 Every shipped plan (``assets/plans/*.json``) and generated variants of them are exported with
 ``planner.export.export_files(job, "urscript")`` and run to the end against a part misplaced at
-the plan's tolerance; each ``meas_<ID>`` must equal what an independent computation of the
-point's searches gives (``program_searches`` of ``planner/program/searches.py``: from the safe
-start along the nominal direction to the target end; an edge point's edge search from the
-measured face point), to 1e-6 mm. The sensor is :class:`tests.box_part.BoxProbe` where the
-plan's points lie on that box, else :class:`PlaneProbe` (each point's nominal face plane moved
-by the true pose).
+the plan's tolerance. A nominal program's ``meas_<ID>`` must equal what an independent
+computation of the point's searches gives (``program_searches`` of
+``planner/program/searches.py``: from the safe start along the nominal direction to the target
+end; an edge point's edge search from the measured face point); an adaptive program (best fit,
+3-2-1, A-H: ``job.program("urscript").adaptive``) must ask the searches that executing its
+measuring program (``planner.program.execute``, what ``wobjcal validate`` simulates) asks, keep
+the points it measures, and end with its frame in ``wobj``; all to 1e-6 mm (an adaptive
+program's later searches to 1e-5 mm, :data:`ADAPTIVE_TOL_M`). The sensor is
+:class:`tests.box_part.BoxProbe` where the plan's points lie on that box, else
+:class:`PlaneProbe` (each point's nominal face plane moved by the true pose). The plans' A-H
+edge-event offset is set to 0 (measured): these ideal sensors report an edge at the edge.
 
 The programs run as exported: the interpreter compiles them as the controller does (block
 keywords reserved, argument counts checked), so a parameter named ``end`` or a ``textmsg`` with
@@ -24,16 +29,19 @@ import msgspec
 import numpy as np
 import pytest
 
-from calib.errors import WobjcalError
+from calib.errors import ProbeFailedError, WobjcalError
 from calib.frames import (
     invert_transform,
     matrix_from_rotvec,
     random_transform,
+    rotvec_from_matrix,
     transform_directions,
     transform_points,
 )
+from calib.paper.xoffset import xoffset_probe_points
 from calib.plan.file import Plan, PlanPoint, Search, load_plan
-from calib.procedures import ProcedureSettings, method_of, procedure_kind
+from calib.probing import ProbeResult, SearchCommand
+from calib.procedures import ProcedureRun, ProcedureSettings, method_of, procedure_kind
 from planner.export import export_files
 from planner.export.job import (
     ExportJob,
@@ -43,7 +51,11 @@ from planner.export.job import (
     default_sensor_rotation,
 )
 from planner.export.text import identifier
+from planner.export.urscript_layout import result_variable, search_slots, slot_table
+from planner.export.urscript_probe import names_of
 from planner.plan_cell import nominal_T_base_wobj
+from planner.program import execute
+from planner.program.model import FACE_APPROACH
 from tests.box_part import BoxProbe, distance_to_box
 from tests.test_export_rapid_adaptive import full_misplacement, rapid_search
 from tests.urscript_interp import (
@@ -60,6 +72,9 @@ PLANS = sorted((REPO / "assets" / "plans").glob("*.json"))
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
 #: 1e-6 mm: the ideal probe and the interpreter are exact up to rounding.
 TOL_M = 1e-9
+#: 1e-5 mm for an adaptive program: its later searches are commanded in a frame estimated from
+#: points measured from targets written to 1e-9 m, which carries that rounding on.
+ADAPTIVE_TOL_M = 1e-8
 NOT_FOUND = "ERR_WHLSEARCH"
 
 
@@ -67,8 +82,9 @@ NOT_FOUND = "ERR_WHLSEARCH"
 class PlaneProbe:
     """An ideal sensor on the plan's faces, each the nominal face plane moved by the true pose.
 
-    A search is answered on the faces of the point whose nominal position lies nearest the
-    commanded line (the program commands it in the nominal frame). Approach (``neg_flank``
+    A search is answered on the faces of the point whose nominal or true position lies
+    nearest the commanded line (a nominal program commands it in the nominal frame, an
+    adaptive one in the frame estimated so far). Approach (``neg_flank``
     False): where the TCP crosses the point's face plane from outside. Edge search: where the
     foot of the sensor axis on the face plane (the face the edge search runs along) crosses the
     plane through the edge point normal to ``edge_normal`` (else the edge direction). Both give
@@ -82,10 +98,13 @@ class PlaneProbe:
     """
 
     def __init__(self, plan: Plan, T_base_true: np.ndarray, T_base_nominal: np.ndarray) -> None:
+        self.T_base_true = T_base_true
         # (nominal anchor, true point on the face, true outward normal), base frame
         self.faces: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
         # (nominal anchor, face point, face normal, edge point, edge normal), base frame
         self.edges: list[tuple[np.ndarray, ...]] = []
+        # the true anchor of each face and edge (the nominal anchor moved by the misplacement)
+        self.moved = invert_transform(T_base_nominal)
         for p in plan.points:
             pos, n, s = np.asarray(p.position_m, float), np.asarray(p.normal, float), p.search
             d = None if s.edge_direction is None else np.asarray(s.edge_direction, float)
@@ -104,11 +123,16 @@ class PlaneProbe:
         u = (end - start) / length
         if neg_flank:
             _, face_p, face_n, edge_p, edge_m = min(
-                self.edges, key=lambda e: _off_line(e[0], start, u)
+                self.edges, key=lambda e: self._off(e[0], start, u)
             )
             return _leave_face(start, u, length, axis, face_p, face_n, edge_p, edge_m)
-        _, point, normal = min(self.faces, key=lambda f: _off_line(f[0], start, u))
+        _, point, normal = min(self.faces, key=lambda f: self._off(f[0], start, u))
         return _enter_plane(start, u, length, point, normal)
+
+    def _off(self, anchor: np.ndarray, start: np.ndarray, u: np.ndarray) -> float:
+        """Distance of the line from the nominal anchor or from the true one."""
+        true = transform_points(self.T_base_true @ self.moved, anchor)
+        return min(_off_line(anchor, start, u), _off_line(true, start, u))
 
 
 def _off_line(p: np.ndarray, start: np.ndarray, u: np.ndarray) -> float:
@@ -187,7 +211,7 @@ def _search_once(
 ) -> np.ndarray | None:
     answer = search(start, end, axis, neg_flank)
     if isinstance(answer, str):
-        assert answer != AT_START, "a search starts with the sensor already at its level"
+        assert not isinstance(answer, str) or answer != AT_START, "sensor at its level at start"
         return None
     return np.asarray(answer, float)
 
@@ -245,11 +269,22 @@ def measured(machine: UrMachine, t: TargetPair) -> list[float]:
     return value
 
 
+def is_adaptive(job: ExportJob) -> bool:
+    """The URScript writer writes ``job``'s adaptive program (its measuring program is
+    adaptive: best fit and 3-2-1 steer themselves, A-H with the job's A-H specifics)."""
+    program = job.program("urscript")
+    return program.steers_itself or (program.adaptive and job.adaptive is not None)
+
+
 def run_and_compare(job: ExportJob, text: str, search: SearchFn, **options: object) -> UrMachine:
     """Run the program against ``search`` and check every point against the reference."""
     program = Recorder(search)
     machine = UrMachine(text, program, **options).run()  # type: ignore[arg-type]
-    assert machine.finished and not machine.halted
+    assert machine.finished
+    if is_adaptive(job):
+        compare_adaptive(job, machine, program, search)
+        return machine
+    assert not machine.halted
     reference = Recorder(search)
     for t in job.targets:
         want = expected_measurement(t, job.T_base_wobj, reference)
@@ -267,6 +302,115 @@ def run_and_compare(job: ExportJob, text: str, search: SearchFn, **options: obje
         assert a[3] == b[3]
     assert [r.search.neg_flank for r in machine.searches] == [c[3] for c in program.calls]  # type: ignore[union-attr]
     return machine
+
+
+#: A recorded search the reference never ran (the program stopped before it).
+NOT_RUN = "not run"
+
+
+def compare_adaptive(
+    job: ExportJob, machine: UrMachine, program: Recorder, search: SearchFn
+) -> None:
+    """An adaptive program asked the searches, kept the points and ended with the frame of
+    its measuring program executed with ``search`` (``planner.program.execute``), to
+    :data:`ADAPTIVE_TOL_M`; a failed
+    search stopped both there, with the points before it kept."""
+    prog = job.program("urscript")
+    reference = Recorder(search)
+    results: list[tuple[str, np.ndarray | None]] = []
+
+    def probe(cmd: SearchCommand) -> ProbeResult:
+        end = cmd.start_m + cmd.length_m * cmd.direction
+        answer = reference(cmd.start_m, end, cmd.sensor_axis, cmd.kind == "edge")
+        assert not isinstance(answer, str) or answer != AT_START, "sensor at its level at start"
+        point = None if isinstance(answer, str) else np.asarray(answer, dtype=float)
+        results.append((cmd.point_id, point))
+        return ProbeResult(point, str(answer) if point is None else "", travel_m=0.0)
+
+    try:
+        run: ProcedureRun | None = execute(prog, job.T_base_wobj, probe)
+    except ProbeFailedError:
+        run = None
+    assert machine.halted == (run is None), machine.messages[-3:]
+    # each recorded search's result in the reference, in program order
+    expected: list[np.ndarray | str | None] = []
+    pending = list(results)
+    for step in prog.searches:
+        if not step.recorded:
+            continue
+        if pending and pending[0][0] == step.key + FACE_APPROACH:
+            face = pending.pop(0)[1]
+            if face is None:  # the approach to the face failed: so did its edge search
+                expected.append(None)
+                continue
+        expected.append(pending.pop(0)[1] if pending else NOT_RUN)
+    assert not pending
+    got = np.asarray(machine.variables["measured"], dtype=float).reshape(-1, 3)
+    codes = machine.variables["measured_code"]
+    table = slot_table(job, prog)
+    names = dict(
+        zip(
+            (t.point_id for t in job.targets),
+            names_of([t.point_id for t in job.targets]),
+            strict=True,
+        )
+    )
+    for want, slot in zip(expected, search_slots(job, prog), strict=True):
+        pid, take = table[slot]
+        var = machine.variables[result_variable(names[pid], take)]
+        if isinstance(want, str):
+            assert codes[slot] == -1.0 and var == [-1.0, 0.0, 0.0, 0.0], (pid, take)
+        elif want is None:
+            assert codes[slot] == 1.0 and var == [1.0, 0.0, 0.0, 0.0], (pid, take)
+        else:
+            assert codes[slot] == 0.0 and var[0] == 0.0, (pid, take)
+            assert np.abs(got[slot] - want).max() < ADAPTIVE_TOL_M, (pid, take, got[slot], want)
+            assert np.abs(np.array(var[1:]) - want).max() < ADAPTIVE_TOL_M
+    # the program asked the reference's searches, in the same order (then the x-offset run's)
+    extra = 0
+    settings = prog.settings
+    if run is not None and getattr(settings, "xoffset", None) is not None:
+        run_x = settings.xoffset
+        extra = sum(len(row) for row in xoffset_probe_points(run_x.grid, run_x.layers, run_x.teeth))
+    assert len(program.calls) == len(reference.calls) + extra
+    for a, b in zip(program.calls, reference.calls, strict=False):
+        for x, y in zip(a[:3], b[:3], strict=True):
+            assert np.abs(x - y).max() < ADAPTIVE_TOL_M
+        assert a[3] == b[3]
+    assert [r.search.neg_flank for r in machine.searches] == [c[3] for c in program.calls]  # type: ignore[union-attr]
+    if run is not None:
+        T = machine.frame("wobj")
+        assert np.abs(T[:3, 3] - run.T_base_wobj[:3, 3]).max() < ADAPTIVE_TOL_M
+        assert np.linalg.norm(rotvec_from_matrix(T[:3, :3].T @ run.T_base_wobj[:3, :3])) < 1e-8
+    assert np.abs(machine.frame("wobj_nominal") - job.T_base_wobj).max() < 1e-8
+
+
+def load(path: Path) -> Plan:
+    """The plan at ``path``; an A-H plan with its edge-event offset measured as 0 (the ideal
+    sensors here report an edge at the edge; unset, every face takes the sensor model's)."""
+    plan = load_plan(path)
+    if plan.method == "hultman2013":
+        proc = msgspec.structs.replace(plan.procedure, edge_event_offset_m=0.0)
+        plan = msgspec.structs.replace(plan, procedure=proc)
+    return plan
+
+
+def nominal_stator() -> Plan:
+    """The stator plan under the best fit: a nominal program (its frame update takes approach
+    searches only, the plan has edge searches), for the error paths of a nominal program."""
+    plan = SHAPES["procedure_best_fit"](load(STATOR))
+    assert not job_of(plan).program("urscript").adaptive
+    return plan
+
+
+def job_of(plan: Plan) -> ExportJob:
+    return build_job(plan, nominal_T_base_wobj(plan), ToolData(T_flange_tcp=np.eye(4)))
+
+
+def slot_points(machine: UrMachine, job: ExportJob) -> tuple[np.ndarray, list[float]]:
+    """An adaptive program's ``measured`` (``(slots, 3)``, base, m) and ``measured_code``."""
+    got = np.asarray(machine.variables["measured"], dtype=float).reshape(-1, 3)
+    return got, list(machine.variables["measured_code"])
 
 
 def misplaced(plan: Plan, T_nom: np.ndarray, seed: int) -> np.ndarray:
@@ -359,14 +503,17 @@ def spun_rotations(plan: Plan, rng: np.random.Generator) -> dict[str, np.ndarray
 def test_shipped_plan_runs_to_the_end_and_measures_each_point_exactly(
     path: Path, seed: int
 ) -> None:
-    plan = load_plan(path)
+    plan = load(path)
     T_nom = nominal_T_base_wobj(plan)
     job, text = build(plan, T_nom)
     machine = run_and_compare(job, text, ideal_search(plan, misplaced(plan, T_nom, seed), T_nom))
-    n_edge = sum(t.kind == "edge" for t in job.targets)
-    assert len(machine.searches) == len(job.targets) + n_edge  # every point found
     for t in job.targets:
         assert any(msg.startswith(t.point_id) for msg in machine.messages), t.point_id
+    if is_adaptive(job):  # its searches, points and frame: compare_adaptive
+        assert not machine.halted and set(slot_points(machine, job)[1]) == {0.0}
+        return
+    n_edge = sum(t.kind == "edge" for t in job.targets)
+    assert len(machine.searches) == len(job.targets) + n_edge  # every point found
     # each point: a joint move to its safe start first, a linear retreat to it last
     safe_starts = [T_nom @ t.safe_start for t in job.targets]
     pose_moves = [m for m in machine.motions if m.kind == "movej" and isinstance(m.target, Pose)]
@@ -379,11 +526,19 @@ def test_shipped_plan_runs_to_the_end_and_measures_each_point_exactly(
 @pytest.mark.parametrize("path", PLANS, ids=[p.stem for p in PLANS])
 def test_nominal_part_gives_the_plan_points(path: Path) -> None:
     """On the part at its nominal pose every ``meas_<ID>`` is the plan's point (base frame):
-    the reference itself checked against the plan."""
-    plan = load_plan(path)
+    the reference itself checked against the plan (an adaptive program's every slot, the
+    retakes too: its frame stays nominal)."""
+    plan = load(path)
     T_nom = nominal_T_base_wobj(plan)
     job, text = build(plan, T_nom)
     machine = run_and_compare(job, text, ideal_search(plan, T_nom, T_nom))
+    if is_adaptive(job):
+        got, codes = slot_points(machine, job)
+        for k, (pid, _take) in enumerate(slot_table(job, job.program("urscript"))):
+            want = transform_points(T_nom, plan.point(pid).position_m)
+            assert codes[k] == 0.0 and np.abs(got[k] - want).max() < TOL_M, pid
+        assert np.abs(machine.frame("wobj") - T_nom).max() < 1e-9
+        return
     for p, t in zip(plan.points, job.targets, strict=True):
         got = measured(machine, t)
         assert got[0] == 0.0
@@ -399,7 +554,7 @@ def test_generated_variants_run_and_measure_exactly(path: Path, shape: str, seed
     tool and sensor spin."""
     rng = np.random.default_rng(1000 + seed)
     try:
-        plan = variant(SHAPES[shape](load_plan(path)), rng)
+        plan = variant(SHAPES[shape](load(path)), rng)
     except WobjcalError as exc:
         pytest.skip(f"{path.stem} {shape}: the plan model refuses it: {exc}")
     T_nom = random_transform(rng, 2.0, np.pi)
@@ -407,29 +562,43 @@ def test_generated_variants_run_and_measure_exactly(path: Path, shape: str, seed
     job, text = build(plan, T_nom, tool, spun_rotations(plan, rng))
     machine = run_and_compare(job, text, ideal_search(plan, misplaced(plan, T_nom, seed), T_nom))
     assert np.abs(machine.tcp_offset.matrix() - tool.T_flange_tcp).max() < 1e-8
-    assert np.abs(machine.frame("wobj") - T_nom).max() < 1e-8
+    order = [t.point_id for t in job.targets]
+    if is_adaptive(job):  # the points it moved to, in its order, up to where it stopped
+        codes = slot_points(machine, job)[1]
+        prog = job.program("urscript")
+        recorded = [s.point_id for s in prog.searches if s.recorded]
+        order = [
+            pid
+            for pid, k in zip(recorded, search_slots(job, prog), strict=True)
+            if codes[k] != -1.0
+        ]
+    else:
+        assert np.abs(machine.frame("wobj") - T_nom).max() < 1e-8
+    by_id = {t.point_id: t for t in job.targets}
+    want = [q for pid in order for q in by_id[pid].vias_q_rad]
     vias = [m.target for m in machine.motions if m.kind == "movej" and isinstance(m.target, list)]
-    assert np.allclose(vias, [q for t in job.targets for q in t.vias_q_rad], atol=1e-6) or (
-        vias == [] and all(not t.vias_q_rad for t in job.targets)
-    )
+    assert np.allclose(vias, want, atol=1e-6) or (vias == [] and want == [])
 
 
 def test_the_plane_probe_agrees_with_the_box_probe() -> None:
-    """Both ideal sensors answer the stator program's searches alike (the plane probe is the
-    reference for the plans that are not the box)."""
-    plan = load_plan(STATOR)
-    T_nom = nominal_T_base_wobj(plan)
-    T_true = misplaced(plan, T_nom, 7)
-    job, text = build(plan, T_nom)
-    a = run_and_compare(job, text, rapid_search(BoxProbe(T_true)))
-    b = run_and_compare(job, text, PlaneProbe(plan, T_true, T_nom))
-    for t in job.targets:
-        assert np.abs(np.array(measured(a, t)) - measured(b, t)).max() < TOL_M
+    """Both ideal sensors answer the stator programs' searches alike (the plane probe is the
+    reference for the plans that are not the box): the adaptive A-H one and a nominal one."""
+    for plan in (load(STATOR), nominal_stator()):
+        T_nom = nominal_T_base_wobj(plan)
+        T_true = misplaced(plan, T_nom, 7)
+        job, text = build(plan, T_nom)
+        a = run_and_compare(job, text, rapid_search(BoxProbe(T_true)))
+        b = run_and_compare(job, text, PlaneProbe(plan, T_true, T_nom))
+        for t in job.targets:
+            assert np.abs(np.array(measured(a, t)) - measured(b, t)).max() < TOL_M
+        assert np.abs(a.frame("wobj") - b.frame("wobj")).max() < TOL_M
+        if is_adaptive(job):
+            assert np.abs(slot_points(a, job)[0] - slot_points(b, job)[0]).max() < TOL_M
 
 
 def test_polling_every_control_cycle_gives_the_same_points() -> None:
     """The event clock is an ideal controller: polling at 125 Hz (CB3) sees the same events."""
-    plan = load_plan(STATOR)
+    plan = load(STATOR)
     T_nom = nominal_T_base_wobj(plan)
     job, text = build(plan, T_nom)
     search = ideal_search(plan, misplaced(plan, T_nom, 3), T_nom)
@@ -437,6 +606,7 @@ def test_polling_every_control_cycle_gives_the_same_points() -> None:
     slow = run_and_compare(job, text, search, cycle_s=0.008)
     for t in job.targets:
         assert np.abs(np.array(measured(fast, t)) - measured(slow, t)).max() < TOL_M
+    assert np.abs(slot_points(fast, job)[0] - slot_points(slow, job)[0]).max() < TOL_M
     assert abs(slow.clock_s - fast.clock_s) < 0.1  # the cycles add at most one per wait
 
 
@@ -452,7 +622,7 @@ def failing_call(search: SearchFn, which: int) -> Recorder:
     return rec
 
 
-#: stator program order of the searches: A B C D E F(face, edge) G H(face, edge)
+#: the nominal stator program's order of the searches: A B C D E F(face, edge) G H(face, edge)
 @pytest.mark.parametrize(
     ("which", "point", "edge_search_runs"),
     [(1, "A", None), (6, "F", False), (7, "F", True), (10, "H", True)],
@@ -461,7 +631,7 @@ def failing_call(search: SearchFn, which: int) -> Recorder:
 def test_a_search_that_finds_nothing_takes_the_error_path(
     which: int, point: str, edge_search_runs: bool | None
 ) -> None:
-    plan = load_plan(STATOR)
+    plan = nominal_stator()
     T_nom = nominal_T_base_wobj(plan)
     job, text = build(plan, T_nom)
     search = ideal_search(plan, misplaced(plan, T_nom, 11), T_nom)
@@ -492,7 +662,7 @@ def test_a_search_that_finds_nothing_takes_the_error_path(
 
 
 def test_input_already_on_at_the_safe_start_gives_code_2_and_no_search() -> None:
-    plan = load_plan(STATOR)
+    plan = nominal_stator()
     T_nom = nominal_T_base_wobj(plan)
     job, text = build(plan, T_nom)
     d = next(t for t in job.targets if t.point_id == "D")
@@ -526,8 +696,9 @@ def test_as_exported_the_program_compiles() -> None:
 
 
 def test_as_exported_the_failure_message_says_which_point_and_why() -> None:
-    """Every search finds nothing: each point logs ``<ID> failed: ... 1.0`` and records code 1."""
-    plan = load_plan(STATOR)
+    """Every search of a nominal program finds nothing: each point logs ``<ID> failed: ...
+    1.0`` and records code 1 (an adaptive program stops at the first: test_urscript_adaptive)."""
+    plan = nominal_stator()
     job, text = build(plan, nominal_T_base_wobj(plan))
     machine = UrMachine(text, lambda *a: NOT_FOUND).run()
     assert machine.finished and not machine.halted

@@ -67,7 +67,9 @@ input switch.
 
 API: ``UrMachine(text, search, ...).run()``, then :attr:`UrMachine.variables`,
 :meth:`UrMachine.measurements` (``meas_<ID>``), :meth:`UrMachine.frame`,
-:attr:`UrMachine.motions`, :attr:`UrMachine.searches`, :attr:`UrMachine.messages`.
+:attr:`UrMachine.motions`, :attr:`UrMachine.searches`, :attr:`UrMachine.messages`;
+:meth:`UrMachine.call` computes one of the program's functions on its globals (e.g. the
+adaptive A-H program's ``slot_target`` after the run).
 """
 
 from __future__ import annotations
@@ -907,9 +909,9 @@ PURE: dict[str, Builtin] = {
     "normalize": _b("v", _normalize),
     "length": _b("v", _length),
     "get_list_length": _b("v", _length),
-    "to_str": _b("val", _text),
+    "to_str": _b("val", lambda val: _text(val)),
     "str_cat": _b("op1 op2", lambda op1, op2: _text(op1) + _text(op2)),
-    "str_len": _b("str", lambda s: len(_str(s, "str"))),
+    "str_len": _b("str", lambda **kw: len(_str(kw["str"], "str"))),
 }
 #: Read-only variables every program has.
 CONSTANTS: dict[str, Any] = {"pi": math.pi}
@@ -1351,6 +1353,32 @@ class UrMachine:
         if not isinstance(value, Pose):
             raise KeyError(f"{name} is not a pose variable: {_text(value)}")
         return value.matrix()
+
+    def call(self, name: str, *args: Any) -> Any:
+        """The value of the program's function ``name`` called with ``args`` (URScript values:
+        ``int``, ``float``, ``bool``, ``str``, lists, :class:`Pose`) on the globals as they
+        stand (e.g. after :meth:`run`), as a ``def`` called from the program would compute it.
+        For functions that only compute: one that waits (a motion, ``sync``, ``sleep``) or
+        halts is an error here.
+
+        Raises:
+            KeyError: the program has no ``def`` of that name.
+            UrSyntaxError: the arguments do not bind to its parameters.
+            UrRuntimeError: it failed, waited or halted.
+        """
+        f = self.program.functions.get(name)
+        if f is None or f.kind != "def":
+            raise KeyError(f"the program has no function {name}()")
+        _bind(name, f.params, f.defaults, len(args), (), f.line)
+        gen = self._invoke(f, [_copy(a) for a in args], {})
+        try:
+            gen.send(None)
+        except StopIteration as done:
+            return done.value
+        except _Halt:
+            raise UrRuntimeError(f"{name}() halted the program") from None
+        gen.close()
+        raise UrRuntimeError(f"{name}() waits (a motion, sync or sleep): run it in the program")
 
     @property
     def searches(self) -> list[Motion]:

@@ -51,13 +51,15 @@ def run_validation(
     """Simulate the plan's calibration ``trials`` times with its error models and seed.
 
     The same :func:`planner.validate.validate_plan` as ``wobjcal validate`` (the same mesh,
-    loaded from the plan), with one in-process worker (no ``fork()`` of a threaded server).
+    loaded from the plan, the same check first), with one in-process worker (no ``fork()`` of
+    a threaded server). A plan ``wobjcal check`` refuses is simulated anyway, as
+    ``validate --force`` does: the report and the headline say check refuses it and why.
 
     Raises:
         PlanError: the plan cannot be simulated (the message names the point or field).
     """
     report = validate_plan(
-        plan, trials=int(trials), workers=1, progress=progress, plan_dir=plan_dir
+        plan, trials=int(trials), workers=1, progress=progress, plan_dir=plan_dir, check="report"
     )
     return summarize(report)
 
@@ -85,6 +87,8 @@ def summarize(report: ValidationReport) -> ValidationSummary:
         hists.append((title, unit, edges, counts.astype(np.float64)))
     failed = sum(report.failures.values())
     headline = f"{report.n_ok}/{report.n_trials} trials calibrated, {failed} failed"
+    if report.check_problems:
+        headline = f"check refuses this plan ({len(report.check_problems)} problems); " + headline
     return ValidationSummary(report, markdown, tuple(hists), headline)
 
 

@@ -178,9 +178,17 @@ def select(
     cov = _inverse(M)
     chosen: list[int] = []
 
+    far: dict[int, NDArray[np.bool_]] = {}  # per chosen candidate: the ones far enough away
+
+    def apart(c: int) -> NDArray[np.bool_]:
+        if c not in far:
+            assert pos is not None
+            far[c] = np.linalg.norm(pos - pos[c], axis=1) >= min_separation_m
+        return far[c]
+
     def allowed(exclude: int = -1) -> NDArray[np.bool_]:
         if quota is not None:
-            ok = np.array([left.get(int(k), 0) > 0 for k in g], dtype=bool)
+            ok = np.isin(g, [k for k, count in left.items() if count > 0])
         else:
             ok = np.full(C, left[0] > 0)
         if available is not None:
@@ -190,7 +198,7 @@ def select(
                 continue
             ok[c] = False
             if pos is not None and min_separation_m > 0:
-                ok &= np.linalg.norm(pos - pos[c], axis=1) >= min_separation_m
+                ok &= apart(c)
         return ok
 
     def info(c: int) -> FloatArray:

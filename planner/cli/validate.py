@@ -15,6 +15,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from calib.atomic_io import write_text_atomic
 from calib.plan.models import MAX_SEED, MAX_TRIALS
 from planner.cli.common import count_arg, read_plan, stderr, stdout
+from planner.errors import PlanRefused
 from planner.program.controllers import CONTROLLERS, DEFAULT_CONTROLLER
 
 #: Most worker processes a validation may start.
@@ -51,8 +52,11 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "linearisation with the same noise, and the bias, for the procedure and for the best\n"
         "fit of the same measurements; then how each point's searches went. A plan that\n"
         "cannot work (roles, free degrees of freedom, points off planar faces, searches too\n"
-        "short for the misplacement) is refused before the run, naming the point.\n\n"
-        "exit codes: 0 every trial calibrated, 1 some trials failed (listed), 2 bad input",
+        "short for the misplacement) is refused before the run, naming the point. So is a\n"
+        "plan `wobjcal check --format` refuses for the same program (poses, paths, moves,\n"
+        "landing risk): every problem is named; --force simulates it anyway.\n\n"
+        "exit codes: 0 every trial calibrated, 1 some trials failed (listed) or check refuses\n"
+        "the plan, 2 bad input",
         "wobjcal validate assets/plans/stator_section_ah.json --trials 400 --seed 1\n"
         "wobjcal validate plan.json --json report.json --plots plots/\n"
         "wobjcal validate plan.json --format krl   # the program the KUKA export runs\n"
@@ -101,6 +105,11 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         help="also print the sensitivity table: the rows with each noise term off in turn "
         "(runs the trials once more per term)",
     )
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="simulate a plan `wobjcal check` refuses (the report names check's problems)",
+    )
     p.add_argument("--json", metavar="FILE", help="also write the report as JSON to FILE")
     p.add_argument(
         "--plots",
@@ -119,6 +128,7 @@ def report_json(report: ValidationReport) -> dict[str, Any]:
     """The JSON of a ``ValidationReport``: rows (display units), outcomes, failures, landings."""
     return {
         "program": {"name": report.program, "steps": list(report.program_steps)},
+        "check_problems": list(report.check_problems),
         "method": report.method,
         "sensor": report.sensor,
         "n_trials": report.n_trials,
@@ -180,19 +190,28 @@ def cmd_validate(args: argparse.Namespace) -> int:
     check_simulatable(plan)  # a clear error before the simulation's heavy imports
     trials = plan.validation.trials if args.trials is None else args.trials
     seed = plan.validation.seed if args.seed is None else args.seed
-    with _bar() as bar:
-        task = bar.add_task("trials", total=trials)
-        report = validate_plan(
-            plan,
-            trials=trials,
-            seed=seed,
-            workers=args.workers,
-            progress=lambda done, total: bar.update(task, completed=done, total=total),
-            reach_trials=min(args.reach_trials, trials),
-            plan_dir=plan_dir,
-            protocol=args.protocol,
-            fmt=args.format,
-        )
+    try:
+        with _bar() as bar:
+            task = bar.add_task("trials", total=trials)
+            report = validate_plan(
+                plan,
+                trials=trials,
+                seed=seed,
+                workers=args.workers,
+                progress=lambda done, total: bar.update(task, completed=done, total=total),
+                reach_trials=min(args.reach_trials, trials),
+                plan_dir=plan_dir,
+                protocol=args.protocol,
+                fmt=args.format,
+                check="report" if args.force else "refuse",
+            )
+    except PlanRefused as exc:
+        err = stderr()
+        err.print(f"error: check refuses this plan for the program {exc.program}:", markup=False)
+        for line in exc.problems:
+            err.print(f"error: {line}", markup=False)
+        err.print("nothing simulated; fix the plan, or simulate it anyway with --force")
+        return 1
     stdout().print(report.to_markdown(), markup=False)
     data = report_json(report) | {"plan": args.plan, "seed": seed}
     if args.sensitivity:

@@ -7,8 +7,12 @@ Owns:
     - :mod:`planner.program.safety`: safe search starts under the plan's misplacement;
     - :mod:`planner.export.text`: identifiers, numbers, and names made safe for comments and
       string literals, shared by writers;
-    - one module per language: ``rapid`` (+ ``rapid_probe``, ``rapid_adaptive``,
-      ``rapid_write``), ``krl``, ``urscript``, ``fanuc`` (FANUC TP ``.ls``);
+    - one module per language, with its helpers: ``rapid`` (+ ``rapid_probe``,
+      ``rapid_adaptive``, ``rapid_steer``, ``rapid_write``), ``krl`` (+ ``krl_probe``,
+      ``krl_adaptive``, ``krl_steer``, ``krl_xoffset``, ``krl_text``), ``urscript`` (+
+      ``urscript_layout``, ``urscript_probe``, ``urscript_adaptive``, ``urscript_steer``,
+      ``urscript_xoffset``), ``fanuc`` (FANUC TP ``.ls``, nominal); the adaptive ones write the
+      frame updates of :mod:`planner.program`;
     - the registry :data:`FORMATS` and :func:`export_files`.
 
 A writer is a function ``(ExportJob) -> {file suffix: text}`` (KRL writes a ``.src`` and a

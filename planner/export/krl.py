@@ -1,5 +1,5 @@
 """KUKA KRL export: a ``.src``/``.dat`` pair that probes every point with an interrupt-driven
-search and records the points.
+search and records the points; adaptive where the controller's measuring program is.
 
 Conventions: millimetres; A, B, C are the Z-Y'-X'' Tait-Bryan angles in degrees (the paper's
 alpha, beta, gamma of eq. 7-9, :func:`calib.frames.tait_bryan_zyx_from_matrix`). The nominal
@@ -8,42 +8,86 @@ work object goes to ``BASE_DATA[10]`` (relative to ``$WORLD``, taken to be the r
 the targets are ``E6POS`` in that base with the status ``S`` and turn ``T`` of the checked pose
 (:func:`status_turn`: from the joint values of the IK solution at each target next to the
 checked pose); without a check they have no S and T (the controller keeps the current status
-and turn; check the first run in T1). Every search runs in the nominal base (not
-adaptive; the frame comes from ``wobjcal calibrate``) and starts at ``x<ID>_safe``, outside
-the nominal surface by the safe clearance of :mod:`planner.program.safety`; an edge point first
+and turn; check the first run in T1). Every search starts at ``x<ID>_safe``, outside the
+nominal surface by the safe clearance of :mod:`planner.program.safety`; an edge point first
 runs an approach search to ``x<ID>_face`` and then the edge search from the measured face point
-along the plan's direction. A search moves ``LIN`` to the end point with
-``INTERRUPT ... WHEN diSensor==TRUE`` (approach) or ``==FALSE`` (edge); the interrupt routine
-brakes, stores ``$POS_INT`` and ``RESUME``-s. KRL's ``RESUME`` ends the routines below the one
-that declared the interrupt and goes on in it after its call into the level below, so the
-search routines (``SEARCH_RISE``, ``SEARCH_FALL``) declare the interrupt and run the ``LIN`` one
-level below, in ``SEARCH_MOVE`` (which ends with ``WAIT SEC 0`` so that the advance run stays
-there). Every name (variables, routines, the module's ``DEF``/``DEFDAT``) has at most
+along the plan's direction (the searches: :mod:`planner.export.krl_probe`).
+
+The program is the controller's measuring program (``job.program("krl")``):
+
+- **nominal**: every search in the nominal base, once, in plan order, inline in the main
+  program; the frame comes from ``wobjcal calibrate``;
+- **adaptive**: the main program runs ``MEASURE_ADAPT``, which probes the points in the
+  program's order (``x<ID>_probe(i)``) and updates ``BASE_DATA[10]`` and ``$BASE`` where the
+  program's steps do: best fit and 3-2-1 by ``STEER`` (:mod:`planner.export.krl_steer`), A-H by
+  its steps and the x-offset run (:mod:`planner.export.krl_adaptive`,
+  :mod:`planner.export.krl_xoffset`), so each later search runs in the frame estimated so far.
+  A point not measured stops it; ``nResult`` says how it ended (1: ``BASE_DATA[10]`` is the
+  calibrated work object).
+
+Every name (variables, routines, the module's ``DEF``/``DEFDAT``) has at most
 :data:`MAX_NAME` characters and is unique ignoring case, as KRL's are: long point ids and plan
 names are cut, ids that differ only in case or are cut alike get ``_2``, ``_3`` ... (the
 comments keep the plan's ids). ``xMeas[i]`` holds point i in the robot base
-(``BASE_DATA[10]:xHit``, mm), ``nFail[i]`` is 0 (measured), 1 (no detection on the path) or 2
-(the input was already at the searched level at the start).
+(``BASE_DATA[10]:xHit``, mm; the adaptive A-H program's slots after the points hold the
+retakes of C and D), ``nFail[i]`` is 0 (measured), 1 (no detection on the path), 2 (the input
+was already at the searched level at the start) or, in an adaptive program, 3 (not run).
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 
 from calib._version import __version__
 from calib.frames import tait_bryan_zyx_from_matrix
 from planner.export.job import ArmPose, ExportJob, TargetPair, safety_header
+from planner.export.krl_adaptive import (
+    ah_body,
+    ah_data,
+    ah_header,
+    ah_routines,
+    measured_slots,
+    with_spec,
+)
+from planner.export.krl_probe import (
+    failed_function,
+    point_lines,
+    probe_routine,
+    search_routines,
+)
+from planner.export.krl_steer import steer_body, steer_data, steer_header, steer_routines
+from planner.export.krl_text import (
+    BASE_NO,
+    MAX_NAME,
+    SENSOR_IN,
+    TOOL_NO,
+    comment_lines,
+    stop_lines,
+)
+from planner.export.krl_xoffset import has_xoffset, xoffset_data, xoffset_routines
 from planner.export.text import comment_text, fmt, identifier
+from planner.program.model import MeasuringProgram
 
-BASE_NO = 10
-TOOL_NO = 10
-SENSOR_IN = 1
-#: Longest name KRL accepts (variables, routines and the module: its ``DEF``, ``DEFDAT`` and
-#: file name); KRL names are case-insensitive.
-MAX_NAME = 24
-#: The suffixes of a point's target names (``x<ID>_start`` ...; vias ``_v1``, ``_v2`` ...): none
-#: is the tail of another, so points with different names get different target names.
-TARGET_SUFFIXES = ("_start", "_end", "_safe", "_face")
+__all__ = [
+    "BASE_NO",
+    "MAX_NAME",
+    "SENSOR_IN",
+    "TARGET_SUFFIXES",
+    "TOOL_NO",
+    "e6pos_text",
+    "export_krl",
+    "frame_text",
+    "program_name",
+    "status_turn",
+]
+
+#: The suffixes of a point's names (its targets ``x<ID>_start`` ...; vias ``_v1``, ``_v2`` ...;
+#: in an adaptive program its routine ``x<ID>_probe`` and, for the A-H edge points, the search
+#: direction ``_dir`` and face normal ``_nrm``): none is the tail of another, so points with
+#: different names get different names.
+TARGET_SUFFIXES = ("_start", "_end", "_safe", "_face", "_probe", "_dir", "_nrm")
 
 
 def frame_text(T: np.ndarray) -> str:
@@ -101,8 +145,9 @@ def _names(targets: tuple[TargetPair, ...]) -> list[str]:
     return names
 
 
-def _dat(job: ExportJob, names: list[str]) -> str:
+def _dat(job: ExportJob, names: list[str], program: MeasuringProgram) -> str:
     n = len(job.targets)
+    n_slots = len(measured_slots(job))
     tool = job.tool
     cog = tool.cog_m
     lines = [
@@ -122,9 +167,17 @@ def _dat(job: ExportJob, names: list[str]) -> str:
         "DECL REAL fDot",
         "DECL BOOL bHit=FALSE",
         f"DECL INT nPoints={n}",
-        f"DECL FRAME xMeas[{n}]",
-        f"DECL INT nFail[{n}]",
+        f"DECL FRAME xMeas[{n_slots}]",
+        f"DECL INT nFail[{n_slots}]",
     ]
+    if program.adaptive:
+        lines += [
+            "; how the program ended: 0 running (or stopped by the operator), 1 calibrated",
+            "; (BASE_DATA[10]), 2 slot nStopAt not measured (nFail says why), 3 the points define",
+            "; no frame, 4 x-offset search nStopAt found nothing (BASE_DATA[10] calibrated)",
+            "DECL INT nResult=0",
+            "DECL INT nStopAt=0",
+        ]
     for t, name in zip(job.targets, names, strict=True):
         lines += [
             f"; {comment_text(t.point_id)}: {comment_text(t.kind)} search, role "
@@ -139,24 +192,17 @@ def _dat(job: ExportJob, names: list[str]) -> str:
         for k, deg in enumerate(t.vias_deg("KRL"), start=1):
             axes = ",".join(f"A{j} {fmt(v, 4)}" for j, v in enumerate(deg, start=1))
             lines.append(f"DECL AXIS {name}_v{k}={{{axes}}}")
+    if program.steers_itself:
+        lines += steer_data(job, program)
+    elif program.adaptive:
+        lines += [*ah_data(job, names), *xoffset_data(job)]
     lines.append("ENDDAT")
     return "\n".join(lines) + "\n"
 
 
-def _src(job: ExportJob, names: list[str]) -> str:
-    lines = [
-        "&ACCESS RVP",
-        "&REL 1",
-        f"DEF {program_name(job.name)}()",
-        f"  ; Generated by wobjcal {__version__} from plan {comment_text(repr(job.plan_name))} "
-        f"(procedure {comment_text(job.method)}).",
-        "  ; Probes each point with the proximity sensor on diSensor; see the .dat file.",
-        _status_note(job),
-        *safety_header(job, "krl", "  ; "),
-        "  ; Results: xMeas[i] = point i in the robot base (mm), nFail[i] = 0 ok, 1 no detection,",
-        "  ; 2 input already at the searched level at the start. Order of points:",
-        "  ; "
-        + ", ".join(f"{i}={comment_text(t.point_id)}" for i, t in enumerate(job.targets, start=1)),
+def _setup_lines() -> list[str]:
+    """Set the work object, the tool and its load."""
+    return [
         "  BAS(#INITMOV,0)",
         f"  BASE_DATA[{BASE_NO}]=xBaseNominal",
         f"  TOOL_DATA[{TOOL_NO}]=xToolSensor",
@@ -165,40 +211,126 @@ def _src(job: ExportJob, names: list[str]) -> str:
         f"  $TOOL=TOOL_DATA[{TOOL_NO}]",
         f"  $LOAD=LOAD_DATA[{TOOL_NO}]",
     ]
+
+
+def _src(job: ExportJob, names: list[str], program: MeasuringProgram) -> str:
+    head = [
+        "&ACCESS RVP",
+        "&REL 1",
+        f"DEF {program_name(job.name)}()",
+    ]
+    about = [
+        f"  ; Generated by wobjcal {__version__} from plan {comment_text(repr(job.plan_name))} "
+        f"(procedure {comment_text(job.method)}).",
+        "  ; Probes each point with the proximity sensor on diSensor; see the .dat file.",
+        _status_note(job),
+    ]
+    if program.adaptive:
+        return "\n".join(_adaptive_src(job, names, program, head, about))
+    lines = [
+        *head,
+        *about,
+        *safety_header(job, "krl", "  ; "),
+        "  ; Results: xMeas[i] = point i in the robot base (mm), nFail[i] = 0 ok, 1 no detection,",
+        "  ; 2 input already at the searched level at the start. Order of points:",
+        "  ; "
+        + ", ".join(f"{i}={comment_text(t.point_id)}" for i, t in enumerate(job.targets, start=1)),
+        *_setup_lines(),
+    ]
     for i, (t, name) in enumerate(zip(job.targets, names, strict=True), start=1):
-        lines += _point_lines(i, t, name)
-    lines += ["END", ""]
-    for routine, level, prio in (("SEARCH_RISE", "TRUE", 20), ("SEARCH_FALL", "FALSE", 21)):
         lines += [
-            f"DEF {routine}(xGoal:IN,fVel:IN)",
-            "  DECL E6POS xGoal",
-            "  DECL REAL fVel",
-            f"  INTERRUPT DECL {prio} WHEN diSensor=={level} DO HIT_{prio}()",
-            "  bHit=FALSE",
-            "  $VEL.CP=fVel",
-            f"  INTERRUPT ON {prio}",
-            "  SEARCH_MOVE(xGoal) ; the motion one level below the declaration, for RESUME",
-            f"  INTERRUPT OFF {prio}",
-            "END",
-            "",
-            f"DEF HIT_{prio}()",
-            f"  INTERRUPT OFF {prio}",
-            "  BRAKE F",
-            "  xHit=$POS_INT",
-            "  bHit=TRUE",
-            f"  RESUME ; ends SEARCH_MOVE, goes on in {routine} after its call",
-            "END",
-            "",
+            f"  ; --- point {comment_text(t.point_id)} ({comment_text(t.kind)} search)",
+            *point_lines(str(i), t, name),
         ]
-    lines += [
-        "DEF SEARCH_MOVE(xTo:IN)",
-        "  DECL E6POS xTo",
-        "  LIN xTo",
-        "  WAIT SEC 0 ; stop the advance run here, so that RESUME ends this routine",
+    lines += ["END", "", *search_routines()]
+    return "\n".join(lines)
+
+
+def _adaptive_header(job: ExportJob, program: MeasuringProgram) -> list[str]:
+    """The header of an adaptive program: its name, what it computes, what it is safe for."""
+    a = job.adaptive
+    from_measured = a is not None and a.settings.edge_start_from_measured
+    edges = (
+        "edge searches first approach the face they run along and start from the measured "
+        "face point"
+        + (" (F and H: from the measured E and G, as the procedure does)" if from_measured else "")
+    )
+    what = steer_header(program) if program.steers_itself else ah_header()
+    return comment_lines(
+        f"PROGRAM: {program.name}. {what} SAFE FOR: {job.safety.describe()}. Every search starts "
+        "outside the nominal surface by at least the largest misplacement of its face plus the "
+        f"sensing distance (the plan's start or farther); {edges}. ASSUMES: the moves between "
+        "the points are clear of the part and fixtures (checked by `wobjcal check`, not here), "
+        "and every motion ends at its target (no approximation: $BASE changes between them)."
+    )
+
+
+def _adaptive_src(
+    job: ExportJob,
+    names: list[str],
+    program: MeasuringProgram,
+    head: list[str],
+    about: list[str],
+) -> list[str]:
+    slots = measured_slots(job)
+    order = ", ".join(
+        f"{i}={comment_text(pid)}{' (retake)' if retake else ''}"
+        for i, (pid, retake) in enumerate(slots, start=1)
+    )
+    if program.steers_itself:
+        body = steer_body(job, program, names)
+        routines = steer_routines()
+    else:
+        body = ah_body(job, program, names)
+        if has_xoffset(job):
+            body += [
+                "  ; 10: the x-offset run over the teeth at two slot-hole levels, in the",
+                "  ;     calibrated frame, and the x-offset matrix (eq. 13-14)",
+                "  XOFFSET_RUN()",
+                *stop_lines("  "),
+            ]
+        routines = ah_routines() + xoffset_routines(job, names)
+    # A-H with edge_start_from_measured: F and H start at the measured E and G (offset, mm)
+    a = job.adaptive  # None for best fit and 3-2-1 (export_krl)
+    from_measured: dict[int, float] = {}
+    if a is not None and a.settings.edge_start_from_measured:
+        offset_mm = a.settings.edge_start_offset_m * 1000.0
+        from_measured = {a.index["F"]: offset_mm, a.index["H"]: offset_mm}
+    probes: list[str] = []
+    for i, (t, name) in enumerate(zip(job.targets, names, strict=True)):
+        probes += probe_routine(t, name, from_measured.get(i))
+    return [
+        *head,
+        "  DECL INT nI",
+        *about,
+        *_adaptive_header(job, program),
+        *comment_lines(
+            "Results: xMeas[i] = point i in the robot base (mm), nFail[i] = 0 ok, 1 no "
+            "detection, 2 input already at the searched level at the start, 3 not run; "
+            "nResult: how the program ended (see the .dat). Order of points: " + order
+        ),
+        *_setup_lines(),
+        "  ; the data list keeps a previous run's values: start from nothing measured",
+        "  nResult=0",
+        "  nStopAt=0",
+        f"  FOR nI=1 TO {len(slots)}",
+        "    nFail[nI]=3",
+        "  ENDFOR",
+        "  MEASURE_ADAPT()",
         "END",
         "",
+        f"; {comment_text(program.name)}: the searches in the program's order, each in",
+        f"; BASE_DATA[{BASE_NO}] (the frame estimated so far), and the frame updates between them",
+        "DEF MEASURE_ADAPT()",
+        *body,
+        "  nResult=1",
+        "END",
+        "",
+        *probes,
+        *routines,
+        *failed_function(),
+        *search_routines(),
     ]
-    return "\n".join(lines)
 
 
 def _status_note(job: ExportJob) -> str:
@@ -211,74 +343,13 @@ def _status_note(job: ExportJob) -> str:
     )
 
 
-def _point_lines(i: int, t: TargetPair, name: str) -> list[str]:
-    """Probe one point: an approach search from ``_safe``; for an edge point, then the edge
-    search from the measured face point along the plan's direction, up to the plan's end."""
-    v = fmt(t.speed_m_s, 6)
-    vias = [
-        f"  PTP {name}_v{k} ; via {k} (axis angles, deg)" for k in range(1, len(t.vias_q_rad) + 1)
-    ]
-    head = [
-        f"  ; --- point {comment_text(t.point_id)} ({comment_text(t.kind)} search)",
-        *vias,
-        "  $VEL.CP=0.1",
-        f"  PTP {name}_safe",
-        "  IF diSensor==TRUE THEN",
-        f"    nFail[{i}]=2",
-        "  ELSE",
-    ]
-    tail = ["  ENDIF", "  $VEL.CP=0.1", f"  LIN {name}_safe"]
-    if t.kind == "approach":
-        return [*head, f"    SEARCH_RISE({name}_end,{v})", *_record(i, "    "), *tail]
-    d = t.edge_direction_wobj
-    dot = "+".join(f"({name}_end.{c}-xStart.{c})*{_factor(d[k])}" for k, c in enumerate("XYZ"))
-    return [
-        *head,
-        "    ; approach the face the edge search runs along",
-        f"    SEARCH_RISE({name}_face,{v})",
-        "    IF bHit THEN",
-        "      ; start the edge search at the measured face point (in the same base)",
-        f"      xStart={name}_start",
-        "      xStart.X=xHit.X",
-        "      xStart.Y=xHit.Y",
-        "      xStart.Z=xHit.Z",
-        "      $VEL.CP=0.1",
-        "      LIN xStart",
-        f"      fDot={dot}",
-        f"      xEnd={name}_end",
-        *[f"      xEnd.{c}=xStart.{c}+fDot*{_factor(d[k])}" for k, c in enumerate("XYZ")],
-        "      IF diSensor==FALSE THEN",
-        f"        nFail[{i}]=2",
-        "      ELSE",
-        f"        SEARCH_FALL(xEnd,{v})",
-        *_record(i, "        "),
-        "      ENDIF",
-        "    ELSE",
-        f"      nFail[{i}]=1",
-        "    ENDIF",
-        *tail,
-    ]
-
-
-def _factor(x: float) -> str:
-    """``x`` as the right operand of ``*``: a negative number in parentheses (``*(-0.5)``,
-    never ``*-0.5``)."""
-    text = fmt(x, 9)
-    return f"({text})" if text.startswith("-") else text
-
-
-def _record(i: int, pad: str) -> list[str]:
-    return [
-        f"{pad}IF bHit THEN",
-        f"{pad}  xMeas[{i}]=BASE_DATA[{BASE_NO}]:xHit",
-        f"{pad}  nFail[{i}]=0",
-        f"{pad}ELSE",
-        f"{pad}  nFail[{i}]=1",
-        f"{pad}ENDIF",
-    ]
-
-
 def export_krl(job: ExportJob) -> dict[str, str]:
-    """The KRL program of ``job``: ``{".src": text, ".dat": text}``."""
+    """The KRL program of ``job``: ``{".src": text, ".dat": text}`` (the program of
+    ``job.program("krl")``: adaptive or nominal)."""
+    program = job.program("krl")
+    if not program.adaptive or program.steers_itself:  # the A-H specifics: for A-H programs
+        job = replace(job, adaptive=None)
+    else:
+        job = with_spec(job, program)
     names = _names(job.targets)
-    return {".src": _src(job, names), ".dat": _dat(job, names)}
+    return {".src": _src(job, names, program), ".dat": _dat(job, names, program)}

@@ -1,134 +1,80 @@
 """Universal Robots URScript export: one program that probes every point and logs the points.
 
-Conventions: metres and rotation vectors, poses ``p[x, y, z, rx, ry, rz]``. The nominal work
-object is the pose ``wobj`` (robot base frame); each target is written in the work-object frame
-and moved to the base with ``pose_trans(wobj, target)``, so replacing ``wobj`` with the
-calibrated frame is a one-line change. Every search runs in that nominal frame (not adaptive)
-and starts at the safe start of :mod:`planner.program.safety` (reached with a joint move,
-``movej`` of the pose); an edge point first approaches
-its face and runs the edge search from the measured face point (``probe``'s ``safe_wobj`` and
-``face_wobj``). A search runs ``movel`` to the end point in a thread
-while the main loop polls ``get_standard_digital_in(SENSOR_IN)`` every control cycle; at the
-switching event it reads ``get_actual_tcp_pose()``, kills the thread and ``stopl``-s.
-``meas_<ID>`` holds ``[code, x, y, z]`` of each point: code 0 measured (x, y, z in the base
-frame, m), 1 no detection on the path, 2 the input already at the searched level at the start;
-each result is also written to the log with ``textmsg``.
+Conventions: metres and rotation vectors, poses ``p[x, y, z, rx, ry, rz]``. The work object is
+the pose ``wobj`` (robot base frame); each target is written in the work-object frame and moved
+to the base with ``pose_trans(wobj, target)``. Every search starts at the safe start of
+:mod:`planner.program.safety` (reached with a joint move, ``movej`` of the pose); an edge point
+first approaches its face and runs the edge search from the measured face point. A search runs
+``movel`` to the end point in a thread while the main loop polls
+``get_standard_digital_in(SENSOR_IN)`` every control cycle (:mod:`planner.export.urscript_probe`).
+
+The program is the controller's :class:`~planner.program.model.MeasuringProgram`
+(``job.program("urscript")``):
+
+- **nominal**: every search once, in plan order, with ``wobj`` the nominal work object;
+  ``meas_<ID>`` holds ``[code, x, y, z]`` of each point (code 0 measured, x, y, z in the base
+  frame, m; 1 no detection on the path; 2 the input already at the searched level at the
+  start), each result also written to the log with ``textmsg``; ``wobjcal calibrate``
+  computes the frame;
+- **adaptive**: the program's steps in its order, ``wobj`` updated between the searches where
+  the program updates its estimate, so each search is commanded in the frame estimated so far,
+  and at the end ``wobj`` is the calibrated work object: best fit and 3-2-1 by the frame
+  update of :mod:`planner.export.urscript_steer`, the paper's A-H procedure (with its x-offset
+  run when the plan has one) by :mod:`planner.export.urscript_adaptive`. The results are kept
+  in ``measured`` (base frame, m, three per slot) and ``measured_code`` (as the code above, -1
+  not run), one slot per point in plan order and then one per retake, and in ``meas_<ID>``
+  (``meas2_<ID>``: the retake); a failed search stops the program (``halt``).
 """
 
 from __future__ import annotations
 
-import numpy as np
+from dataclasses import replace
 
-from calib._version import __version__
-from calib.frames import rotvec_from_matrix
 from planner.export.job import ExportJob, safety_header
-from planner.export.text import comment_text, fmt, identifier, literal_text
+from planner.export.text import identifier, literal_text
+from planner.export.urscript_layout import preamble
+from planner.export.urscript_probe import (
+    SENSOR_IN,
+    pose_text,
+    probe_args,
+    search_routines,
+    target_comment,
+    via_lines,
+)
 
-SENSOR_IN = 0
-
-
-def pose_text(T: np.ndarray) -> str:
-    """``p[x, y, z, rx, ry, rz]`` of a transform (metres, rotation vector in radians)."""
-    vals = [*T[:3, 3], *rotvec_from_matrix(T[:3, :3])]
-    return "p[" + ", ".join(fmt(v, 9) for v in vals) + "]"
+__all__ = ["SENSOR_IN", "export_urscript", "pose_text", "urscript_files"]
 
 
 def export_urscript(job: ExportJob) -> str:
-    """The URScript program text of ``job``."""
-    tool = job.tool
+    """The URScript program text of ``job``: the adaptive program when the controller's
+    measuring program is adaptive, else the nominal one (module docstring)."""
+    from planner.export.urscript_adaptive import export_adaptive
+    from planner.export.urscript_steer import export_steered
+
+    program = job.program("urscript")
+    if not program.adaptive:  # the A-H specifics are for the controllers that run them
+        job = replace(job, adaptive=None)
+    if program.steers_itself:
+        return export_steered(job, program)
+    if program.adaptive and job.adaptive is not None:
+        return export_adaptive(job, program)
+    return _export_nominal(job)
+
+
+def _export_nominal(job: ExportJob) -> str:
+    """Every search once, in plan order, in the nominal ``wobj``; ``meas_<ID>``."""
     lines = [
-        f"def {identifier(job.name.lower(), 'w')}():",
-        f"  # Generated by wobjcal {__version__} from plan {comment_text(repr(job.plan_name))} "
-        f"(procedure {comment_text(job.method)}).",
-        "  # Units m and rad; poses p[x, y, z, rx, ry, rz] with rotation vectors.",
-        *safety_header(job, "urscript", "  # "),
-        f"  SENSOR_IN = {SENSOR_IN}  # standard digital input of the proximity sensor",
-        f"  set_tcp({pose_text(tool.T_flange_tcp)})",
-        f"  set_payload({fmt(tool.mass_kg, 3)}, [{', '.join(fmt(c, 6) for c in tool.cog_m)}])",
-        f"  wobj = {pose_text(job.T_base_wobj)}  # nominal work object in the base frame",
-        "  search_end = p[0, 0, 0, 0, 0, 0]",
-        "  search_speed = 0.01",
-        "  move_done = False",
-        "  thread search_move():",
-        "    global move_done",
-        "    movel(search_end, a=0.2, v=search_speed)",
-        "    move_done = True",
-        "  end",
-        "  # one search from the current position to `goal` (base): [code, x, y, z] (floats),",
-        "  # code 0 measured (x, y, z base frame, m), 1 no detection,",
-        "  # 2 input already at the searched level at the start",
-        "  def run_search(goal, want, speed):",
-        "    global search_end",
-        "    global search_speed",
-        "    global move_done",
-        "    if get_standard_digital_in(SENSOR_IN) == want:",
-        "      return [2.0, 0.0, 0.0, 0.0]",
-        "    end",
-        "    search_end = goal",
-        "    search_speed = speed",
-        "    move_done = False",
-        "    mover = run search_move()",
-        "    while (get_standard_digital_in(SENSOR_IN) != want) and (not move_done):",
-        "      sync()",
-        "    end",
-        "    hit = get_actual_tcp_pose()",
-        "    kill mover",
-        "    stopl(1.0)",
-        "    if get_standard_digital_in(SENSOR_IN) == want:",
-        "      return [0.0, hit[0], hit[1], hit[2]]",
-        "    end",
-        "    return [1.0, 0.0, 0.0, 0.0]",
-        "  end",
-        "  # probe one point (poses in the wobj frame): approach search from safe_wobj; for an",
-        "  # edge point (want False) first approach the face (safe_wobj -> face_wobj), then run",
-        "  # along the plan's direction from the measured face point up to the plan's end",
-        "  def probe(name, start_wobj, end_wobj, want, speed, safe_wobj, face_wobj):",
-        "    safe = pose_trans(wobj, safe_wobj)",
-        "    # a joint move into the safe start (IK nearest the current joints), as the vias and",
-        "    # the other formats, and as wobjcal check walks it; the searches are linear",
-        "    movej(safe, a=1.4, v=1.05)",
-        "    if want:",
-        "      result = run_search(pose_trans(wobj, end_wobj), True, speed)",
-        "    else:",
-        "      result = run_search(pose_trans(wobj, face_wobj), True, speed)",
-        "      if result[0] == 0.0:",
-        "        f = pose_trans(pose_inv(wobj), p[result[1], result[2], result[3], 0, 0, 0])",
-        "        s = p[f[0], f[1], f[2], start_wobj[3], start_wobj[4], start_wobj[5]]",
-        "        movel(pose_trans(wobj, s), a=0.5, v=0.1)",
-        "        d = [end_wobj[0] - start_wobj[0], end_wobj[1] - start_wobj[1], "
-        "end_wobj[2] - start_wobj[2]]",
-        "        k = ((end_wobj[0] - s[0]) * d[0] + (end_wobj[1] - s[1]) * d[1] + "
-        "(end_wobj[2] - s[2]) * d[2]) / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2])",
-        "        e = p[s[0] + k * d[0], s[1] + k * d[1], s[2] + k * d[2], end_wobj[3], "
-        "end_wobj[4], end_wobj[5]]",
-        "        result = run_search(pose_trans(wobj, e), False, speed)",
-        "      end",
-        "    end",
-        "    if result[0] == 0.0:",
-        "      textmsg(name, result)",
-        "    else:",
-        '      textmsg(str_cat(name, " failed: code (1 no detection, 2 at level at start) "), '
-        "result[0])",
-        "    end",
-        "    movel(safe, a=0.5, v=0.1)",
-        "    return result",
-        "  end",
+        *preamble(
+            job, safety_header(job, "urscript", "  # "), "nominal work object in the base frame"
+        ),
+        *search_routines(),
     ]
     for t in job.targets:
-        want = "False" if t.kind == "edge" else "True"
-        t.vias_deg("URScript")  # six joint values each, or a clear error
-        vias = [
-            f"  movej([{', '.join(fmt(v, 6) for v in q)}], a=1.4, v=1.05)  # via {k} (rad)"
-            for k, q in enumerate(t.vias_q_rad, start=1)
-        ]
         lines += [
-            f"  # {comment_text(t.point_id)}: {comment_text(t.kind)} search, role "
-            f"{comment_text(t.role)}, "
-            f"{fmt(t.length_m * 1000.0, 1)} mm at {fmt(t.speed_m_s * 1000.0, 1)} mm/s",
-            *vias,
+            target_comment(t),
+            *via_lines(t, "  "),
             f'  {identifier("meas_" + t.point_id)} = probe("{literal_text(t.point_id)}", '
-            f"{pose_text(t.T_wobj_start)}, {pose_text(t.T_wobj_end)}, {want}, "
-            f"{fmt(t.speed_m_s, 6)}, {pose_text(t.safe_start)}, {pose_text(t.face_end)})",
+            f"{probe_args(t)})",
         ]
     lines += ["end", ""]
     return "\n".join(lines)

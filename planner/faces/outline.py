@@ -37,10 +37,16 @@ class FaceOutlines:
         self._free: dict[int, shapely.Geometry] = {}
         self._face: dict[int, shapely.Geometry] = {}
         self._rim: dict[int, tuple[FloatArray, FloatArray]] = {}
+        self._basis: dict[int, FloatArray] = {}
+        self._clearance: dict[tuple[int, bytes], float] = {}
 
     def basis(self, face_id: int) -> FloatArray:
-        """``(3, 2)`` the face's in-plane basis."""
-        return plane_basis(self._faces.faces[face_id].normal)
+        """``(3, 2)`` the face's in-plane basis (computed once per face; read-only)."""
+        if face_id not in self._basis:
+            b = np.asarray(plane_basis(self._faces.faces[face_id].normal), dtype=np.float64)
+            b.setflags(write=False)
+            self._basis[face_id] = b
+        return self._basis[face_id]
 
     def face(self, face_id: int) -> shapely.Geometry:
         """The face itself (not eroded), in :meth:`basis` coordinates."""
@@ -102,7 +108,11 @@ class FaceOutlines:
     def clearance_m(self, face_id: int, point_m: FloatArray) -> float:
         """How far the footprint at ``point_m`` may move in any direction and stay on the
         face, metres (negative: it is already off)."""
-        free = self.free(face_id)
-        c = shapely.Point(np.asarray(point_m, dtype=np.float64) @ self.basis(face_id))
-        d = float(free.boundary.distance(c))
-        return d if free.contains(c) else -d
+        p = np.asarray(point_m, dtype=np.float64)
+        key = (int(face_id), p.tobytes())
+        if key not in self._clearance:
+            free = self.free(face_id)
+            c = shapely.Point(p @ self.basis(face_id))
+            d = float(free.boundary.distance(c))
+            self._clearance[key] = d if free.contains(c) else -d
+        return self._clearance[key]

@@ -46,13 +46,23 @@ CONTROLLERS: dict[str, Controller] = {
         Controller(
             "rapid", "RAPID", "ABB", frozenset({"hultman2013", "best_fit", "three_two_one"})
         ),
-        Controller("krl", "KRL", "KUKA"),
-        Controller("urscript", "URScript", "Universal Robots"),
+        Controller("krl", "KRL", "KUKA", frozenset({"hultman2013", "best_fit", "three_two_one"})),
+        Controller(
+            "urscript",
+            "URScript",
+            "Universal Robots",
+            adaptive_methods=frozenset({"hultman2013", "best_fit", "three_two_one"}),
+        ),
         Controller(
             "fanuc",
             "TP",
             "FANUC",
-            why_nominal="the TP writer computes no frame update (position-register arithmetic)",
+            why_nominal=(
+                "the TP writer computes no frame update: writing an updated frame's W, P, R "
+                "needs ATAN2 (FANUC's math-function option, not standard TP register "
+                "arithmetic) and the update's constants need more registers than a standard "
+                "R[] set; the frame comes from wobjcal calibrate"
+            ),
         ),
     )
 }

@@ -144,6 +144,9 @@ class ValidationReport:
         program: the measuring program every trial executed, by name (e.g. ``"RAPID,
             adaptive A-H"``), and why it runs nominal when it does.
         program_steps: its steps, one line each.
+        check_problems: every problem ``wobjcal check`` names for the plan and this program
+            (``()``: it passes, or the plan was not checked): a report of a plan check refuses
+            says so at the top.
     """
 
     n_trials: int
@@ -171,6 +174,7 @@ class ValidationReport:
     error_map: ErrorMap | None = None
     program: str = ""
     program_steps: tuple[str, ...] = ()
+    check_problems: tuple[str, ...] = ()
 
     def row(self, key: str, level_percent: float) -> IntervalRow:
         """The row ``key`` at ``level_percent``; raises KeyError when absent."""
@@ -235,6 +239,11 @@ def report_markdown(report: ValidationReport) -> str:
     head += ["paper"] if paper else []
     lines = [
         f"Program: {report.program}" if report.program else "Program: not given",
+        *(
+            [f"CHECK REFUSES THIS PLAN (simulated anyway): {'; '.join(report.check_problems)}"]
+            if report.check_problems
+            else []
+        ),
         f"Procedure: {report.method}, sensor: {report.sensor}. Trials: {report.n_trials}, "
         f"calibrated: {report.n_ok}, time: {report.elapsed_s:.2f} s on {report.workers} "
         "worker(s)" + (f"; paper protocol: {report.protocol}" if protocol else ""),

@@ -43,6 +43,62 @@ def cell_search_hook(cell: Any, step_m: float = 0.002) -> ReachabilityHook:
     return hook
 
 
+@dataclass(frozen=True)
+class ProgramPose:
+    """How the measuring program runs one point, as ``wobjcal check`` chose it: the pose every
+    exported program commands (its targets' orientation and configuration).
+
+    Attributes:
+        sensor_x_base: ``(3,)`` the sensor TCP's x axis at the checked probe pose, robot base
+            frame, nominal part: the rotation about the sensor axis the targets carry.
+        branch: the IK branch of that pose (OPW configuration 0-7; -1: any).
+        q: ``(n,)`` its joint values, rad: the start of the nearest-solution choice.
+    """
+
+    sensor_x_base: FloatArray
+    branch: int
+    q: FloatArray
+
+
+def program_search_hook(
+    cell: Any,
+    poses: Mapping[str, ProgramPose],
+    keys: Mapping[str, str],
+    T_base_wobj_nominal: FloatArray,
+    tcp: str,
+    step_m: float = 0.002,
+) -> ReachabilityHook:
+    """A hook that vets each commanded search the way ``wobjcal check`` walks it: with the
+    sensor rotation and IK branch of the point's checked pose (``poses`` by plan id; a
+    search's key maps to its plan id through ``keys``, :func:`planner.program.model.search_keys`),
+    turned with the frame the search is commanded in (a target written in the work object
+    moves with the program's estimate). Searches of no checked point (the x-offset run) are
+    vetted with any rotation and branch, as :func:`cell_search_hook` does.
+
+    The reason returned is ``"unreachable or colliding: <the cell's reason>"``.
+    """
+    R_nom_T = np.asarray(T_base_wobj_nominal, dtype=float)[:3, :3].T
+
+    def hook(command: SearchCommand) -> str:
+        pose = poses.get(keys.get(command.point_id, command.point_id))
+        if pose is None:
+            res = cell.check_search(command, step_m=step_m, tcp=tcp)
+        else:
+            R = np.asarray(command.T_base_wobj_estimate, dtype=float)[:3, :3] @ R_nom_T
+            res = cell.check_search(
+                command,
+                step_m=step_m,
+                tcp=tcp,
+                q_ref=pose.q,
+                sensor_x=R @ pose.sensor_x_base,
+                branch=pose.branch,
+                max_starts=1,
+            )
+        return "" if res.feasible else f"unreachable or colliding: {res.reason}"
+
+    return hook
+
+
 def robot_offset(
     start_m: FloatArray,
     axis: FloatArray,
