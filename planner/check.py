@@ -140,8 +140,8 @@ def plan_landing_risk(
     from planner.faces.checks import check_plan_faces
     from planner.faces.detection import NoPlanarFaceError, find_planar_faces
     from planner.sim.landing import landing_risk
-    from planner.validate import prediction_setup
     from planner.validate_checks import check_simulatable
+    from planner.validate_setup import prediction_setup
 
     try:
         setup = prediction_setup(plan, check_simulatable(plan), fmt)
@@ -261,8 +261,8 @@ def plan_quality(
     from calib.estimators.observability import analyze_layout
     from planner.sim.quality import layout_quality, unobservable_quality
     from planner.sim.report_points import poi_rows
-    from planner.validate import prediction_setup
     from planner.validate_checks import check_simulatable
+    from planner.validate_setup import prediction_setup
 
     try:
         probes = [p.to_probe_point() for p in plan.points]

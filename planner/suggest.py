@@ -413,13 +413,16 @@ def _design_until_checked(
         if not refused or attempt == REDESIGNS:
             break
         by_id = {p.id: p for p in new_plan.points}
+        before = len(set_aside)
         for c in refused:
             i = _candidate_of(ctx.pool, by_id[c.point_id])
             if i is None:  # not a candidate (a kept point): nothing to set aside
                 continue
-            ctx.path_ok[i] = False
+            ctx.path_ok[i] = False  # the design never picks it again
             ctx.path_why[i] = c.reason
             set_aside[_where(ctx.pool, i)] = c.search_reason or c.reason
+        if len(set_aside) == before:  # nothing new to leave out: the same design again
+            break
     note = ""
     if set_aside:
         note = f"; {len(set_aside)} candidates check refused were set aside"
@@ -490,11 +493,12 @@ def _smallest_change(
     if lo >= 0:
         f = fractions[lo]
         out.append(
-            f"For {label} a layout exists at a misplacement bound of "
+            f"For {label} the footprints fit a layout at a misplacement bound of "
             f"{f * m.max_translation_m * 1e3:.1f} mm and "
-            f"{math.degrees(f * m.max_angle_rad):.2f} deg ({f:.0%} of the plan's): "
-            "place the part more tightly, or measure it first coarsely (e.g. three touch-up "
-            "points) and give that bound"
+            f"{math.degrees(f * m.max_angle_rad):.2f} deg ({f:.0%} of the plan's; its search "
+            "paths not yet walked at that bound: run suggest with it): place the part more "
+            "tightly, or measure it first coarsely (e.g. three touch-up points) and give that "
+            "bound"
         )
     else:
         out.append(

@@ -34,20 +34,16 @@ import numpy as np
 import trimesh
 
 from calib.errors import InputError
-from calib.plan.file import Plan, PlanError
-from calib.procedures import RolePoint
+from calib.plan.file import Plan
 from planner.errors import PlanRefused
 from planner.plan_cell import nominal_T_base_wobj, open_cell
-from planner.program.build import build_program, measuring_program, safety_spec
-from planner.program.controllers import controller
+from planner.program.build import measuring_program
 from planner.program.model import search_keys
 from planner.sim.montecarlo import simulate
 from planner.sim.report import PAPER_TABLE1, ValidationReport
 from planner.sim.report_points import report_rows
 from planner.sim.search_events import ProgramPose, program_search_hook
 from planner.sim.sensitivity import SensitivityTable, sensitivity
-from planner.sim.setup import SimulationSetup, default_pivot, face_lookup
-from planner.sim.xoffset import xoffset_setup
 from planner.validate_checks import (
     SIMULATED_PARTS,
     ProgressCallback,
@@ -57,6 +53,7 @@ from planner.validate_checks import (
     validation_models,
     work_object_mesh,
 )
+from planner.validate_setup import prediction_setup, simulation_setup
 
 __all__ = [
     "SIMULATED_PARTS",
@@ -178,7 +175,9 @@ def _validate_in_cell(
         }
         program = measuring_program(plan, fmt)
         keys = search_keys(program.points)
-        hook = program_search_hook(cell, poses, keys, T_nom, plan.cell.tool.tcp)
+        # the x-offset run's searches are commanded with D's orientation (A-H programs)
+        d = next((rp.point.id for rp in program.points if rp.role == "D"), None)
+        hook = program_search_hook(cell, poses, keys, T_nom, plan.cell.tool.tcp, other_searches=d)
     report = _simulate(
         plan, models, part, trials, seed, workers, progress, protocol, fmt,
         cell=cell if reach_trials else None, reachability=hook, reach_trials=reach_trials,
@@ -242,54 +241,4 @@ def sensitivity_plan(
         plan.validation.seed if seed is None else int(seed),
         workers=workers,
         progress=progress,
-    )
-
-
-def simulation_setup(
-    plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh, fmt: str | None = None
-) -> SimulationSetup:
-    """What every trial of ``plan`` shares (the part ``mesh`` in wobj, metres) for the program
-    of the controller ``fmt`` (``None``: the default), with the x-offset run's targets on the
-    stator's bulged slot holes when the plan has one."""
-    xo = getattr(models.settings, "xoffset", None)
-    xs = None
-    if xo is not None and models.geometry is not None:
-        g = models.geometry
-        grid = xo.grid
-        y, z = np.meshgrid(grid.slot_y_m, grid.layer_z_m, indexing="xy")  # (layers, slots)
-        if not np.all(g.hole_near(y, z)):
-            raise PlanError(
-                "procedure.xoffset: the slot grid does not lie on the stator's slot holes"
-            )
-        # the true hole of each target: at its y and z, pushed out by the bolts' bulge
-        xs = xoffset_setup(xo, np.stack([g.side_face_offset_m(y, z), y, z], axis=-1))
-    px = tuple(RolePoint("xoffset", p) for row in (xs.points if xs else ()) for p in row)
-    return dataclasses.replace(
-        prediction_setup(plan, models, fmt),
-        faces=face_lookup(mesh, models.points + px, models.sensor.footprint_radius_m),
-        xoffset=xs,
-    )
-
-
-def prediction_setup(
-    plan: Plan, models: ValidationModels, fmt: str | None = None
-) -> SimulationSetup:
-    """What the prediction of ``plan`` needs (:func:`planner.sim.predict.predict`, the layout
-    quality): its points, procedure, nominal pose, models and the measuring program of the
-    controller ``fmt`` (``None``: the default); no part faces, no x-offset run.
-
-    Raises:
-        InputError: unknown controller.
-    """
-    vias = {p.id: len(p.via_points) for p in plan.points}
-    safety = safety_spec(plan)
-    program = build_program(models.points, models.settings, safety, controller(fmt), vias)
-    return SimulationSetup(
-        program=program,
-        T_base_wobj_nominal=nominal_T_base_wobj(plan),
-        sensor=models.sensor,
-        robot_error=models.robot_error,
-        misplacement=models.misplacement,
-        pivot_wobj_m=default_pivot(list(models.points)),
-        edge_inset_m=models.edge_inset_m,
     )

@@ -1,12 +1,11 @@
 """Tests of planner.export.fanuc: the TP program parsed back (poses, frames, registers, labels)
-and run in a small interpreter of the TP subset it writes, against an ideal misplaced part."""
+and run in a small interpreter of the TP subset it writes (:mod:`tests.fanuc_interp`), against an
+ideal misplaced part."""
 
 from __future__ import annotations
 
-import itertools
 import re
-import warnings
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -36,72 +35,23 @@ from planner.export.job import (
 )
 from planner.export_plan import export_job_for
 from tests.box_part import BoxProbe, distance_to_box
+from tests.fanuc_interp import (
+    COMMENT,
+    Program,
+    TPMachine,
+    frame_constants,
+    parse_ls,
+    pose_matrix,
+    rot_wpr,
+)
 from tests.test_export_rapid_adaptive import full_misplacement
 
 REPO = Path(__file__).resolve().parent.parent
 VALID = REPO / "tests" / "data" / "plans" / "valid_three_two_one.json"
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
 
-NUM = r"-?\d+\.\d+"
-CONST = r"\d+(?:\.\d+)?|\(-\d+(?:\.\d+)?\)"
-OPERAND = rf"PR\[\d+,[1-6]\]|R\[\d+\]|{CONST}"
-COMMENT = r"![A-Za-z0-9 _+*/=.,:()<>\[\]#%&?@-]{1,32}"
-POS = re.compile(
-    r'P\[(\d+):"([A-Za-z0-9_ ]{0,16})"\]\{\n   GP1:\n'
-    r"\tUF : (\d+), UT : (\d+),\t\tCONFIG : '([^'\n]*)',\n"
-    rf"\tX = ({NUM})  mm,\tY = ({NUM})  mm,\tZ = ({NUM})  mm,\n"
-    rf"\tW = ({NUM}) deg,\tP = ({NUM}) deg,\tR = ({NUM}) deg\n}};"
-)
-#: A via: joint representation (``J1= ... deg``), no configuration.
-JPOS = re.compile(
-    r'P\[(\d+):"([A-Za-z0-9_ ]{0,16})"\]\{\n   GP1:\n'
-    r"\tUF : (\d+), UT : (\d+),\n"
-    rf"\tJ1= ({NUM}) deg,\tJ2= ({NUM}) deg,\tJ3= ({NUM}) deg,\n"
-    rf"\tJ4= ({NUM}) deg,\tJ5= ({NUM}) deg,\tJ6= ({NUM}) deg\n}};"
-)
-
 
 # ------------------------------------------------------------------ parsing the .ls back
-
-
-def rot_wpr(w: float, p: float, r: float) -> np.ndarray:
-    """FANUC W, P, R (deg) to a matrix, built here by hand: ``Rz(r) @ Ry(p) @ Rx(w)``."""
-    w, p, r = np.radians([w, p, r])
-    Rx = np.array([[1, 0, 0], [0, np.cos(w), -np.sin(w)], [0, np.sin(w), np.cos(w)]])
-    Ry = np.array([[np.cos(p), 0, np.sin(p)], [0, 1, 0], [-np.sin(p), 0, np.cos(p)]])
-    Rz = np.array([[np.cos(r), -np.sin(r), 0], [np.sin(r), np.cos(r), 0], [0, 0, 1]])
-    return Rz @ Ry @ Rx
-
-
-def pose_matrix(v: np.ndarray) -> np.ndarray:
-    """``[X, Y, Z, W, P, R]`` (mm, deg) to a transform in metres."""
-    return make_transform(rot_wpr(*v[3:]), np.asarray(v[:3]) / 1000.0)
-
-
-def pose_values(T: np.ndarray) -> np.ndarray:
-    """A transform (m) to ``[X, Y, Z, W, P, R]`` (mm, deg) with scipy (extrinsic xyz)."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # gimbal lock at P = +-90: any split of W, R is fine
-        wpr = Rotation.from_matrix(T[:3, :3]).as_euler("xyz", degrees=True)
-    return np.array([*(T[:3, 3] * 1000.0), *wpr])
-
-
-@dataclass
-class Position:
-    comment: str
-    uf: int
-    ut: int
-    config: str
-    values: np.ndarray  # X, Y, Z, W, P, R (mm, deg)
-
-
-@dataclass
-class Program:
-    name: str
-    attr: str
-    lines: list[str]  # /MN instructions without line number and " ;"
-    positions: dict[int, Position]
-    joints: dict[int, Position] = field(default_factory=dict)  # vias: J1..J6, deg
 
 
 def _no_vias(plan: Plan) -> Plan:
@@ -112,49 +62,6 @@ def _no_vias(plan: Plan) -> Plan:
     return msgspec.structs.replace(
         plan, points=[msgspec.structs.replace(p, vias=msgspec.UNSET) for p in plan.points]
     )
-
-
-def parse_ls(text: str) -> Program:
-    """The sections of a TP ASCII program; asserts its layout on the way."""
-    rows = text.split("\n")
-    assert text.endswith("/END\n")
-    heads = [i for i, row in enumerate(rows) if row.startswith("/")]
-    assert [rows[i].split()[0] for i in heads] == ["/PROG", "/ATTR", "/MN", "/POS", "/END"]
-    m = re.fullmatch(r"/PROG  (\w+)", rows[0])
-    assert m, rows[0]
-    _, attr, mn, pos = ("\n".join(rows[a + 1 : b]) for a, b in itertools.pairwise(heads))
-    lines = []
-    for k, row in enumerate(mn.split("\n"), start=1):
-        lm = re.fullmatch(r" *(\d+):(.*) ;", row)
-        assert lm and int(lm.group(1)) == k, (k, row)  # numbered 1, 2, 3, ... without gaps
-        lines.append(lm.group(2).strip())
-    positions = {}
-    for pm in POS.finditer(pos):
-        n = int(pm.group(1))
-        assert n not in positions
-        vals = np.array([float(pm.group(k)) for k in range(6, 12)])
-        positions[n] = Position(pm.group(2), int(pm.group(3)), int(pm.group(4)), pm.group(5), vals)
-    joints = {}
-    for jm in JPOS.finditer(pos):
-        n = int(jm.group(1))
-        assert n not in positions and n not in joints
-        vals = np.array([float(jm.group(k)) for k in range(5, 11)])
-        joints[n] = Position(jm.group(2), int(jm.group(3)), int(jm.group(4)), "", vals)
-    assert not JPOS.sub("", POS.sub("", pos)).strip(), "text in /POS that is no position"
-    lc = re.search(r"^LINE_COUNT\t= (\d+);$", attr, re.M)
-    assert lc and int(lc.group(1)) == len(lines)
-    return Program(m.group(1), attr, lines, positions, joints)
-
-
-def frame_constants(lines: list[str], pr: int) -> np.ndarray:
-    """The six constants the program writes into ``PR[pr]``: X, Y, Z, W, P, R."""
-    vals = {}
-    for line in lines:
-        m = re.fullmatch(rf"PR\[{pr},([1-6])\]=({CONST})", line)
-        if m:
-            vals[int(m.group(1))] = float(m.group(2).strip("()"))
-    assert sorted(vals) == [1, 2, 3, 4, 5, 6]
-    return np.array([vals[k] for k in range(1, 7)])
 
 
 def point_blocks(lines: list[str]) -> list[dict]:
@@ -197,130 +104,40 @@ def assert_pose(got: np.ndarray, want: np.ndarray, what: object) -> None:
 # ------------------------------------------------------------------ a TP interpreter
 
 
-class TPRun:
-    """Runs the ``/MN`` of a program (only the instructions the exporter writes: anything else
-    fails) with the sensor TCP moving in the robot base and an ideal box part posed at
-    ``T_base_true`` (:class:`tests.box_part.BoxProbe`). ``DI[1]`` is on while the TCP is on or
-    inside the part (``stuck``: always that level)."""
+class TPRun(TPMachine):
+    """:class:`tests.fanuc_interp.TPMachine` against an ideal box part posed at ``T_base_true``
+    (:class:`tests.box_part.BoxProbe` answers the skip motions). ``DI[1]`` is on while the TCP
+    is on or inside the part (``stuck``: always that level, and no skip motion finds a change)."""
 
     def __init__(self, text: str, T_base_true: np.ndarray, stuck: bool | None = None) -> None:
-        self.prog = parse_ls(text)
-        self.labels: dict[int, int] = {}
-        for i, line in enumerate(self.prog.lines):
-            if m := re.fullmatch(r"LBL\[(\d+)\]", line):
-                assert int(m.group(1)) not in self.labels, line
-                self.labels[int(m.group(1))] = i
+        super().__init__(text, self._box_search)
         self.probe = BoxProbe(T_base_true)
         self.T_true_base = invert_transform(T_base_true)
         self.stuck = stuck
-        self.PR: dict[int, np.ndarray] = {}
-        self.R: dict[int, float] = {}
-        self.uframe: dict[int, np.ndarray] = {0: np.eye(4)}
-        self.utool: dict[int, np.ndarray] = {0: np.eye(4)}
-        self.uf = self.ut = 0
-        self.tcp = make_transform(np.eye(3), [0.9, 0.1, 1.3])  # TCP in the base, m
-        self.skip_on: bool | None = None
-        self.searches: list[dict] = []
-        self.joint_targets: list[np.ndarray] = []
 
     def di(self) -> bool:
         if self.stuck is not None:
             return self.stuck
-        return distance_to_box(transform_points(self.T_true_base, self.tcp[:3, 3])) <= 1e-9
+        return distance_to_box(transform_points(self.T_true_base, self.here()[:3, 3])) <= 1e-9
 
-    def value(self, tok: str) -> float:
-        if m := re.fullmatch(r"PR\[(\d+),([1-6])\]", tok):
-            return float(self.PR[int(m.group(1))][int(m.group(2)) - 1])
-        if m := re.fullmatch(r"R\[(\d+)\]", tok):
-            return self.R[int(m.group(1))]
-        return float(tok.strip("()"))
-
-    def target(self, kind: str, n: int) -> np.ndarray:
-        if kind == "P":
-            pos = self.prog.positions[n]
-            assert (pos.uf, pos.ut) == (self.uf, self.ut), "P[] frame numbers not active"
-            return self.uframe[self.uf] @ pose_matrix(pos.values)
-        return self.uframe[self.uf] @ pose_matrix(self.PR[n])
-
-    def lpos(self) -> np.ndarray:
-        return pose_values(invert_transform(self.uframe[self.uf]) @ self.tcp)
-
-    def search(self, target: np.ndarray) -> bool:
-        """One skip move from the TCP to ``target``: True when the skip fired."""
-        start, end = self.tcp[:3, 3].copy(), target[:3, 3]
-        record = {"on": self.skip_on, "start": start, "end": end.copy(), "found": True}
-        self.searches.append(record)
-        if self.di() == self.skip_on:  # condition already true: the skip fires at once
-            return True
+    def _box_search(
+        self, start: np.ndarray, end: np.ndarray, axis: np.ndarray, neg_flank: bool
+    ) -> np.ndarray | str:
+        if self.stuck is not None:
+            return "ERR_WHLSEARCH"
         length = float(np.linalg.norm(end - start))
         cmd = SearchCommand(
             point_id="",
-            kind="approach" if self.skip_on else "edge",
+            kind="edge" if neg_flank else "approach",
             start_m=start,
             direction=(end - start) / length,
             length_m=length,
-            sensor_axis=target[:3, 2],
+            sensor_axis=axis,
             T_base_wobj_estimate=np.eye(4),
             nominal_m=start,
         )
-        res = None if self.stuck is not None else self.probe(cmd).point_m
-        record["found"] = res is not None
-        self.tcp = target if res is None else make_transform(target[:3, :3], res)
-        return res is not None
-
-    def run(self) -> TPRun:
-        lines, pc = self.prog.lines, 0
-        while pc < len(lines):
-            line = lines[pc]
-            pc += 1
-            if line.startswith("!"):
-                assert re.fullmatch(COMMENT, line), line
-            elif re.fullmatch(r"LBL\[\d+\]", line):
-                pass
-            elif m := re.fullmatch(r"PR\[(\d+)\]=LPOS", line):
-                self.PR[int(m.group(1))] = self.lpos()
-            elif m := re.fullmatch(r"PR\[(\d+)\]=P\[(\d+)\]", line):
-                self.PR[int(m.group(1))] = self.prog.positions[int(m.group(2))].values.copy()
-            elif m := re.fullmatch(rf"PR\[(\d+),([1-6])\]=({OPERAND})(?:([+-])({OPERAND}))?", line):
-                v = self.value(m.group(3))
-                if m.group(4):
-                    v += self.value(m.group(5)) * (1 if m.group(4) == "+" else -1)
-                self.PR[int(m.group(1))][int(m.group(2)) - 1] = v
-            elif m := re.fullmatch(rf"R\[(\d+)\]=({OPERAND})(?:([-+*])({OPERAND}))?", line):
-                v = self.value(m.group(2))
-                if m.group(3):
-                    w = self.value(m.group(4))
-                    v = {"+": v + w, "-": v - w, "*": v * w}[m.group(3)]
-                self.R[int(m.group(1))] = v
-            elif m := re.fullmatch(r"(UFRAME|UTOOL)\[(\d+)\]=PR\[(\d+)\]", line):
-                frames = self.uframe if m.group(1) == "UFRAME" else self.utool
-                frames[int(m.group(2))] = pose_matrix(self.PR[int(m.group(3))])
-            elif m := re.fullmatch(r"(UFRAME|UTOOL)_NUM=(\d+)", line):
-                if m.group(1) == "UFRAME":
-                    self.uf = int(m.group(2))
-                else:
-                    self.ut = int(m.group(2))
-            elif m := re.fullmatch(r"IF DI\[1\]=(ON|OFF),JMP LBL\[(\d+)\]", line):
-                if self.di() == (m.group(1) == "ON"):
-                    pc = self.labels[int(m.group(2))]
-            elif m := re.fullmatch(r"SKIP CONDITION DI\[1\]=(ON|OFF)", line):
-                self.skip_on = m.group(1) == "ON"
-            elif m := re.fullmatch(r"J P\[(\d+)\] \d+% FINE", line):
-                self.tcp = self.target("P", int(m.group(1)))
-                self.joint_targets.append(self.tcp)
-            elif m := re.fullmatch(
-                r"L (P|PR)\[(\d+)\] \d+mm/sec FINE(?: Skip,LBL\[(\d+)\],PR\[(\d+)\]=LPOS)?", line
-            ):
-                goal = self.target(m.group(1), int(m.group(2)))
-                if m.group(3) is None:
-                    self.tcp = goal
-                elif self.search(goal):
-                    self.PR[int(m.group(4))] = self.lpos()
-                else:
-                    pc = self.labels[int(m.group(3))]
-            else:
-                raise AssertionError(f"instruction the exporter should not write: {line!r}")
-        return self
+        res = self.probe(cmd).point_m
+        return "ERR_WHLSEARCH" if res is None else res
 
     def measured_wobj(self, job: ExportJob) -> dict[str, np.ndarray | int]:
         """Per point: the measured position (nominal wobj frame, m) or the failure code."""

@@ -13,6 +13,7 @@ the nominal part pose it passes exactly the searches check passes.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import json
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -258,3 +259,59 @@ def test_the_vetting_passes_at_the_nominal_pose_what_check_passes(
             continue
         cmd = SearchCommand.from_point(by_id[c.point_id].to_probe_point(), T_nom)
         assert hook(cmd) == "", c.point_id
+
+
+class _Spy:
+    """A cell whose ``check_search`` records what it was asked (and answers as the cell)."""
+
+    def __init__(self, cell: Any) -> None:
+        self.cell = cell
+        self.asked: list[dict[str, Any]] = []
+
+    def check_search(self, command: SearchCommand, **kw: Any) -> Any:
+        self.asked.append(kw)
+        return self.cell.check_search(command, **kw)
+
+
+def test_the_vetting_turns_the_sensor_with_the_frame_the_search_is_commanded_in(
+    cells: dict[str, Any],
+) -> None:
+    """A search commanded in an estimate turned 3 deg from the nominal frame is vetted with the
+    sensor x axis of the exported target (the checked pose's, written in the work object) as
+    the robot runs it in that estimate, and the checked IK branch; a point check found no pose
+    for is named, not vetted with a pose no program runs; the x-offset run's searches take D's
+    pose (the A-H programs command them with D's orientation)."""
+    from calib.frames import make_transform, matrix_from_rotvec
+    from planner.export_plan import export_job_for
+
+    base = "plate_holes_best_fit.json"
+    plan, cell = _plan(base, None), cells[base]
+    checked = check_plan(plan, cell=cell)
+    job, _ = export_job_for(plan, PLANS, checked)
+    T_nom = nominal_T_base_wobj(plan)
+    poses = {
+        c.point_id: ProgramPose(np.asarray(c.T_base_tcp)[:3, 0], c.branch, np.asarray(c.q))
+        for c in checked.points
+        if c.T_base_tcp is not None and c.q is not None
+    }
+    keys = search_keys(measuring_program(plan, None).points)
+    spy = _Spy(cell)
+    hook = program_search_hook(spy, poses, keys, T_nom, plan.cell.tool.tcp)
+    turn = make_transform(matrix_from_rotvec([0.0, 0.0, np.radians(3.0)]), [0.002, -0.001, 0.0])
+    T_est = T_nom @ turn
+    by_id = {p.id: p for p in plan.points}
+    for t in job.targets:
+        cmd = SearchCommand.from_point(by_id[t.point_id].to_probe_point(), T_est)
+        hook(cmd)
+        asked = spy.asked[-1]
+        want = T_est[:3, :3] @ np.asarray(t.T_wobj_start)[:3, 0]  # the target's x, in the base
+        assert np.abs(asked["sensor_x"] - want).max() < 1e-9, t.point_id
+        assert asked["branch"] == poses[t.point_id].branch and asked["max_starts"] == 1
+    # no pose: named; another search (x-offset): the given point's pose
+    first = plan.points[0].id
+    lost = program_search_hook(spy, {}, keys, T_nom, plan.cell.tool.tcp)
+    cmd = SearchCommand.from_point(plan.points[0].to_probe_point(), T_nom)
+    assert lost(cmd) == f"unreachable or colliding: check found no pose for point {first}"
+    px = program_search_hook(spy, poses, keys, T_nom, plan.cell.tool.tcp, other_searches=first)
+    px(dataclasses.replace(cmd, point_id="PX1_1"))
+    assert np.abs(spy.asked[-1]["sensor_x"] - poses[first].sensor_x_base).max() < 1e-12

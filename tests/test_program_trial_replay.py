@@ -34,6 +34,10 @@ from tests.rapid_interp import Machine, _vec
 PLANS = Path(__file__).resolve().parents[1] / "assets" / "plans"
 #: Agreement of a recorded point, metres: the programs' written decimals (0.0001 mm).
 TOL_M = 1e-7
+#: Agreement of an A-H frame, metres and radians: F and H agree to the simulator's bisection of
+#: the edge event (``edge_tolerance_m``, 0.02 mm) and pass it on to the origin and rotation
+#: (over seeds 3, 7, 11: at most 0.009 mm and 1.7e-5 rad); a 0.1 mm error fails it.
+A_H_TOL_M, A_H_TOL_RAD = 5e-5, 1e-4
 
 
 def _trial(path: Path, fmt: str, seed: int) -> tuple[Any, Any, Any, np.ndarray]:
@@ -108,7 +112,9 @@ def test_the_rapid_module_replays_a_validate_trial(name: str, seed: int) -> None
     T_prog = m.wobj_matrix_m("wobjCal")
     # the trial's frame, the module's: the same points (an A-H edge point to the simulator's
     # bisection, which F and H pass on to the origin and rotation) and one edge-event offset
-    tol_m, tol_rad = (1e-6, 1e-8) if setup.program.method != "hultman2013" else (2e-4, 2e-4)
+    tol_m, tol_rad = (
+        (1e-6, 1e-8) if setup.program.method != "hultman2013" else (A_H_TOL_M, A_H_TOL_RAD)
+    )
     assert np.abs(T_prog[:3, 3] - run.T_base_wobj[:3, 3]).max() < tol_m
     dR = T_prog[:3, :3].T @ run.T_base_wobj[:3, :3]
     assert np.arccos(np.clip((np.trace(dR) - 1.0) / 2.0, -1.0, 1.0)) < tol_rad

@@ -70,5 +70,6 @@ def test_a_refusal_says_at_which_bound_a_layout_exists() -> None:
     assert "no layout fixes all 6 degrees of freedom" in msg
     assert "the TP program" in msg
     assert (
-        "a layout exists at a misplacement bound of" in msg or "no layout exists even at" in msg
+        "the footprints fit a layout at a misplacement bound of" in msg
+        or "no layout exists even at" in msg
     ), msg

@@ -25,7 +25,14 @@ from planner.export import export_files
 from planner.export.job import ExportJob, ToolData, build_job
 from planner.export.urscript_layout import slot_table
 from planner.program import execute
-from tests.test_program_trial_replay import PLANS, TOL_M, _search_callback, _trial
+from tests.test_program_trial_replay import (
+    A_H_TOL_M,
+    A_H_TOL_RAD,
+    PLANS,
+    TOL_M,
+    _search_callback,
+    _trial,
+)
 from tests.urscript_interp import UrMachine
 
 CASES = [
@@ -97,7 +104,7 @@ def test_the_urscript_program_replays_a_validate_trial(name: str, seed: int) -> 
     T_prog = m.frame("wobj")
     # the trial's frame, the program's: the same points (an A-H edge point to the simulator's
     # bisection, which F and H pass on to the origin and rotation) and one edge-event offset
-    tol_m, tol_rad = (1e-6, 1e-8) if program.method != "hultman2013" else (2e-4, 2e-4)
+    tol_m, tol_rad = (1e-6, 1e-8) if program.method != "hultman2013" else (A_H_TOL_M, A_H_TOL_RAD)
     assert np.abs(T_prog[:3, 3] - run.T_base_wobj[:3, 3]).max() < tol_m
     assert angle_rad(T_prog, run.T_base_wobj) < tol_rad
     assert np.abs(m.frame("wobj_nominal") - T_nom).max() < 1e-9

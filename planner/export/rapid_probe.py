@@ -134,6 +134,16 @@ def probe_proc(t: TargetPair, name: str, from_measured: float | None) -> list[st
         f"        pEnd:={name}_end;",
         f"        pEnd.trans:=pStart.trans+DotProd({name}_end.trans-pStart.trans,{name}_dir)"
         f"*{name}_dir;",
+        "        ! a start past where the plan's search ends: searching on would run backwards",
+        f"        IF DotProd({name}_end.trans-pStart.trans,{name}_dir)<=0 THEN",
+        f'            measuredErr{{i}}:="edge not found within {fmt(t.length_m * 1000.0, 1)} mm";',
+        "            measuredOk{i}:=FALSE;",
+        f'            TPWrite "wobjcal: point {literal_text(t.point_id)} failed: "'
+        "+measuredErr{i};",
+        f"            MoveL {safe},vApproach,fine,{wobj};",
+        "            IF bStopOnFail Stop;",
+        "            RETURN;",
+        "        ENDIF",
         "        nStage:=2;",
         f"        SearchL{BS}SStop,diSensor{BS}NegFlank,pMeas,pEnd,vSearch_{name},{wobj};",
         *_store("i"),

@@ -129,9 +129,15 @@ def search_routines() -> list[str]:
         "end_wobj[2] - start_wobj[2]]",
         "        k = ((end_wobj[0] - s[0]) * d[0] + (end_wobj[1] - s[1]) * d[1] + "
         "(end_wobj[2] - s[2]) * d[2]) / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2])",
-        "        e = p[s[0] + k * d[0], s[1] + k * d[1], s[2] + k * d[2], end_wobj[3], "
+        "        if k <= 0.0:",
+        "          # the face point lies past where the plan's search ends: searching on would",
+        "          # run backwards and could find another edge; no detection on the path",
+        "          result = [1.0, 0.0, 0.0, 0.0]",
+        "        else:",
+        "          e = p[s[0] + k * d[0], s[1] + k * d[1], s[2] + k * d[2], end_wobj[3], "
         "end_wobj[4], end_wobj[5]]",
-        "        result = run_search(pose_trans(wobj, e), False, speed)",
+        "          result = run_search(pose_trans(wobj, e), False, speed)",
+        "        end",
         "      end",
         "    end",
         *_log_and_retreat("    "),

@@ -67,20 +67,27 @@ def program_search_hook(
     T_base_wobj_nominal: FloatArray,
     tcp: str,
     step_m: float = 0.002,
+    other_searches: str | None = None,
 ) -> ReachabilityHook:
     """A hook that vets each commanded search the way ``wobjcal check`` walks it: with the
     sensor rotation and IK branch of the point's checked pose (``poses`` by plan id; a
     search's key maps to its plan id through ``keys``, :func:`planner.program.model.search_keys`),
     turned with the frame the search is commanded in (a target written in the work object
-    moves with the program's estimate). Searches of no checked point (the x-offset run) are
-    vetted with any rotation and branch, as :func:`cell_search_hook` does.
+    moves with the program's estimate). Searches of no plan point (the x-offset run) run with
+    the pose of the plan point ``other_searches`` names (the A-H programs run them with D's
+    orientation), or any rotation and branch when it is ``None``. A plan point check found no
+    pose for (a plan simulated though check refuses it) is reported as such, never vetted with
+    a pose no program runs.
 
     The reason returned is ``"unreachable or colliding: <the cell's reason>"``.
     """
     R_nom_T = np.asarray(T_base_wobj_nominal, dtype=float)[:3, :3].T
 
     def hook(command: SearchCommand) -> str:
-        pose = poses.get(keys.get(command.point_id, command.point_id))
+        pid = keys.get(command.point_id)
+        if pid is not None and pid not in poses:
+            return f"unreachable or colliding: check found no pose for point {pid}"
+        pose = poses.get(pid if pid is not None else (other_searches or ""))
         if pose is None:
             res = cell.check_search(command, step_m=step_m, tcp=tcp)
         else:

@@ -413,6 +413,15 @@ MODULE WobjcalStatorSectionAh
         ! run along the search direction up to where the plan's search ends
         pEnd:=pF_end;
         pEnd.trans:=pStart.trans+DotProd(pF_end.trans-pStart.trans,pF_dir)*pF_dir;
+        ! a start past where the plan's search ends: searching on would run backwards
+        IF DotProd(pF_end.trans-pStart.trans,pF_dir)<=0 THEN
+            measuredErr{i}:="edge not found within 142.5 mm";
+            measuredOk{i}:=FALSE;
+            TPWrite "wobjcal: point F failed: "+measuredErr{i};
+            MoveL pF_safe,vApproach,fine,tSensor\WObj:=wobjCal;
+            IF bStopOnFail Stop;
+            RETURN;
+        ENDIF
         nStage:=2;
         SearchL\SStop,diSensor\NegFlank,pMeas,pEnd,vSearch_pF,tSensor\WObj:=wobjCal;
         measured{i}:=PoseVect(wobjCal.uframe,PoseVect(wobjCal.oframe,pMeas.trans));
@@ -477,6 +486,15 @@ MODULE WobjcalStatorSectionAh
         ! run along the search direction up to where the plan's search ends
         pEnd:=pH_end;
         pEnd.trans:=pStart.trans+DotProd(pH_end.trans-pStart.trans,pH_dir)*pH_dir;
+        ! a start past where the plan's search ends: searching on would run backwards
+        IF DotProd(pH_end.trans-pStart.trans,pH_dir)<=0 THEN
+            measuredErr{i}:="edge not found within 142.5 mm";
+            measuredOk{i}:=FALSE;
+            TPWrite "wobjcal: point H failed: "+measuredErr{i};
+            MoveL pH_safe,vApproach,fine,tSensor\WObj:=wobjCal;
+            IF bStopOnFail Stop;
+            RETURN;
+        ENDIF
         nStage:=2;
         SearchL\SStop,diSensor\NegFlank,pMeas,pEnd,vSearch_pH,tSensor\WObj:=wobjCal;
         measured{i}:=PoseVect(wobjCal.uframe,PoseVect(wobjCal.oframe,pMeas.trans));
