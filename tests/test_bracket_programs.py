@@ -15,11 +15,10 @@ nominal frame), what the issue promises:
 
 What does not hold today is marked ``xfail(strict=True)`` with the gap or the bug named: the
 nominal FANUC programs cannot measure the 20 mm end strips under a 20 mm bound (check says so,
-rightly); suggest's best fit for RAPID refuses a part it has a layout for; the planar-face test
-depends on the STL's triangles. The hand-placed top points lie 25 mm in front of the upright:
-check names them (the sensor runs into the upright when the part lies towards them), as the
-validation's failures show. 200 trials, the plan's own seed: a half-width scatters by about
-10 %.
+rightly); suggest's best fit for RAPID refuses a part it has a layout for. The hand-placed top
+points lie 25 mm in front of the upright: check names them (the sensor runs into the upright
+when the part lies towards them), as the validation's failures show. 200 trials, the plan's own
+seed: a half-width scatters by about 10 %.
 """
 
 from __future__ import annotations
@@ -181,16 +180,6 @@ def test_the_planar_face_check_refuses_15_mm_end_strips_for_an_18_mm_sensor() ->
         assert "too narrow for the 18 mm sensor" in why
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason=(
-        "bug: planner/faces/footprint.py holds_footprint tries only the centroids of a "
-        "region's triangles; no centroid of the fewest-triangles STL lies near the 20 mm end "
-        "strips' centre line, so the whole face is refused as 'too narrow for the 18 mm "
-        "sensor (no spot of it holds the sensor face)' though the footprint fits there (the "
-        "same part meshed with 20 mm triangles passes; 15 mm or 7 mm triangles lose other faces)"
-    ),
-)
 def test_a_20_mm_end_strip_holds_the_18_mm_sensor_however_the_stl_is_meshed() -> None:
     from planner.faces.checks import plan_face_reasons
 

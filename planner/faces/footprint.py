@@ -94,7 +94,11 @@ def holds_footprint(
 ) -> NDArray[np.bool_]:
     """Whether each region has a spot where the whole sensor footprint lies on it.
 
-    Tries the centroids of the region's largest triangles and of triangles spread over it.
+    Tries the centroids of the region's largest triangles and of triangles spread over it;
+    where none holds it, the centre of the largest circle inside the region's outline (its
+    triangles projected onto the plane, holes included): the spot with the most room, so the
+    answer does not depend on how the mesh is triangulated (a 20 mm strip meshed as two long
+    triangles has no centroid on its centre line).
     """
     if len(regions) == 0:
         return np.zeros(0, dtype=bool)
@@ -114,4 +118,32 @@ def holds_footprint(
     at, region = np.vstack(centres), np.concatenate(ids)
     hits = footprint_hits(mesh, labels, at, n[region], region, radius_m, tol_m)
     ok = np.all(hits, axis=1)
-    return np.array([bool(np.any(ok[region == r])) for r in regions], dtype=bool)
+    out = np.array([bool(np.any(ok[region == r])) for r in regions], dtype=bool)
+    for k in np.flatnonzero(~out):
+        r = int(regions[k])
+        spot = _roomiest_spot(mesh, labels, r, n[r], float(d[r]), radius_m)
+        if spot is not None:
+            hit = footprint_hits(
+                mesh, labels, spot[None], n[r][None], np.array([r]), radius_m, tol_m
+            )
+            out[k] = bool(np.all(hit))
+    return out
+
+
+def _roomiest_spot(
+    mesh: trimesh.Trimesh, labels: IntArray, region: int, n: FloatArray, d: float, radius_m: float
+) -> FloatArray | None:
+    """``(3,)`` the centre of the largest circle inside ``region``'s outline, on its plane
+    (``n . x = d``), wobj frame, m; ``None`` when the outline is empty."""
+    import shapely
+
+    from calib.estimators.steering import plane_basis
+
+    B = np.asarray(plane_basis(n), dtype=np.float64)  # (3, 2)
+    uv = np.asarray(mesh.triangles[labels == region], dtype=np.float64) @ B  # (T, 3, 2)
+    outline = shapely.union_all(shapely.polygons(uv)).buffer(1e-7)
+    if outline.is_empty:
+        return None
+    line = shapely.maximum_inscribed_circle(outline, tolerance=radius_m * 0.02)
+    centre = np.asarray(shapely.get_coordinates(line)[0], dtype=np.float64)
+    return B @ centre + d * np.asarray(n, dtype=np.float64)
