@@ -203,8 +203,37 @@ def export_rapid(job: ExportJob) -> str:
             start_at = a.settings.edge_start_offset_m
         lines += probe_proc(t, name, start_at)
     lines += write_proc()
-    lines.append("ENDMODULE")
-    return "\n".join(lines) + "\n"
+    return "\n".join(_data_first(lines)) + "\nENDMODULE\n"
+
+
+_ROUTINE_START = ("    PROC ", "    FUNC ", "    TRAP ", "    LOCAL PROC ", "    LOCAL FUNC ")
+_ROUTINE_END = ("    ENDPROC", "    ENDFUNC", "    ENDTRAP")
+
+
+def _data_first(lines: list[str]) -> list[str]:
+    """The module's lines (``MODULE`` line first, no ``ENDMODULE``) with every module-level
+    data declaration before the first routine, as RAPID's module syntax requires (``MODULE
+    name <data declarations> <routine declarations> ENDMODULE``); the writers' sections put
+    their constants beside their routines. Comment lines go with the item after them; the
+    order within data and within routines is kept."""
+    head, data, routines = [lines[0]], [], []
+    pending: list[str] = []
+    in_routine = False
+    for line in lines[1:]:
+        if in_routine:
+            routines.append(line)
+            if line.startswith(_ROUTINE_END):
+                in_routine = False
+            continue
+        if not line.strip() or line.startswith("    !"):
+            pending.append(line)
+        elif line.startswith(_ROUTINE_START):
+            routines += [*pending, line]
+            pending, in_routine = [], True
+        else:  # a data declaration
+            (data if data or routines else head).extend([*pending, line])
+            pending = []
+    return [*head, *data, *routines, *pending]
 
 
 def _comment(text: str, width: int = 92) -> list[str]:
