@@ -231,6 +231,9 @@ def test_validate_refuses_what_check_refuses_naming_every_problem(tmp_path: Path
     assert [p.split(":")[0] for p in problems] == ["point S1", "point S2", "point T1"]
     assert all("lands off its face" in p for p in problems)
     assert data["program"]["name"].startswith("TP, nominal 3-2-1")
+    # --no-check: no verdict at all (a study of a plan known to fail)
+    assert main([*argv, "--no-check"]) in (0, 1)
+    assert json.loads(out.read_text())["check_problems"] == []
 
 
 @pytest.mark.parametrize("base", ["plate_holes_best_fit.json", "stator_section_ah.json"])

@@ -110,6 +110,12 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         action="store_true",
         help="simulate a plan `wobjcal check` refuses (the report names check's problems)",
     )
+    p.add_argument(
+        "--no-check",
+        action="store_true",
+        help="skip `wobjcal check` before the run (no verdict; with --reach-trials 0 no cell is "
+        "opened), e.g. for a study of a plan known to fail",
+    )
     p.add_argument("--json", metavar="FILE", help="also write the report as JSON to FILE")
     p.add_argument(
         "--plots",
@@ -203,7 +209,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
                 plan_dir=plan_dir,
                 protocol=args.protocol,
                 fmt=args.format,
-                check="report" if args.force else "refuse",
+                check="off" if args.no_check else "report" if args.force else "refuse",
             )
     except PlanRefused as exc:
         err = stderr()
