@@ -216,7 +216,9 @@ def _data_first(lines: list[str]) -> list[str]:
     name <data declarations> <routine declarations> ENDMODULE``); the writers' sections put
     their constants beside their routines. Comment lines go with the item after them; the
     order within data and within routines is kept."""
-    head, data, routines = [lines[0]], [], []
+    head: list[str] = [lines[0]]
+    data: list[str] = []
+    routines: list[str] = []
     pending: list[str] = []
     in_routine = False
     for line in lines[1:]:
