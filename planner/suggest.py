@@ -313,7 +313,12 @@ def suggest_plan(
         ctx, plan, procedure, target_m, max_points, add, fixed, at_m, steered, fmt, tried, say
     )
     say("prediction", 0, 1)
-    quality, note = plan_quality(new_plan, mesh, fmt)
+    # check predicted the written plan's quality for the same program already (unless it
+    # refused the layout, when it predicts nothing)
+    if check.layout:
+        quality, note = plan_quality(new_plan, mesh, fmt)
+    else:
+        quality, note = check.quality, check.quality_note
     worst = quality.worst_poi_m(level) if quality is not None else math.nan
     met = target_m is None or (math.isfinite(worst) and worst <= target_m)
     n = len(new_plan.points)

@@ -20,7 +20,6 @@ failed x-offset search stops the run (``nResult`` 4) with the frame calibrated.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -29,7 +28,7 @@ import numpy as np
 import pytest
 
 from calib.paper.xoffset import slot_target, xoffset_matrix
-from calib.plan.file import Plan, load_plan
+from calib.plan.file import load_plan
 from calib.probing import ProbeResult, SearchCommand
 from planner.export import export_files
 from planner.export.job import ToolData, build_job
@@ -38,9 +37,7 @@ from planner.plan_cell import nominal_T_base_wobj
 from planner.program import execute
 from planner.program.model import MeasuringProgram, SearchStep, UpdateStep
 from planner.program.steering import steer
-from planner.sim.trial import TrialRunner
 from planner.sim.xoffset import run_xoffset
-from planner.validate import check_simulatable, simulation_setup, work_object_mesh
 from tests.krl_interp import KrlMachine, SearchFn
 from tests.test_export_rapid_adaptive import full_misplacement
 from tests.test_krl_program_runs import (
@@ -51,64 +48,13 @@ from tests.test_krl_program_runs import (
     slot_of,
     written,
 )
-from tests.test_program_trial_replay import A_H_TOL_M, A_H_TOL_RAD
+from tests.test_program_trial_replay import A_H_TOL_M, A_H_TOL_RAD, _search_callback, _trial
 
 PLANS = Path(__file__).resolve().parents[1] / "assets" / "plans"
 STATOR = PLANS / "stator_section_ah.json"
 PLATE_321 = PLANS / "plate_holes_321.json"
 #: Agreement of a recorded approach point, metres: the written decimals (1e-6 mm) and better.
 TOL_M = 1e-7
-
-
-# ------------------------------------------------------------------ the trial and its sensor
-def _trial(path: Path, seed: int) -> tuple[Plan, Any, Callable[[], Any], np.ndarray]:
-    """The plan, the setup of a validate trial of its KRL program, a maker of the trial's
-    simulated probe (the same noise, search by search, every time), and the true pose."""
-    plan = load_plan(path)
-    models = check_simulatable(plan)
-    mesh = work_object_mesh(plan, PLANS, models)
-    setup = simulation_setup(plan, models, mesh, "krl")
-    runner = TrialRunner(setup, mesh)
-    T_nom = setup.T_base_wobj_nominal
-    T_true = T_nom @ setup.misplacement.sample(np.random.default_rng(seed), setup.pivot_wobj_m)
-
-    def probe() -> Any:
-        return runner.simulator(
-            runner.caster,
-            T_true,
-            np.random.default_rng(1000 + seed),
-            sensor=setup.sensor,
-            robot_error=setup.robot_error,
-            faces=setup.faces,
-            edge_inset_m=setup.edge_inset_m,
-            edge_tolerance_m=setup.edge_tolerance_m,
-        )
-
-    return plan, setup, probe, T_true
-
-
-def _search_callback(probe: Any) -> SearchFn:
-    """The interpreter's search callback answered by a probe (``SearchCommand`` ->
-    ``ProbeResult``): an input already on at the start is ``ERR_SIGSUPSEARCH``."""
-
-    def search(start: np.ndarray, end: np.ndarray, axis: np.ndarray, neg: bool) -> Any:
-        length = float(np.linalg.norm(end - start))
-        cmd = SearchCommand(
-            point_id="",
-            kind="edge" if neg else "approach",
-            start_m=np.asarray(start, float),
-            direction=(end - start) / length,
-            length_m=length,
-            sensor_axis=np.asarray(axis, float),
-            T_base_wobj_estimate=np.eye(4),
-            nominal_m=np.asarray(start, float),
-        )
-        res = probe(cmd)
-        if res.point_m is None:
-            return "ERR_SIGSUPSEARCH" if "at start" in res.reason else "ERR_WHLSEARCH"
-        return res.point_m
-
-    return search
 
 
 def failing_at(search: SearchFn, k: int, answer: str = "ERR_WHLSEARCH") -> SearchFn:
@@ -128,7 +74,7 @@ def failing_at(search: SearchFn, k: int, answer: str = "ERR_WHLSEARCH") -> Searc
     [("plate_holes_best_fit.json", 1), ("plate_holes_321.json", 2), ("stator_section_ah.json", 3)],
 )
 def test_the_adaptive_krl_program_replays_a_validate_trial(name: str, seed: int) -> None:
-    plan, setup, probe, T_true = _trial(PLANS / name, seed)
+    plan, setup, probe, T_true = _trial(PLANS / name, "krl", seed)
     program = setup.program
     assert program.adaptive and program.name.startswith("KRL, adaptive")
     T_nom = setup.T_base_wobj_nominal

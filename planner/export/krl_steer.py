@@ -33,24 +33,7 @@ from planner.export.krl_probe import probe_call
 from planner.export.krl_text import WOBJ, array_lines, stop_lines, vector_text
 from planner.export.text import fmt
 from planner.program.model import MeasuringProgram, SearchStep, UpdateStep
-from planner.program.steering import ITERATIONS, STEP_TOL_M, update_basis
-
-
-def _updates(program: MeasuringProgram) -> list[tuple[int, np.ndarray]]:
-    """``(k, basis (6, r))`` of each update: it fits the first ``k`` points of the program's
-    order (checked: every update of a steered program does)."""
-    order = [s.point_id for s in program.searches if s.recorded]
-    by_id = {rp.point.id: rp.point for rp in program.points}
-    if program.pivot_m is None:
-        raise ValueError(f"{program.name}: a steered program without a pivot")
-    out = []
-    for u in program.updates:
-        k = len(u.uses)
-        if list(u.uses) != order[:k]:
-            raise ValueError(f"update of {u.uses} does not fit the first points of {order}")
-        V = update_basis([by_id[i] for i in u.uses], np.asarray(program.pivot_m), program.scale_m)
-        out.append((k, V))
-    return out
+from planner.program.steering import ITERATIONS, STEP_TOL_M, update_bases
 
 
 def steer_header(program: MeasuringProgram) -> str:
@@ -72,11 +55,11 @@ def steer_data(job: ExportJob, program: MeasuringProgram) -> list[str]:
     by_id = {rp.point.id: rp.point for rp in program.points}
     normals = np.array([by_id[t.point_id].normal for t in job.targets], dtype=float)
     nominal = np.array([by_id[t.point_id].position_m for t in job.targets], dtype=float) * 1e3
-    updates = _updates(program)
+    updates = update_bases(program)
     basis = np.full((len(updates), 6, 6), np.nan)
     for u, (_k, V) in enumerate(updates):
         basis[u, :, : V.shape[1]] = V
-    assert program.pivot_m is not None  # checked by _updates
+    assert program.pivot_m is not None  # checked by update_bases
     n = len(job.targets)
     return [
         f"; {program.name}: the frame update between searches (planner.program.steering)",
@@ -247,7 +230,7 @@ def steer_body(job: ExportJob, program: MeasuringProgram, names: list[str]) -> l
     """The measuring routine's body: each point's probe in the program's order, a point not
     measured stops the program (nothing to steer by), and the updates between."""
     index = {t.point_id: i for i, t in enumerate(job.targets)}
-    updates = iter(_updates(program))
+    updates = iter(update_bases(program))
     pad = "  "
     lines: list[str] = []
     n_update = 0

@@ -21,34 +21,16 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from calib.procedures.base import RolePoint
 from planner.export.job import ExportJob
 from planner.export.rapid_probe import WOBJ, stop_procs
 from planner.export.text import fmt
 from planner.program.model import MeasuringProgram, SearchStep, UpdateStep
-from planner.program.steering import ITERATIONS, STEP_TOL_M, update_basis
+from planner.program.steering import ITERATIONS, STEP_TOL_M, update_bases
 
 
 def _nums(values: list[float], decimals: int) -> str:
     return "[" + ",".join(fmt(v, decimals) for v in values) + "]"
-
-
-def _updates(program: MeasuringProgram) -> list[tuple[int, int, np.ndarray]]:
-    """``(k, rank, basis)`` of each update: it fits the first ``k`` points of the program's
-    order (checked: every update of a steered program does)."""
-    order = [s.point_id for s in program.searches if s.recorded]
-    by_id = {rp.point.id: rp.point for rp in program.points}
-    assert program.pivot_m is not None
-    out = []
-    for u in program.updates:
-        k = len(u.uses)
-        if list(u.uses) != order[:k]:
-            raise ValueError(f"update of {u.uses} does not fit the first points of {order}")
-        V = update_basis([by_id[i] for i in u.uses], np.asarray(program.pivot_m), program.scale_m)
-        out.append((k, V.shape[1], V))
-    return out
 
 
 def steer_procs(job: ExportJob, program: MeasuringProgram) -> list[str]:
@@ -63,7 +45,7 @@ def steer_procs(job: ExportJob, program: MeasuringProgram) -> list[str]:
         normals += [float(v) for v in p.normal]
         nominal += [float(v) * 1000.0 for v in p.position_m]
     basis: list[float] = []
-    for _k, _r, V in _updates(program):
+    for _k, V in update_bases(program):
         basis += [float(v) for v in V.ravel()]  # row-major: 6 rows of r
     assert program.pivot_m is not None
     n = len(job.targets)
@@ -211,7 +193,7 @@ def steer_main(job: ExportJob, program: MeasuringProgram, names: list[str]) -> l
     """The body of ``main``: each point's probe in the program's order, a failed search stops
     the program (nothing to steer by), and the updates between."""
     index = {t.point_id: i for i, t in enumerate(job.targets)}
-    updates = iter(_updates(program))
+    updates = iter(update_bases(program))
     ind = "        "
     off = 0
     lines = [f"{ind}! {program.name}: each search in wobjCal, the frame estimated so far"]
@@ -220,7 +202,8 @@ def steer_main(job: ExportJob, program: MeasuringProgram, names: list[str]) -> l
             i = index[step.point_id]
             lines += [f"{ind}Probe_{names[i]} {i + 1};", f"{ind}Require {i + 1};"]
         elif isinstance(step, UpdateStep) and step.uses:
-            k, r, _V = next(updates)
+            k, V = next(updates)
+            r = V.shape[1]
             lines.append(f"{ind}Steer {k},{off},{r};")
             off += 6 * r
     lines.append(f'{ind}TPWrite "wobjcal: done, {WOBJ} is the calibrated work object";')

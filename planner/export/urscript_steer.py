@@ -23,34 +23,15 @@ rotation vector: ``p[.., w]`` is the exact rotation ``exp(w)``). It stops after
 
 from __future__ import annotations
 
-import numpy as np
-
 from planner.export.job import ExportJob
 from planner.export.text import comment_text
 from planner.export.urscript_layout import SearchCalls, adaptive_program
 from planner.export.urscript_probe import num, nums
 from planner.program.model import MeasuringProgram, SearchStep, UpdateStep
-from planner.program.steering import ITERATIONS, STEP_TOL_M, update_basis
+from planner.program.steering import ITERATIONS, STEP_TOL_M, update_bases
 
 #: A pivot below this in the normal equations: the points fix no frame (as RAPID's).
 PIVOT_TOL = 1e-12
-
-
-def updates(program: MeasuringProgram) -> list[tuple[int, int, np.ndarray]]:
-    """``(k, rank, basis (6, rank))`` of each update: it fits the first ``k`` points of the
-    program's order (checked: every update of a steered program does)."""
-    order = [s.point_id for s in program.searches if s.recorded]
-    by_id = {rp.point.id: rp.point for rp in program.points}
-    if program.pivot_m is None:
-        raise ValueError(f"{program.name}: a steered program without a pivot")
-    out = []
-    for u in program.updates:
-        k = len(u.uses)
-        if list(u.uses) != order[:k]:
-            raise ValueError(f"update of {u.uses} does not fit the first points of {order}")
-        V = update_basis([by_id[i] for i in u.uses], np.asarray(program.pivot_m), program.scale_m)
-        out.append((k, V.shape[1], V))
-    return out
 
 
 def steer_procs(job: ExportJob, program: MeasuringProgram) -> list[str]:
@@ -65,7 +46,7 @@ def steer_procs(job: ExportJob, program: MeasuringProgram) -> list[str]:
         normals += [float(v) for v in p.normal]
         nominal += [float(v) for v in p.position_m]
     basis: list[float] = []
-    for _k, _r, V in updates(program):
+    for _k, V in update_bases(program):
         basis += [float(v) for v in V.ravel()]  # row-major: 6 rows of r
     if program.pivot_m is None:
         raise ValueError(f"{program.name}: a steered program without a pivot")
@@ -241,14 +222,15 @@ def steer_main(job: ExportJob, program: MeasuringProgram) -> list[str]:
     """The main body: each point's searches in the program's order (a failed search stops
     the program: nothing to steer by), and the updates between."""
     calls = SearchCalls(job, program)
-    steps = iter(updates(program))
+    steps = iter(update_bases(program))
     off = 0
     lines = [f"  # {comment_text(program.name)}: each search in wobj, the frame estimated so far"]
     for step in program.steps:
         if isinstance(step, SearchStep) and step.recorded:
             lines += calls.next(step)
         elif isinstance(step, UpdateStep) and step.uses:
-            k, r, _V = next(steps)
+            k, V = next(steps)
+            r = V.shape[1]
             lines.append(f"  steer({k}, {off}, {r})")
             off += 6 * r
     lines.append('  textmsg("wobjcal: done, wobj is the calibrated work object: ", wobj)')

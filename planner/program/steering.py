@@ -27,6 +27,7 @@ from numpy.typing import NDArray
 from calib.estimators.layout import ConstraintSet, constraint_set
 from calib.estimators.runners import fixed_motions, min_norm_update
 from calib.probing import ProbePoint
+from planner.program.model import MeasuringProgram
 
 FloatArray = NDArray[np.float64]
 
@@ -94,3 +95,27 @@ def steer(
     return min_norm_update(
         cs, q, T_base_wobj, np.asarray(pivot), float(scale_m), ITERATIONS, basis=V
     )
+
+
+def update_bases(program: MeasuringProgram) -> list[tuple[int, FloatArray]]:
+    """``(k, basis (6, r))`` of each update of a steered ``program``, in order: it fits the
+    first ``k`` points the program records, and moves the estimate in the ``r`` scaled
+    motions their nominal layout fixes (:func:`update_basis`): what a writer puts in its
+    constants.
+
+    Raises:
+        ValueError: the program has no pivot, or an update does not fit the first points of
+            its order (every steered program's does).
+    """
+    order = [s.point_id for s in program.searches if s.recorded]
+    by_id = {rp.point.id: rp.point for rp in program.points}
+    if program.pivot_m is None:
+        raise ValueError(f"{program.name}: a steered program without a pivot")
+    out = []
+    for u in program.updates:
+        k = len(u.uses)
+        if list(u.uses) != order[:k]:
+            raise ValueError(f"update of {u.uses} does not fit the first points of {order}")
+        V = update_basis([by_id[i] for i in u.uses], np.asarray(program.pivot_m), program.scale_m)
+        out.append((k, V))
+    return out
