@@ -88,7 +88,9 @@ def summarize(report: ValidationReport) -> ValidationSummary:
     failed = sum(report.failures.values())
     headline = f"{report.n_ok}/{report.n_trials} trials calibrated, {failed} failed"
     if report.check_problems:
-        headline = f"check refuses this plan ({len(report.check_problems)} problems); " + headline
+        n = len(report.check_problems)
+        problems = "1 problem" if n == 1 else f"{n} problems"
+        headline = f"check refuses this plan ({problems}); " + headline
     return ValidationSummary(report, markdown, tuple(hists), headline)
 
 
