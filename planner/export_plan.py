@@ -6,7 +6,9 @@ configuration from the check, and the robot's joint values and configuration at 
 (:func:`with_arm_poses`: IK next to the checked pose; FANUC ``CONFIG`` and KUKA ``S``/``T`` come
 from them), and formats it with the writer registered for the format
 (:data:`planner.export.FORMATS`). Whether infeasible points stop the export is the caller's
-decision (``wobjcal export`` exits 1 unless ``--force``); the result says which they are.
+decision (``wobjcal export`` exits 1 unless ``--force``, for every format); the result says
+which they are, and the job's :class:`planner.export.job.CheckStatus` (:func:`check_status`)
+makes every program's header say it (``CHECKED`` / ``NOT CHECKED``, with the plan's digest).
 
 The plan's layout is checked even without the cell check (:func:`planner.check.layout_problem`):
 an A-H plan that lacks a role would otherwise become a program that runs every search in the
@@ -27,7 +29,7 @@ from calib.frames import invert_transform
 from calib.plan.file import Plan
 from planner.check import ConfData, PlanCheck, check_plan, layout_problem
 from planner.export import export_files
-from planner.export.job import TARGET_KINDS, ArmPose, ExportJob, build_job
+from planner.export.job import TARGET_KINDS, ArmPose, CheckStatus, ExportJob, build_job
 from planner.plan_cell import nominal_T_base_wobj, open_cell, tool_data
 
 if TYPE_CHECKING:
@@ -59,10 +61,22 @@ class ProgramExport:
         return () if self.check is None else tuple(p.point_id for p in self.check.infeasible)
 
 
+def check_status(check: PlanCheck | None, layout: str = "") -> CheckStatus:
+    """What the program headers say was checked: ``check`` (``None``: not run), and the
+    plan's ``layout`` problem when there was no check (with one, ``check.layout``)."""
+    if check is None:
+        return CheckStatus(problems=(f"layout: {layout}",) if layout else ())
+    problems = [f"error: {check.error}"] if check.error else []
+    problems += [f"layout: {check.layout}"] if check.layout else []
+    refused = tuple(p.point_id for p in check.infeasible)
+    return CheckStatus(checked=True, refused=refused, problems=tuple(problems))
+
+
 def export_job_for(
     plan: Plan, plan_dir: Path, check: PlanCheck | None
 ) -> tuple[ExportJob, tuple[str, ...]]:
-    """The export job of ``plan``, with orientations and confdata from ``check`` when given.
+    """The export job of ``plan``, with orientations and confdata from ``check`` when given
+    (and its verdict, :func:`check_status`, for the headers).
 
     Returns:
         The job and notes for the user.
@@ -88,7 +102,8 @@ def export_job_for(
             notes.append(f"no feasible pose for {no_pose}: default orientation, no confdata")
         if blocked:
             notes.append(f"points {blocked} are not feasible (see 'wobjcal check')")
-    return build_job(plan, T_nom, tool, rotations, confs), tuple(notes)
+    job = build_job(plan, T_nom, tool, rotations, confs, check=check_status(check))
+    return job, tuple(notes)
 
 
 def export_program(
@@ -113,6 +128,7 @@ def export_program(
     check = check_plan(plan, plan_dir, cell=cell, fmt=fmt) if run_check else None
     layout = check.layout if check is not None else layout_problem(plan, fmt)
     job, notes = export_job_for(plan, plan_dir, check)
+    job = replace(job, check=check_status(check, layout))
     if check is not None and cell is not None:
         job = with_arm_poses(job, cell, check, plan.cell.tool.tcp)
     if layout:

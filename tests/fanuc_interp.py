@@ -6,7 +6,7 @@ Cartesian and joint representation) and asserts its layout on the way. :class:`T
 its ``/MN`` instructions, each exactly as the exporter writes it (anything else fails):
 comments, ``LBL[i]``, ``PR[i]=LPOS``, ``PR[i]=P[n]``, ``PR[i,j]=a`` and ``R[i]=a`` with at
 most one ``+``/``-``/``*``, ``UFRAME[i]=PR[j]``/``UTOOL[i]=PR[j]``, ``UFRAME_NUM``/``UTOOL_NUM``,
-``IF DI[1]=ON|OFF,JMP LBL[i]``, ``SKIP CONDITION DI[1]=ON|OFF``, ``J P[n] k% FINE`` and
+``IF DI[1]=ON|OFF,JMP LBL[i]``, ``SKIP CONDITION DI[1]=ON|OFF``, ``J P[n]|PR[n] k% FINE`` and
 ``L P[n]|PR[n] v mm/sec FINE`` with or without ``Skip,LBL[i],PR[k]=LPOS``.
 
 Frames (mm and degrees; WORLD = the robot base): a Cartesian ``P[]`` or ``PR[]`` target puts the
@@ -395,6 +395,9 @@ class TPMachine:
             else:
                 self._move(self.target("P", n))
                 self.joint_targets.append(self.here())
+        elif m := re.fullmatch(r"J PR\[(\d+)\] \d+% FINE", line):  # a target without CONFIG
+            self._move(self.target("PR", int(m.group(1))))
+            self.joint_targets.append(self.here())
         elif m := _SKIP_MOVE.fullmatch(line):
             goal = self.target(m.group(1), int(m.group(2)))
             if m.group(3) is None:

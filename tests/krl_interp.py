@@ -65,6 +65,13 @@ its target the input is
 ``sensor(tcp_m, sensor_axis)`` when that callback is given; without it, FALSE after a motion
 that moved the TCP (more than 1e-6 mm), unchanged after one that did not (so it stays on after
 a search stopped on the part and a move to where it stopped).
+
+REAL is float64 here unless ``KrlMachine(..., real_float32=True)``: then, as on the controller
+(KRL's REAL is an IEEE 754 single), every REAL is rounded to float32 where it is made or stored:
+literals, the result of each ``+ - * /`` on REALs (so that arithmetic is exactly single
+precision), of each built-in function, of ``:`` and ``INV_POS`` (their components; the maths
+inside is float64), ``$POS_ACT``/``$POS_INT``, and every value stored in a REAL or a REAL
+component of a structure (FRAME, POS, E6POS...). INT stays exact.
 """
 
 from __future__ import annotations
@@ -1221,6 +1228,22 @@ def to_metres(T_mm: np.ndarray) -> np.ndarray:
     return T
 
 
+def f32(x: float) -> float:
+    """``x`` rounded to the nearest IEEE 754 single (a KRL REAL on the controller)."""
+    return float(np.float32(x))
+
+
+def round_real(value: Any) -> Any:
+    """``value`` with every REAL in it (a float, the float components of a structure, nested)
+    rounded to single precision; structures are rounded in place."""
+    if isinstance(value, float):
+        return f32(value)
+    if isinstance(value, Struct):
+        for k, v in value.f.items():
+            value.f[k] = round_real(v)
+    return value
+
+
 def _family(typ: str) -> set[str] | None:
     return next((f for f in FAMILIES if typ in f), None)
 
@@ -1477,6 +1500,8 @@ class KrlMachine:
         sensor_input: the number of the input the sensor drives (``$IN[n]``).
         start_tcp_m: ``(4, 4)`` the TCP pose at the start, robot base, metres (``None``:
             unknown until the first Cartesian motion).
+        real_float32: round every REAL to single precision, as the controller stores it
+            (module docstring); ``False``: float64.
 
     Raises:
         KrlError: the module does not compile (the message names the line).
@@ -1490,6 +1515,7 @@ class KrlMachine:
         sensor: SensorFn | None = None,
         sensor_input: int = 1,
         start_tcp_m: np.ndarray | None = None,
+        real_float32: bool = False,
     ) -> None:
         if ".src" not in files:
             raise KrlError(f"no .src among {sorted(files)}")
@@ -1497,6 +1523,7 @@ class KrlMachine:
         self.main = next(iter(self.routines.values()))
         self.search = search
         self.sensor = sensor
+        self.real_float32 = real_float32
         self.sensor_input = sensor_input
         self.structs: dict[str, tuple[tuple[str, str], ...]] = dict(STRUCTS)
         self.enums: dict[str, tuple[str, ...]] = {}
@@ -1788,7 +1815,8 @@ class KrlMachine:
         if isinstance(value, Array):
             raise KrlError("an array cannot be assigned as a whole")
         if typ in SIMPLE:
-            return self._simple(value, typ)
+            out = self._simple(value, typ)
+            return f32(out) if self.real_float32 and typ == "REAL" else out
         if typ in self.enums:
             if not isinstance(value, EnumVal) or value.name not in self.enums[typ]:
                 raise KrlError(f"{_kind(value)} is not a value of ENUM {typ}")
@@ -1902,9 +1930,13 @@ class KrlMachine:
         place.set(self._coerce(value, place.type, place.get()))
 
     # -- expressions
+    def _real(self, value: Any) -> Any:
+        """A value just made: its REALs rounded to single precision when :attr:`real_float32`."""
+        return round_real(value) if self.real_float32 else value
+
     def _eval(self, e: Expr, frame: _Frame | None) -> Any:
         if isinstance(e, Lit):
-            return e.value
+            return self._real(e.value)
         if isinstance(e, Name | Index):
             place = self._place(e, frame)
             if place.dims is not None:
@@ -1924,9 +1956,10 @@ class KrlMachine:
         if isinstance(e, Unary):
             return self._unary(e.op, self._eval(e.operand, frame))
         if isinstance(e, Binary):
-            return self._binary(e.op, self._eval(e.left, frame), self._eval(e.right, frame))
+            v = self._binary(e.op, self._eval(e.left, frame), self._eval(e.right, frame))
+            return self._real(v)
         if isinstance(e, Call):
-            return self._function(e, frame)
+            return self._real(self._function(e, frame))
         raise KrlError(f"cannot evaluate {e!r}")
 
     @staticmethod
@@ -2352,7 +2385,7 @@ class KrlMachine:
         s.f.update(frame_values(T))
         s.f.update({f"E{k}": 0.0 for k in range(1, 7)})
         s.f["S"], s.f["T"] = self._st
-        return s
+        return self._real(s)
 
     def _frame_var(self, name: str) -> np.ndarray:
         return frame_matrix(self.system[name].value.f, name)

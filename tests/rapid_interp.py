@@ -14,6 +14,15 @@ and leaves it: no FK here); ``SearchL`` asks a callback
 ``search(start_m, end_m, sensor_axis, neg_flank) -> (3,) hit or "ERR_..."`` (base frame,
 metres) and stores the hit in the result robtarget in the work object, as the controller does.
 The world frame is the robot base. One statement per line, as the generator writes.
+
+Arithmetic is float64 unless ``Machine(..., num_float32=True)``: then, as on a controller whose
+``num`` is an IEEE 754 single (RAPID's ``num`` holds integers exactly only up to 8388608, the
+24-bit significand of a single), every ``num`` value is rounded to float32 where it is made or
+stored: literals, the result of each ``+ - * /`` (so scalar arithmetic is exactly single
+precision), the result of each built-in function (components of a ``pos``, ``orient`` or
+``pose`` result too; inside a built-in the maths is float64, how the controller computes there
+is not documented) and every value stored in a variable, a parameter or a record component
+(the hit ``SearchL`` stores included). Motion targets are taken from the stored values.
 """
 
 from __future__ import annotations
@@ -130,6 +139,25 @@ def coerce(value: Any, typ: str) -> Any:
         raise TypeError(f"{value!r} is not a bool")
     if typ == "string" and not isinstance(value, str):
         raise TypeError(f"{value!r} is not a string")
+    return value
+
+
+def f32(x: float) -> float:
+    """``x`` rounded to the nearest IEEE 754 single (a RAPID ``num`` on the controller)."""
+    return float(np.float32(x))
+
+
+def round_num(value: Any) -> Any:
+    """``value`` with every ``num`` in it (a float, the float components of a record, the
+    elements of a list) rounded to single precision; records are rounded in place."""
+    if isinstance(value, float):
+        return f32(value)
+    if isinstance(value, Rec):
+        for k, v in value.f.items():
+            value.f[k] = round_num(v)
+        return value
+    if isinstance(value, list):
+        return [round_num(v) for v in value]
     return value
 
 
@@ -479,9 +507,11 @@ class Motion:
 class Machine:
     """Runs a parsed module against ``search``."""
 
-    def __init__(self, text: str, search: SearchFn) -> None:
+    def __init__(self, text: str, search: SearchFn, *, num_float32: bool = False) -> None:
         self.decls, self.routines = parse_module(text)
         self.search = search
+        #: every ``num`` made or stored is rounded to single precision (module docstring)
+        self.num_float32 = num_float32
         self.globals: dict[str, Any] = {}
         self.types: dict[str, str] = {}
         self.tcp_m: np.ndarray | None = None
@@ -497,9 +527,18 @@ class Machine:
         types[name] = typ
         if size is not None:
             vals = self.eval(init, scopes) if init else [self._default(typ)] * size
-            env[name] = [coerce(v, typ) for v in vals]
+            env[name] = [self._coerce(v, typ) for v in vals]
         else:
-            env[name] = coerce(self.eval(init, scopes), typ) if init else self._default(typ)
+            env[name] = self._coerce(self.eval(init, scopes), typ) if init else self._default(typ)
+
+    def _coerce(self, value: Any, typ: str) -> Any:
+        """:func:`coerce`, then rounded to single precision when :attr:`num_float32`."""
+        out = coerce(value, typ)
+        return round_num(out) if self.num_float32 else out
+
+    def _num(self, value: Any) -> Any:
+        """A value just made: rounded to single precision when :attr:`num_float32`."""
+        return round_num(value) if self.num_float32 else value
 
     def _default(self, typ: str) -> Any:
         if typ in SCHEMA:
@@ -517,7 +556,9 @@ class Machine:
 
     def eval(self, e: Any, scopes: list) -> Any:
         k = e[0]
-        if k in ("num", "str", "bool"):
+        if k == "num":
+            return self._num(e[1])
+        if k in ("str", "bool"):
             return e[1]
         if k == "var":
             if e[1] in ERRNOS:
@@ -532,7 +573,7 @@ class Machine:
             return [self.eval(x, scopes) for x in e[1]]
         if k == "neg":
             v = self.eval(e[1], scopes)
-            return -v if isinstance(v, float | int) else _arith("*", -1.0, v)
+            return -v if isinstance(v, float | int) else self._num(_arith("*", -1.0, v))
         if k == "not":
             return not self.eval(e[1], scopes)
         if k == "bin":
@@ -551,11 +592,11 @@ class Machine:
                     "<=": a <= b,
                     ">=": a >= b,
                 }[op]
-            return _arith(op, a, b)
+            return self._num(_arith(op, a, b))
         if k == "call":
             args = [self.eval(a, scopes) for a in e[2]]
             if e[1] in BUILTINS:
-                return BUILTINS[e[1]](*args)
+                return self._num(BUILTINS[e[1]](*args))
             return self.call(e[1], args)
         raise ValueError(f"cannot evaluate {e!r}")
 
@@ -567,7 +608,7 @@ class Machine:
         env, types = self._scope_of(target[1], scopes)
         typ = types[target[1]]
         if not path:
-            env[target[1]] = coerce(value, typ)
+            env[target[1]] = self._coerce(value, typ)
             return
         path.reverse()
         holder: Any = env
@@ -579,7 +620,7 @@ class Machine:
             else:
                 typ = dict(SCHEMA[obj.type])[step[2]]
                 holder, key = obj.f, step[2]
-        holder[key] = coerce(value, typ)
+        holder[key] = self._coerce(value, typ)
 
     # -- statements
     def run(self, body: list, scopes: list) -> None:
@@ -617,7 +658,7 @@ class Machine:
 
     def call(self, name: str, args: list) -> Any:
         r = self.routines[name]
-        env = {n: coerce(a, t) for (t, n), a in zip(r.params, args, strict=True)}
+        env = {n: self._coerce(a, t) for (t, n), a in zip(r.params, args, strict=True)}
         scopes = [(env, {n: t for t, n in r.params})]
         try:
             try:
@@ -684,7 +725,7 @@ class Machine:
         self.tcp_m = np.asarray(hit, float)
         T_base_wobj = pose_matrix(wobj.f["uframe"]) @ pose_matrix(wobj.f["oframe"])
         p_w = np.linalg.solve(T_base_wobj, np.append(self.tcp_m * 1000.0, 1.0))[:3]
-        rec = coerce(self.eval(target, scopes), "robtarget")
+        rec = self._coerce(self.eval(target, scopes), "robtarget")
         rec.f["trans"] = _pos(p_w)
         self._assign(result, rec, scopes)
 

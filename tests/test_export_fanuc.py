@@ -528,16 +528,39 @@ def test_fanuc_config_comes_from_the_checked_pose(tmp_path: Path) -> None:
                 assert prog.positions[b[kind]].config == want, (c.point_id, kind)
 
 
-def test_fanuc_refuses_a_configuration_it_cannot_derive(
+def test_fanuc_without_a_checked_pose_keeps_the_robots_configuration(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """Before: 'N U T, 0, 0, 0' on every position whatever the pose. Without a checked pose
-    there is nothing to derive it from: refused, naming the point."""
+    """Before: refused (exit 2), so --force could not write an infeasible plan. Without a
+    checked pose there is no CONFIG to derive, and none is guessed: each such target is a PR
+    made from LPOS and its six components (the robot keeps its configuration, as a KRL target
+    without S and T), the header names the points, and the program measures what the one with
+    configurations measures."""
     plan = _no_vias(load_plan(STATOR))
-    job = build_job(plan, np.eye(4), ToolData(T_flange_tcp=np.eye(4)))
-    with pytest.raises(InputError, match=r"FANUC export: point A: no checked robot pose"):
-        export_files(job, "fanuc")
+    rng = np.random.default_rng(3)
+    T_nom = make_transform(matrix_from_rotvec([0.0, 0.2, 0.1]), [1.4, -0.3, 0.8])
+    T_true = T_nom @ full_misplacement(plan, rng)
+    job = build_job(plan, T_nom, ToolData(T_flange_tcp=random_transform(rng, 0.3, np.pi)))
+    text = export_files(job, "fanuc")[".ls"]
+    prog = parse_ls(text)
+    assert prog.positions == {}  # no Cartesian P[], so no CONFIG written anywhere
+    header = " ".join(c[1:] for c in prog.lines if c.startswith("!"))
+    ids = ", ".join(t.point_id for t in job.targets)
+    assert f"NO CONFIG for points {ids} (no checked robot pose)" in header
+    assert "made from LPOS" in header and "T1" in header
+    assert f"J PR[{F.PR_SAFE}] {F.JOINT_PCT}% FINE" in prog.lines
+    assert prog.lines.count(f"PR[{F.PR_SAFE}]=LPOS") == len(job.targets)
+    run = TPRun(text, T_true).run()
+    want = TPRun(ls_of(job), T_true).run()
+    got, ref = run.measured_wobj(job), want.measured_wobj(job)
+    assert got.keys() == ref.keys()
+    for pid in ref:
+        assert np.allclose(got[pid], ref[pid], atol=1e-9), pid
+    assert [s["start"].tolist() for s in run.searches] == [
+        s["start"].tolist() for s in want.searches
+    ]
+    # the command line: --no-check writes it too (the header says NOT CHECKED)
     out = tmp_path / "x.ls"
     code = main(["export", str(STATOR), "--format", "fanuc", "--no-check", "-o", str(out)])
-    assert code == 2 and "CONFIG cannot be derived" in capsys.readouterr().err
-    assert not out.exists()
+    assert code == 0, capsys.readouterr().err
+    assert "NOT CHECKED" in out.read_text() and "NO CONFIG for points" in out.read_text()

@@ -12,85 +12,17 @@ now does (:func:`planner.export.rapid._data_first`).
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from pathlib import Path
-
-import msgspec
 import numpy as np
 import pytest
 
-from calib.plan.file import Plan, load_plan
-from calib.procedures import BestFit, Iterative
+from calib.plan.file import Plan
 from planner.export import export_files
 from planner.export.job import ToolData, build_job
 from planner.plan_cell import nominal_T_base_wobj
+from tests.program_cases import PLANS_MADE, load, ninety
 from tests.rapid_grammar import rapid_errors
 
 pytest.importorskip("rapidchecker")
-
-PLANS = Path(__file__).resolve().parents[1] / "assets" / "plans"
-
-
-def _load(name: str) -> Plan:
-    return load_plan(PLANS / name)
-
-
-def _stator(**settings: object) -> Plan:
-    plan = _load("stator_section_ah.json")
-    return msgspec.structs.replace(
-        plan, procedure=msgspec.structs.replace(plan.procedure, **settings)
-    )
-
-
-def _fit(plan: Plan, points: list) -> Plan:  # type: ignore[type-arg]
-    return msgspec.structs.replace(plan, points=points, procedure=BestFit())
-
-
-def _ninety() -> Plan:
-    """The plate best fit with 80 more points on its top: 90 points."""
-    plan = _load("plate_holes_best_fit.json")
-    top = next(p for p in plan.points if p.id == "T1")
-    xs, ys = np.linspace(0.02, 0.17, 8), np.linspace(0.03, 0.27, 10)
-    more = [
-        msgspec.structs.replace(top, id=f"G{k}", position_m=(float(x), float(y), 0.0127))
-        for k, (x, y) in enumerate((x, y) for x in xs for y in ys)
-    ]
-    return _fit(plan, [*plan.points, *more])
-
-
-def _with_edge() -> Plan:
-    """The plate best fit plus the stator's edge point F: RAPID runs it nominal."""
-    plan = _load("plate_holes_best_fit.json")
-    f = next(p for p in _load("stator_section_ah.json").points if p.role == "F")
-    return _fit(plan, [*plan.points, msgspec.structs.replace(f, id="E9", role="fit")])
-
-
-def _hostile() -> Plan:
-    plan = _load("plate_holes_321.json")
-    ids = ["P1", "p1.x", "P-2", "S_1", "s.2", "T1"]
-    points = [msgspec.structs.replace(p, id=i) for p, i in zip(plan.points, ids, strict=True)]
-    return msgspec.structs.replace(plan, points=points, name="plate (v2): A/B + C, 1.5 -- x")
-
-
-def _fewest() -> Plan:
-    """A best fit of the fewest points that fix a frame (six)."""
-    plan = _load("plate_holes_best_fit.json")
-    keep = ["T1", "T2", "T3", "X1", "X2", "Y1"]
-    return _fit(plan, [p for p in plan.points if p.id in keep])
-
-
-PLANS_MADE: dict[str, Callable[[], Plan]] = {
-    "stator A-H (shipped)": lambda: _load("stator_section_ah.json"),
-    "stator A-H, edges from the face approach": lambda: _stator(edge_start_from_measured=False),
-    "plate 3-2-1 (shipped)": lambda: _load("plate_holes_321.json"),
-    "plate best fit with vias (shipped)": lambda: _load("plate_holes_best_fit.json"),
-    "plate iterative (nominal)": lambda: msgspec.structs.replace(
-        _load("plate_holes_best_fit.json"), procedure=Iterative()
-    ),
-    "best fit with an edge search (nominal)": _with_edge,
-    "best fit of six points": _fewest,
-    "hostile ids and name": _hostile,
-}
 
 
 def _errors(plan: Plan) -> list[str]:
@@ -106,12 +38,12 @@ def test_the_module_passes_rapidchecker(case: str) -> None:
 @pytest.mark.slow
 def test_a_module_of_90_points_passes_rapidchecker() -> None:
     """2,950 lines: the tool takes about 45 s over it."""
-    assert _errors(_ninety()) == []
+    assert _errors(ninety()) == []
 
 
 def test_the_checker_sees_a_declaration_after_a_routine() -> None:
     """The layout error the tool found, put back by hand: it is reported."""
-    plan = _load("plate_holes_321.json")
+    plan = load("plate_holes_321.json")
     job = build_job(plan, nominal_T_base_wobj(plan), ToolData(T_flange_tcp=np.eye(4)))
     text = export_files(job, "rapid")[".mod"]
     bad = text.replace("ENDMODULE", "    CONST num nLate:=1;\nENDMODULE")

@@ -145,7 +145,7 @@ def test_a_failed_search_stops_the_procedure_with_what_was_measured() -> None:
     before = UrMachine(export_files(job, "urscript")[".script"], search).run()
     m = UrMachine(export_files(job, "urscript")[".script"], failing).run()
     assert m.halted and len(calls) == 3  # nothing searched after C failed
-    assert m.messages[-1].startswith("wobjcal: A-H stopped: point C: code"), m.messages
+    assert m.messages[-1].startswith("wobjcal/1 stop A-H: point C: code"), m.messages
     assert m.variables["measured_code"] == [0.0, 0.0, 1.0] + [-1.0] * 7
     got = np.asarray(m.variables["measured"]).reshape(-1, 3)
     want = np.asarray(before.variables["measured"]).reshape(-1, 3)
@@ -209,7 +209,7 @@ def test_a_failed_x_offset_search_stops_the_program_with_its_name() -> None:
 
     m = UrMachine(export_files(_job(plan), "urscript")[".script"], search).run()
     assert m.halted and len(calls) == N_AH + 1
-    assert m.messages[-1] == "wobjcal: A-H stopped: x-offset point PX1_1 not found"
+    assert m.messages[-1] == "wobjcal/1 stop A-H: x-offset point PX1_1 not found"
     assert np.abs(m.frame("wobj") - T).max() < 1e-9  # the calibrated frame is kept
 
 

@@ -142,7 +142,7 @@ def test_a_failed_search_stops_the_program_with_what_was_measured(
     assert m.searches[-1].search is not None and m.searches[-1].search.answer == "ERR_WHLSEARCH"
     assert len(m.searches) == which  # stopped at once
     assert any(
-        msg.startswith(f"wobjcal: {setup.program.method_label} stopped: point {failed}: code")
+        msg.startswith(f"wobjcal/1 stop {setup.program.method_label}: point {failed}: code")
         for msg in m.messages
     ), m.messages
     table = slot_table(job, setup.program)

@@ -508,7 +508,9 @@ def test_shipped_plan_runs_to_the_end_and_measures_each_point_exactly(
     job, text = build(plan, T_nom)
     machine = run_and_compare(job, text, ideal_search(plan, misplaced(plan, T_nom, seed), T_nom))
     for t in job.targets:
-        assert any(msg.startswith(t.point_id) for msg in machine.messages), t.point_id
+        assert any(
+            msg.startswith(f"wobjcal/1 point {t.point_id} 0 ") for msg in machine.messages
+        ), t.point_id
     if is_adaptive(job):  # its searches, points and frame: compare_adaptive
         assert not machine.halted and set(slot_points(machine, job)[1]) == {0.0}
         return
@@ -651,7 +653,7 @@ def test_a_search_that_finds_nothing_takes_the_error_path(
     assert len(edge_searches) == n_edge - (edge_search_runs is False)
     assert measured(machine, t) == [1.0, 0.0, 0.0, 0.0]
     assert any(
-        msg.startswith(f"{point} failed") and msg.endswith("1.0") for msg in machine.messages
+        msg == f"wobjcal/1 point {point} 1 0 0 0" for msg in machine.messages
     )
     for other in job.targets:  # every other point is measured as without the failure
         if other.point_id != point:
@@ -674,7 +676,7 @@ def test_input_already_on_at_the_safe_start_gives_code_2_and_no_search() -> None
     rec = Recorder(ideal_search(plan, T_nom, T_nom))
     machine = UrMachine(text, rec, rest_level=rest_level).run()
     assert measured(machine, d) == [2.0, 0.0, 0.0, 0.0]
-    assert any(msg.startswith("D failed") and msg.endswith("2.0") for msg in machine.messages)
+    assert "wobjcal/1 point D 2 0 0 0" in machine.messages
     assert len(rec.calls) == len(job.targets) + 2 - 1  # D's search never started
     assert all(np.linalg.norm(c[0] - d_safe) > 1e-6 for c in rec.calls)
 
@@ -688,26 +690,25 @@ def _stator_text() -> str:
 def test_as_exported_the_program_compiles() -> None:
     """No block keyword names a variable or a parameter (``run_search``'s goal was once
     ``end``) and every call has the built-in's argument count (the failure message was once a
-    three-argument ``textmsg``: now ``textmsg(str_cat(name, text), code)``)."""
+    three-argument ``textmsg``: now one results line, ``textmsg(line)``)."""
     text = _stator_text()
     UrMachine(text, lambda *a: NOT_FOUND)
     assert "def run_search(goal, want, speed):" in text
-    assert 'textmsg(str_cat(name, " failed: ' in text
+    assert "def log_result(name, result):" in text and "    textmsg(line)" in text
 
 
 def test_as_exported_the_failure_message_says_which_point_and_why() -> None:
-    """Every search of a nominal program finds nothing: each point logs ``<ID> failed: ...
-    1.0`` and records code 1 (an adaptive program stops at the first: test_urscript_adaptive)."""
+    """Every search of a nominal program finds nothing: each point logs ``wobjcal/1 point <ID>
+    1 0 0 0`` (the results line ``wobjcal calibrate`` reads) and records code 1 (an adaptive
+    program stops at the first: test_urscript_adaptive)."""
     plan = nominal_stator()
     job, text = build(plan, nominal_T_base_wobj(plan))
     machine = UrMachine(text, lambda *a: NOT_FOUND).run()
     assert machine.finished and not machine.halted
     for t in job.targets:
         assert measured(machine, t) == [1.0, 0.0, 0.0, 0.0]
-    want = [
-        f"{t.point_id} failed: code (1 no detection, 2 at level at start) 1.0" for t in job.targets
-    ]
-    assert machine.messages == want
+    want = [f"wobjcal/1 point {t.point_id} 1 0 0 0" for t in job.targets]
+    assert machine.messages == [f"wobjcal/1 start {job.plan_digest}", *want, "wobjcal/1 end"]
 
 
 # ------------------------------------------------------------------ the interpreter itself

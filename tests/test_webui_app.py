@@ -151,6 +151,19 @@ def test_exports_are_robot_programs(app: WobjcalApp) -> None:
     assert ur.files[0][0].endswith(".script")
 
 
+def test_downloads_are_named_after_the_loaded_plan(app: WobjcalApp) -> None:
+    """Issue item 4: the downloads of an uploaded plan are named after that plan's name (as
+    ``wobjcal export -o DIR`` names them), whatever the file it came in was called."""
+    text = box_plan(app.plan_dir, name="other").read_text()
+    app.files_panel.upload_plan("some_file.json", text.replace('"other"', '"My plan 2"').encode())
+    try:
+        assert app.files_panel.plan_bytes()[0] == "My_plan_2.json"
+        names = {fmt: [n for n, _ in app.files_panel.export(fmt).files] for fmt in ("RAPID", "TP")}
+        assert names == {"RAPID": ["My_plan_2.mod"], "TP": ["WOBJCALMYPLAN2.ls"]}
+    finally:
+        app.state.undo()
+
+
 def test_mesh_and_urdf_uploads_replace_the_cell(app: WobjcalApp) -> None:
     from webui.testing import box_mesh
 

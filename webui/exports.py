@@ -2,7 +2,9 @@
 
 The program is made exactly as ``wobjcal export`` makes it
 (:func:`planner.export_plan.export_program`: orientations and configurations from the plan
-check in the session's cell). Call :func:`export_program` on the cell worker.
+check in the session's cell). Call :func:`export_program` on the cell worker. The files are
+named as ``wobjcal export -o DIR`` names them: after the session plan's name
+(:func:`planner.export.export_file_stem`; KRL and FANUC after the program's name).
 """
 
 from __future__ import annotations
@@ -14,7 +16,6 @@ from typing import TYPE_CHECKING
 from calib.errors import InputError
 from calib.plan.file import Plan
 from planner.export import FORMATS as EXPORT_FORMATS
-from planner.export.text import module_name
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
@@ -53,6 +54,6 @@ def export_program(plan: Plan, fmt: str, plan_dir: Path, cell: Cell | None = Non
     if fmt not in FORMATS:
         raise InputError(f"unknown export format {fmt!r}; known: {', '.join(FORMATS)}")
     result = make(plan, plan_dir, FORMATS[fmt], cell=cell)
-    stem = module_name(plan.name or "plan") or "wobjcal_plan"
+    stem = EXPORT_FORMATS[FORMATS[fmt]].file_stem(plan.name)
     out = tuple((f"{stem}{suffix}", text.encode("utf-8")) for suffix, text in result.files.items())
     return ExportResult(out, "; ".join(result.notes))

@@ -15,11 +15,12 @@ from typing import TYPE_CHECKING, Any
 import msgspec
 
 from calib.errors import InputError
-from calib.plan.file import Plan, PlanError
+from calib.plan.file import Plan, PlanError, plan_to_json
 from calib.units import MESH_UNITS
+from planner.export import export_file_stem
 from webui.exports import FORMATS, ExportResult, export_program
 from webui.part_upload import PendingPart, drop_points, frame_note, off_surface, project_points
-from webui.plan_adapter import plan_from_ui, plan_json_from_ui, ui_plan_from_bytes, with_source
+from webui.plan_adapter import plan_from_ui, ui_plan_from_bytes, with_source
 from webui.state import atomic_write_bytes
 from webui.urdf_zip import unpack_robot_zip
 
@@ -270,9 +271,10 @@ class FilesPanel:
 
     # ---- downloads -------------------------------------------------------------------------
     def plan_bytes(self) -> tuple[str, bytes]:
-        """File name and canonical JSON of the session plan (raises when it is incomplete)."""
-        doc = self._app.state.doc
-        return f"{doc.name or 'plan'}.json", plan_json_from_ui(doc).encode("utf-8")
+        """File name (after the plan's name, as the program downloads) and canonical JSON of
+        the session plan (raises when it is incomplete)."""
+        plan = plan_from_ui(self._app.state.doc)
+        return f"{export_file_stem(plan.name, 'json')}.json", plan_to_json(plan).encode("utf-8")
 
     def download_plan(self, client: Any) -> None:
         """Send the session plan JSON to ``client``."""

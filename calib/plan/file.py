@@ -14,6 +14,8 @@ msgspec and numpy only, no simulator.
 
 from __future__ import annotations
 
+import hashlib
+import json
 from pathlib import Path
 from typing import Any, Final, Literal, get_args
 
@@ -85,6 +87,7 @@ __all__ = [
     "check_plan_files",
     "file_sha256",
     "load_plan",
+    "plan_digest",
     "plan_from_json",
     "plan_to_json",
     "resolve_ref",
@@ -316,6 +319,33 @@ def plan_from_json(text: str, source: str = "plan") -> Plan:
 def plan_to_json(plan: Plan) -> str:
     """The canonical JSON text of ``plan`` (sorted keys, indent 2, trailing newline)."""
     return canonical_json(plan)
+
+
+def plan_digest(plan: Plan) -> str:
+    """The plan's digest: the first 16 hex digits of the sha256 of its canonical JSON, with
+    every ``-0.0`` taken as ``0.0`` (the same plan gives the same digest whatever wrote it).
+
+    Program headers carry it and ``wobjcal calibrate`` compares it with the plan it is given,
+    so results measured with another plan's program are named, not used.
+    """
+    text = json.dumps(
+        _unsigned_zeros(msgspec.to_builtins(plan)),
+        sort_keys=True,
+        separators=(",", ":"),
+        ensure_ascii=False,
+        allow_nan=False,
+    )
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+
+
+def _unsigned_zeros(value: Any) -> Any:
+    if isinstance(value, float):
+        return 0.0 if value == 0.0 else value
+    if isinstance(value, dict):
+        return {k: _unsigned_zeros(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_unsigned_zeros(v) for v in value]
+    return value
 
 
 def check_plan_files(plan: Plan, plan_dir: str | Path, source: str = "plan") -> None:

@@ -55,6 +55,8 @@ class Measurements(msgspec.Struct, frozen=True, forbid_unknown_fields=True, kw_o
         retakes: ``{id: [(x, y, z), ...]}`` later measurements of a point, in order.
         failed: ``{id: reason}`` points whose search failed on the robot.
         comment: free text (robot, date, operator).
+        plan_digest: :func:`calib.plan.file.plan_digest` of the plan whose program measured
+            the points (the RAPID program writes it; ``""``: not given, e.g. written by hand).
     """
 
     schema: Literal["wobjcal.measurements/1"] = MEASUREMENTS_SCHEMA
@@ -64,6 +66,7 @@ class Measurements(msgspec.Struct, frozen=True, forbid_unknown_fields=True, kw_o
     retakes: dict[str, list[Vec3]] = {}
     failed: dict[str, str] = {}
     comment: str = ""
+    plan_digest: str = ""
 
     def __post_init__(self) -> None:
         for pid in self.retakes:

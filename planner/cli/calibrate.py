@@ -13,12 +13,12 @@ from rich.table import Table
 
 from calib.estimators.gross_errors import K_SIGMA
 from calib.frames import motion_between, quat_wxyz_from_matrix, tait_bryan_zyx_from_matrix
-from calib.plan.measurements import load_measurements
 from calib.procedures import METHODS
 from planner.calibrate import CalibrationOutput, calibrate_plan
 from planner.cli.common import print_json, read_plan, stdout
 from planner.export.krl import BASE_NO, frame_text
 from planner.export.rapid import pose_text
+from planner.results import KINDS, read_results
 
 
 def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
@@ -27,11 +27,21 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         sub,
         "calibrate",
         "compute the work-object frame from points measured on the real robot",
-        "Compute T_base_wobj from the points measured on the robot (MEASURED, a\n"
-        "wobjcal.measurements/1 file, e.g. the HOME:/wobjcal_measured.json the RAPID export\n"
-        "writes):\n"
-        '  {"schema": "wobjcal.measurements/1", "frame": "base", "units": "mm",\n'
-        '   "points": {"A": [x, y, z], ...}}\n'
+        "Compute T_base_wobj from the points measured on the robot, read from what the\n"
+        "controller wrote (RESULTS; which controller is detected from the contents, or\n"
+        "given with --from):\n"
+        "  rapid     the wobjcal.measurements/1 JSON the RAPID program writes\n"
+        "            (HOME:/wobjcal_measured.json), or one written by hand:\n"
+        '            {"schema": "wobjcal.measurements/1", "frame": "base", "units": "mm",\n'
+        '             "points": {"A": [x, y, z], ...}}\n'
+        "  krl       the program's .dat as the controller saved it after the run (xMeas[],\n"
+        "            nFail[]: robot base, mm)\n"
+        "  urscript  the controller's log (log_history.txt or a capture) with the program's\n"
+        "            'wobjcal/1' lines; the last run in it is read\n"
+        "  fanuc     POSREG.VA and NUMREG.VA backed up from MD: (two files, or their folder):\n"
+        "            PR[11..] in the nominal user frame PR[1] (checked), R[11..] the codes\n"
+        "A results file of another plan's program (its plan digest), or one that is partial or\n"
+        "malformed, is refused naming the point, slot or register (exit 2).\n"
         "hultman2013 replays the paper's A-H procedure with the recorded points; three_two_one\n"
         "uses the plan's 3-2-1 roles (or picks them from the faces); best_fit fits all points.\n"
         "Text output: origin (mm), Tait-Bryan z-y'-x'' angles (deg, paper eq. 7-9 = KUKA A, B,\n"
@@ -45,11 +55,25 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "nothing is printed to paste (and --json leaves out the frame) unless --force.\n\n"
         "exit codes: 0 ok, 1 gross error or frame beyond the misplacement bound (named on\n"
         "stderr), 2 bad input (file, missing point, layout the method cannot use)",
-        "wobjcal calibrate plan.json measured.json\n"
-        "wobjcal calibrate plan.json measured.json --method best_fit --json",
+        "wobjcal calibrate plan.json wobjcal_measured.json\n"
+        "wobjcal calibrate plan.json WobjcalPlate.dat --method best_fit --json\n"
+        "wobjcal calibrate plan.json log_history.txt --from urscript\n"
+        "wobjcal calibrate plan.json backup/POSREG.VA backup/NUMREG.VA",
     )
     p.add_argument("plan", metavar="PLAN", help="plan file (wobjcal.plan/1)")
-    p.add_argument("measured", metavar="MEASURED", help="measurements (wobjcal.measurements/1)")
+    p.add_argument(
+        "results",
+        metavar="RESULTS",
+        nargs="+",
+        help="what the controller wrote: measurements JSON, KRL .dat, URScript log, or FANUC "
+        "POSREG.VA and NUMREG.VA (or their folder)",
+    )
+    p.add_argument(
+        "--from",
+        dest="source_kind",
+        choices=KINDS,
+        help="the controller that wrote RESULTS (default: detected from the contents)",
+    )
     p.add_argument("--method", choices=METHODS, help="method (default: the plan's procedure)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument(
@@ -185,8 +209,10 @@ def _print_text(out: CalibrationOutput, paste: bool) -> None:
 def cmd_calibrate(args: argparse.Namespace) -> int:
     """Compute and print the calibrated frame."""
     plan, _ = read_plan(args.plan)
-    measurements = load_measurements(args.measured)
-    out = calibrate_plan(plan, measurements, args.method, k_sigma=args.k_sigma)
+    results = read_results(plan, args.results, args.source_kind)
+    for note in results.notes:
+        print(f"wobjcal calibrate: note: {note}", file=sys.stderr)
+    out = calibrate_plan(plan, results.measurements, args.method, k_sigma=args.k_sigma)
     paste = out.trusted or args.force
     for note in out.notes:
         print(f"wobjcal calibrate: note: {note}", file=sys.stderr)

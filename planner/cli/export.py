@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -10,7 +11,7 @@ from typing import Any
 from calib.atomic_io import write_text_atomic
 from calib.plan.file import plan_to_json
 from planner.cli.common import read_plan, stderr
-from planner.export import FORMAT_CHOICES, FORMATS
+from planner.export import FORMAT_CHOICES, FORMATS, export_file_stem
 
 
 def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
@@ -26,13 +27,19 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "confdata, noted in the program). FILE gets the format's first file; further files\n"
         "(KRL's .dat) go beside it: "
         + "; ".join(f"{f.name}: {' + '.join(f.suffixes)}" for f in FORMATS.values())
-        + ".\nExit 1 (nothing written) when the check finds an infeasible point, or the plan's\n"
+        + ".\nWith -o DIR (an existing folder, or a path ending in /) or without -o (the current\n"
+        "folder) the files are named after the plan's name (letters, digits, _ - . kept; KRL\n"
+        "and FANUC files after the program's name, as their controllers want).\n"
+        "Exit 1 (nothing written) when the check finds an infeasible point, or the plan's\n"
         "procedure refuses its points (e.g. an A-H plan without a role, which would run as a\n"
-        "plain non-adaptive program), naming it; --force writes the program anyway. A file\n"
-        "is written like cp writes it: through a symbolic link, never over a read-only file,\n"
-        "never half (atomic, no temporary file left behind).",
+        "plain non-adaptive program), naming each; the same for every format. --force writes\n"
+        "the program anyway, and its header says NOT CHECKED and names the refused points\n"
+        "(every header names the wobjcal version, the plan and its digest, and what was\n"
+        "checked). A file is written like cp writes it: through a symbolic link, never over\n"
+        "a read-only file, never half (atomic, no temporary file left behind).",
         "wobjcal export plan.json --format rapid -o WobjcalStator.mod\n"
-        "wobjcal export plan.json --format krl -o wobjcal_stator.src",
+        "wobjcal export plan.json --format krl -o wobjcal_stator.src\n"
+        "wobjcal export plan.json --format fanuc -o programs/",
     )
     p.add_argument("plan", metavar="PLAN", help="plan file (wobjcal.plan/1)")
     p.add_argument(
@@ -43,7 +50,13 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         + ", ".join(f"{f.name} ({f.vendor} {f.label})" for f in FORMATS.values())
         + ", json (the canonical plan)",
     )
-    p.add_argument("-o", "--output", required=True, metavar="FILE", help="output file")
+    p.add_argument(
+        "-o",
+        "--output",
+        metavar="FILE|DIR",
+        help="output file, or a folder the files go into named after the plan "
+        "(default: the current folder)",
+    )
     p.add_argument(
         "--no-check",
         action="store_true",
@@ -57,11 +70,30 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
     p.set_defaults(handler=cmd_export)
 
 
+def output_paths(output: str | None, plan_name: str, fmt: str) -> list[Path]:
+    """Where ``wobjcal export`` writes the files of ``fmt``, first file first.
+
+    ``-o FILE``: the first file there, the others beside it with their suffix. ``-o DIR`` (an
+    existing folder, or a path ending in a separator: created) and no ``-o`` (the current
+    folder): ``DIR/<stem><suffix>``, the stem from the plan's name
+    (:func:`planner.export.export_file_stem`).
+    """
+    suffixes = FORMATS[fmt].suffixes if fmt in FORMATS else (".json",)
+    is_dir = output is None or output.endswith(("/", os.sep)) or Path(output).is_dir()
+    if not is_dir:
+        out = Path(output or "")
+        return [out if i == 0 else out.with_suffix(s) for i, s in enumerate(suffixes)]
+    folder = Path(output or ".")
+    folder.mkdir(parents=True, exist_ok=True)
+    stem = export_file_stem(plan_name, fmt)
+    return [folder / f"{stem}{s}" for s in suffixes]
+
+
 def cmd_export(args: argparse.Namespace) -> int:
     """Write the export file(s)."""
     plan, plan_dir = read_plan(args.plan)
-    out = Path(args.output)
     if args.format == "json":
+        (out,) = output_paths(args.output, plan.name, "json")
         write_text_atomic(out, plan_to_json(plan))
         stderr().print(f"wrote {out}")
         return 0
@@ -85,10 +117,9 @@ def cmd_export(args: argparse.Namespace) -> int:
         return 1
     if result.notes:
         stderr().print("note: " + "; ".join(result.notes), markup=False)
-    files = result.files
+    targets = output_paths(args.output, plan.name, args.format)
     written = []
-    for i, (suffix, text) in enumerate(files.items()):
-        target = out if i == 0 else out.with_suffix(suffix)
+    for target, text in zip(targets, result.files.values(), strict=True):
         write_text_atomic(target, text)
         written.append(str(target))
     stderr().print("wrote " + ", ".join(written))

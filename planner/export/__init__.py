@@ -23,7 +23,9 @@ buttons and the tests all look formats up here::
     CONTROLLERS["mylang"] = Controller("mylang", "MyLang", "Maker")  # planner.program
     FORMATS["mylang"] = ExportFormat("mylang", "planner.export.mylang:export_mylang", (".prg",))
 
-Writers are imported when first used, so listing the formats imports no writer.
+Writers are imported when first used, so listing the formats imports no writer. Files are
+named after the plan (:func:`export_file_stem`; the command line's ``-o DIR`` and the UI's
+downloads), or after the program where the controller wants that (``program_name``).
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ from dataclasses import dataclass
 
 from calib.errors import InputError
 from planner.export.job import ExportJob, TargetPair, ToolData, build_job
+from planner.export.text import file_stem, module_name
 from planner.program.controllers import CONTROLLERS
 
 #: A writer: the program files of a job, ``{suffix: text}``.
@@ -51,11 +54,15 @@ class ExportFormat:
         writer: ``"module:function"`` of the writer ``(ExportJob) -> {suffix: text}``.
         suffixes: the suffixes of the files the writer returns, first one first (the first
             file is written to the output path, the others beside it with their suffix).
+        program_name: ``"module:function"`` naming the program from the job's name, for a
+            controller whose file must be named as the program in it (KRL's ``DEF``, FANUC's
+            ``/PROG``); ``""``: the files are named after the plan (:meth:`file_stem`).
     """
 
     name: str
     writer: str
     suffixes: tuple[str, ...]
+    program_name: str = ""
 
     @property
     def label(self) -> str:
@@ -73,15 +80,36 @@ class ExportFormat:
         writer: Writer = getattr(importlib.import_module(module), function)
         return writer
 
+    def file_stem(self, plan_name: str) -> str:
+        """The name (without suffix) of the files of the plan named ``plan_name``, as the
+        command line and the UI's downloads name them: the program's name where the controller
+        wants the file named so (:attr:`program_name`), else the plan's name made safe for file
+        systems (:func:`planner.export.text.file_stem`)."""
+        if not self.program_name:
+            return file_stem(plan_name)
+        module, _, function = self.program_name.partition(":")
+        name: Callable[[str], str] = getattr(importlib.import_module(module), function)
+        return file_stem(name(module_name(plan_name or "plan")))
+
 
 #: The robot-program formats by name.
 FORMATS: dict[str, ExportFormat] = {
     f.name: f
     for f in (
         ExportFormat("rapid", "planner.export.rapid:rapid_files", (".mod",)),
-        ExportFormat("krl", "planner.export.krl:export_krl", (".src", ".dat")),
+        ExportFormat(
+            "krl",
+            "planner.export.krl:export_krl",
+            (".src", ".dat"),
+            "planner.export.krl:program_name",
+        ),
         ExportFormat("urscript", "planner.export.urscript:urscript_files", (".script",)),
-        ExportFormat("fanuc", "planner.export.fanuc:export_fanuc", (".ls",)),
+        ExportFormat(
+            "fanuc",
+            "planner.export.fanuc:export_fanuc",
+            (".ls",),
+            "planner.export.fanuc_text:program_name",
+        ),
     )
 }
 #: What ``wobjcal export --format`` accepts: the robot formats and the plan's own JSON.
@@ -96,8 +124,17 @@ __all__ = [
     "ToolData",
     "Writer",
     "build_job",
+    "export_file_stem",
     "export_files",
 ]
+
+
+def export_file_stem(plan_name: str, fmt: str) -> str:
+    """The name (without suffix) of the files of the plan named ``plan_name`` in ``fmt`` (a
+    key of :data:`FORMATS`, or ``"json"``: the plan's name made safe for file systems)."""
+    if fmt in FORMATS:
+        return FORMATS[fmt].file_stem(plan_name)
+    return file_stem(plan_name)
 
 
 def export_files(job: ExportJob, fmt: str) -> dict[str, str]:

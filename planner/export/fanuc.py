@@ -10,8 +10,12 @@ robot base of the plan, as KRL takes ``$WORLD``), and the sensor TCP into ``PR[P
 ``UTOOL[UTOOL_NO]``; every ``P[]`` is a sensor-TCP pose in that user frame with that tool, with
 the ``CONFIG`` of the robot's configuration there (:func:`config_text`: flip, up, top and the
 turn numbers of :data:`TURN_AXES`, from the IK solution at that target next to the pose
-``wobjcal check`` chose). Without a checked pose the configuration cannot be derived and the
-export is refused (:class:`calib.errors.InputError`), never written as a guess.
+``wobjcal check`` chose). A target without a checked pose (``--no-check``, a point check
+refuses, exported with ``--force``; a robot that is not a 6-axis OPW arm) has no ``CONFIG`` to
+derive, and none is guessed: it is written as a position register built from ``LPOS`` (``PR[k]=
+LPOS``, then its six components), so the robot keeps the configuration and turn numbers it has
+when it gets there, as a KRL target without ``S`` and ``T`` does; the header names those points
+and says to run the program the first time in T1 (:data:`PR_SAFE`, :data:`PR_TARGET`).
 
 Every search runs in the nominal user frame (not adaptive; the frame comes from ``wobjcal
 calibrate``) and starts at the safe start of :mod:`planner.program.safety`. A search is
@@ -59,7 +63,7 @@ from planner.export.fanuc_text import (
     wpr_deg,
     xyzwpr,
 )
-from planner.export.job import ExportJob, TargetPair, safety_header
+from planner.export.job import ExportJob, TargetPair, check_header, digest_text, safety_header
 from planner.export.text import fmt
 
 __all__ = [
@@ -92,6 +96,10 @@ PR_EDGE_START = 3
 PR_EDGE_END = 4
 #: Scratch: the face point measured by the approach search of an edge point.
 PR_FACE = 5
+#: Scratch: the safe start of a point without a checked pose there (``LPOS`` + components).
+PR_SAFE = 6
+#: Scratch: the end of the first search of a point without a checked pose there.
+PR_TARGET = 7
 #: Point ``i`` (1-based) is measured into ``PR[PR_MEAS_BASE + i]``: PR[11], PR[12], ...
 PR_MEAS_BASE = 10
 #: Point ``i`` (1-based) reports its result code in ``R[R_CODE_BASE + i]``: R[11], R[12], ...
@@ -118,20 +126,34 @@ class _Program:
     def comment(self, text: str) -> None:
         self.lines += ["!" + c for c in comment_lines(text)]
 
+    def target(self, t: TargetPair, kind: str, label: str, pr: int) -> str:
+        """The target ``kind`` of ``t`` as a motion's destination: ``P[n]`` (:meth:`position`)
+        when the robot's configuration there is known, else ``PR[pr]`` written here from
+        ``LPOS`` and the target's six components (:meth:`set_register`), so the robot keeps its
+        current configuration and turn numbers (written where the motion starts)."""
+        if t.arm_pose(kind) is None:
+            self.set_register(pr, t.target(kind))
+            return f"PR[{pr}]"
+        return f"P[{self.position(t, kind, label)}]"
+
+    def copy_target(self, pr: int, t: TargetPair, kind: str, label: str) -> None:
+        """``PR[pr]`` = the target ``kind`` of ``t``: ``PR[pr]=P[n]`` when its configuration is
+        known, else from ``LPOS`` and its six components (the robot's configuration)."""
+        if t.arm_pose(kind) is None:
+            self.set_register(pr, t.target(kind))
+        else:
+            self.add(f"PR[{pr}]=P[{self.position(t, kind, label)}]")
+
     def position(self, t: TargetPair, kind: str, label: str) -> int:
         """Add the sensor-TCP pose of target ``kind`` of ``t`` (user frame) as the next
         ``P[n]`` with its configuration; return ``n``.
 
         Raises:
-            InputError: the robot's configuration there is not known (no checked pose).
+            ValueError: the robot's configuration there is not known (use :meth:`target`).
         """
         arm = t.arm_pose(kind)
         if arm is None:
-            raise InputError(
-                f"FANUC export: point {_ascii_ident(t.point_id)}: no checked robot pose at its "
-                f"{kind} target, so its CONFIG cannot be derived (export with the check, on a "
-                "6-axis arm with a spherical wrist, and a feasible pose for every point)"
-            )
+            raise ValueError(f"point {t.point_id}: no configuration at its {kind} target")
         n = len(self.positions) + 1
         x, y, z, w, p, r = (_pos_num(v) for v in xyzwpr(t.target(kind)))
         self.positions.append(
@@ -232,14 +254,23 @@ def export_fanuc(job: ExportJob) -> dict[str, str]:
 
 
 def _header(prog: _Program, job: ExportJob, name: str) -> None:
-    """The comment lines at the top of ``/MN``: units, frames, safety, results."""
+    """The comment lines at the top of ``/MN``: provenance (version, plan, digest), what was
+    checked, units, frames, safety, results, and the points written without ``CONFIG``."""
     n = len(job.targets)
     tool = job.tool
     cog = ", ".join(fmt(c * 1000.0, 1) for c in tool.cog_m)
     first, last = PR_MEAS_BASE + 1, PR_MEAS_BASE + n
+    no_config = [
+        _ascii_ident(t.point_id)
+        for t in job.targets
+        if any(t.arm_pose(k) is None for k in _KINDS.get(t.kind, ("safe", "end")))
+    ]
+    scratch = PR_TARGET if no_config else PR_FACE
     for text in (
         f"Generated by wobjcal {__version__} from plan {job.plan_name} (procedure {job.method}). "
         f"Save as {name}.ls (file name = program name).",
+        digest_text(job),  # one comment line: what a results reader looks for
+        check_header(job, "fanuc"),
         "Units mm, deg. W,P,R: fixed angles about x,y,z of the user frame, R = Rz(R) Ry(P) "
         "Rx(W) (the paper's Tait-Bryan z-y-x angles alpha,beta,gamma = R,P,W).",
         f"UFRAME[{UFRAME_NO}] = PR[{PR_UFRAME}] = nominal work object in WORLD, taken to be the "
@@ -257,21 +288,32 @@ def _header(prog: _Program, job: ExportJob, name: str) -> None:
         f"point to the base, p_base = Rot(W,P,R) p + (X,Y,Z) with the PR[{PR_UFRAME}] values set "
         "below, and write a wobjcal.measurements/1 file (frame base, units mm) for wobjcal "
         "calibrate.",
-        f"Overwrites PR[{PR_UFRAME}]..PR[{PR_FACE}], PR[{first}]..PR[{last}], "
+        f"Overwrites PR[{PR_UFRAME}]..PR[{scratch}], PR[{first}]..PR[{last}], "
         f"R[{R_TMP[0]}]..R[{R_TMP[1]}], R[{R_CODE_BASE + 1}]..R[{R_CODE_BASE + n}]. CONFIG of "
-        "every position from the pose wobjcal check chose (turn numbers of "
+        "every P[] from the pose wobjcal check chose (turn numbers of "
         + ", ".join(f"J{a}" for a in TURN_AXES)
         + ": check $SCR_GRP[1].$TURN_AXIS); run the first time in T1. Limits "
         f"assumed: name {NAME_MAX}, comment {COMMENT_MAX} chars, PR[1..{PR_COUNT}], "
         f"R[1..{R_COUNT}].",
     ):
         prog.comment(text)
+    if no_config:
+        prog.comment(
+            f"NO CONFIG for points {', '.join(no_config)} (no checked robot pose): their targets "
+            f"are PR[{PR_SAFE}], PR[{PR_TARGET}], PR[{PR_EDGE_START}], PR[{PR_EDGE_END}] made "
+            "from LPOS, so the robot keeps its current configuration and turn numbers there. "
+            "Run the first time in T1 at low override."
+        )
     if any(t.vias_q_rad for t in job.targets):
         prog.comment(
             "Via points: P[] in joint representation, the URDF's joint values (no offsets). "
             "Where the controller measures J3 against the horizontal (J2/J3 interaction), "
             "correct J3 first. Joint positions have no CONFIG."
         )
+
+
+#: The targets a point's program moves to, by search kind.
+_KINDS = {"approach": ("safe", "end"), "edge": ("safe", "face", "start", "end")}
 
 
 def _point(prog: _Program, i: int, t: TargetPair) -> None:
@@ -285,30 +327,28 @@ def _point(prog: _Program, i: int, t: TargetPair) -> None:
         prog.joint_position(deg, f"{ident[:keep]} v{k}")
         for k, deg in enumerate(t.vias_deg("FANUC"), start=1)
     ]
-    safe = prog.position(t, "safe", f"{ident[:keep]} safe")
     prog.comment(f"--- point {i} {ident}: {t.kind} search")
     for n in vias:
         prog.add(f"J P[{n}] {JOINT_PCT}% FINE")
-    prog.add(f"J P[{safe}] {JOINT_PCT}% FINE")
+    safe = prog.target(t, "safe", f"{ident[:keep]} safe", PR_SAFE)
+    prog.add(f"J {safe} {JOINT_PCT}% FINE")
+    first = "end" if t.kind == "approach" else "face"
+    goal = prog.target(t, first, f"{ident[:keep]} {first}", PR_TARGET)
     prog.add(f"R[{code}]=2")
     prog.add(f"IF DI[{SENSOR_DI}]=ON,JMP LBL[{label}]")
     prog.add(f"R[{code}]=1")
     prog.add(f"SKIP CONDITION DI[{SENSOR_DI}]=ON")
     if t.kind == "approach":
-        end = prog.position(t, "end", f"{ident[:keep]} end")
-        prog.add(f"L P[{end}] {speed}mm/sec FINE Skip,LBL[{label}],PR[{meas}]=LPOS")
+        prog.add(f"L {goal} {speed}mm/sec FINE Skip,LBL[{label}],PR[{meas}]=LPOS")
     else:
-        face = prog.position(t, "face", f"{ident[:keep]} face")
-        start = prog.position(t, "start", f"{ident[:keep]} start")
-        end = prog.position(t, "end", f"{ident[:keep]} end")
-        prog.add(f"L P[{face}] {speed}mm/sec FINE Skip,LBL[{label}],PR[{PR_FACE}]=LPOS")
+        prog.add(f"L {goal} {speed}mm/sec FINE Skip,LBL[{label}],PR[{PR_FACE}]=LPOS")
         prog.comment("edge start: the measured face point, plan orientation")
         s, e = PR_EDGE_START, PR_EDGE_END
-        prog.add(f"PR[{s}]=P[{start}]")
+        prog.copy_target(s, t, "start", f"{ident[:keep]} start")
         for k in (1, 2, 3):
             prog.add(f"PR[{s},{k}]=PR[{PR_FACE},{k}]")
         prog.add(f"L PR[{s}] {LINEAR_MM_S}mm/sec FINE")
-        prog.add(f"PR[{e}]=P[{end}]")
+        prog.copy_target(e, t, "end", f"{ident[:keep]} end")
         _project_end(prog, t.edge_direction_wobj)
         prog.add(f"R[{code}]=2")
         prog.add(f"IF DI[{SENSOR_DI}]=OFF,JMP LBL[{label}]")
@@ -317,7 +357,7 @@ def _point(prog: _Program, i: int, t: TargetPair) -> None:
         prog.add(f"L PR[{e}] {speed}mm/sec FINE Skip,LBL[{label}],PR[{meas}]=LPOS")
     prog.add(f"R[{code}]=0")
     prog.add(f"LBL[{label}]")
-    prog.add(f"L P[{safe}] {LINEAR_MM_S}mm/sec FINE")
+    prog.add(f"L {safe} {LINEAR_MM_S}mm/sec FINE")
 
 
 def _project_end(prog: _Program, d: np.ndarray) -> None:

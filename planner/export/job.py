@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import InputError
 from calib.frames import check_transform, make_transform
-from calib.plan.file import Plan
+from calib.plan.file import Plan, plan_digest
 from calib.probing import SearchCommand
 from planner.export.text import module_name
 from planner.program.build import AdaptiveSpec, adaptive_spec, measuring_program, safety_spec
@@ -161,6 +161,31 @@ class ToolData:
 
 
 @dataclass(frozen=True)
+class CheckStatus:
+    """What ``wobjcal check`` said about the program a job writes: every program's header says
+    it (:func:`check_header`).
+
+    Attributes:
+        checked: the job was built from a check of the plan in its cell for this controller
+            (``False``: built without one, e.g. ``wobjcal export --no-check`` or a job made in
+            code).
+        refused: ids of the points the check refuses, in plan order.
+        problems: what refuses the plan besides its points, one line each: the check's error
+            (``"error: ..."``) and the procedure's layout problem (``"layout: ..."``, known
+            without a check too).
+    """
+
+    checked: bool = False
+    refused: tuple[str, ...] = ()
+    problems: tuple[str, ...] = ()
+
+    @property
+    def passed(self) -> bool:
+        """The check ran and refuses nothing."""
+        return self.checked and not self.refused and not self.problems
+
+
+@dataclass(frozen=True)
 class ExportJob:
     """Everything an exporter writes.
 
@@ -180,6 +205,10 @@ class ExportJob:
             writer serialises (:meth:`program`).
         program_errors: why a controller has no program (its adaptive procedure refuses the
             layout), by controller name.
+        plan_digest: :func:`calib.plan.file.plan_digest` of the plan (``""``: not known, a job
+            made in code); every header carries it as ``plan digest <16 hex digits>``.
+        check: what ``wobjcal check`` said about the program (:class:`CheckStatus`; the
+            default: built without a check).
     """
 
     name: str
@@ -193,6 +222,8 @@ class ExportJob:
     adaptive: AdaptiveSpec | None = None
     programs: Mapping[str, MeasuringProgram] = field(default_factory=dict)
     program_errors: Mapping[str, str] = field(default_factory=dict)
+    plan_digest: str = ""
+    check: CheckStatus = field(default_factory=CheckStatus)
 
     def program(self, fmt: str) -> MeasuringProgram:
         """The measuring program the controller ``fmt`` runs for this job's plan.
@@ -233,6 +264,7 @@ def build_job(
     rotations_wobj: Mapping[str, ArrayLike] | None = None,
     confdata: Mapping[str, ConfData] | None = None,
     sensor_input: str = "diSensor",
+    check: CheckStatus | None = None,
 ) -> ExportJob:
     """The export job of ``plan``.
 
@@ -244,6 +276,8 @@ def build_job(
             the check); missing points get :func:`default_sensor_rotation`.
         confdata: ``{id: (cf1, cf4, cf6, cfx)}`` per point (from the check), or ``None``.
         sensor_input: name of the sensor input.
+        check: what ``wobjcal check`` said about the program (``None``: built without a
+            check).
     """
     T = check_transform(T_base_wobj, "T_base_wobj")
     rotations = rotations_wobj or {}
@@ -297,6 +331,43 @@ def build_job(
         adaptive=spec,
         programs=programs,
         program_errors=errors,
+        plan_digest=plan_digest(plan),
+        check=check or CheckStatus(),
+    )
+
+
+def digest_text(job: ExportJob) -> str:
+    """``"plan digest <16 hex digits>"`` of the job's plan, as every program header writes it
+    (results readers look for it; ``"plan digest unknown"`` for a job made in code)."""
+    return f"plan digest {job.plan_digest or 'unknown'}"
+
+
+def check_header(job: ExportJob, fmt: str) -> str:
+    """What was checked, as the header of the controller ``fmt``'s program says it: ``CHECKED:
+    ...`` when ``wobjcal check`` passed this program in the plan's cell, else ``NOT CHECKED:
+    ...`` naming why (built without a check; or the points and problems check refuses)."""
+    status = job.check
+    c = CONTROLLERS[fmt]
+    if status.passed:
+        return (
+            "CHECKED: wobjcal check passed for this program in the plan's cell "
+            f"({len(job.targets)} points, controller {c.vendor} {c.label})."
+        )
+    refused = []
+    if status.refused:
+        ids = ", ".join(status.refused)
+        refused.append(f"point{'s' if len(status.refused) > 1 else ''} {ids}")
+    refused += status.problems
+    if not status.checked:
+        text = (
+            "NOT CHECKED: built without a cell check (wobjcal export --no-check, or a job made "
+            f"in code): run `wobjcal check --format {fmt}` on the plan before the first run."
+        )
+        return text + (f" Refused: {'; '.join(refused)}." if refused else "")
+    return (
+        "NOT CHECKED: exported with --force (or downloaded from the UI) although wobjcal check "
+        f"refuses {'; '.join(refused)}: fix the plan, or make sure by hand that those moves are "
+        "safe, and run the program the first time at reduced speed."
     )
 
 

@@ -83,6 +83,16 @@ def with_spec(job: ExportJob, program: MeasuringProgram) -> ExportJob:
     return replace(job, adaptive=spec)
 
 
+def krl_job(job: ExportJob) -> tuple[ExportJob, MeasuringProgram]:
+    """``job`` as the KRL writer uses it, and its KRL program: the A-H specifics kept (or
+    taken from the program) for an adaptive A-H program, dropped for any other (the data list
+    and the slots of ``xMeas`` follow from it)."""
+    program = job.program("krl")
+    if not program.adaptive or program.steers_itself:
+        return replace(job, adaptive=None), program
+    return with_spec(job, program), program
+
+
 def measured_slots(job: ExportJob) -> list[tuple[str, bool]]:
     """``(point id, is a retake)`` of each slot of ``xMeas``/``nFail``, in order: the points
     in plan order, then (adaptive A-H with retakes) C and D retaken."""

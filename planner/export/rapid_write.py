@@ -22,7 +22,8 @@ def _write_points(cond: str, left: str, right: str) -> list[str]:
     ]
 
 
-def write_proc() -> list[str]:
+def write_proc(plan_digest: str = "") -> list[str]:
+    """``WriteMeasurements``: the measurements file, with the plan's digest (``""``: none)."""
     q = '""'
     return [
         "    ! Write the measurements as wobjcal.measurements/1 for `wobjcal calibrate`",
@@ -45,7 +46,7 @@ def write_proc() -> list[str]:
         '                sep:=", ";',
         "            ENDIF",
         "        ENDFOR",
-        '        Write file,"}}";',
+        f'        Write file,"}}, {q}plan_digest{q}: {q}{plan_digest}{q}}}";',
         "        Close file;",
         f'        TPWrite "wobjcal: measurements written to HOME:/{MEASURED_FILE}";',
         "    ENDPROC",

@@ -33,6 +33,14 @@ def literal_text(text: object) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]", "_", str(text))
 
 
+def file_stem(name: str, fallback: str = "wobjcal_plan") -> str:
+    """A file name (without suffix) made of ``name``: letters, digits and ``_ - .`` kept, every
+    run of anything else (spaces, ``/``, ``:`` ...) one ``_``; no leading ``.`` or ``-`` (a
+    hidden file, an option), no trailing ``.``; ``fallback`` when nothing is left."""
+    stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", name).lstrip(".-").rstrip(".")
+    return stem or fallback
+
+
 def module_name(plan_name: str) -> str:
     """``"stator_section_ah"`` -> ``"WobjcalStatorSectionAh"`` (max 32 characters)."""
     words = re.split(r"[^A-Za-z0-9]+", plan_name)

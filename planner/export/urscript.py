@@ -34,6 +34,7 @@ from planner.export.job import ExportJob, safety_header
 from planner.export.text import identifier, literal_text
 from planner.export.urscript_layout import preamble
 from planner.export.urscript_probe import (
+    LOG_MARK,
     SENSOR_IN,
     pose_text,
     probe_args,
@@ -76,7 +77,7 @@ def _export_nominal(job: ExportJob) -> str:
             f'  {identifier("meas_" + t.point_id)} = probe("{literal_text(t.point_id)}", '
             f"{probe_args(t)})",
         ]
-    lines += ["end", ""]
+    lines += [f'  textmsg("{LOG_MARK} end")', "end", ""]
     return "\n".join(lines)
 
 

@@ -109,6 +109,7 @@ def search_routines() -> list[str]:
         "    end",
         "    return [1.0, 0.0, 0.0, 0.0]",
         "  end",
+        *log_routine(),
         "  # probe one point (poses in the wobj frame): approach search from safe_wobj; for an",
         "  # edge point (want False) first approach the face (safe_wobj -> face_wobj), then run",
         "  # along the plan's direction from the measured face point up to the plan's end",
@@ -147,14 +148,31 @@ def search_routines() -> list[str]:
 
 
 def _log_and_retreat(ind: str) -> list[str]:
+    return [f"{ind}log_result(name, result)", f"{ind}movel(safe, {MOVEL})"]
+
+
+#: What begins every results line in the log (:mod:`planner.results.urscript_log`).
+LOG_MARK = "wobjcal/1"
+
+
+def log_routine() -> list[str]:
+    """``log_result(name, result)``: the results line of a search in the controller's log,
+    ``wobjcal/1 point <id> <code> <x> <y> <z>`` (base frame, integer nanometres: an integer
+    prints exactly; :mod:`planner.results.urscript_log` reads it)."""
+    nm = "1000000000.0"
     return [
-        f"{ind}if result[0] == 0.0:",
-        f"{ind}  textmsg(name, result)",
-        f"{ind}else:",
-        f'{ind}  textmsg(str_cat(name, " failed: code (1 no detection, 2 at level at start) "), '
-        "result[0])",
-        f"{ind}end",
-        f"{ind}movel(safe, {MOVEL})",
+        "  # the result of a search as one log line, read by `wobjcal calibrate`:",
+        "  # wobjcal/1 point <id> <code> <x> <y> <z>, code 0 measured, 1 no detection, 2 input",
+        "  # already at the searched level; x y z the point, base frame, integer nanometres",
+        "  def log_result(name, result):",
+        f'    line = str_cat(str_cat("{LOG_MARK} point ", name), '
+        'str_cat(" ", to_str(floor(result[0] + 0.5))))',
+        *(
+            f'    line = str_cat(line, str_cat(" ", to_str(floor(result[{k}] * {nm} + 0.5))))'
+            for k in (1, 2, 3)
+        ),
+        "    textmsg(line)",
+        "  end",
     ]
 
 
@@ -177,7 +195,8 @@ def probe_from_routine() -> list[str]:
         "    k = ((end_wobj[0] - s[0]) * d[0] + (end_wobj[1] - s[1]) * d[1] + "
         "(end_wobj[2] - s[2]) * d[2]) / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2])",
         "    if k <= 0.0:",
-        '      textmsg(name, " failed: the measured start lies past the end of the search")',
+        "      # the measured start lies past the end of the search: no detection on the path",
+        "      log_result(name, [1.0, 0.0, 0.0, 0.0])",
         "      return [1.0, 0.0, 0.0, 0.0]",
         "    end",
         f"    movel(pose_trans(wobj, s), {MOVEL})",
@@ -198,7 +217,7 @@ def keep_routines(label: str) -> list[str]:
         "  # stop the procedure: say why; what was measured stays in measured, measured_code",
         "  # and meas_<ID> (and in the log)",
         "  def stop_procedure(why):",
-        f'    textmsg("wobjcal: {lab} stopped: ", why)',
+        f'    textmsg("{LOG_MARK} stop {lab}: ", why)',
         "    halt",
         "  end",
         "  # keep the result of slot i (base frame, m); a failed search stops the program: the",

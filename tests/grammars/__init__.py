@@ -1,0 +1,1 @@
+"""Third-party grammars, and the parsers generated from them, for the tests (README.md)."""
