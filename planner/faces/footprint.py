@@ -104,11 +104,13 @@ def holds_footprint(
         return np.zeros(0, dtype=bool)
     area = np.asarray(mesh.area_faces)
     centres, ids = [], []
+    tris: dict[int, IntArray] = {}
     order = np.argsort(labels, kind="stable")
     starts = np.searchsorted(labels[order], regions, side="left")
     ends = np.searchsorted(labels[order], regions, side="right")
     for r, lo, hi in zip(regions, starts, ends, strict=True):
         tri = order[lo:hi]
+        tris[int(r)] = tri
         big = tri[np.argsort(-area[tri], kind="stable")[:_N_CANDIDATES]]
         spread = tri[np.linspace(0, len(tri) - 1, min(len(tri), _N_CANDIDATES)).astype(int)]
         pick = np.unique(np.concatenate([big, spread]))
@@ -121,7 +123,9 @@ def holds_footprint(
     out = np.array([bool(np.any(ok[region == r])) for r in regions], dtype=bool)
     for k in np.flatnonzero(~out):
         r = int(regions[k])
-        spot = _roomiest_spot(mesh, labels, r, n[r], float(d[r]), radius_m)
+        if _too_narrow(mesh, tris[r], n[r], radius_m):
+            continue
+        spot = _roomiest_spot(mesh, tris[r], n[r], float(d[r]), radius_m)
         if spot is not None:
             hit = footprint_hits(
                 mesh, labels, spot[None], n[r][None], np.array([r]), radius_m, tol_m
@@ -130,17 +134,31 @@ def holds_footprint(
     return out
 
 
+def _too_narrow(mesh: trimesh.Trimesh, tri: IntArray, n: FloatArray, radius_m: float) -> bool:
+    """No footprint can lie wholly on the region of the triangles ``tri``: its outline is
+    narrower, along one of two in-plane axes, than the rim samples span in every direction
+    (``2 r cos(pi / N)``: the samples are :data:`N_RIM_SAMPLES` apart around the rim, so some
+    lie within ``pi / N`` of any direction and its opposite). A necessary condition, cheap,
+    that spares the inscribed circle of the many small regions of a curved or finely meshed
+    part."""
+    u, v = plane_basis(np.asarray(n, dtype=np.float64)[None])
+    pts = np.asarray(mesh.vertices, dtype=np.float64)[np.asarray(mesh.faces)[tri].ravel()]
+    need = 2.0 * radius_m * math.cos(math.pi / N_RIM_SAMPLES) - 1e-9
+    return bool(np.ptp(pts @ u[0]) < need or np.ptp(pts @ v[0]) < need)
+
+
 def _roomiest_spot(
-    mesh: trimesh.Trimesh, labels: IntArray, region: int, n: FloatArray, d: float, radius_m: float
+    mesh: trimesh.Trimesh, tri: IntArray, n: FloatArray, d: float, radius_m: float
 ) -> FloatArray | None:
-    """``(3,)`` the centre of the largest circle inside ``region``'s outline, on its plane
+    """``(3,)`` the centre of the largest circle inside the outline of the region of the
+    triangles ``tri``, on its plane
     (``n . x = d``), wobj frame, m; ``None`` when the outline is empty."""
     import shapely
 
     from calib.estimators.steering import plane_basis
 
     B = np.asarray(plane_basis(n), dtype=np.float64)  # (3, 2)
-    uv = np.asarray(mesh.triangles[labels == region], dtype=np.float64) @ B  # (T, 3, 2)
+    uv = np.asarray(mesh.triangles[tri], dtype=np.float64) @ B  # (T, 3, 2)
     outline = shapely.union_all(shapely.polygons(uv)).buffer(1e-7)
     if outline.is_empty:
         return None
