@@ -14,7 +14,19 @@ The target is treated like ``cp`` treats it:
   link is refused (``cp``: "not writing through dangling symlink");
 - an existing file without any write permission bit is refused, even for root (who may
   write anything): a read-only program or plan stays as it is;
-- a directory is refused.
+- a directory is refused;
+- a target that exists and is not a regular file (a character or block device such as
+  ``/dev/null``, a FIFO) is written in place, like ``cp`` writes it: opened, written, closed,
+  never replaced by a regular file;
+- ``/dev/stdout``, ``/dev/stderr``, ``/dev/fd/N`` and ``/proc/self/fd/N`` are this process's
+  open file descriptor ``N``, written where it points at its current offset (``sys.stdout`` and
+  ``sys.stderr`` for 1 and 2, so a command that sends native output elsewhere meanwhile still
+  writes to its real standard output), never opened again by name.
+
+Every step is checked: a failed write, flush, ``fsync``, close or rename (a full disk:
+``ENOSPC``) raises :class:`OSError` whose ``filename`` is the path the caller gave, so the
+message names the file and the reason. A device that cannot ``fsync`` (``EINVAL``) is not an
+error.
 """
 
 from __future__ import annotations
@@ -25,6 +37,7 @@ import os
 import re
 import secrets
 import stat
+import sys
 from pathlib import Path
 
 #: The temporary files this module names: ``.<target name>.wobjcal-<pid>-<hex>.tmp``.
@@ -60,28 +73,43 @@ def resolve_target(path: str | os.PathLike[str]) -> Path:
 def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
     """Write ``data`` to ``path`` atomically and return the path written (a symlink's target).
 
+    A device, FIFO or standard stream is written in place instead (see the module docstring).
+
     Args:
         path: target file; its directory must exist.
         data: the bytes to write.
 
     Raises:
-        OSError: the directory does not exist or is not writable, or the target is refused
-            (see the module docstring); the target is unchanged.
+        OSError: the directory does not exist or is not writable, the target is refused, or a
+            write, flush, sync, close or rename failed (see the module docstring); its
+            ``filename`` is ``path``; a regular target is unchanged.
     """
+    fd_number = own_descriptor(path)
+    if fd_number is not None:
+        _write_descriptor(fd_number, data, path)
+        return Path(path)
     target = resolve_target(path)
+    try:
+        mode = target.stat().st_mode
+    except FileNotFoundError:
+        mode = stat.S_IFREG
+    if not stat.S_ISREG(mode):
+        _write_in_place(target, data, path)
+        return target
     directory = target.parent if str(target.parent) else Path()
     remove_stale_temporaries(directory)
     name = f".{target.name}.wobjcal-{os.getpid()}-{secrets.token_hex(4)}.tmp"
     tmp = directory / name
     fd, named = _open_temporary(directory, tmp, path)
     try:
-        with os.fdopen(fd, "wb") as handle:
-            handle.write(data)
-            handle.flush()
-            os.fsync(handle.fileno())
+        try:
+            _write_all(fd, data)
+            os.fsync(fd)
             if not named:  # give the finished file its temporary name
-                _link_unnamed(handle.fileno(), directory, tmp.name)
+                _link_unnamed(fd, directory, tmp.name)
                 named = True
+        finally:
+            os.close(fd)  # a close error (NFS, a full quota) is a failed write too
         if target.exists():
             # keep the permissions of the file being replaced
             with contextlib.suppress(OSError):
@@ -91,10 +119,12 @@ def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
             os.umask(umask)
             tmp.chmod(0o666 & ~umask)
         tmp.replace(target)  # os.replace: atomic
-    except BaseException:
+    except BaseException as exc:
         if named:
             with contextlib.suppress(OSError):
                 tmp.unlink()
+        if isinstance(exc, OSError):
+            raise _naming(exc, path) from None
         raise
     _fsync_directory(directory)
     return target
@@ -103,6 +133,89 @@ def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
 def write_text_atomic(path: str | os.PathLike[str], text: str, encoding: str = "utf-8") -> Path:
     """Write ``text`` to ``path`` atomically (newlines written as given) and return the path."""
     return write_bytes_atomic(path, text.encode(encoding))
+
+
+#: ``/proc/<pid>/fd/<n>`` (or a thread's ``/proc/<pid>/task/<tid>/fd/<n>``).
+_PROC_FD_RE = re.compile(r"/proc/(?P<pid>\d+)(?:/task/\d+)?/fd/(?P<fd>\d+)")
+
+
+def own_descriptor(path: str | os.PathLike[str]) -> int | None:
+    """The file descriptor of this process that ``path`` names (``/dev/stdout`` is 1,
+    ``/dev/fd/5`` and ``/proc/self/fd/5`` are 5), or ``None`` for any other path.
+
+    Symbolic links are followed one at a time up to ``/proc/<pid>/fd/<n>``, whose own link
+    (``pipe:[...]``, or a file that may have been replaced meanwhile) is not followed.
+    """
+    current = Path(path).absolute()
+    try:
+        for _ in range(40):  # the kernel's limit of nested links
+            parent = current.parent.resolve()
+            current = parent / current.name
+            m = _PROC_FD_RE.fullmatch(str(current))
+            if m is not None:
+                return int(m.group("fd")) if int(m.group("pid")) == os.getpid() else None
+            if not current.is_symlink():
+                return None
+            current = parent / current.readlink()
+    except (OSError, RuntimeError):  # a loop, an unreadable link: an ordinary path
+        return None
+    return None
+
+
+def _write_descriptor(fd: int, data: bytes, path: str | os.PathLike[str]) -> None:
+    """Write ``data`` to this process's descriptor ``fd`` where it stands (standard output and
+    error through ``sys.stdout`` and ``sys.stderr``, after what they hold), checked."""
+    stream = {1: sys.stdout, 2: sys.stderr}.get(fd)
+    try:
+        if stream is None:
+            _write_all(fd, data)
+            return
+        stream.flush()
+        binary = getattr(stream, "buffer", None)
+        if binary is not None:
+            binary.write(data)
+            binary.flush()
+        else:
+            stream.write(data.decode(getattr(stream, "encoding", None) or "utf-8", "replace"))
+            stream.flush()
+    except OSError as exc:
+        raise _naming(exc, path) from None
+
+
+def _write_in_place(target: Path, data: bytes, path: str | os.PathLike[str]) -> None:
+    """Write ``data`` into the existing non-regular file ``target`` (a device, a FIFO): open,
+    write, sync (where the device can), close, each checked; the node stays."""
+    try:
+        fd = os.open(target, os.O_WRONLY | getattr(os, "O_NOCTTY", 0))
+        try:
+            _write_all(fd, data)
+            try:
+                os.fsync(fd)
+            except OSError as exc:  # a terminal, pipe or /dev/null has nothing to sync
+                if exc.errno not in (errno.EINVAL, errno.EROFS, errno.ENOTSUP, errno.ENOTTY):
+                    raise
+        finally:
+            os.close(fd)
+    except OSError as exc:
+        raise _naming(exc, path) from None
+
+
+def _write_all(fd: int, data: bytes) -> None:
+    """``os.write`` until every byte of ``data`` is written (a write may take only part)."""
+    view = memoryview(data)
+    while view:
+        written = os.write(fd, view)
+        if written <= 0:  # never for a blocking descriptor; do not loop forever
+            raise OSError(errno.EIO, "nothing written")
+        view = view[written:]
+
+
+def _naming(exc: OSError, path: str | os.PathLike[str]) -> OSError:
+    """``exc`` with ``filename`` the path the user gave (not a temporary file's)."""
+    if exc.filename == os.fspath(path) and exc.filename2 is None:
+        return exc
+    reason = exc.strerror or str(exc)
+    return OSError(exc.errno, reason, os.fspath(path))
 
 
 def remove_stale_temporaries(directory: Path) -> list[Path]:

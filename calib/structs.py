@@ -10,10 +10,12 @@ rejected. A check in ``__post_init__`` raises :class:`calib.errors.PlanError` wi
 from __future__ import annotations
 
 import math
+from collections.abc import Sized
 
 import msgspec
 
 from calib.errors import PlanError
+from calib.limits import MAX_SEARCH_LENGTH_M
 from calib.tolerances import COORDINATE_LIMIT_M
 
 Vec3 = tuple[float, float, float]
@@ -63,12 +65,35 @@ def check_positive(value: float, field: str, allow_zero: bool = False) -> None:
         raise PlanError(f"{field}: must be {'>= 0' if allow_zero else '> 0'}, got {value}")
 
 
-def check_count(value: int, field: str, minimum: int = 1, maximum: int | None = None) -> None:
+def check_count(
+    value: int, field: str, minimum: int = 1, maximum: int | None = None, why: str = ""
+) -> None:
     """Raise :class:`PlanError` unless ``value`` is an integer ``>= minimum`` (and
     ``<= maximum`` when given: a count that would allocate without bound is refused here,
-    naming the field, not met later as an overflow)."""
+    naming the field, not met later as an overflow; ``why`` says why the bound, see
+    :mod:`calib.limits`)."""
     if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
         raise PlanError(f"{field}: must be an integer >= {minimum}, got {value!r}")
     if maximum is not None and value > maximum:
         shown = f"{value:,}" if value < 10**15 else f"{value:.3g}"
-        raise PlanError(f"{field}: must be at most {maximum:,}, got {shown}")
+        reason = f" ({why})" if why else ""
+        raise PlanError(f"{field}: must be at most {maximum:,}, got {shown}{reason}")
+
+
+def check_length(items: Sized, field: str, maximum: int, what: str, why: str) -> None:
+    """Raise :class:`PlanError` when ``items`` holds more than ``maximum`` ``what``
+    (``"points: 10,000 points, at most 500 (why)"``), before any of them is used."""
+    if len(items) > maximum:
+        raise PlanError(f"{field}: {len(items):,} {what}, at most {maximum:,} ({why})")
+
+
+def check_search_lengths(start_offset_m: float, overtravel_m: float) -> None:
+    """Raise :class:`PlanError` when a search starts or overtravels more than
+    :data:`calib.limits.MAX_SEARCH_LENGTH_M` (a search is centimetres; its scan steps 2.5 mm)."""
+    for field, value in (("start_offset_m", start_offset_m), ("overtravel_m", overtravel_m)):
+        if value > MAX_SEARCH_LENGTH_M:
+            raise PlanError(
+                f"{field}: {value:g} m, at most {MAX_SEARCH_LENGTH_M:g} m (a search runs "
+                "centimetres within a robot's reach of 1-3 m, and a simulated edge scan casts "
+                "its rays every 2.5 mm of it; a value in mm given as metres?)"
+            )

@@ -14,7 +14,9 @@ Every result is screened before anyone pastes it into a robot (:func:`trust_prob
   is compared with the noise the plan expects (:func:`expected_sigma_m`: the plan's sensor and
   robot error models and the planar-face flatness); a point beyond ``k_sigma`` is flagged and,
   with redundant points, the point to re-measure is named by leave-one-out
-  (:func:`calib.estimators.gross_errors.screen_measurements`);
+  (:func:`calib.estimators.gross_errors.screen_measurements`); the points whose gross error no
+  residual can show (a plain 3-2-1: all six) are named in a note, with how many points to add
+  (:func:`calib.estimators.gross_errors.detectability`);
 - misplacement: a frame farther from nominal than the plan's misplacement bound
   (``validation.misplacement``) is flagged;
 - uncertainty: the frame's 6x6 covariance for that noise, propagated through the method
@@ -35,7 +37,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.errors import InputError
-from calib.estimators.gross_errors import K_SIGMA, GrossErrorScreen, screen_measurements
+from calib.estimators.gross_errors import (
+    K_SIGMA,
+    GrossErrorScreen,
+    detectability,
+    screen_measurements,
+)
 from calib.frames import invert_transform, rotvec_from_matrix, transform_points
 from calib.plan.file import Plan
 from calib.plan.measurements import Measurements
@@ -179,7 +186,9 @@ def calibrate_plan(
     sequences = {pid: measured[pid] for pid in measured}
     cov = propagated_covariance(kind, points, sequences, T_nom, settings, sigma)
     problems = [*screen.messages(), *misplacement_problems(plan, run.T_base_wobj, screen)]
-    notes = [screen.note] if screen.note else []
+    unseen = detectability([p.to_probe_point() for p in plan.points if p.id in first])
+    # which points' gross errors the screen could not see, and how many points would show them
+    notes = [unseen.message()] if unseen.unseen else [screen.note] if screen.note else []
     return CalibrationOutput(
         method,
         run.T_base_wobj,

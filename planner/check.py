@@ -30,6 +30,9 @@ Per plan, the procedure's own preconditions (:func:`layout_problem`): the plan h
 role the procedure needs, and the procedure computes the nominal frame from exact measurements
 of the nominal points (a dry run of the same ``estimate`` that ``wobjcal calibrate`` runs), so
 a plan that ``calibrate`` would refuse fails at ``check``, before the robot has measured.
+Then which points' gross errors ``calibrate``'s screen could see at all
+(:func:`plan_detectability`; a plain 3-2-1 has no redundancy: none), and how many points to
+add so it sees one in every point: said, not failed.
 """
 
 from __future__ import annotations
@@ -45,7 +48,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.errors import InputError, ProbeFailedError
-from calib.frames import transform_points
+from calib.frames import invert_transform, transform_points
 from calib.plan.file import Plan, PlanPoint
 from calib.procedures import procedure_kind
 from calib.procedures.base import edge_offset_of
@@ -62,6 +65,7 @@ from planner.program.reach import search_problems
 if TYPE_CHECKING:
     import trimesh
 
+    from calib.estimators.gross_errors import Detectability
     from planner.cell.cell import Cell
     from planner.cell.feasibility import ProbeFeasibility
     from planner.faces.detection import PlanarFaces
@@ -77,10 +81,12 @@ __all__ = [
     "PlanCheck",
     "PointCheck",
     "Status",
+    "base_in_part",
     "check_plan",
     "check_points",
     "check_via_moves",
     "layout_problem",
+    "plan_detectability",
     "plan_quality",
 ]
 
@@ -107,6 +113,8 @@ def check_plan(
         with open_cell(plan, plan_dir or Path.cwd()) as own:
             return check_plan(plan, cell=own, fmt=fmt)
     checks, error = _check(plan, list(plan.points), cell)
+    # a robot standing inside the part makes every point fail: the cause, said once, first
+    error = "; ".join(e for e in (base_in_part(cell), error) if e)
     checks = check_via_moves(cell, plan, checks)
     layout = layout_problem(plan, fmt)
     quality, note = None, ""
@@ -128,7 +136,58 @@ def check_plan(
         quality,
         note,
         landing,
+        None if layout else plan_detectability(plan),
     )
+
+
+def base_in_part(cell: Cell) -> str:
+    """Why the robot's base lies inside the cell's work object, or ``""``: its origin within
+    the part's bounds (wobj frame), or a robot link no joint moves (the base link) overlapping
+    the part. Every point then fails, each for a reason of its own (a joint at its limit, the
+    base hitting the tool); this names the one cause."""
+    from planner.cell.pybullet_client import pb
+
+    wo = cell.work_object
+    if wo is None or cell.checker.wobj_body is None:
+        return ""
+    o = invert_transform(cell.T_base_wobj)[:3, 3]
+    lo, hi = np.asarray(wo.mesh.bounds, dtype=np.float64)
+    what = []
+    if bool(np.all(o >= lo) and np.all(o <= hi)):
+        at = ", ".join(f"{v * 1e3:.1f}" for v in o)
+        what.append(f"its origin is at ({at}) mm in the work-object frame, within the part")
+    checker = cell.checker
+    robot = checker.robot.body_id
+    for i in sorted(checker.static_links):
+        hits = pb.getClosestPoints(
+            robot, checker.wobj_body, 0.0, linkIndexA=i, physicsClientId=cell.client
+        )
+        if hits:
+            depth = -min(float(h[8]) for h in hits) * 1e3
+            what.append(f"{checker.names(robot, i)} overlaps the part by {depth:.1f} mm")
+    if not what:
+        return ""
+    return (
+        f"the robot's base lies inside the work object {wo.name} ({'; '.join(what)}): check "
+        "cell.robot.T_world_base and work_object.T_world_wobj (one world frame, metres); the "
+        "points fail because of it"
+    )
+
+
+def plan_detectability(plan: Plan) -> Detectability | None:
+    """Which points' gross errors ``wobjcal calibrate`` could see once they are measured, and
+    how many points to add so it sees one in every point
+    (:func:`calib.estimators.gross_errors.detectability`); ``None`` when the plan's points
+    fix no frame (the layout check says why)."""
+    from calib.estimators.gross_errors import detectability
+
+    if not plan.points:
+        return None
+    try:
+        d = detectability([p.to_probe_point() for p in plan.points])
+    except InputError:
+        return None
+    return None if d.add is None and not d.unseen else d
 
 
 def plan_landing_risk(
@@ -224,9 +283,7 @@ def _outlines(faces: PlanarFaces, radius_m: float) -> FaceOutlines:
     return out
 
 
-def _with_landing(
-    checks: Sequence[PointCheck], problems: dict[str, str]
-) -> tuple[PointCheck, ...]:
+def _with_landing(checks: Sequence[PointCheck], problems: dict[str, str]) -> tuple[PointCheck, ...]:
     """``checks`` with the points whose searches go wrong too often made infeasible."""
     out = []
     for c in checks:

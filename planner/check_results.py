@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 if TYPE_CHECKING:
+    from calib.estimators.gross_errors import Detectability
     from planner.sim.landing import LandingRisk
     from planner.sim.quality import LayoutQuality
 
@@ -148,6 +149,10 @@ class PlanCheck:
         quality_note: why there is no quality, ``""`` otherwise.
         landing: how often each search of the program goes wrong under the plan's
             misplacement (:mod:`planner.sim.landing`), ``None`` when not computed.
+        detectability: which points' gross errors ``wobjcal calibrate``'s screen could see,
+            and how many points to add so it sees one in every point
+            (:func:`calib.estimators.gross_errors.detectability`); ``None`` when the points
+            fix no frame. Said, not a failure: a plain 3-2-1 has no redundancy by design.
     """
 
     points: tuple[PointCheck, ...]
@@ -158,6 +163,7 @@ class PlanCheck:
     quality: LayoutQuality | None = None
     quality_note: str = ""
     landing: LandingRisk | None = None
+    detectability: Detectability | None = None
 
     @property
     def layout_status(self) -> Status:
@@ -199,8 +205,9 @@ class PlanCheck:
         raise KeyError(f"no point {point_id!r}; points: {[p.point_id for p in self.points]}")
 
     def to_json(self) -> dict[str, Any]:
-        """A JSON-ready dict; ``ik_note``, ``error``, ``layout``, ``quality_note`` and
-        ``quality`` appear only when set; ``layout_status`` always."""
+        """A JSON-ready dict; ``ik_note``, ``error``, ``layout``, ``quality_note``,
+        ``quality``, ``landing`` and ``redundancy`` appear only when set; ``layout_status``
+        always."""
         out: dict[str, Any] = {
             "feasible": self.feasible,
             "ik_kind": self.ik_kind,
@@ -214,6 +221,15 @@ class PlanCheck:
             out["quality"] = self.quality.to_json()
         if self.landing is not None:
             out["landing"] = self.landing.to_json()
+        d = self.detectability
+        if d is not None:
+            out["redundancy"] = {
+                "constraints": d.n_constraints,
+                "redundant": d.redundancy,
+                "unseen": list(d.unseen),
+                "add": d.add,
+                "note": d.message(),
+            }
         return out
 
 

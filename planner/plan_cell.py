@@ -10,10 +10,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import msgspec
 import numpy as np
 from numpy.typing import NDArray
 
 from calib.frames import invert_transform
+from calib.limits import MAX_CELL_TRIANGLES
 from calib.plan.file import Plan, resolve_ref
 
 if TYPE_CHECKING:
@@ -31,6 +33,26 @@ def T_base_world(plan: Plan) -> FloatArray:
 def nominal_T_base_wobj(plan: Plan) -> FloatArray:
     """``(4, 4)`` the nominal work object in the robot base frame."""
     return T_base_world(plan) @ plan.work_object.T_world_wobj.matrix()
+
+
+#: The cell of a plan file without a ``cell`` section: msgspec fills a missing field with this
+#: very object (``tests/test_messages.py`` holds it to that), so ``plan.cell is _DEFAULT_CELL``
+#: tells a missing section from one given, even one that spells the defaults out.
+_DEFAULT_CELL = next(f.default for f in msgspec.structs.fields(Plan) if f.name == "cell")
+
+
+def default_cell_note(plan: Plan) -> str:
+    """One line when the plan file has no ``cell`` section (``""`` otherwise): the commands say
+    which robot, tool and fixtures they take instead of taking them silently."""
+    if plan.cell is not _DEFAULT_CELL:
+        return ""
+    robot, tool = plan.cell.robot, plan.cell.tool
+    return (
+        "plan has no cell section: using the built-in robot "
+        f"{robot.urdf.removeprefix('builtin:')} with its base at the world origin, the built-in "
+        f"tool {tool.name.removeprefix('builtin:')} (TCP {tool.tcp!r}) and no fixtures; give "
+        "the cell (cell.robot, cell.tool, cell.fixtures) to check the real one"
+    )
 
 
 def plan_dir_of(path: str | Path) -> Path:
@@ -99,13 +121,17 @@ def open_cell(plan: Plan, plan_dir: Path) -> Cell:
     try:
         wobj = plan_work_object(plan, plan_dir, reach_m=cell.reach_model.reach_m)
         cell.set_work_object(wobj, T_world_wobj=plan.work_object.T_world_wobj.matrix())
+        left = MAX_CELL_TRIANGLES - len(wobj.mesh.faces)  # the cell's meshes share one budget
         for f in plan.cell.fixtures:
             T = f.T_world_fixture.matrix()
             if f.box_size_m is not None:
                 cell.add_fixture(f.name, size_m=f.box_size_m, T_world_fixture=T)
             else:
                 mesh = resolve_ref(f.mesh or "", plan_dir)
-                cell.add_fixture(f.name, mesh=str(mesh), units=f.units, T_world_fixture=T)
+                fixture = cell.add_fixture(
+                    f.name, mesh=str(mesh), units=f.units, T_world_fixture=T, max_triangles=left
+                )
+                left -= 0 if fixture.mesh is None else len(fixture.mesh.faces)
     except BaseException:
         cell.close()
         raise
@@ -170,6 +196,7 @@ def tool_data(plan: Plan, plan_dir: Path) -> tuple[Any, str]:
 
 __all__ = [
     "T_base_world",
+    "default_cell_note",
     "nominal_T_base_wobj",
     "open_cell",
     "plan_work_object",

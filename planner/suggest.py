@@ -31,7 +31,8 @@ points of interest) and proposes the points:
    reach, landing risk): anything it refuses is named in the message and the result does not
    count as met (``wobjcal suggest`` exits 1).
 
-``add=N`` keeps the plan's points and adds the ``N`` best (best fit only).
+``add=N`` keeps the plan's points and adds the ``N`` best, by best fit (a 3-2-1 or A-H plan
+becomes a best fit of all its points: those procedures take exactly their own).
 """
 
 from __future__ import annotations
@@ -53,6 +54,7 @@ from calib.estimators.layout import search_constraint_set
 from calib.plan.file import Plan, PlanError, PlanPoint
 from calib.plan.report_spec import PointOfInterest
 from calib.probing import ProbePoint, SearchSpec
+from calib.procedures import BestFit
 from planner.check import check_plan, plan_quality
 from planner.check_results import PlanCheck
 from planner.faces.candidates import Candidates, FaceTried, face_candidates
@@ -192,7 +194,8 @@ def suggest_plan(
         at_m: ``(K, 3)`` points of interest, wobj frame, metres (default: the plan's).
         max_points: most points to suggest (best fit; 3-2-1 takes six).
         procedure: ``"best_fit"`` or ``"three_two_one"``.
-        add: keep the plan's points and add this many (best fit only).
+        add: keep the plan's points and add this many (a plan of another procedure becomes a
+            best fit of all, :func:`as_best_fit`).
         progress: ``progress(stage, done, total)``.
         cell: the plan's open cell (the UI's); ``None`` opens one.
         per_face: candidates per planar face.
@@ -209,11 +212,6 @@ def suggest_plan(
         raise InputError(f"procedure: one of {', '.join(PROCEDURES)}, got {procedure!r}")
     if add and procedure != "best_fit":
         raise InputError("--add works with the best fit (3-2-1 takes exactly six points)")
-    if add and plan.method not in ("best_fit",):
-        raise InputError(
-            f"--add: the plan's procedure is {plan.method}; added points need the best fit "
-            "(suggest a new layout with --procedure best_fit instead)"
-        )
     if target_m is not None and not (math.isfinite(target_m) and target_m > 0):
         raise InputError(f"target: a positive distance, got {target_m!r} m")
     if max_points < 6 and not add:
@@ -233,6 +231,13 @@ def suggest_plan(
                 per_face=per_face,
                 fmt=fmt,
             )
+    converted = ""
+    if add and plan.method != "best_fit":  # 3-2-1 and A-H take exactly their own points
+        converted = (
+            f"; the plan's procedure {plan.method} takes exactly its own points, so the plan "
+            f"written is a best fit of all {len(plan.points) + add}"
+        )
+        plan = as_best_fit(plan)
     target_controller = controller(fmt)
     steered = procedure in target_controller.adaptive_methods
     t0 = time.perf_counter()
@@ -337,7 +342,7 @@ def suggest_plan(
         )
     if note:
         msg += f" ({note})"
-    msg += design_note
+    msg += design_note + converted
     problems = tuple(f"{p.point_id}: {p.reason}" for p in check.infeasible)
     if check.layout:
         problems += (f"layout: {check.layout}",)
@@ -363,6 +368,17 @@ def suggest_plan(
         elapsed_s=time.perf_counter() - t0,
         pool=pool,
         problems=problems,
+    )
+
+
+def as_best_fit(plan: Plan) -> Plan:
+    """``plan`` with its points kept as they are, every role ``fit`` and the best fit as its
+    procedure (the same edge-event offset): what ``--add`` grows a 3-2-1 or A-H plan into."""
+    offset = getattr(plan.procedure, "edge_event_offset_m", None)
+    return msgspec.structs.replace(
+        plan,
+        points=[msgspec.structs.replace(p, role="fit") for p in plan.points],
+        procedure=BestFit(edge_event_offset_m=offset),
     )
 
 

@@ -39,6 +39,7 @@ from planner.errors import PlanRefused
 from planner.plan_cell import nominal_T_base_wobj, open_cell
 from planner.program.build import measuring_program
 from planner.program.model import search_keys
+from planner.sim.budget import check_run_size, run_size, sensitivity_runs
 from planner.sim.montecarlo import simulate
 from planner.sim.report import PAPER_TABLE1, ValidationReport
 from planner.sim.report_points import report_rows
@@ -123,8 +124,11 @@ def validate_plan(
         InputError: ``trials`` < 2, another argument out of range, or a mesh that cannot load.
     """
     models = check_simulatable(plan)
+    size = run_size(plan, trials, protocol, fmt)
+    check_run_size(size)  # memory and time, before any work
     folder = plan_dir or Path.cwd()
     part = work_object_mesh(plan, folder, models) if mesh is None else mesh
+    check_run_size(dataclasses.replace(size, triangles=len(part.faces)))  # and beside the part
     if check not in ("refuse", "report", "off"):
         raise InputError(f"check must be 'refuse', 'report' or 'off', got {check!r}")
     if check != "off" or reach_trials:
@@ -228,7 +232,10 @@ def sensitivity_plan(
         PlanError, InputError: as :func:`validate_plan`.
     """
     models = check_simulatable(plan)
+    size = run_size(plan, trials, None, fmt, runs=sensitivity_runs(plan))
+    check_run_size(size, "sensitivity")
     part = work_object_mesh(plan, plan_dir or Path.cwd(), models) if mesh is None else mesh
+    check_run_size(dataclasses.replace(size, triangles=len(part.faces)), "sensitivity")
     preflight(plan, models, part)
     setup = simulation_setup(plan, models, part, fmt)
     rows = report_rows(plan.validation.report, part, models.geometry, setup.xoffset)

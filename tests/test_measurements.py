@@ -55,7 +55,7 @@ def test_world_frame_is_converted(rng: np.random.Generator) -> None:
     [
         ({"schema": "wobjcal.measurements/9"}, "schema: unsupported version"),
         ({"schema": None}, "schema: required field missing"),
-        ({"units": "inch"}, "units: invalid value 'inch' (valid: 'm', 'mm')"),
+        ({"units": "inch"}, "units: 'inch' is not a unit of this format (m or mm); convert to mm"),
         ({"frame": "tool0"}, "frame: invalid value 'tool0' (valid: 'base', 'world')"),
         ({"points": {"A": [1.0, 2.0]}}, "points.A: must have length 3, got 2"),
         ({"points": {"A": [1.0, "x", 2.0]}}, "points.A[1]: must be a number, got str"),

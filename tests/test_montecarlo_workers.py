@@ -35,7 +35,7 @@ def _alive(pid: int) -> bool:
 
 
 def _start_validation() -> tuple[subprocess.Popen[bytes], set[int]]:
-    cmd = [sys.executable, "-m", "planner", "validate", str(STATOR), "--trials", "20000",
+    cmd = [sys.executable, "-m", "planner", "validate", str(STATOR), "--trials", "12000",
            "--reach-trials", "0", "--no-check", "--workers", "2"]  # fmt: skip
     env = {**os.environ, "PYTHONPATH": str(REPO)}
     proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)

@@ -40,6 +40,7 @@ ADDED = {
     "layout_status",  # issue 13: the layout quality
     "quality",
     "vias",  # the moves between points (the shipped plan got vias for its colliding moves)
+    "redundancy",  # issue 27: the points whose gross error calibrate cannot see
 }
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")

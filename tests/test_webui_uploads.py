@@ -161,3 +161,45 @@ def test_a_new_part_starts_with_its_own_frame_unless_the_frame_is_kept(
         files.keep_frame.value = False
         for _ in range(undo_depth):
             app.state.undo()
+
+
+def test_uploads_no_plan_uses_are_removed(app: WobjcalApp, reference_dir: Path) -> None:
+    """Issue 27: every upload stayed in ~/.cache/wobjcal/uploads for ever, the refused and the
+    cancelled ones too; a 10,000-point plan uploaded drove the server past 9 GB."""
+    import hashlib
+    import json
+
+    import trimesh
+
+    files = app.files_panel
+    box = trimesh.creation.box(extents=(0.5, 0.35, 0.25))  # a part no earlier test used
+    box.apply_translation((0.0, 0.0, -0.125))
+    data = box.export(file_type="stl")
+    files.units.value = "m"
+    files.stage_mesh("block.stl", data)
+    staged = files.pending.path.parent  # type: ignore[union-attr]
+    assert staged.is_dir()
+    files.cancel_mesh()
+    assert not staged.exists(), "a cancelled upload is removed"
+    broken, missing = b"solid y\nendsolid y\n", _ur5_zip(reference_dir, drop="wrist2.stl")
+    with pytest.raises(InputError):
+        files.stage_mesh("broken_part.stl", broken)
+    with pytest.raises(InputError, match="refers to"):
+        files.upload_urdf("ur5_missing.zip", missing)
+    for refused in (broken, missing):
+        folder = files.upload_dir / hashlib.sha256(refused).hexdigest()[:16]
+        assert not folder.exists(), "a refused upload is removed"
+    files.stage_mesh("block.stl", data)
+    files.accept_mesh()  # used by the plan: kept, also once the pending part is gone
+    used = Path(app.state.doc.source.work_object.mesh)
+    files.close()
+    assert used.is_file(), "the session's plan (and its autosave) uses it"
+    app.state.undo()
+    files.close()  # the end of a session whose plan no longer uses it
+    assert not used.exists()
+    doc = json.loads((Path(app.plan_dir) / "box_plan.json").read_text())
+    doc["points"] = [dict(doc["points"][i % 6], id=f"Q{i}") for i in range(10_000)]
+    before = app.state.doc
+    with pytest.raises(InputError, match=r"10,000 points, at most 500"):
+        files.upload_plan("big.json", json.dumps(doc).encode())
+    assert app.state.doc is before

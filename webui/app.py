@@ -125,7 +125,13 @@ class WobjcalApp:
         """
         self.heatmap.stop()
         with self.busy("loading the cell"):
-            self.worker.replace_resource(lambda: CellSession(plan, plan_dir)).result(300)
+            try:
+                self.worker.replace_resource(lambda: CellSession(plan, plan_dir)).result(300)
+            except TimeoutError:  # it has no message of its own
+                raise InputError(
+                    f"the cell of the plan ({len(plan.points)} points, work object "
+                    f"{plan.work_object.mesh}) did not load within 300 s"
+                ) from None
         session = self.worker.call(lambda s: s)
         view = session.view
         picker = SurfacePicker(view.wobj_mesh, view.T_world_wobj)
@@ -352,7 +358,11 @@ class WobjcalApp:
         clients.notify(self.server, title, body, client, error)
 
     def stop(self) -> None:
-        """Stop the server and the worker."""
+        """Stop the server and the worker; remove the uploads only this session used."""
+        try:
+            self.files_panel.close()
+        except Exception:  # cleaning must not stop the stop
+            logger.exception("upload folders not cleaned")
         if self.robot is not None:
             self.robot.stop()
         self.validate_panel.close()

@@ -11,6 +11,12 @@ On start, :func:`find_newer_autosave` looks for this plan's autosaves from earli
 port) that no running server holds, whose content differs from the plan file and that are
 newer than it: the newest is what the last session left. The app restores it and says so, or
 with ``fresh`` keeps it aside as ``<file>.<time>.bak`` (:func:`set_aside`) so no edit is lost.
+
+A restore is marked (``<file>.restoring``, :func:`mark_restoring`) until the restored session
+has loaded its cell and checked its points (:func:`clear_restoring`). A mark left behind means
+that restore never finished: the server ran out of memory, was killed or failed while loading
+that autosave. The next start does not restore it again (it would crash again, at every start
+until ``--fresh``): it sets it aside and says so, with the path (issue 27).
 """
 
 from __future__ import annotations
@@ -148,6 +154,28 @@ def find_newer_autosave(
     return best
 
 
+def restoring_mark(path: Path) -> Path:
+    """The mark of a restore of the autosave ``path`` under way: ``<path>.restoring``."""
+    return Path(str(path) + ".restoring")
+
+
+def mark_restoring(path: Path) -> None:
+    """Mark that the autosave ``path`` is being restored (the pid and time in the mark)."""
+    mark = restoring_mark(path)
+    mark.write_text(f"{os.getpid()} {time.strftime('%Y-%m-%d %H:%M:%S')}\n", encoding="utf-8")
+
+
+def clear_restoring(path: Path) -> None:
+    """The restore of the autosave ``path`` finished: drop its mark."""
+    with contextlib.suppress(OSError):
+        restoring_mark(path).unlink()
+
+
+def restore_unfinished(path: Path) -> bool:
+    """True when an earlier restore of the autosave ``path`` left its mark: it never finished."""
+    return restoring_mark(path).exists()
+
+
 def set_aside(path: Path) -> Path | None:
     """Rename ``path`` to ``<path>.<time>.bak`` so a fresh session does not overwrite it."""
     if not path.is_file():
@@ -162,8 +190,12 @@ __all__ = [
     "AutosaveLock",
     "AutosaveLockedError",
     "FoundAutosave",
+    "clear_restoring",
     "default_autosave_path",
     "find_newer_autosave",
     "in_use",
+    "mark_restoring",
+    "restore_unfinished",
+    "restoring_mark",
     "set_aside",
 ]

@@ -14,10 +14,12 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 
+from calib import limits
 from calib.errors import InputError
 from calib.plan.file import Plan, PlanError, plan_to_json
 from calib.units import MESH_UNITS
 from planner.export import export_file_stem
+from webui import autosave, uploads
 from webui.exports import FORMATS, ExportResult, export_program
 from webui.part_upload import PendingPart, drop_points, frame_note, off_surface, project_points
 from webui.plan_adapter import plan_from_ui, ui_plan_from_bytes, with_source
@@ -29,8 +31,8 @@ if TYPE_CHECKING:
 
 logger = logging.getLogger(__name__)
 
-#: Largest accepted upload, bytes.
-MAX_UPLOAD_BYTES = 50 * 1024 * 1024
+#: Largest accepted upload, bytes (:mod:`calib.limits`).
+MAX_UPLOAD_BYTES = limits.MAX_UPLOAD_BYTES
 MESH_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".glb", ".gltf")
 UPLOAD_DIR = Path.home() / ".cache" / "wobjcal" / "uploads"
 
@@ -75,6 +77,8 @@ class FilesPanel:
     def __init__(self, app: AppContext, upload_dir: Path = UPLOAD_DIR) -> None:
         self._app = app
         self.upload_dir = upload_dir
+        #: the upload folders this session wrote (removed at the end unless its plan uses them)
+        self.created: set[Path] = set()
         gui = app.server.gui
         with app.tab("Files"):
             self.plan_upload = gui.add_upload_button("Upload plan (.json)", mime_type=".json")
@@ -149,9 +153,56 @@ class FilesPanel:
 
     def _keep(self, name: str, content: bytes) -> tuple[Path, str]:
         digest = hashlib.sha256(content).hexdigest()
-        path = self.upload_dir / digest[:16] / Path(name).name
+        path = self._new_folder(digest, len(content)) / Path(name).name
         atomic_write_bytes(path, content)
         return path, digest
+
+    # ---- the upload folders (webui.uploads) --------------------------------------------------
+    def _new_folder(self, digest: str, size: int) -> Path:
+        """The folder an upload is kept in; room is made for it first (issue 27)."""
+        folder = self.upload_dir / digest[:16]
+        if not folder.exists():
+            uploads.check_room(self.upload_dir, size, self.in_use(), self._autosave_dir())
+            self.created.add(folder)
+        return folder
+
+    def in_use(self) -> list[str]:
+        """File references of the session's plans (undo history included) and of the mesh
+        waiting for its units."""
+        refs = [
+            r
+            for d in self._app.state.docs()
+            if isinstance(d.source, Plan)
+            for r in uploads.plan_refs(d.source)
+        ]
+        return refs + ([] if self.pending is None else [str(self.pending.path)])
+
+    def _autosave_dir(self) -> Path | None:
+        """The autosave folder beside the uploads (``None`` when it is elsewhere, as in tests:
+        then only the folders this session wrote are ever removed)."""
+        folder = autosave.AUTOSAVE_DIR
+        return folder if folder.parent == self.upload_dir.parent else None
+
+    def _discard(self, path: Path | None) -> None:
+        """Remove the folder of an upload refused, cancelled or replaced, unless a plan uses it."""
+        if path is None or not path.is_relative_to(self.upload_dir):
+            return
+        folder = self.upload_dir / path.relative_to(self.upload_dir).parts[0]
+        if folder in self.created or self._autosave_dir() is not None:
+            uploads.remove_unused(self.upload_dir, [folder], self.in_use(), self._autosave_dir())
+
+    def prune_stale(self) -> list[Path]:
+        """At start: remove the upload folders no plan and no autosave uses (older than
+        :data:`webui.uploads.RECENT_S`)."""
+        folder = self._autosave_dir()
+        return [] if folder is None else uploads.prune(self.upload_dir, self.in_use(), folder)
+
+    def close(self) -> None:
+        """At the end: remove the upload folders this session wrote that its plan does not use
+        (its undo history ends here; its autosave keeps what the plan uses)."""
+        doc = self._app.state.doc
+        refs = uploads.plan_refs(doc.source) if isinstance(doc.source, Plan) else []
+        uploads.remove_unused(self.upload_dir, self.created, refs, self._autosave_dir())
 
     def _apply_source(
         self, plan: Plan, label: str, kept: Path | None = None, name: str = ""
@@ -172,9 +223,12 @@ class FilesPanel:
         self._current_plan()
         path, digest = self._keep(name, content)
         try:
-            self.pending = PendingPart.read(name, path, digest)
+            pending = PendingPart.read(name, path, digest)
         except InputError as exc:
+            self._discard(path)
             raise UploadError(_named(str(exc), path, name)) from None
+        before, self.pending = self.pending, pending
+        self._discard(None if before is None else before.path)  # replaced
         self._show_pending()
         return ""
 
@@ -189,8 +243,9 @@ class FilesPanel:
         self.accept.visible = self.cancel.visible = True
 
     def cancel_mesh(self) -> str:
-        """Forget the uploaded mesh waiting for its units."""
-        self.pending = None
+        """Forget the uploaded mesh waiting for its units (its file too, unless a plan uses it)."""
+        before, self.pending = self.pending, None
+        self._discard(None if before is None else before.path)
         self._show_pending()
         return ""
 
@@ -252,15 +307,23 @@ class FilesPanel:
         check_upload(name, content, (".urdf", ".zip"), "robot description")
         source = self._current_plan()
         if name.lower().endswith(".zip"):
-            digest = hashlib.sha256(content).hexdigest()
-            path = unpack_robot_zip(name, content, self.upload_dir / digest[:16] / "robot")
+            folder = self._new_folder(hashlib.sha256(content).hexdigest(), len(content))
+            try:
+                path = unpack_robot_zip(name, content, folder / "robot")
+            except BaseException:
+                self._discard(folder)
+                raise
             kept = path
         else:
             path, _ = self._keep(name, content)
             kept = path
         robot = msgspec.structs.replace(source.cell.robot, urdf=str(path))
         cell = msgspec.structs.replace(source.cell, robot=robot)
-        self._apply_source(msgspec.structs.replace(source, cell=cell), "new robot", kept, name)
+        try:
+            self._apply_source(msgspec.structs.replace(source, cell=cell), "new robot", kept, name)
+        except BaseException:
+            self._discard(path)
+            raise
         return f"Robot {name} loaded"
 
     def _current_plan(self) -> Plan:

@@ -3,7 +3,9 @@
 After every edit of the points the plan's quality is predicted again
 (:func:`planner.check.plan_quality`, what ``wobjcal check`` prints) on this panel's own thread,
 the latest edit only (edits that arrive meanwhile are skipped): 1 sigma per degree of freedom,
-noise gain, the weakest motion in words, the error at the points of interest. Ticked, the
+noise gain, the weakest motion in words, the error at the points of interest, and which points'
+gross errors calibrate could not detect with how many points to add
+(:func:`redundancy_markdown`). Ticked, the
 predicted error is painted on the part (:func:`planner.sim.quality.error_radius`, green small
 to red large) and each point of interest carries a sphere of its predicted error (drawn 100
 times larger). "Suggest layout" and "Add best point" run :func:`planner.suggest.suggest_plan`
@@ -22,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from calib.errors import InputError, PlanError
-from planner.check import plan_quality
+from planner.check import plan_detectability, plan_quality
 from planner.sim.quality import DOF_NAMES, LayoutQuality, error_radius
 from webui.plan_adapter import plan_from_ui, ui_plan_from_plan
 from webui.scene import heat_rgb
@@ -62,6 +64,19 @@ def quality_markdown(q: LayoutQuality | None, note: str = "") -> str:
         )
         lines.append(f"{p.label}: {hw}  ")
     return "\n".join(lines)
+
+
+def redundancy_markdown(doc: UiPlan) -> str:
+    """Which points' gross errors calibrate could not detect, and how many points to add
+    (what ``wobjcal check`` says, :func:`planner.check.plan_detectability`), or ``""``."""
+    try:
+        d = plan_detectability(plan_from_ui(doc))
+    except PlanError:
+        return ""
+    if d is None or d.ok:
+        return ""
+    how = f"*Add best point* {d.add} time(s), or `wobjcal suggest PLAN --add {d.add} -o OUT`"
+    return "**Redundancy:** " + d.message(how=how).replace("|", "/")
 
 
 class LayoutPanel:
@@ -111,10 +126,13 @@ class LayoutPanel:
         if gen != self._generation:
             return self.last
         t0 = time.perf_counter()
-        q, note = self.compute(self._app.state.doc)
+        doc = self._app.state.doc
+        q, note = self.compute(doc)
         self.last, self.last_note = q, note
         self.last_seconds = time.perf_counter() - t0
-        self.quality_md.content = quality_markdown(q, note)
+        self.quality_md.content = "\n\n".join(
+            t for t in (quality_markdown(q, note), redundancy_markdown(doc)) if t
+        )
         self._paint()
         return q
 

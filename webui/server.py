@@ -23,8 +23,11 @@ from webui.autosave import (
     AutosaveLock,
     AutosaveLockedError,
     FoundAutosave,
+    clear_restoring,
     default_autosave_path,
     find_newer_autosave,
+    mark_restoring,
+    restore_unfinished,
     set_aside,
 )
 from webui.plan_adapter import autosave_bytes, ui_plan_from_file
@@ -105,6 +108,7 @@ def run(
         )
         lock = None
         note = ""
+        restoring: Path | None = None
         if path is not None:
             found = find_newer_autosave(  # before taking our lock: it would hide our file
                 plan_path,
@@ -116,11 +120,25 @@ def run(
                 lock = AutosaveLock(path)
             except AutosaveLockedError as exc:
                 raise InputError(str(exc)) from None
-            if found is not None and not fresh:
+            if found is not None and not fresh and restore_unfinished(found.path):
+                aside = set_aside(found.path)
+                clear_restoring(found.path)
+                note = (
+                    f"not restored: the last start from the autosave {found.path} did not finish "
+                    "(the server ran out of memory, was killed or failed while loading it), so "
+                    f"it is not loaded again; started from the plan; the autosave is kept as "
+                    f"{aside}: to open it, copy it beside the plan file and run "
+                    "`wobjcal ui COPY.json`"
+                )
+            elif found is not None and not fresh:
                 try:
+                    mark_restoring(found.path)  # cleared once the restored session has loaded
+                    restoring = found.path
                     ui_plan = _restore(found, plan_dir)
                     note = f"restored the edits of the last session from {found.describe()}"
                 except (InputError, OSError) as exc:
+                    clear_restoring(found.path)
+                    restoring = None
                     aside = set_aside(found.path)
                     note = (
                         f"not restored: {found.path} is unusable ({exc}); started from the plan, "
@@ -128,6 +146,7 @@ def run(
                     )
             elif found is not None:
                 aside = set_aside(found.path)
+                clear_restoring(found.path)
                 note = f"started fresh; the last session's autosave is kept as {aside}"
     except BaseException:
         server.stop()
@@ -140,8 +159,11 @@ def run(
     logger.info("wobjcal UI at http://%s:%d", host, bound)
     if path is not None:
         logger.info("the session plan autosaves to %s", path)
-    app = WobjcalApp(server, ui_plan, plan_dir, autosave_path=path)
+    app = WobjcalApp(server, ui_plan, plan_dir, autosave_path=path)  # the cell, the checks
+    if restoring is not None:  # loaded: a later start may restore this session's autosave
+        clear_restoring(restoring)
     app.autosave_lock, app.autosave_note = lock, note
+    app.files_panel.prune_stale()  # uploads no plan and no autosave uses (issue 27)
     if note:
         logger.warning("%s", note)
     if not block:

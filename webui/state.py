@@ -88,6 +88,11 @@ class SessionState(Generic[D]):
         """Where the session autosaves, or ``None``."""
         return self._autosave_path
 
+    def docs(self) -> list[D]:
+        """The document and every one undo or redo can bring back."""
+        with self._lock:
+            return [self._doc, *(d for d, _ in self._undo), *(d for d, _ in self._redo)]
+
     @property
     def can_undo(self) -> bool:
         """True when there is a change to undo."""

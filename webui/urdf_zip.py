@@ -10,29 +10,41 @@ file that is not in the archive is an error naming it.
 from __future__ import annotations
 
 import re
+import shutil
 import zipfile
 from io import BytesIO
 from pathlib import Path, PurePosixPath
 
 from calib.atomic_io import write_bytes_atomic
 from calib.errors import InputError
+from calib.limits import MAX_ZIP_MEMBERS, MAX_ZIP_RATIO, MAX_ZIP_UNPACKED_BYTES
 
 #: At most this many files in a robot zip.
-MAX_MEMBERS = 2000
-#: At most this many bytes unpacked.
-MAX_UNPACKED_BYTES = 500 * 1024 * 1024
+MAX_MEMBERS = MAX_ZIP_MEMBERS
+#: At most this many bytes unpacked (the URDF may refer to no more, :mod:`calib.limits`).
+MAX_UNPACKED_BYTES = MAX_ZIP_UNPACKED_BYTES
+#: Beyond this many bytes unpacked, a zip must not unpack to more than
+#: :data:`calib.limits.MAX_ZIP_RATIO` times its size (a zip bomb).
+RATIO_FREE_BYTES = 16 * 1024 * 1024
 _MESH_REF = re.compile(r'filename\s*=\s*"([^"]+)"')
 
 
-def _safe_members(archive: zipfile.ZipFile, name: str) -> list[zipfile.ZipInfo]:
+def _safe_members(archive: zipfile.ZipFile, name: str, packed: int) -> list[zipfile.ZipInfo]:
     members = [m for m in archive.infolist() if not m.is_dir()]
     if len(members) > MAX_MEMBERS:
         raise InputError(f"{name}: {len(members)} files, more than the {MAX_MEMBERS} allowed")
     total = sum(m.file_size for m in members)
     if total > MAX_UNPACKED_BYTES:
         raise InputError(
-            f"{name}: unpacks to {total / 2**20:.0f} MiB, more than "
-            f"{MAX_UNPACKED_BYTES / 2**20:.0f}"
+            f"{name}: unpacks to {total / 2**20:.0f} MiB, at most "
+            f"{MAX_UNPACKED_BYTES / 2**20:.0f} MiB (a robot's meshes are 5-40 MB; PyBullet and "
+            "the drawings load them all); refused before unpacking"
+        )
+    if total > RATIO_FREE_BYTES and total > MAX_ZIP_RATIO * packed:
+        raise InputError(
+            f"{name}: {packed / 1024:.0f} KB unpack to {total / 2**20:.0f} MiB, "
+            f"{total / max(packed, 1):.0f} times its size, at most {MAX_ZIP_RATIO} (meshes "
+            "compress 3 to 10 times; this is a zip bomb); refused before unpacking"
         )
     for m in members:
         p = PurePosixPath(m.filename)
@@ -53,15 +65,16 @@ def unpack_robot_zip(name: str, content: bytes, folder: Path) -> Path:
     except zipfile.BadZipFile:
         raise InputError(f"{name}: not a zip archive") from None
     with archive:
-        members = _safe_members(archive, name)
+        members = _safe_members(archive, name, len(content))
         urdfs = [m.filename for m in members if m.filename.lower().endswith(".urdf")]
         if len(urdfs) != 1:
             found = ", ".join(urdfs) or "none"
             raise InputError(f"{name}: a robot zip must hold exactly one .urdf file, found {found}")
-        for m in members:
+        for m in members:  # a file at a time, a MiB at a time: never a whole file in memory
             target = folder / m.filename
             target.parent.mkdir(parents=True, exist_ok=True)
-            write_bytes_atomic(target, archive.read(m))
+            with archive.open(m) as src, target.open("wb") as dst:
+                shutil.copyfileobj(src, dst, 1 << 20)
     urdf = folder / urdfs[0]
     text = urdf.read_text(encoding="utf-8", errors="replace")
 

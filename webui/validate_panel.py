@@ -14,15 +14,19 @@ be validated is refused before anything runs, with the point and the reason in a
 
 from __future__ import annotations
 
+import dataclasses
 import logging
+import os
 import threading
 import time
 from concurrent.futures import Future
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from calib.errors import InputError, PlanError
+from planner.sim.budget import check_run_size, run_size
 from planner.sim.report import ValidationReport
 from planner.validate import check_simulatable
 from webui import validation
@@ -95,6 +99,10 @@ class ValidatePanel:
         """
         plan = plan_from_ui(self._app.state.doc)
         check_simulatable(plan)
+        view = self._app.view
+        size = run_size(plan, trials)  # this server and the run within 2 GB (issue 27)
+        faces = 0 if view is None else len(view.wobj_mesh.faces)
+        check_run_size(dataclasses.replace(size, triangles=faces, held_bytes=_rss_bytes()))
         with self._start_lock:  # two tabs may click at once
             if self._running.is_set():
                 raise InputError("a validation is already running")
@@ -229,3 +237,12 @@ class ValidatePanel:
     def close(self) -> None:
         """Stop the validation thread (after a running validation)."""
         self._worker.close(timeout=1.0)
+
+
+def _rss_bytes() -> int:
+    """This process's resident memory, bytes (0 where ``/proc`` is not there)."""
+    try:
+        pages = int(Path("/proc/self/statm").read_text().split()[1])
+        return pages * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return 0

@@ -16,10 +16,17 @@ screens the measurements against the noise the plan expects:
 
 Without redundancy (exactly 6 constraints, a plain 3-2-1) nothing can be screened; the result
 says so instead of passing silently.
+
+Before anything is measured, :func:`detectability` says which points' gross errors the screen
+cannot see at all, and how many more points would let it see one in every point: a gross error
+in a point shows in the residuals only when the other points fix, without it, everything it
+fixes (its redundancy number, the diagonal of ``I - J (J^T J)^-1 J^T``, is above zero). In a
+plain 3-2-1 no point has one: each fixes something no other point does.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -28,8 +35,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import DegenerateGeometryError
 from calib.estimators.best_fit import BestFitResult, best_fit
-from calib.estimators.layout import constraint_set
-from calib.estimators.observability import analyze_layout
+from calib.estimators.layout import ConstraintSet, constraint_set
+from calib.estimators.observability import analyze_layout, scaled_jacobian
 from calib.probing import ProbePoint
 from calib.validation import check_points, check_positive
 
@@ -181,6 +188,179 @@ def screen_measurements(
     return GrossErrorScreen(sigma, k, redundancy, residuals, flagged, remeasure, loo, fit)
 
 
+#: A point whose redundancy number (the share of its gross error that shows in its own
+#: residual) is below this cannot be seen: the other points fit it exactly.
+SEEN_TOL = 1e-6
+#: :func:`detectability` counts at most this many points to add.
+MAX_ADDED = 12
+#: Two constraints lie on one face when their normals are this close (cosine) ...
+_SAME_NORMAL_COS = math.cos(math.radians(1.0))
+#: ... and their points this close to one plane, metres.
+_SAME_PLANE_M = 5e-4
+
+
+@dataclass(frozen=True)
+class Detectability:
+    """Which gross errors a point layout lets the screen see, before anything is measured.
+
+    Attributes:
+        n_constraints: face constraints of the points (an edge point has two).
+        redundancy: constraints beyond the 6 degrees of freedom.
+        unseen: the points whose gross error cannot show in the residuals, in the order given:
+            nothing else fixes what each of them fixes, so the fit absorbs its error whole.
+        edge_only: of those, the edge points whose error is unseen only along their edge
+            (the position the search finds the face's end at).
+        add: how many more points would let a gross error in every point show (0 when none is
+            unseen, ``None`` when more than :data:`MAX_ADDED` or the layout fixes no frame).
+        faces: for each point to add, the face it was counted on, named by a point on it
+            (``"F's face"``, or ``"F's edge face"``: the face whose end an edge point finds).
+    """
+
+    n_constraints: int
+    redundancy: int
+    unseen: tuple[str, ...]
+    add: int | None
+    faces: tuple[str, ...] = ()
+    edge_only: tuple[str, ...] = ()
+
+    @property
+    def ok(self) -> bool:
+        """A gross error in any one point shows in the residuals."""
+        return not self.unseen
+
+    def message(self, plan: str = "PLAN", how: str = "") -> str:
+        """What the user should know, in one line (``""`` when every point is seen).
+
+        Args:
+            plan: the plan file's name for the ``wobjcal suggest`` command shown.
+            how: how to add the points, instead of that command (e.g. a button of the UI).
+        """
+        if not self.unseen:
+            return ""
+        if self.redundancy <= 0:
+            head = (
+                f"{self.n_constraints} constraints for 6 degrees of freedom: no redundancy, so "
+                "a gross error in any point (a burr, a chip, the wrong spot) cannot be detected: "
+                "the frame fits it exactly"
+            )
+        else:
+            which = ", ".join(
+                p + (" (its edge)" if p in self.edge_only else "") for p in self.unseen
+            )
+            head = (
+                f"a gross error in {which} cannot be detected: no other point fixes what it "
+                f"fixes ({self.redundancy} redundant constraint(s) elsewhere), so the frame fits "
+                "it exactly"
+            )
+        if not self.add:
+            return head + "; measure more points on the faces of those points"
+        counts: dict[str, int] = {}
+        for f in self.faces:
+            counts[f] = counts.get(f, 0) + 1
+        where = ", ".join(f"{f} ({n})" if n > 1 else f for f, n in counts.items())
+        each = "one on each of" if len(counts) > 1 else "on"
+        how = how or f"`wobjcal suggest {plan} --add {self.add} -o OUT`"
+        return f"{head}; add {self.add} point(s) to make it detectable, e.g. {each} {where} ({how})"
+
+
+def detectability(points: Sequence[ProbePoint]) -> Detectability:
+    """Which points' gross errors the screen can see, and how many points to add for all.
+
+    A gross error in point ``i`` shows in the least-squares residuals by its redundancy number
+    (the block of ``I - J (J^T J)^-1 J^T`` on its rows; ``J`` the constraint Jacobian of
+    :func:`screen_measurements`' fit); zero means the other points do not fix what it fixes.
+    Points to add are counted greedily: each is a point at a generic place among the points of
+    an unseen point's face (inside their hull, where the sensor already fits; on a face of one
+    point, a point beside it), on the face that leaves the fewest unseen. Pure
+    geometry: where the points really go is :mod:`planner.suggest`'s.
+
+    Raises:
+        ShapeError, DegenerateGeometryError: bad points (see
+            :func:`calib.estimators.layout.constraint_set`).
+    """
+    cs = constraint_set(tuple(points), "points")
+    n = cs.n_constraints
+    if not analyze_layout(cs).observable:
+        return Detectability(n, n - 6, (), None)
+    J = scaled_jacobian(cs)
+    owner = [int(i) for i in cs.point_index]
+    ids = cs.point_ids
+    unseen, edge_only = _unseen(J, owner)
+    row_face, new_rows, names = _faces(cs)
+    added: list[str] = []
+    left = unseen
+    while left and len(added) < MAX_ADDED:
+        candidates = dict.fromkeys(row_face[k] for k, o in enumerate(owner) if o in left)
+        best: tuple[int, list[int]] | None = None
+        for f in candidates:
+            trial, _ = _unseen(np.vstack([J, new_rows[f]]), [*owner, -1 - len(added)])
+            if best is None or len(trial) < len(best[1]):
+                best = (f, trial)
+        if best is None or len(best[1]) >= len(left):
+            break
+        f, left = best
+        J = np.vstack([J, new_rows[f]])
+        owner.append(-1 - len(added))
+        row_face.append(f)
+        added.append(names[f])
+    return Detectability(
+        n,
+        n - 6,
+        tuple(ids[i] for i in unseen),
+        None if left else len(added),
+        () if left else tuple(added),
+        tuple(ids[i] for i in edge_only),
+    )
+
+
+def _unseen(J: FloatArray, owner: Sequence[int]) -> tuple[list[int], list[int]]:
+    """The owners (point indices; added points negative) of rows whose gross error the
+    least-squares fit of ``J`` can absorb whole, in order of first row; and those of them
+    with two rows (an edge point) where that error lies along the second (the edge)."""
+    R = np.eye(len(J)) - J @ np.linalg.solve(J.T @ J, J.T)
+    out: list[int] = []
+    edge: list[int] = []
+    for i in dict.fromkeys(owner):
+        rows = [k for k, o in enumerate(owner) if o == i]
+        w, v = np.linalg.eigh(R[np.ix_(rows, rows)])
+        if float(w[0]) < SEEN_TOL:
+            out.append(i)
+            if len(rows) == 2 and abs(float(v[1, 0])) > 0.99:
+                edge.append(i)
+    return out, edge
+
+
+def _faces(cs: ConstraintSet) -> tuple[list[int], list[FloatArray], list[str]]:
+    """The faces of the constraint rows: ``(face of each row, the scaled Jacobian row of a
+    point at a generic place among each face's points, each face named by its first point)``."""
+    row_face: list[int] = []
+    planes: list[tuple[FloatArray, FloatArray]] = []  # (normal, a point on it)
+    members: list[list[FloatArray]] = []
+    names: list[str] = []
+    for k, (nk, pk) in enumerate(zip(cs.normals, cs.nominal_m, strict=True)):
+        for f, (nf, pf) in enumerate(planes):
+            if float(nf @ nk) > _SAME_NORMAL_COS and abs(float(nf @ (pk - pf))) < _SAME_PLANE_M:
+                row_face.append(f)
+                members[f].append(pk)
+                break
+        else:
+            row_face.append(len(planes))
+            planes.append((nk, pk))
+            members.append([pk])
+            i = int(cs.point_index[k])
+            second = k > 0 and int(cs.point_index[k - 1]) == i  # an edge point's edge face
+            names.append(cs.point_ids[i] + ("'s edge face" if second else "'s face"))
+    rows = []
+    for (nf, _), pts in zip(planes, members, strict=True):
+        # a generic place among the face's points (inside their hull: where the sensor already
+        # fits); on a face of one point, a point beside it: to first order the same constraint
+        w = 1.0 / (np.arange(len(pts)) + 1.618)
+        p = (w / w.sum()) @ np.asarray(pts)
+        lever = np.cross(p - cs.centroid_m, nf) / cs.scale_m
+        rows.append(np.concatenate([nf, lever])[None, :])
+    return row_face, rows, names
+
+
 def _by_point(fit: BestFitResult) -> dict[str, tuple[float, ...]]:
     out: dict[str, list[float]] = {pid: [] for pid in fit.point_ids}
     for pid, r in zip(fit.residual_ids, fit.residuals_m.tolist(), strict=True):
@@ -209,4 +389,11 @@ def _leave_one_out(
     return tuple(out)
 
 
-__all__ = ["K_SIGMA", "GrossErrorScreen", "LeaveOneOut", "screen_measurements"]
+__all__ = [
+    "K_SIGMA",
+    "Detectability",
+    "GrossErrorScreen",
+    "LeaveOneOut",
+    "detectability",
+    "screen_measurements",
+]

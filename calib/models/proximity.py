@@ -33,14 +33,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.errors import PlanError
+from calib.limits import MAX_RAYS, MAX_SCAN_RAYS
 from calib.models.sensor import SearchNoise, face_frame
 from calib.structs import Strict, check_count, check_positive
 
 FloatArray = NDArray[np.float64]
 
 _GOLDEN_ANGLE = math.pi * (3.0 - math.sqrt(5.0))
-#: Most rays over the sensor face (the default 256 resolves coverage to 0.4 %).
-MAX_RAYS = 65_536
+#: Why the rays are bounded (:data:`calib.limits.MAX_RAYS`, :data:`calib.limits.MAX_SCAN_RAYS`).
+RAYS_WHY = "each search casts them at once, ~0.3 kB a ray; the default 256 resolves 0.4 %"
+SCAN_RAYS_WHY = "an edge scan casts them at every 2.5 mm step at once, ~0.3 kB a ray"
 
 
 @lru_cache(maxsize=32)
@@ -96,8 +98,8 @@ class ProximitySensor(Strict, frozen=True, kw_only=True, tag="proximity", tag_fi
         check_positive(self.decay_length_m, "decay_length_m")
         check_positive(self.hysteresis_fraction, "hysteresis_fraction", allow_zero=True)
         check_positive(self.repeatability_sigma_m, "repeatability_sigma_m", allow_zero=True)
-        check_count(self.n_rays, "n_rays", maximum=MAX_RAYS)
-        check_count(self.n_scan_rays, "n_scan_rays", maximum=MAX_RAYS)
+        check_count(self.n_rays, "n_rays", maximum=MAX_RAYS, why=RAYS_WHY)
+        check_count(self.n_scan_rays, "n_scan_rays", maximum=MAX_SCAN_RAYS, why=SCAN_RAYS_WHY)
 
     @classmethod
     def ideal(cls) -> ProximitySensor:

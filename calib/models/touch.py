@@ -39,11 +39,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.errors import PlanError
+from calib.limits import MAX_RAYS
 from calib.models.proximity import sunflower_disk
 from calib.models.sensor import SearchNoise, face_frame
 from calib.structs import Strict, check_count, check_positive
 
 FloatArray = NDArray[np.float64]
+#: Why the ball's rays are bounded (:data:`calib.limits.MAX_RAYS`).
+TOUCH_RAYS_WHY = "each contact casts them at once, ~0.3 kB a ray; the default 121 covers the ball"
 
 
 class TouchProbe(Strict, frozen=True, kw_only=True, tag="touch", tag_field="kind"):
@@ -83,7 +86,7 @@ class TouchProbe(Strict, frozen=True, kw_only=True, tag="touch", tag_field="kind
         check_positive(
             self.trigger_repeatability_sigma_m, "trigger_repeatability_sigma_m", allow_zero=True
         )
-        check_count(self.n_rays, "n_rays", minimum=7)
+        check_count(self.n_rays, "n_rays", minimum=7, maximum=MAX_RAYS, why=TOUCH_RAYS_WHY)
 
     @classmethod
     def ideal(cls) -> TouchProbe:

@@ -13,7 +13,7 @@ import msgspec
 
 from calib.errors import PlanError
 from calib.paper.xoffset import SlotGrid
-from calib.structs import Strict, check_positive
+from calib.structs import Strict, check_length, check_positive, check_search_lengths
 
 
 class XOffsetRun(Strict, frozen=True, kw_only=True):
@@ -42,6 +42,12 @@ class XOffsetRun(Strict, frozen=True, kw_only=True):
     def __post_init__(self) -> None:
         check_positive(self.start_offset_m, "start_offset_m")
         check_positive(self.overtravel_m, "overtravel_m")
+        check_search_lengths(self.start_offset_m, self.overtravel_m)
+        for field, values, top in (
+            ("layers", self.layers, self.grid.n_layers),
+            ("teeth", self.teeth, self.grid.n_slots),
+        ):
+            check_length(values or (), field, top, "values", "one per layer or tooth of the grid")
         for field, values, check in (
             ("layers", self.layers, lambda v: self.grid.check_slot(1, v)),
             ("teeth", self.teeth, self.grid.tooth_y_m),

@@ -23,6 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import DegenerateGeometryError, ShapeError
 from calib.frames import check_transform, make_transform
+from calib.limits import MAX_XOFFSET_LAYERS, MAX_XOFFSET_SLOTS
 from calib.probing import ProbePoint, SearchSpec
 from calib.validation import check_shape
 
@@ -78,6 +79,16 @@ class SlotGrid(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     def __post_init__(self) -> None:
         _count(self.n_slots, "grid.n_slots")
         _count(self.n_layers, "grid.n_layers")
+        for name, value, top in (
+            ("n_slots", self.n_slots, MAX_XOFFSET_SLOTS),
+            ("n_layers", self.n_layers, MAX_XOFFSET_LAYERS),
+        ):
+            if value > top:
+                raise ShapeError(
+                    f"{name}: {value:,}, at most {top:,} (a stator section has a few dozen "
+                    "slots and about ten layers; every trial of validate keeps an x-offset per "
+                    "slot hole)"
+                )
         for name in ("first_slot_y_m", "first_layer_z_m", "slot_step_y_m", "layer_step_z_m"):
             _finite(getattr(self, name), f"grid.{name}")
         if self.n_slots > 1 and abs(self.slot_step_y_m) < MIN_SPACING_M:

@@ -19,8 +19,9 @@ from calib.frames import (
     matrix_from_quat_wxyz,
     quat_wxyz_from_matrix,
 )
+from calib.limits import MAX_FIXTURES
 from calib.plan.base import MeshUnits, check_sha256
-from calib.structs import Strict, Vec3, check_coordinates, check_unit
+from calib.structs import Strict, Vec3, check_coordinates, check_length, check_unit
 from calib.tolerances import COORDINATE_LIMIT_M
 
 
@@ -134,6 +135,15 @@ class CellSpec(Strict, frozen=True, kw_only=True):
     robot: RobotSpec = RobotSpec()
     tool: ToolSpec = ToolSpec()
     fixtures: list[FixtureSpec] = []  # noqa: RUF012 (msgspec copies empty defaults)
+
+    def __post_init__(self) -> None:
+        check_length(
+            self.fixtures,
+            "fixtures",
+            MAX_FIXTURES,
+            "fixtures",
+            "a cell has a handful (table, clamps, pallet), each a body of the cell",
+        )
 
 
 class WorkObjectSpec(Strict, frozen=True, kw_only=True):

@@ -25,6 +25,7 @@ from numpy.typing import ArrayLike
 
 from calib.atomic_io import write_text_atomic
 from calib.errors import PlanError
+from calib.limits import MAX_PLAN_POINTS, MAX_VIAS_PER_POINT
 from calib.models import SENSOR_KINDS, ProximitySensor
 from calib.plan.base import (
     BUILTIN_PREFIX,
@@ -64,7 +65,9 @@ from calib.structs import (
     Strict,
     Vec3,
     check_coordinates,
+    check_length,
     check_positive,
+    check_search_lengths,
     check_unit,
 )
 
@@ -96,6 +99,12 @@ __all__ = [
 
 PLAN_SCHEMA: Final = "wobjcal.plan/1"
 SUPPORTED_PLAN_SCHEMAS = (PLAN_SCHEMA,)
+#: Why a plan's points and a point's vias are bounded (:mod:`calib.limits`).
+POINTS_WHY = (
+    "a calibration uses 6 to a few dozen; check holds ~0.15 MB a point and compares points "
+    "pairwise, so 10,000 points took 6.8 GB"
+)
+VIAS_WHY = "a path needs 1 to 3; each is checked in the cell"
 
 
 class Search(Strict, frozen=True, kw_only=True):
@@ -118,6 +127,7 @@ class Search(Strict, frozen=True, kw_only=True):
     def __post_init__(self) -> None:
         check_positive(self.start_offset_m, "start_offset_m")
         check_positive(self.overtravel_m, "overtravel_m")
+        check_search_lengths(self.start_offset_m, self.overtravel_m)
         check_positive(self.speed_m_s, "speed_m_s")
         if self.kind == "edge" and self.edge_direction is None:
             raise PlanError("edge_direction: required for an edge search")
@@ -160,6 +170,7 @@ class PlanPoint(Strict, frozen=True, kw_only=True):
 
     def __post_init__(self) -> None:
         check_pattern(self.id, POINT_ID_PATTERN, "id", "a point id")
+        check_length(self.via_points, "vias", MAX_VIAS_PER_POINT, "vias", VIAS_WHY)
         check_coordinates(self.position_m, "position_m")
         check_unit(self.normal, "normal")
         check_unit(self.edge_normal, "edge_normal")
@@ -234,6 +245,7 @@ class Plan(Strict, frozen=True, kw_only=True):
     validation: ValidationSpec = ValidationSpec()
 
     def __post_init__(self) -> None:
+        check_length(self.points, "points", MAX_PLAN_POINTS, "points", POINTS_WHY)
         check_pattern(self.name, PLAN_NAME_PATTERN, "name", "a plan name")
         seen: dict[str, int] = {}
         for i, p in enumerate(self.points):

@@ -147,9 +147,19 @@ def _check_xyz(value: object, where: str, source: str, unit: str) -> None:
             )
 
 
+#: How to convert a length unit people use into mm, for the message refusing it.
+_TO_MM = {"cm": "multiply by 10", "dm": "multiply by 100", "in": "multiply by 25.4"}
+_TO_MM |= {"inch": _TO_MM["in"], "um": "divide by 1000", "µm": "divide by 1000"}
+
+
 def _check_point_maps(raw: dict[str, object], source: str) -> None:
     unit = raw.get("units", "m")
-    unit = unit if isinstance(unit, str) and unit in _SCALE else "m"
+    if not (isinstance(unit, str) and unit in _SCALE):  # named before any coordinate is judged
+        how = _TO_MM.get(unit.strip().lower(), "") if isinstance(unit, str) else ""
+        raise MeasurementsError(
+            f"{source}: units: {unit!r} is not a unit of this format (m or mm); convert to mm"
+            + (f" ({how})" if how else "")
+        )
     points = raw.get("points")
     if isinstance(points, dict):
         for pid, xyz in points.items():

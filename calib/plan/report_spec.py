@@ -19,7 +19,8 @@ from __future__ import annotations
 from typing import Literal, get_args
 
 from calib.errors import PlanError
-from calib.structs import Strict, Vec3, check_count, check_finite
+from calib.limits import MAX_REGION_POINTS, MAX_REPORT_LEVELS, MAX_REPORT_ROWS
+from calib.structs import Strict, Vec3, check_count, check_finite, check_length
 
 Components = Literal["xyz", "yz", "xz", "xy", "x", "y", "z"]
 #: The valid ``components`` values.
@@ -36,6 +37,7 @@ def check_levels(levels: tuple[float, ...] | None, field: str) -> None:
         return
     if not levels:
         raise PlanError(f"{field}: needs at least one confidence level")
+    check_length(levels, field, MAX_REPORT_LEVELS, "levels", "each is a row of every report")
     check_finite(levels, field)
     for lv in levels:
         if not 0.0 < lv <= MAX_LEVEL_PERCENT:
@@ -98,7 +100,13 @@ class RegionSpec(Strict, frozen=True, kw_only=True):
     def __post_init__(self) -> None:
         _check_name(self.name)
         check_levels(self.levels_percent, "levels_percent")
-        check_count(self.max_points, "max_points")
+        check_count(
+            self.max_points,
+            "max_points",
+            maximum=MAX_REGION_POINTS,
+            why="validate keeps 2 samples per trial and point: 20,000 points x 400 trials are "
+            "128 MB",
+        )
         if (self.points == "face") != (self.face_point_m is not None):
             raise PlanError("face_point_m: give it for points 'face', and only then")
         check_finite(self.face_point_m, "face_point_m")
@@ -121,6 +129,11 @@ class ReportSpec(Strict, frozen=True, kw_only=True):
 
     def __post_init__(self) -> None:
         check_levels(self.levels_percent, "levels_percent")
+        for field, group in (
+            ("points_of_interest", self.points_of_interest or []),
+            ("regions", self.regions or []),
+        ):
+            check_length(group, field, MAX_REPORT_ROWS, "rows", "each is a row of every report")
         for group in (self.points_of_interest or [], self.regions or []):
             names = [g.name for g in group]
             if len(set(names)) != len(names):

@@ -15,6 +15,7 @@ import numpy as np
 from calib.errors import PlanError
 from calib.estimators.best_fit import best_fit
 from calib.estimators.runners import run_best_fit
+from calib.limits import MAX_FIT_ITERATIONS
 from calib.paper.stator_layout import StatorLayout
 from calib.probing import Probe
 from calib.procedures.base import (
@@ -27,6 +28,7 @@ from calib.procedures.base import (
     edge_offset_of,
     unknown_role_problem,
 )
+from calib.structs import check_count
 
 ROLE = "fit"
 MIN_POINTS = 3
@@ -56,6 +58,12 @@ class BestFit(
     edge_event_offset_m: float | None = None
 
     def __post_init__(self) -> None:
+        check_count(
+            self.max_iterations,
+            "max_iterations",
+            maximum=MAX_FIT_ITERATIONS,
+            why="Gauss-Newton converges in fewer than 10",
+        )
         check_edge_offset(self.edge_event_offset_m)
 
 

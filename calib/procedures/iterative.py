@@ -23,6 +23,7 @@ from calib.estimators.layout import constraint_set, search_constraint_set
 from calib.estimators.observability import require_observable
 from calib.estimators.runners import ProbeStep, ProcedureResult, corrected_point, probe_point
 from calib.frames import check_transform, motion_between
+from calib.limits import MAX_ROUNDS
 from calib.probing import Probe, ProbePoint
 from calib.procedures.base import (
     FloatArray,
@@ -65,7 +66,12 @@ class Iterative(
 
     def __post_init__(self) -> None:
         check_positive(self.tolerance_m, "tolerance_m")
-        check_count(self.max_rounds, "max_rounds")
+        check_count(
+            self.max_rounds,
+            "max_rounds",
+            maximum=MAX_ROUNDS,
+            why="each round runs every search again; it settles in 2 or 3",
+        )
         check_edge_offset(self.edge_event_offset_m)
 
 

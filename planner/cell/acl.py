@@ -28,6 +28,7 @@ import numpy as np
 
 from calib.atomic_io import write_bytes_atomic
 from planner.cell.bodies import BodyLinks
+from planner.cell.disk_cache import warn_once
 from planner.cell.pybullet_client import pb
 
 log = logging.getLogger(__name__)
@@ -151,7 +152,7 @@ def compute_acl(
             acl = AllowedCollisions.from_json(path.read_text())
             _MEMORY_CACHE[key] = acl
             return acl
-        except (ValueError, KeyError, TypeError):
+        except (OSError, ValueError, KeyError, TypeError):
             log.warning("ignoring unreadable ACL cache %s", path)
     counts: dict[Pair, int] = {}
     bodies = [(robot.body_id, robot.body_id)]
@@ -197,8 +198,8 @@ def compute_acl(
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
             write_bytes_atomic(path, acl.to_json().encode())
-        except OSError as exc:
-            log.warning("cannot write ACL cache %s: %s", path, exc)
+        except OSError as exc:  # a cache is optional: told once, never a failed command
+            warn_once("acl", f"cannot write ACL cache {path}: {exc.strerror or exc}")
     return acl
 
 

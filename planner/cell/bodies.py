@@ -28,6 +28,11 @@ log = logging.getLogger(__name__)
 #: Above this many vertices a mesh goes to PyBullet through a temporary OBJ file (the in-memory
 #: ``vertices=`` path of ``createCollisionShape`` fails somewhere between 49k and 98k vertices).
 MAX_INLINE_VERTICES = 40_000
+#: PyBullet answers pose queries (``getBasePositionAndOrientation``, ``getLinkState``) of a body
+#: of at most this many links, base included; beyond, they fail with a bare
+#: ``GetBasePositionAndOrientation failed`` (measured: 128 links pass, 129 fail, whatever the
+#: joint types).
+PYBULLET_MAX_LINKS = 128
 
 
 @dataclass(frozen=True)
@@ -104,7 +109,8 @@ def load_urdf_body(client: int, path: Path, T_world_root: FloatArray, what: str)
         what: ``"robot"`` or ``"tool"``, for error messages.
 
     Raises:
-        URDFError: the file is missing or PyBullet cannot parse it (the message names it).
+        URDFError: the file is missing, PyBullet cannot parse it, or it has more links than
+            PyBullet can pose (:data:`PYBULLET_MAX_LINKS`); the message names it.
     """
     if not path.is_file():
         raise URDFError(f"{what} URDF not found: {path}")
@@ -121,6 +127,14 @@ def load_urdf_body(client: int, path: Path, T_world_root: FloatArray, what: str)
             )
     except pb.error as exc:
         raise URDFError(f"cannot load {what} URDF {path}: {exc} (malformed XML?)") from None
+    n_links = pb.getNumJoints(body, physicsClientId=client) + 1
+    if n_links > PYBULLET_MAX_LINKS:
+        pb.removeBody(body, physicsClientId=client)
+        raise URDFError(
+            f"{what} URDF {path}: {n_links:,} links; PyBullet, the collision engine, keeps the "
+            f"state of at most {PYBULLET_MAX_LINKS} links in one body (its pose queries fail "
+            "beyond): merge the links joined by fixed joints (a robot arm needs about ten)"
+        )
     return _body_links(client, body)
 
 

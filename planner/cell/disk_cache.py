@@ -4,6 +4,8 @@ Files live in ``$WOBJCAL_CACHE_DIR/<kind>`` (default ``~/.cache/wobjcal/<kind>``
 allowed-collision lists use too) as ``<key>.npz``. Writes are atomic (temporary file and
 rename); a reader that finds a missing, partial, corrupt or foreign file (its stored key or
 version differ) gets ``None`` and the caller rebuilds: a cache can cost time, never an answer.
+A write that fails (a full disk, a root that is not a directory) is told once per kind
+(:func:`warn_once`) and the command goes on without the cache.
 
 Each kind is bounded: after a write, the least recently used files of that kind (a load
 refreshes a file's time) are deleted until the kind holds at most ``$WOBJCAL_CACHE_MAX_MB``
@@ -71,9 +73,26 @@ def save_arrays(kind: str, key: str, version: int, arrays: dict[str, NDArray]) -
         path.parent.mkdir(parents=True, exist_ok=True)
         write_bytes_atomic(path, buf.getvalue())
     except OSError as exc:
-        log.warning("cannot write cache file %s: %s", path, exc)
+        warn_once(kind, f"cannot write cache file {path}: {exc.strerror or exc}")
         return
     evict(kind, keep=path)
+
+
+#: The caches (root directory, kind) whose failure was already told in this process.
+_WARNED: set[tuple[str, str]] = set()
+
+
+def warn_once(kind: str, message: str) -> None:
+    """Log that cache ``kind`` cannot be used (``message`` says which file and why): a
+    warning the first time for this kind under the current root in this process, a debug line
+    after. A cache is optional: an unwritable or full one slows a command, never fails it, and
+    does not fill its output with one line per file either."""
+    key = (str(cache_root()), kind)
+    if key in _WARNED:
+        log.debug("%s", message)
+        return
+    _WARNED.add(key)
+    log.warning("%s; going on without the %s cache (slower)", message, kind)
 
 
 def max_bytes() -> float:

@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import ShapeError
 from calib.frames import check_transform, make_transform
+from calib.limits import MAX_MESH_TRIANGLES
 from calib.validation import check_positive
 from planner.cell.bodies import BodyLinks, mesh_collision_shape, static_body
 from planner.cell.pybullet_client import pb
@@ -69,13 +70,15 @@ class Fixture:
         mesh: str | Path | trimesh.Trimesh,
         T_world_fixture: ArrayLike | None = None,
         units: str = "auto",
+        max_triangles: int = MAX_MESH_TRIANGLES,
     ) -> Fixture:
-        """A mesh fixture (any format trimesh reads; units as for work objects).
+        """A mesh fixture (any format trimesh reads; units as for work objects) of at most
+        ``max_triangles`` triangles.
 
         Raises:
-            MeshError: missing, unreadable or empty mesh (the message names the file).
+            MeshError: missing, unreadable, empty or too large mesh (the message names the file).
         """
-        wobj = load_work_object(mesh, units=units, name=name)
+        wobj = load_work_object(mesh, units=units, name=name, max_triangles=max_triangles)
         return cls(name, "mesh", _pose(name, T_world_fixture), (), wobj.mesh)
 
     def create_body(self, client: int) -> BodyLinks:
@@ -106,7 +109,8 @@ def fixture_from_spec(name: str, **spec: Any) -> Fixture:
     """
     T = spec.get("T_world_fixture")
     if "mesh" in spec:
-        return Fixture.from_mesh(name, spec["mesh"], T, spec.get("units", "auto"))
+        limit = int(spec.get("max_triangles", MAX_MESH_TRIANGLES))
+        return Fixture.from_mesh(name, spec["mesh"], T, spec.get("units", "auto"), limit)
     if "radius_m" in spec and "height_m" in spec:
         return Fixture.cylinder(name, spec["radius_m"], spec["height_m"], T)
     if "size_m" in spec:

@@ -7,7 +7,10 @@ read-only install cannot. :func:`configure` points numba at ``<cache root>/numba
 (``$WOBJCAL_CACHE_DIR/numba``, default ``~/.cache/wobjcal/numba``), beside the distance fields
 and allowed-collision lists, so one directory holds every derived file and emptying it is a
 true cold start. ``NUMBA_CACHE_DIR``, when set, wins. When the directory cannot be created or
-written, numba's own fallbacks apply (next to the source, then its user-wide directory).
+written, numba's own fallbacks apply (next to the source, then its user-wide directory). A
+kernel numba then cannot save or load (a full disk, an unreadable file) is compiled in memory
+with one warning per process (:func:`guard_cache_io`): the cache is optional, a command that
+finds it broken is slower, never failed.
 
 The kernels live in a subdirectory named by a hash of all the kernel modules' sources
 (:func:`source_key`), and other versions' subdirectories are deleted: numba checks a cached
@@ -23,6 +26,7 @@ directory when a function is decorated. The first call also starts the backgroun
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import logging
 import os
@@ -30,12 +34,13 @@ import shutil
 import subprocess
 import sys
 import threading
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import numba
 
-from planner.cell.disk_cache import cache_root
+from planner.cell.disk_cache import cache_root, warn_once
 
 log = logging.getLogger(__name__)
 #: numba's settings (attributes made at run time, so untyped).
@@ -53,6 +58,7 @@ def configure() -> Path | None:
     Returns:
         The directory in use, or ``None`` when numba's defaults apply (not writable).
     """
+    guard_cache_io()
     if _CONFIG.CACHE_DIR:  # NUMBA_CACHE_DIR or an earlier call
         return Path(_CONFIG.CACHE_DIR)
     key = source_key()
@@ -65,10 +71,40 @@ def configure() -> Path | None:
     return None
 
 
+def guard_cache_io() -> None:
+    """Make a failure of numba's cache I/O a slower compile, not an error (idempotent).
+
+    numba saves and loads each kernel inside ``Cache._guard_against_spurious_io_errors``,
+    which on Windows swallows ``EACCES`` and elsewhere lets everything through: a full disk
+    under the cache made ``wobjcal check`` fail. Here any :class:`OSError` there is swallowed
+    (numba then compiles, or keeps the compiled kernel in memory) and told once per process.
+    """
+    from numba.core import caching
+
+    cache_class: Any = caching.Cache
+    if getattr(cache_class, "_wobjcal_guarded", False):
+        return
+
+    @contextlib.contextmanager
+    def guard(cache: Any) -> Iterator[None]:
+        try:
+            yield
+        except OSError as exc:
+            where = getattr(cache, "cache_path", "numba's cache")
+            warn_once("numba", f"cannot use the kernel cache {where}: {exc.strerror or exc}")
+
+    cache_class._guard_against_spurious_io_errors = guard
+    cache_class._wobjcal_guarded = True
+
+
 def _remove_other_versions(root: Path, key: str) -> None:
     """Delete the kernels of other sources (best effort: another process of another version
     that loses its cache only compiles again)."""
-    for d in root.iterdir():
+    try:
+        entries = list(root.iterdir())
+    except OSError:
+        return
+    for d in entries:
         if d.is_dir() and d.name != key and len(d.name) == len(key) and _is_hex(d.name):
             shutil.rmtree(d, ignore_errors=True)
 

@@ -24,6 +24,7 @@ against its source and the CPU, so a stale or missing entry costs a compile, nev
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import os
 import sys
@@ -31,6 +32,7 @@ import time
 
 from numba.core import sigutils
 
+from planner.cell.disk_cache import warn_once
 from planner.cell.kernel_cache import CHILD_ENV, configure, marker_path
 
 #: The kernels a check calls from Python (module, function), in the order a map first needs
@@ -103,8 +105,13 @@ def main(argv: list[str] | None = None) -> int:
     if cache_dir is not None:
         marker = marker_path(cache_dir)
         tmp = marker.with_suffix(f".{os.getpid()}.tmp")
-        tmp.write_text(f"{seconds:.2f} s\n")
-        tmp.replace(marker)
+        try:
+            tmp.write_text(f"{seconds:.2f} s\n")
+            tmp.replace(marker)
+        except OSError as exc:  # a cache is optional: the next process warms it again
+            warn_once("numba", f"cannot write {marker}: {exc.strerror or exc}")
+            with contextlib.suppress(OSError):
+                tmp.unlink()
     if not os.environ.get(CHILD_ENV):
         sys.stdout.write(f"wobjcal kernels ready in {cache_dir or 'numba default cache'} ")
         sys.stdout.write(f"({seconds:.1f} s)\n")

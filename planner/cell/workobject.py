@@ -37,6 +37,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from calib.errors import InputError
+from calib.limits import MAX_CELL_TRIANGLES, MAX_MESH_TRIANGLES
 from calib.reading import MAX_MESH_BYTES, check_regular_file
 from calib.units import AUTO, METRES_PER_UNIT, canonical_unit
 from planner.builtins import builtin_mesh, is_builtin
@@ -51,9 +52,6 @@ from planner.errors import MeshError
 
 FloatArray = NDArray[np.float64]
 log = logging.getLogger(__name__)
-
-#: Most triangles a work object may have (face detection: ~6 s and ~1 GB per million).
-MAX_MESH_TRIANGLES = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -122,10 +120,15 @@ class WorkObject:
         return static_body(client, shape, T_world_wobj, self.name)
 
 
-def _too_many(path: object, n: int) -> MeshError:
+def _too_many(path: object, n: int, limit: int = MAX_MESH_TRIANGLES) -> MeshError:
+    which = (
+        f"wobjcal takes at most {limit:,}"
+        if limit >= MAX_MESH_TRIANGLES
+        else f"the cell's other meshes leave {limit:,} of the {MAX_CELL_TRIANGLES:,} a cell takes"
+    )
     return MeshError(
-        f"{path}: {n:,} triangles; wobjcal takes at most {MAX_MESH_TRIANGLES:,} (planar-face "
-        "detection needs about 6 s and 1 GB per million): decimate it first (e.g. MeshLab's "
+        f"{path}: {n:,} triangles; {which} (validate holds about 2.6 kB a triangle: 500,000 "
+        "are 1.6 GB of the 2 GB a command stays within): decimate it first (e.g. MeshLab's "
         "quadric edge collapse)"
     )
 
@@ -153,11 +156,13 @@ def stl_triangle_count(path: Path, size: int) -> int | None:
     )
 
 
-def _read(source: str | Path | trimesh.Trimesh) -> tuple[trimesh.Trimesh, str]:
+def _read(
+    source: str | Path | trimesh.Trimesh, limit: int = MAX_MESH_TRIANGLES
+) -> tuple[trimesh.Trimesh, str]:
     if isinstance(source, trimesh.Trimesh):
         meta = source.metadata or {}
-        if len(source.faces) > MAX_MESH_TRIANGLES:
-            raise _too_many(meta.get("name") or "work object", len(source.faces))
+        if len(source.faces) > limit:
+            raise _too_many(meta.get("name") or "work object", len(source.faces), limit)
         return source.copy(), str(meta.get("name") or "work object")
     if is_builtin(source):
         return builtin_mesh(str(source)), str(source)
@@ -168,8 +173,8 @@ def _read(source: str | Path | trimesh.Trimesh) -> tuple[trimesh.Trimesh, str]:
         raise MeshError(f"mesh file not found: {path}") from None
     if path.suffix.lower() == ".stl":
         n = stl_triangle_count(path, size)
-        if n is not None and n > MAX_MESH_TRIANGLES:
-            raise _too_many(path, n)  # before a byte of geometry is parsed
+        if n is not None and n > limit:
+            raise _too_many(path, n, limit)  # before a byte of geometry is parsed
     try:
         mesh = trimesh.load(str(path), force="mesh", process=False)
     except Exception as exc:  # trimesh raises many types for unreadable files
@@ -181,8 +186,8 @@ def _read(source: str | Path | trimesh.Trimesh) -> tuple[trimesh.Trimesh, str]:
             f"mesh file {path}: no triangle could be read from its {size:,} bytes (corrupt, or "
             f"not a {path.suffix.lstrip('.').upper() or 'mesh'} file)"
         )
-    if len(mesh.faces) > MAX_MESH_TRIANGLES:
-        raise _too_many(path, len(mesh.faces))
+    if len(mesh.faces) > limit:
+        raise _too_many(path, len(mesh.faces), limit)
     return mesh, str(path)
 
 
@@ -191,6 +196,7 @@ def load_work_object(
     units: str = "auto",
     name: str | None = None,
     reach_m: float | None = None,
+    max_triangles: int = MAX_MESH_TRIANGLES,
 ) -> WorkObject:
     """Load, scale and lightly repair a work-object mesh.
 
@@ -202,12 +208,14 @@ def load_work_object(
         name: a short name; default the file stem.
         reach_m: the robot's reach, m, for ``auto`` and the size warning; default
             :data:`DEFAULT_REACH_M`.
+        max_triangles: refuse a mesh of more triangles (before its geometry is parsed when
+            it is a binary STL); default :data:`calib.limits.MAX_MESH_TRIANGLES`.
 
     Raises:
         MeshError: missing or unreadable file, empty mesh, NaN/infinite vertices, bad units;
             the message names the file.
     """
-    mesh, src = _read(source)
+    mesh, src = _read(source, max_triangles)
     try:
         units = canonical_unit(units, f"units for {src}")
     except InputError as exc:

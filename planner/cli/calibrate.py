@@ -215,6 +215,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     out = calibrate_plan(plan, results.measurements, args.method, k_sigma=args.k_sigma)
     paste = out.trusted or args.force
     for note in out.notes:
+        note = note.replace("wobjcal suggest PLAN ", f"wobjcal suggest {args.plan} ")
         print(f"wobjcal calibrate: note: {note}", file=sys.stderr)
     for problem in out.problems:
         print(f"wobjcal calibrate: {problem}", file=sys.stderr)

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 from rich.table import Table
 
 from planner.cli.common import print_json, read_plan, stdout
+from planner.plan_cell import default_cell_note
 from planner.program.controllers import CONTROLLERS, DEFAULT_CONTROLLER
 
 if TYPE_CHECKING:
@@ -40,7 +41,9 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "The layout's predicted quality follows: 1 sigma of each degree of freedom, noise gain,\n"
         "the weakest motion in words and the predicted error at the points of interest at the\n"
         "plan's confidence levels; a weak layout is marginal, one that leaves a degree of\n"
-        "freedom free fails.\n\n"
+        "freedom free fails. Points whose gross error calibrate could not detect (no other\n"
+        "point fixes what they fix; a plain 3-2-1: all six) are named, with how many points to\n"
+        "add (wobjcal suggest PLAN --add N): said, not failed.\n\n"
         "Both judge the measuring program the controller of --format runs (default rapid):\n"
         "every search from its safe start must reach its face wherever the part may lie, and\n"
         "executed on the ideal part misplaced as the validation misplaces it, no search may\n"
@@ -155,6 +158,8 @@ def cmd_check(args: argparse.Namespace) -> int:
     from planner.check import check_plan  # PyBullet: not for ``wobjcal --help``
 
     plan, plan_dir = read_plan(args.plan)
+    if note := default_cell_note(plan):
+        print(f"wobjcal check: note: {note}", file=sys.stderr)
     if args.add_vias:
         plan, plan_dir, shown = _with_vias(plan, plan_dir, Path(args.add_vias))
         args.plan = shown
@@ -179,6 +184,10 @@ def cmd_check(args: argparse.Namespace) -> int:
         out.print(quality_table(check.quality, check.layout_status))
     elif check.quality_note:
         out.print(f"layout quality: not predicted: {check.quality_note}", markup=False)
+    if check.detectability is not None and check.detectability.unseen:
+        out.print(
+            f"redundancy: {check.detectability.message(args.plan)}", markup=False, style="yellow"
+        )
     if check.landing is not None:
         L = check.landing
         risky = [s for s in L.searches if s.worst > 0 or s.partly_off > 0]

@@ -7,12 +7,13 @@ import contextlib
 import json
 import os
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO, cast
 
 from rich.console import Console
 
+from calib.errors import WobjcalError
 from calib.plan.file import Plan, load_plan
 
 
@@ -66,6 +67,68 @@ def native_output_to_stderr() -> Iterator[None]:
         os.close(saved_fd)
         with contextlib.suppress(BrokenPipeError, OSError):
             private.close()
+
+
+class StdoutError(WobjcalError):
+    """Standard output could not be written (a full disk or device, an I/O error): the
+    command's output is lost, so it fails (exit 2) instead of reporting success."""
+
+
+class _CheckedStdout:
+    """``sys.stdout`` for a command: a write or flush that fails raises :class:`StdoutError`
+    naming standard output (a reader that left, :class:`BrokenPipeError`, passes unchanged);
+    everything else is the wrapped stream's."""
+
+    def __init__(self, stream: TextIO) -> None:
+        self._stream = stream
+
+    def _checked(self, action: Callable[[], int | None]) -> int | None:
+        try:
+            return action()
+        except BrokenPipeError:
+            raise
+        except OSError as exc:
+            raise StdoutError(f"cannot write to standard output: {exc}") from exc
+
+    def write(self, text: str) -> int | None:
+        return self._checked(lambda: self._stream.write(text))
+
+    def writelines(self, lines: Iterable[str]) -> None:
+        for line in lines:
+            self.write(line)
+
+    def flush(self) -> None:
+        self._checked(self._stream.flush)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
+
+
+@contextlib.contextmanager
+def checked_stdout() -> Iterator[None]:
+    """Make ``sys.stdout`` a :class:`_CheckedStdout` for the duration; the caller flushes it
+    before leaving, so that an output lost at the last flush is an error too."""
+    if sys.stdout is None or isinstance(sys.stdout, _CheckedStdout):
+        yield
+        return
+    old = sys.stdout
+    sys.stdout = cast(TextIO, _CheckedStdout(old))
+    try:
+        yield
+    finally:
+        sys.stdout = old
+
+
+def flush_stdout() -> None:
+    """Flush ``sys.stdout``; a failure (not a reader that left) raises :class:`StdoutError`."""
+    if sys.stdout is None:
+        return
+    try:
+        sys.stdout.flush()
+    except (BrokenPipeError, StdoutError):
+        raise
+    except OSError as exc:
+        raise StdoutError(f"cannot write to standard output: {exc}") from exc
 
 
 def stdout() -> Console:

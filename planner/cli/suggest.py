@@ -14,7 +14,9 @@ from typing import Any
 
 import numpy as np
 
+from calib.limits import MAX_REPORT_ROWS
 from planner.cli.common import count_arg, read_plan, stdout
+from planner.plan_cell import default_cell_note
 from planner.program.controllers import CONTROLLERS, DEFAULT_CONTROLLER
 
 
@@ -28,6 +30,11 @@ def _points_mm(text: str) -> np.ndarray:
         ) from None
     if not rows or any(len(r) != 3 for r in rows) or not np.all(np.isfinite(rows)):
         raise argparse.ArgumentTypeError(f"points are X,Y,Z[;X,Y,Z...] in mm, got {text!r}")
+    if len(rows) > MAX_REPORT_ROWS:
+        raise argparse.ArgumentTypeError(
+            f"{len(rows):,} points, at most {MAX_REPORT_ROWS} (each is a row of the design's "
+            "prediction, as validation.report.points_of_interest)"
+        )
     return np.asarray(rows, dtype=np.float64) * 1e-3
 
 
@@ -63,7 +70,8 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "the predicted error at the points of interest (greedy plus exchange on the\n"
         "information matrix), adding points until the target holds at the confidence or\n"
         "--max-points is reached. Writes the plan (atomically) and prints its predicted\n"
-        "quality. With --add N the plan's points are kept and N are added (best fit).\n\n"
+        "quality. With --add N the plan's points are kept and N are added (best fit; a 3-2-1\n"
+        "or A-H plan becomes a best fit of all its points, since those take exactly their own).\n\n"
         "exit codes: 0 target met (or none given) and the plan passes 'wobjcal check' for\n"
         "--format, 1 target not reached or check refuses the plan (named; the best plan found\n"
         "is still written), 2 bad input or no feasible layout (faces tried and why)",
@@ -130,6 +138,8 @@ def cmd_suggest(args: argparse.Namespace) -> int:
     from planner.suggest import suggest_plan
 
     plan, plan_dir = read_plan(args.plan)
+    if note := default_cell_note(plan):
+        print(f"wobjcal suggest: note: {note}", file=sys.stderr)
     out = stdout()
     res = suggest_plan(
         plan,

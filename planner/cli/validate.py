@@ -6,6 +6,7 @@ import argparse
 import json
 import math
 import re
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -13,9 +14,11 @@ from typing import TYPE_CHECKING, Any
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from calib.atomic_io import write_text_atomic
+from calib.limits import MAX_PROTOCOL_TRIALS
 from calib.plan.models import MAX_SEED, MAX_TRIALS
 from planner.cli.common import count_arg, read_plan, stderr, stdout
 from planner.errors import PlanRefused
+from planner.plan_cell import default_cell_note
 from planner.program.controllers import CONTROLLERS, DEFAULT_CONTROLLER
 
 #: Most worker processes a validation may start.
@@ -26,13 +29,23 @@ if TYPE_CHECKING:
 
 
 def protocol_arg(text: str) -> tuple[int, int]:
-    """``"20x20"`` -> ``(20, 20)``: positions x repeats, each >= 2."""
+    """``"20x20"`` -> ``(20, 20)``: positions x repeats, each >= 2, at most
+    :data:`calib.limits.MAX_PROTOCOL_TRIALS` trials together."""
     m = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", text)
-    if not m or min(int(m.group(1)), int(m.group(2))) < 2:
+    if not m or min(int(g[:12]) for g in m.groups()) < 2:
         raise argparse.ArgumentTypeError(
             f"must be POSITIONSxREPEATS with both >= 2, e.g. 20x20, got {text!r}"
         )
-    return int(m.group(1)), int(m.group(2))
+    big = max(len(g) for g in m.groups()) > 12  # int() of thousands of digits is refused
+    positions, repeats = (int(g[:12]) for g in m.groups())
+    if big or positions * repeats > MAX_PROTOCOL_TRIALS:
+        total = "more than 10^12" if big else f"{positions * repeats:,}"
+        raise argparse.ArgumentTypeError(
+            f"{text.strip()} is {total} trials, at most "
+            f"{MAX_PROTOCOL_TRIALS:,} (as --trials: every trial's result stays in memory until "
+            "the report; the paper's protocol is 20x20)"
+        )
+    return positions, repeats
 
 
 def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
@@ -130,6 +143,19 @@ def _num(x: float) -> float | None:
     return float(x) if math.isfinite(x) else None
 
 
+def check_budget(
+    plan: Any, trials: int, protocol: tuple[int, int] | None, fmt: str, sensitivity: bool
+) -> None:
+    """Refuse a run whose results or ray casts exceed the budget (:mod:`planner.sim.budget`)
+    before the check and the simulation start; with ``sensitivity`` its runs too."""
+    from planner.sim.budget import check_run_size, run_size, sensitivity_runs
+
+    check_run_size(run_size(plan, trials, protocol, fmt))
+    if sensitivity:
+        size = run_size(plan, trials, None, fmt, runs=sensitivity_runs(plan))
+        check_run_size(size, "--sensitivity")
+
+
 def report_json(report: ValidationReport) -> dict[str, Any]:
     """The JSON of a ``ValidationReport``: rows (display units), outcomes, failures, landings."""
     return {
@@ -193,9 +219,12 @@ def cmd_validate(args: argparse.Namespace) -> int:
     from planner.validate import check_simulatable, sensitivity_plan, validate_plan
 
     plan, plan_dir = read_plan(args.plan)
+    if note := default_cell_note(plan):
+        print(f"wobjcal validate: note: {note}", file=sys.stderr)
     check_simulatable(plan)  # a clear error before the simulation's heavy imports
     trials = plan.validation.trials if args.trials is None else args.trials
     seed = plan.validation.seed if args.seed is None else args.seed
+    check_budget(plan, trials, args.protocol, args.format, args.sensitivity)
     try:
         with _bar() as bar:
             task = bar.add_task("trials", total=trials)

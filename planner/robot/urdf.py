@@ -33,7 +33,9 @@ How the work is split with yourdfpy:
 * Mesh URIs are resolved by :mod:`planner.robot.urdf_meshes`, not by yourdfpy's filename
   handlers: those strip the package name from ``package://pkg/rest`` and then search ``rest``
   upwards (so a mesh of a sibling package is not found, and a same-named file of another package
-  is taken instead), and they try paths relative to the process's working directory.
+  is taken instead), and they try paths relative to the process's working directory. A mesh
+  outside the URDF's own folder or package (``/etc/passwd``, ``../../x``, ``package://p/../..``)
+  is refused here, naming the file, the link and the path, before PyBullet or trimesh reads it.
 
 :func:`load_urdf` raises when a referenced mesh is missing unless ``check_meshes=False``. The
 data model's names are importable from here too. Angles follow URDF: ``rpy`` is roll, pitch, yaw
@@ -46,15 +48,17 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections import Counter
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from calib.limits import MAX_URDF_LINKS, MAX_URDF_MESH_BYTES, MiB
 from calib.reading import MAX_URDF_BYTES, read_bytes_capped
 from planner.errors import URDFError
-from planner.robot.urdf_meshes import resolve_mesh
+from planner.robot.urdf_meshes import outside_problem, resolve_mesh
 from planner.robot.urdf_model import (
     JOINT_TYPES,
     FloatArray,
@@ -146,6 +150,9 @@ def load_urdf(path: str | Path, check_meshes: bool = True) -> URDFModel:
     if check_meshes and missing:
         listed = "; ".join(f"link {link!r}: {uri!r}" for link, uri in missing)
         raise URDFError(f"{p}: mesh file(s) not found: {listed}")
+    too_big = mesh_bytes_problem(model)
+    if too_big:
+        raise URDFError(f"{p}: {too_big}")
     return model
 
 
@@ -167,9 +174,47 @@ def parse_urdf(text: str | bytes, source: Path | None = None) -> URDFModel:
         material = _parsed(URDF._parse_material, e, what)
         if material.name and material.color is not None:
             colors[material.name] = _tuple(material.color.rgba)
+    _check_sizes(root, where)
     links = tuple(_link(e, URDF._parse_link, where, base_dir, colors) for e in root.findall("link"))
     joints = tuple(_joint(e, URDF._parse_joint, where) for e in root.findall("joint"))
     return _validated(name, source, links, joints, where)
+
+
+def _check_sizes(root: Any, where: str) -> None:
+    """Refuse more than :data:`calib.limits.MAX_URDF_LINKS` links or joints before either is
+    parsed (the tree checks and the cell's collision pairs grow with the square)."""
+    for tag in ("link", "joint"):
+        n = len(root.findall(tag))
+        if n > MAX_URDF_LINKS:
+            raise URDFError(
+                f"{where}: {n:,} <{tag}> elements, at most {MAX_URDF_LINKS:,} (an arm has 7 to "
+                "10 links, with a track, a positioner and a tool changer a few dozen; PyBullet "
+                "poses at most 128 in one body)"
+            )
+
+
+def mesh_bytes_problem(model: URDFModel) -> str:
+    """Why the mesh files ``model`` refers to are too large to load, or ``""``: more than
+    :data:`calib.limits.MAX_URDF_MESH_BYTES` together (PyBullet and the drawings read them
+    all)."""
+    files = {g.mesh_path for link in model.links for g in _geometries(link) if g.mesh_path}
+    total = 0
+    for f in files:
+        try:
+            total += f.stat().st_size
+        except OSError:
+            continue
+    if total <= MAX_URDF_MESH_BYTES:
+        return ""
+    return (
+        f"its {len(files)} mesh files hold {total / MiB:.1f} MiB, at most "
+        f"{MAX_URDF_MESH_BYTES / MiB:.0f} MiB (PyBullet and the drawings load every one; a "
+        "vendor arm's meshes are 5-40 MB): simplify them (e.g. MeshLab's quadric edge collapse)"
+    )
+
+
+def _geometries(link: Link) -> list[Any]:
+    return [shape.geometry for shape in (*link.visuals, *link.collisions)]
 
 
 def _xml_root(text: str | bytes, where: str) -> Any:
@@ -195,7 +240,7 @@ def _validated(
     if not links:
         raise URDFError(f"{where}: <robot name={name!r}> has no <link> elements")
     names = [link.name for link in links]
-    dup = sorted({n for n in names if names.count(n) > 1})
+    dup = sorted(n for n, k in Counter(names).items() if k > 1)  # linear: links are many
     if dup:
         raise URDFError(f"{where}: duplicate link name(s) {dup}")
     known = set(names)
@@ -214,14 +259,16 @@ def _validated(
     if len(roots) != 1:
         what = "no root link (the joints form a cycle)" if not roots else f"several roots {roots}"
         raise URDFError(f"{where}: the links must form one tree, found {what}")
+    children: dict[str, list[str]] = {}
+    for j in joints:
+        children.setdefault(j.parent, []).append(j.child)
     reached = {roots[0]}
     frontier = [roots[0]]
     while frontier:
-        link = frontier.pop()
-        for j in joints:
-            if j.parent == link and j.child not in reached:
-                reached.add(j.child)
-                frontier.append(j.child)
+        for child in children.get(frontier.pop(), ()):
+            if child not in reached:
+                reached.add(child)
+                frontier.append(child)
     if len(reached) != len(names):
         cyc = sorted(known - reached)
         raise URDFError(f"{where}: links {cyc} form a cycle, unreachable from root {roots[0]!r}")
@@ -351,6 +398,12 @@ def _shape(
         geom = Geometry("sphere", radius=float(g.sphere.radius))
     else:
         uri = g.mesh.filename
+        outside = outside_problem(uri, base_dir)
+        if outside:
+            raise URDFError(
+                f"{what}: mesh {uri!r} {outside}: a URDF reads only files in its own folder or "
+                "package; copy the mesh there and refer to it by a relative path"
+            )
         scale = (1.0, 1.0, 1.0) if g.mesh.scale is None else _tuple(g.mesh.scale)
         geom = Geometry("mesh", filename=uri, mesh_path=resolve_mesh(uri, base_dir), scale=scale)
     rgba = None

@@ -31,6 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import InputError, ShapeError
 from calib.frames import check_transform
+from calib.limits import MAX_PROTOCOL_TRIALS
 from calib.models import Misplacement, RobotErrorModel
 from calib.models.proximity import ProximitySensor
 from calib.paper.settings import Hultman2013
@@ -117,6 +118,11 @@ def simulate(
         raise ShapeError(f"n_trials must be an integer 2 to {MAX_TRIALS:,}, got {n_trials!r}")
     if protocol is not None and (min(protocol) < 2 or len(protocol) != 2):
         raise ShapeError(f"protocol must be (positions, repeats), each >= 2, got {protocol!r}")
+    if protocol is not None and protocol[0] * protocol[1] > MAX_PROTOCOL_TRIALS:
+        raise ShapeError(
+            f"protocol: {protocol[0]:,} x {protocol[1]:,} trials, at most "
+            f"{MAX_PROTOCOL_TRIALS:,} (every trial's result stays in memory until the report)"
+        )
     prediction = predict(setup)  # before the run: a plan that cannot work fails here
     setup = dataclasses.replace(setup, accuracy_field=setup.robot_error.sample_field(rng))
     seeds: list[TrialSeed] = list(np.random.SeedSequence(int(rng.integers(2**63))).spawn(n_trials))

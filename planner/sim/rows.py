@@ -101,6 +101,11 @@ def _unsigned(errors: FloatArray, components: str) -> FloatArray:
     return np.linalg.norm(errors[..., [_AXIS[c] for c in components]], axis=-1)
 
 
+#: Samples (trials x points) whose error vectors one step of :func:`samples_and_bias` holds at
+#: once: the row's transients stay ~100 MB whatever its trials and points (issue 27).
+CHUNK_SAMPLES = 500_000
+
+
 def point_errors(delta: FloatArray, p_wobj: FloatArray) -> FloatArray:
     """Errors ``(n, M, 3)`` of wobj points ``(M, 3)`` under frame errors ``(n, 6)`` (exact)."""
     T = small_motion(delta)  # T_true_est, (n, 4, 4)
@@ -126,12 +131,19 @@ def samples_and_bias(
     if spec.frame_index is not None:
         x = delta[:, spec.frame_index]
         return x - x.mean(), float(x.mean())
-    e = point_errors(delta, _points(spec)) if point_err is None else point_err
-    if spec.offset_m is not None:
-        e = e - spec.offset_m
-    mean = e.mean(axis=0)
-    samples = measure(e - mean, spec.components).ravel()
-    return samples, float(np.mean(_unsigned(mean, spec.components)))
+    pts = _points(spec) if point_err is None else np.zeros((0, 3))
+    n, m = (len(delta), len(pts)) if point_err is None else point_err.shape[:2]
+    samples = np.empty((n, m))
+    means = np.empty((m, 3))
+    step = max(1, CHUNK_SAMPLES // max(n, 1))  # a few points at a time: bounded transients
+    for i in range(0, m, step):
+        j = min(i + step, m)
+        e = point_errors(delta, pts[i:j]) if point_err is None else point_err[:, i:j]
+        if spec.offset_m is not None:
+            e = e - spec.offset_m[i:j]
+        means[i:j] = e.mean(axis=0)
+        samples[:, i:j] = measure(e - means[i:j], spec.components)
+    return samples.ravel(), float(np.mean(_unsigned(means, spec.components)))
 
 
 def predicted_sigma(spec: RowSpec, cov: FloatArray) -> float:
