@@ -30,7 +30,7 @@ lines to paste unless ``--force``, and the UI does not draw the frame as calibra
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import msgspec
 import numpy as np
@@ -187,6 +187,8 @@ def calibrate_plan(
     cov = propagated_covariance(kind, points, sequences, T_nom, settings, sigma)
     problems = [*screen.messages(), *misplacement_problems(plan, run.T_base_wobj, screen)]
     unseen = detectability([p.to_probe_point() for p in plan.points if p.id in first])
+    if unseen.unseen and (why := plan.fixed_points()):
+        unseen = replace(unseen, fixed=why)
     # which points' gross errors the screen could not see, and how many points would show them
     notes = [unseen.message()] if unseen.unseen else [screen.note] if screen.note else []
     return CalibrationOutput(

@@ -187,7 +187,11 @@ def plan_detectability(plan: Plan) -> Detectability | None:
         d = detectability([p.to_probe_point() for p in plan.points])
     except InputError:
         return None
-    return None if d.add is None and not d.unseen else d
+    if d.add is None and not d.unseen:
+        return None
+    if why := plan.fixed_points():
+        d = replace(d, fixed=why)
+    return d
 
 
 def plan_landing_risk(

@@ -232,6 +232,8 @@ def suggest_plan(
                 fmt=fmt,
             )
     converted = ""
+    if add and (why := plan.fixed_points()):
+        raise InputError(f"--add: {why}")
     if add and plan.method != "best_fit":  # 3-2-1 and A-H take exactly their own points
         converted = (
             f"; the plan's procedure {plan.method} takes exactly its own points, so the plan "

@@ -37,14 +37,12 @@ from typing import Any
 import numpy as np
 import pytest
 
-from calib.plan.file import load_plan
 from planner.export import export_files
 from planner.export.job import ToolData, build_job
-from planner.sim.trial import TrialRunner
-from planner.validate import check_simulatable, simulation_setup, work_object_mesh
 from tests.krl_interp import KrlMachine
 from tests.rapid_interp import Machine, _vec
 from tests.test_program_trial_replay import _search_callback
+from tests.test_program_trial_replay import _trial as replay_trial
 
 PLANS = Path(__file__).resolve().parents[1] / "assets" / "plans"
 #: The issue's limit: the float32 frame within this of the float64 frame at the part's
@@ -97,31 +95,11 @@ def stray(
 
 @functools.cache
 def _trial(name: str, fmt: str, seed: int) -> tuple[Any, Any, Any, np.ndarray]:
-    """The plan, its setup for ``fmt``, a maker of the trial's probe (the same noise every
-    time, edges bisected to :data:`FINE_EDGE_M`) and the part's bounding-box corners (wobj, m).
+    """The trial of ``tests/test_program_trial_replay.py`` with the edges bisected to
+    :data:`FINE_EDGE_M`, and the part's bounding-box corners (wobj, m) instead of the true pose.
     The part's planar faces are cached per mesh: the second format's setup is quick."""
-    plan = load_plan(PLANS / name)
-    models = check_simulatable(plan)
-    mesh = work_object_mesh(plan, PLANS, models)
-    setup = simulation_setup(plan, models, mesh, fmt)
-    runner = TrialRunner(setup, mesh)
-    T_true = setup.T_base_wobj_nominal @ setup.misplacement.sample(
-        np.random.default_rng(seed), setup.pivot_wobj_m
-    )
-
-    def probe() -> Any:
-        return runner.simulator(
-            runner.caster,
-            T_true,
-            np.random.default_rng(1000 + seed),
-            sensor=setup.sensor,
-            robot_error=setup.robot_error,
-            faces=setup.faces,
-            edge_inset_m=setup.edge_inset_m,
-            edge_tolerance_m=FINE_EDGE_M,
-        )
-
-    lo, hi = np.asarray(mesh.bounds, dtype=float)
+    plan, setup, probe, _T_true = replay_trial(PLANS / name, fmt, seed, FINE_EDGE_M)
+    lo, hi = np.asarray(probe().caster.mesh.bounds, dtype=float)
     corners = np.array(
         [[(lo, hi)[k][i] for i, k in enumerate(c)] for c in product((0, 1), repeat=3)]
     )

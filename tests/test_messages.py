@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 import trimesh
 
+from calib.errors import InputError
 from calib.estimators.gross_errors import detectability
 from calib.frames import make_transform, transform_points
 from calib.plan.file import load_plan, plan_from_json
@@ -290,3 +291,21 @@ def test_suggest_add_grows_a_three_two_one_plan_into_a_best_fit() -> None:
     grown = as_best_fit(plan)
     assert grown.method == "best_fit" and {p.role for p in grown.points} == {"fit"}
     assert [p.position_m for p in grown.points] == [p.position_m for p in plan.points]
+
+
+def test_a_plan_with_an_x_offset_run_is_not_grown_into_a_best_fit() -> None:
+    """Was: the A-H plan's redundancy line named `suggest --add 2`, which wrote a best fit of ten
+    points without the paper's x-offset run: a plan that places no slot. Now the line says why
+    no point can be added, and `--add` refuses the plan naming it."""
+    from planner.suggest import suggest_plan
+
+    plan = load_plan(STATOR)
+    d = plan_detectability(plan)
+    assert d is not None and d.unseen == ("C", "F", "H") and d.add == 2
+    note = d.message()
+    assert "x-offset run" in note and "--add" not in note, note
+    with pytest.raises(InputError, match="--add: the plan's hultman2013 procedure takes exactly"):
+        suggest_plan(plan, STATOR.parent, add=2)
+    plate = load_plan(PLATE_321, check_files=False)
+    assert plate.fixed_points() == ""
+    assert "--add 3" in (plan_detectability(plate) or d).message()

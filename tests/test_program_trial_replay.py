@@ -40,8 +40,12 @@ TOL_M = 1e-7
 A_H_TOL_M, A_H_TOL_RAD = 5e-5, 1e-4
 
 
-def _trial(path: Path, fmt: str, seed: int) -> tuple[Any, Any, Any, np.ndarray]:
-    """The plan, the trial's setup, a maker of its simulated probe, and the true pose."""
+def _trial(
+    path: Path, fmt: str, seed: int, edge_tolerance_m: float | None = None
+) -> tuple[Any, Any, Any, np.ndarray]:
+    """The plan, the trial's setup, a maker of its simulated probe, and the true pose.
+
+    ``edge_tolerance_m`` bisects the edge events finer than the setup's (``None``: its own)."""
     plan = load_plan(path)
     models = check_simulatable(plan)
     mesh = work_object_mesh(plan, PLANS, models)
@@ -59,7 +63,7 @@ def _trial(path: Path, fmt: str, seed: int) -> tuple[Any, Any, Any, np.ndarray]:
             robot_error=setup.robot_error,
             faces=setup.faces,
             edge_inset_m=setup.edge_inset_m,
-            edge_tolerance_m=setup.edge_tolerance_m,
+            edge_tolerance_m=edge_tolerance_m or setup.edge_tolerance_m,
         )
 
     return plan, setup, probe, T_true

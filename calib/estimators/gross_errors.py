@@ -214,6 +214,8 @@ class Detectability:
             unseen, ``None`` when more than :data:`MAX_ADDED` or the layout fixes no frame).
         faces: for each point to add, the face it was counted on, named by a point on it
             (``"F's face"``, or ``"F's edge face"``: the face whose end an edge point finds).
+        fixed: why no point can be added to this plan without giving up part of its procedure
+            (e.g. the A-H procedure's x-offset run, which a best fit has not), or ``""``.
     """
 
     n_constraints: int
@@ -222,6 +224,7 @@ class Detectability:
     add: int | None
     faces: tuple[str, ...] = ()
     edge_only: tuple[str, ...] = ()
+    fixed: str = ""
 
     @property
     def ok(self) -> bool:
@@ -252,6 +255,8 @@ class Detectability:
                 f"fixes ({self.redundancy} redundant constraint(s) elsewhere), so the frame fits "
                 "it exactly"
             )
+        if self.fixed:
+            return f"{head}; {self.fixed}"
         if not self.add:
             return head + "; measure more points on the faces of those points"
         counts: dict[str, int] = {}

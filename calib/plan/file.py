@@ -267,6 +267,19 @@ class Plan(Strict, frozen=True, kw_only=True):
         """The procedure's method: ``hultman2013``, ``three_two_one`` or ``best_fit``."""
         return method_of(self.procedure)
 
+    def fixed_points(self) -> str:
+        """Why no point can be added to this plan (``suggest --add`` grows a plan into a best
+        fit of all its points): what of its procedure a best fit would drop, or ``""`` when
+        nothing would (a 3-2-1 plan's six points are a best fit's too)."""
+        if getattr(self.procedure, "xoffset", None) is None:
+            return ""
+        return (
+            f"the plan's {self.method} procedure takes exactly its own points and runs the "
+            "x-offset run after them, which a best fit of more points would not: measure those "
+            "points again if the calibrated frame is in doubt (calibrate's screen fits every "
+            "point measured)"
+        )
+
     def require_complete(self) -> None:
         """Raise :class:`PlanError` unless the points have all roles the procedure needs."""
         msg = procedure_kind(self.procedure).role_problem([p.role for p in self.points], True)
