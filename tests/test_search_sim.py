@@ -116,3 +116,45 @@ def test_reachability_hook_fails_the_probe_with_its_reason() -> None:
     probe = _probe(reachability=lambda cmd: "unreachable: joint 5 at limit")
     res = probe(SearchCommand.from_point(ProbePoint("p", (0.0, -0.2, 0.0), TOP), np.eye(4)))
     assert res.reason == "unreachable: joint 5 at limit"
+
+
+def _commands(T: np.ndarray) -> list[SearchCommand]:
+    """Approaches on the top face (noisy, a tilted part), an edge search between them, one
+    approach with nothing below (it fails), and one after it."""
+    top = [ProbePoint(f"t{i}", (0.03 * i - 0.15, -0.05 - 0.01 * i, 0.0), TOP) for i in range(9)]
+    edge = ProbePoint(
+        "f", (0.05, 0.0, 0.0), TOP, SearchSpec("edge", 0.06, 0.03, (0.0, 1.0, 0.0)), (0, 1, 0)
+    )
+    off = ProbePoint("o", (0.5, -0.2, 0.0), TOP)
+    points = [*top[:4], edge, *top[4:], off, top[0]]
+    return [SearchCommand.from_point(p, T) for p in points]
+
+
+@pytest.mark.parametrize("stop_at", [None, "o"])
+def test_searches_in_turn_equal_one_by_one(stop_at: str | None) -> None:
+    """``run_in_turn`` (one ray cast for a run of approaches: the x-offset run) gives the same
+    points, failures, events and noise as the probe called on each search until one fails."""
+    T = _tilted()
+    cmds = _commands(T @ make_transform(None, [0.001, -0.002, 0.0005]))
+    if stop_at is None:
+        cmds = [c for c in cmds if c.point_id != "o"]
+    noise = {
+        "robot_error": RobotErrorModel(repeatability_sigma_m=2e-5),
+        "sensor": ProximitySensor(),
+    }
+    one, batch = _probe(T, **noise), _probe(T, **noise)
+    expected = []
+    for c in cmds:
+        expected.append(one(c))
+        if not expected[-1].ok:
+            break
+    got = batch.run_in_turn(cmds)
+    assert [r.reason for r in got] == [r.reason for r in expected]
+    assert len(got) == (len(cmds) if stop_at is None else 11)  # up to and with the failure
+    for a, b in zip(got, expected, strict=True):
+        assert (a.point_m is None) == (b.point_m is None)
+        if a.point_m is not None:
+            assert np.array_equal(a.point_m, b.point_m) and a.travel_m == b.travel_m
+    assert batch.events == one.events
+    if stop_at is None:  # the same noise drawn: both generators are in the same state
+        assert batch.rng.random() == one.rng.random()

@@ -25,6 +25,7 @@ recorded with the fraction of its area that is off.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -148,6 +149,60 @@ class SimulatedProbe:
             return self._approach_along_axis(cmd, tcp0, axis, length)
         return self._scan(cmd, tcp0, axis, direction, length, want_on=cmd.kind == "approach")
 
+    def run_in_turn(self, commands: Sequence[SearchCommand]) -> list[ProbeResult]:
+        """Run ``commands`` one after the other, up to and including the first that fails.
+
+        The same results, events and noise as calling the probe on each in turn and stopping
+        at a failure (the x-offset run does): approaches along their sensor axes are cast in
+        one ray bundle for all of them, the rest one by one. The noise of a search is drawn
+        in the same order (its robot offset, then its switching jitter); after a failure the
+        generator may have drawn the next searches' noise, which nothing uses: a run that
+        fails ends its trial.
+        """
+        out: list[ProbeResult] = []
+        pending: list[tuple[SearchCommand, FloatArray, FloatArray, float]] = []
+        for cmd in commands:
+            axis = np.asarray(cmd.sensor_axis, float)
+            along = cmd.kind == "approach" and float(np.asarray(cmd.direction) @ axis) > 1 - 1e-12
+            if not along:
+                out += self._cast_in_turn(pending)
+                pending = []
+                if out and not out[-1].ok:
+                    return out
+                out.append(self(cmd))
+                if not out[-1].ok:
+                    return out
+                continue
+            start = np.asarray(cmd.start_m, float)
+            tcp0 = start + robot_offset(
+                start, axis, self.rng, self.robot_error, self.accuracy_field, self.tcp_error_m
+            )
+            pending.append((cmd, tcp0, axis, self.sensor.sample_jitter_m(self.rng)))
+        return out + self._cast_in_turn(pending)
+
+    def _cast_in_turn(
+        self, searches: Sequence[tuple[SearchCommand, FloatArray, FloatArray, float]]
+    ) -> list[ProbeResult]:
+        """Approaches along their axes ``(command, tcp0, axis, jitter)``: one ray cast, then
+        each judged in turn as :meth:`_approach_along_axis` does, up to the first failure."""
+        if not searches:
+            return []
+        R = self._T_wobj_base[:3, :3]
+        origins = np.concatenate(
+            [self._to_part(self.sensor.ray_origins(tcp0, axis)) for _, tcp0, axis, _ in searches]
+        )
+        n_rays = len(origins) // len(searches)
+        axes = np.repeat(np.array([R @ axis for _, _, axis, _ in searches]), n_rays, axis=0)
+        dist_all, tri_all = self.caster.first_hits_ids(origins, axes)
+        out: list[ProbeResult] = []
+        for k, (cmd, _, _, jitter) in enumerate(searches):
+            rays = slice(k * n_rays, (k + 1) * n_rays)
+            res = self._judge_approach(cmd, dist_all[rays], tri_all[rays], jitter)
+            out.append(res)
+            if not res.ok:
+                break
+        return out
+
     def _approach_along_axis(
         self, cmd: SearchCommand, tcp0: FloatArray, axis: FloatArray, length: float
     ) -> ProbeResult:
@@ -156,7 +211,17 @@ class SimulatedProbe:
         dist, tri = self.caster.first_hits_ids(origins, axis_part)
         if np.any(dist <= 0.0):
             return self._fail(cmd, "sensor face inside the part at start")
-        travel = self.sensor.switch_travel_m(dist, self.sensor.sample_jitter_m(self.rng))
+        return self._judge_approach(cmd, dist, tri, self.sensor.sample_jitter_m(self.rng))
+
+    def _judge_approach(
+        self, cmd: SearchCommand, dist: FloatArray, tri: NDArray[np.int64], jitter: float
+    ) -> ProbeResult:
+        """Where an approach along the sensor axis switches, from its rays' distances ``dist``
+        and triangles ``tri`` at the start and the switching jitter (m)."""
+        length = float(cmd.length_m)
+        if np.any(dist <= 0.0):
+            return self._fail(cmd, "sensor face inside the part at start")
+        travel = self.sensor.switch_travel_m(dist, jitter)
         if travel <= 0.0:
             return self._fail(cmd, "sensor already detecting at start")
         if not math.isfinite(travel) or travel > length:

@@ -20,7 +20,7 @@ from calib.errors import ProbeFailedError
 from calib.frames import invert_transform, transform_points
 from calib.paper.settings import XOffsetRun
 from calib.paper.xoffset import slot_positions_wobj, xoffset_matrix, xoffset_probe_points
-from calib.probing import Probe, ProbePoint, SearchCommand, SearchSpec
+from calib.probing import Probe, ProbePoint, ProbeResult, SearchCommand, SearchSpec
 
 FloatArray = NDArray[np.float64]
 
@@ -76,16 +76,32 @@ def run_xoffset(
         ProbeFailedError: a search failed (its id and reason).
     """
     T_wobj_base = invert_transform(T_base_wobj_cal)
-    px = np.zeros((len(xs.points), len(xs.points[0]), 3))
-    for k, row in enumerate(xs.points):
-        for j, p in enumerate(row):
-            res = probe(SearchCommand.from_point(p, T_base_wobj_cal))
-            if res.point_m is None:
-                raise ProbeFailedError(p.id, res.reason or "no reason given")
-            px[k, j] = transform_points(T_wobj_base, np.asarray(res.point_m, dtype=np.float64))
+    points = [p for row in xs.points for p in row]
+    commands = [SearchCommand.from_point(p, T_base_wobj_cal) for p in points]
+    results = in_turn(probe, commands)
+    for p, res in zip(points, results, strict=False):
+        if res.point_m is None:
+            raise ProbeFailedError(p.id, res.reason or "no reason given")
+    measured = np.array([r.point_m for r in results], dtype=np.float64)
+    px = transform_points(T_wobj_base, measured).reshape(len(xs.points), len(xs.points[0]), 3)
     mx = xoffset_matrix(px, xs.run.grid)
     targets = xs.targets_wobj.copy()
     targets[..., 0] = mx
     T_true_cal = invert_transform(T_base_wobj_true) @ T_base_wobj_cal
     placed = transform_points(T_true_cal, targets.reshape(-1, 3))
     return placed - xs.holes_wobj.reshape(-1, 3)
+
+
+def in_turn(probe: Probe, commands: list[SearchCommand]) -> list[ProbeResult]:
+    """``probe`` on each of ``commands`` in turn, up to and including the first failure: at once
+    where the probe can (``run_in_turn`` of :class:`planner.sim.probe.SimulatedProbe`: one ray
+    cast for all its approaches), else one by one."""
+    batch = getattr(probe, "run_in_turn", None)
+    if batch is not None:
+        return list(batch(commands))
+    out: list[ProbeResult] = []
+    for cmd in commands:
+        out.append(probe(cmd))
+        if out[-1].point_m is None:
+            break
+    return out
