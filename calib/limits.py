@@ -83,6 +83,15 @@ MAX_FIT_ITERATIONS: Final = 1_000
 #: Most rounds of the iterative best fit (each runs every search again; it settles in 2 or 3).
 MAX_ROUNDS: Final = 20
 
+# ---- cycle time (plausibility, not memory: a typo such as ms given as s is refused) --------
+#: Longest settle time per search stop and longest I/O time per recorded point, s: a robot
+#: settles in 0.1-0.5 s and writes a measurement in milliseconds; a minute is a typo.
+MAX_SETTLE_S: Final = 60.0
+MAX_IO_S: Final = 60.0
+#: Largest joint acceleration of the cycle-time model, rad/s^2 (m/s^2 for a sliding joint):
+#: industrial arms reach 5-50; 1,000 is far above any and still finite arithmetic.
+MAX_JOINT_ACCELERATION_RAD_S2: Final = 1000.0
+
 # ---- meshes and URDFs --------------------------------------------------------------------
 #: Most triangles of one mesh (work object or fixture), and of all the cell's meshes together:
 #: ``validate`` holds ~2.6 kB a triangle, so 500,000 take 1.6 GB of the 2 GB and leave the rest
@@ -97,6 +106,11 @@ MAX_URDF_LINKS: Final = 10_000
 #: Most bytes of the mesh files a URDF refers to (all distinct files together): PyBullet and the
 #: drawings load every one (a vendor arm's meshes are 5-40 MB).
 MAX_URDF_MESH_BYTES: Final = 128 * MiB
+#: Largest CAD file (STEP, IGES) read: OpenCASCADE holds its whole model and the triangulation
+#: in memory, ~12 times the file over a ~0.3 GB base (measured: box_sides.STEP copied 4 and 16
+#: times, 6.3 MB and 26 MB, read in 462 MB and 613 MB); 64 MiB stays near 1.1 GB, and a machined
+#: part's STEP is a few MB.
+MAX_CAD_FILE_BYTES: Final = 64 * MiB
 
 # ---- the UI server -------------------------------------------------------------------------
 #: Largest upload, bytes (viser holds an upload in memory until it is complete).
@@ -121,9 +135,12 @@ MAX_UPLOADS_KEPT_BYTES: Final = 1024 * MiB
 
 
 __all__ = [
+    "MAX_CAD_FILE_BYTES",
     "MAX_CELL_TRIANGLES",
     "MAX_FIT_ITERATIONS",
     "MAX_FIXTURES",
+    "MAX_IO_S",
+    "MAX_JOINT_ACCELERATION_RAD_S2",
     "MAX_MESH_TRIANGLES",
     "MAX_PLAN_POINTS",
     "MAX_PROTOCOL_TRIALS",
@@ -136,6 +153,7 @@ __all__ = [
     "MAX_ROUNDS",
     "MAX_SCAN_RAYS",
     "MAX_SEARCH_LENGTH_M",
+    "MAX_SETTLE_S",
     "MAX_UPLOADS_IN_FLIGHT_BYTES",
     "MAX_UPLOADS_KEPT_BYTES",
     "MAX_UPLOADS_PER_CLIENT",

@@ -32,7 +32,8 @@ of the nominal points (a dry run of the same ``estimate`` that ``wobjcal calibra
 a plan that ``calibrate`` would refuse fails at ``check``, before the robot has measured.
 Then which points' gross errors ``calibrate``'s screen could see at all
 (:func:`plan_detectability`; a plain 3-2-1 has no redundancy: none), and how many points to
-add so it sees one in every point: said, not failed.
+add so it sees one in every point: said, not failed. Last, the program's estimated cycle time
+(:func:`planner.check_cycle.plan_cycle_time`, the model of :mod:`planner.program.cycle_time`).
 """
 
 from __future__ import annotations
@@ -53,6 +54,7 @@ from calib.plan.file import Plan, PlanPoint
 from calib.procedures import procedure_kind
 from calib.procedures.base import edge_offset_of
 from calib.tolerances import FACE_MAX_DEVIATION_M
+from planner.check_cycle import plan_cycle_time
 from planner.check_paths import ProgramPath, check_program_path, measured_starts_wobj
 from planner.check_results import ConfData, PlanCheck, PointCheck, Status
 from planner.dry_run import nominal_part_probe
@@ -102,8 +104,9 @@ def check_plan(
             current folder); used only when ``cell`` is ``None``.
         cell: an open cell of the plan (the UI's); ``None`` opens the plan's cell and closes
             it afterwards.
-        fmt: the controller whose program the quality and the landing risk judge (``None``:
-            the default, RAPID); the poses, paths and moves are those of every program.
+        fmt: the controller whose program the quality, the landing risk and the cycle time
+            (:mod:`planner.check_cycle`) judge (``None``: the default, RAPID); the poses, paths
+            and moves are those of every program.
 
     Raises:
         InputError: a file of the plan cannot be loaded (named in the message).
@@ -137,7 +140,19 @@ def check_plan(
         note,
         landing,
         None if layout else plan_detectability(plan),
+        plan_cycle_time(plan, checks, cell, fmt),
+        *_part_units(cell),
     )
+
+
+def _part_units(cell: Cell) -> tuple[str, str]:
+    """The unit the cell's work object was read in and how it was chosen (``("", "")``
+    without one)."""
+    wobj = cell.work_object
+    report = None if wobj is None else getattr(wobj, "report", None)
+    if report is None:
+        return "", ""
+    return str(report.units), str(report.units_note)
 
 
 def base_in_part(cell: Cell) -> str:

@@ -15,6 +15,7 @@ from numpy.typing import NDArray
 
 if TYPE_CHECKING:
     from calib.estimators.gross_errors import Detectability
+    from planner.program.cycle_time import CycleTime
     from planner.sim.landing import LandingRisk
     from planner.sim.quality import LayoutQuality
 
@@ -153,6 +154,12 @@ class PlanCheck:
             and how many points to add so it sees one in every point
             (:func:`calib.estimators.gross_errors.detectability`); ``None`` when the points
             fix no frame. Said, not a failure: a plain 3-2-1 has no redundancy by design.
+        cycle: the estimated cycle time of the judged program (:mod:`planner.check_cycle`),
+            ``None`` when the controller has no program for the plan.
+        part_units: the length unit the work object's file was read in (``"mm"``, ``"in"``,
+            ...: as given, detected for ``auto``, or declared by a CAD file), ``""``: not known.
+        part_note: how that unit was chosen and the part's size, in words
+            (:attr:`planner.cell.workobject.RepairReport.units_note`).
     """
 
     points: tuple[PointCheck, ...]
@@ -164,6 +171,9 @@ class PlanCheck:
     quality_note: str = ""
     landing: LandingRisk | None = None
     detectability: Detectability | None = None
+    cycle: CycleTime | None = None
+    part_units: str = ""
+    part_note: str = ""
 
     @property
     def layout_status(self) -> Status:
@@ -206,8 +216,9 @@ class PlanCheck:
 
     def to_json(self) -> dict[str, Any]:
         """A JSON-ready dict; ``ik_note``, ``error``, ``layout``, ``quality_note``,
-        ``quality``, ``landing`` and ``redundancy`` appear only when set; ``layout_status``
-        always."""
+        ``quality``, ``landing``, ``redundancy`` and ``cycle_time_s`` with its breakdown
+        ``cycle_time`` appear only when set, ``work_object`` (``units``, ``note``) when the
+        part was loaded; ``layout_status`` always."""
         out: dict[str, Any] = {
             "feasible": self.feasible,
             "ik_kind": self.ik_kind,
@@ -230,6 +241,11 @@ class PlanCheck:
                 "add": d.add,
                 "note": d.message(),
             }
+        if self.cycle is not None:
+            out["cycle_time_s"] = self.cycle.total_s
+            out["cycle_time"] = self.cycle.to_json()
+        if self.part_units:
+            out["work_object"] = {"units": self.part_units, "note": self.part_note}
         return out
 
 

@@ -8,7 +8,8 @@ from them), and formats it with the writer registered for the format
 (:data:`planner.export.FORMATS`). Whether infeasible points stop the export is the caller's
 decision (``wobjcal export`` exits 1 unless ``--force``, for every format); the result says
 which they are, and the job's :class:`planner.export.job.CheckStatus` (:func:`check_status`)
-makes every program's header say it (``CHECKED`` / ``NOT CHECKED``, with the plan's digest).
+makes every program's header say it (``CHECKED`` / ``NOT CHECKED``, with the plan's digest),
+and the estimated cycle time of each program (:func:`with_cycle_times`) too.
 
 The plan's layout is checked even without the cell check (:func:`planner.check.layout_problem`):
 an A-H plan that lacks a role would otherwise become a program that runs every search in the
@@ -131,9 +132,24 @@ def export_program(
     job = replace(job, check=check_status(check, layout))
     if check is not None and cell is not None:
         job = with_arm_poses(job, cell, check, plan.cell.tool.tcp)
+        job = with_cycle_times(job, plan, check, cell)
     if layout:
         notes = (*notes, f"layout: {layout}")
     return ProgramExport(export_files(job, fmt), notes, check, layout)
+
+
+def with_cycle_times(job: ExportJob, plan: Plan, check: PlanCheck, cell: Cell) -> ExportJob:
+    """``job`` with the estimated cycle time of every controller's program
+    (:func:`planner.check_cycle.plan_cycle_time`, from the poses of ``check`` in ``cell``),
+    which every program's header says."""
+    from planner.check_cycle import plan_cycle_time
+
+    times = {}
+    for name in job.programs:
+        cycle = plan_cycle_time(plan, check.points, cell, name)
+        if cycle is not None:
+            times[name] = cycle
+    return replace(job, cycle_times=times)
 
 
 def with_arm_poses(job: ExportJob, cell: Cell, check: PlanCheck, tcp: str) -> ExportJob:

@@ -69,11 +69,35 @@ def resolved_refs(plan: Plan, plan_dir: Path) -> dict[str, str | Path]:
     }
 
 
+def plan_robot_urdf(plan: Plan, plan_dir: Path) -> Path:
+    """The URDF file of the plan's robot that the cell and the kinematics read.
+
+    A built-in's bundled URDF; a ``.urdf`` as it is, or, when a ROS package path is set
+    (``cell.robot.package_path``, else ``ROS_PACKAGE_PATH``), prepared with its
+    ``package://`` meshes found there; a ``.xacro`` expanded with ``cell.robot.xacro_args``
+    (:func:`planner.robot.description.robot_description`).
+
+    Raises:
+        URDFError: the robot file cannot be read, expanded or resolved (the message names it,
+            and the package path searched when a package is missing).
+    """
+    from planner.builtins import is_builtin, robot_urdf
+    from planner.robot.description import robot_description
+    from planner.robot.ros_packages import package_path
+
+    spec = plan.cell.robot
+    if is_builtin(spec.urdf):
+        return Path(robot_urdf(spec.urdf))
+    source = Path(resolve_ref(spec.urdf, plan_dir))
+    return robot_description(source, package_path(spec.packages, plan_dir), spec.args)
+
+
 def plan_work_object(plan: Plan, plan_dir: Path, reach_m: float | None = None) -> WorkObject:
     """The plan's work object in the work-object frame, metres: the one place every job (check,
     validate, suggest, export, the UI) loads the part.
 
-    The mesh file (or built-in) is loaded in its ``units`` and lightly repaired
+    The mesh file (or built-in) is loaded in its ``units`` (a CAD file: the unit it
+    declares, and the plan's ``body``) and lightly repaired
     (:func:`planner.cell.workobject.load_work_object`), then put at
     ``work_object.T_wobj_mesh`` (identity when the plan leaves it out).
 
@@ -88,7 +112,9 @@ def plan_work_object(plan: Plan, plan_dir: Path, reach_m: float | None = None) -
     from planner.cell.workobject import WorkObject, load_work_object
 
     wo = plan.work_object
-    loaded = load_work_object(resolve_ref(wo.mesh, plan_dir), units=wo.units, reach_m=reach_m)
+    loaded = load_work_object(
+        resolve_ref(wo.mesh, plan_dir), units=wo.units, reach_m=reach_m, body=wo.body_choice
+    )
     if wo.mesh_pose is None:
         return loaded
     mesh = loaded.mesh.copy()
@@ -111,7 +137,7 @@ def open_cell(plan: Plan, plan_dir: Path) -> Cell:
     robot = plan.cell.robot
     mount = plan.cell.tool.mount
     cell = Cell(
-        robot=str(refs["robot"]),
+        robot=str(plan_robot_urdf(plan, plan_dir)),
         tool=str(refs["tool"]),
         T_world_base=robot.T_world_base.matrix(),
         base_link=robot.base_link,
@@ -149,13 +175,10 @@ def controller_T_flange_tool(plan: Plan, plan_dir: Path) -> FloatArray:
     Raises:
         ToolMountError: the mount cannot be worked out (names ``cell.tool.T_flange_tool``).
     """
-    from planner.builtins import is_builtin, robot_urdf
     from planner.cell.tool import tool_mount
     from planner.robot.kinematics.chain import KinematicChain
 
-    refs = resolved_refs(plan, plan_dir)
-    ref = plan.cell.robot.urdf
-    urdf = robot_urdf(ref) if is_builtin(ref) else refs["robot"]
+    urdf = plan_robot_urdf(plan, plan_dir)
     chain = KinematicChain.from_urdf(urdf, plan.cell.robot.base_link, plan.cell.robot.tip_link)
     given = plan.cell.tool.mount
     mount = tool_mount(chain, None if given is None else given.matrix())
@@ -199,6 +222,7 @@ __all__ = [
     "default_cell_note",
     "nominal_T_base_wobj",
     "open_cell",
+    "plan_robot_urdf",
     "plan_work_object",
     "resolved_refs",
     "tool_data",

@@ -584,9 +584,9 @@ def _no_layout(
 
 
 def moved_plan(plan: Plan, from_dir: Path, to_dir: Path) -> Plan:
-    """``plan`` with its file references (robot, tool, work object, fixture meshes) made
-    relative to ``to_dir`` instead of ``from_dir`` (``builtin:`` references unchanged), so a
-    plan written into another folder still finds its files."""
+    """``plan`` with its file references (robot, its ROS package path, tool, work object,
+    fixture meshes) made relative to ``to_dir`` instead of ``from_dir`` (``builtin:``
+    references unchanged), so a plan written into another folder still finds its files."""
     import os
 
     from calib.plan.base import BUILTIN_PREFIX
@@ -596,11 +596,17 @@ def moved_plan(plan: Plan, from_dir: Path, to_dir: Path) -> Plan:
             return r
         return os.path.relpath((from_dir / r).resolve(), to_dir.resolve())
 
+    def packages(path: str | msgspec.UnsetType) -> str | msgspec.UnsetType:
+        if not isinstance(path, str):
+            return path
+        entries = (p.strip() for p in path.split(":"))  # as split_path reads them
+        return ":".join(p if p.startswith("~") else ref(p) or p for p in entries if p)
+
     rep = msgspec.structs.replace
     c = plan.cell
     cell = rep(
         c,
-        robot=rep(c.robot, urdf=ref(c.robot.urdf)),
+        robot=rep(c.robot, urdf=ref(c.robot.urdf), package_path=packages(c.robot.package_path)),
         tool=rep(c.tool, name=ref(c.tool.name)),
         fixtures=[rep(f, mesh=ref(f.mesh)) for f in c.fixtures],
     )

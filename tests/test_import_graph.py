@@ -22,6 +22,7 @@ BELOW_JOBS = {
     "planner.robot",
     "planner.parts",
     "planner.faces",
+    "planner.cad",
     "planner.cell",
     "planner.program",
     "planner.sim",
@@ -35,7 +36,8 @@ ALLOWED: dict[str, set[str]] = {
     "planner.robot": {"calib", "planner.errors", "planner.builtins"},
     "planner.parts": {"calib", "planner.errors"},
     "planner.faces": {"calib", "planner.errors"},
-    "planner.cell": {"calib", "planner.errors", "planner.builtins", "planner.robot"},
+    "planner.cad": {"calib", "planner.errors", "planner.faces"},
+    "planner.cell": {"calib", "planner.errors", "planner.builtins", "planner.robot", "planner.cad"},
     "planner.program": {"calib", "planner.errors"},
     "planner.sim": {"calib", "planner.errors", "planner.parts", "planner.faces", "planner.program"},
     "planner.export": {"calib", "planner.errors", "planner.program"},
@@ -44,7 +46,7 @@ ALLOWED: dict[str, set[str]] = {
     "planner.__main__": {"planner.cli"},
     "webui": BELOW_JOBS | {JOBS},
 }
-SUBPACKAGES = ("robot", "cell", "faces", "program", "sim", "parts", "export", "cli")
+SUBPACKAGES = ("robot", "cad", "cell", "faces", "program", "sim", "parts", "export", "cli")
 #: The one allowed upward import: ``wobjcal ui`` starts the web app, lazily, in one function.
 LAZY_UI = ("planner.cli.misc", "webui", "cmd_ui")
 

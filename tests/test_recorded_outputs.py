@@ -41,6 +41,8 @@ ADDED = {
     "quality",
     "vias",  # the moves between points (the shipped plan got vias for its colliding moves)
     "redundancy",  # issue 27: the points whose gross error calibrate cannot see
+    "cycle_time_s",  # issue 26: the program's estimated cycle time
+    "cycle_time",
 }
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")

@@ -21,6 +21,7 @@ from calib.errors import InputError
 from calib.plan.file import CellSpec, Plan, WorkObjectSpec
 from calib.probing import ProbePoint
 from planner.check import PointCheck
+from planner.program.cycle_time import CycleTime
 from webui import click_place, clients, plan_doc
 from webui.autosave import AutosaveLock
 from webui.backend import CellSession, CellView
@@ -86,6 +87,8 @@ class WobjcalApp:
         self.picker: SurfacePicker | None = None
         self.robot: TabRobots | None = None  # one drawing per tab, each at its own pose
         self._checks: dict[str, tuple[ProbePoint, PointCheck]] = {}
+        #: the estimated cycle time of the plan as edited, from the latest checks
+        self.cycle: CycleTime | None = None
         self._lock = threading.RLock()
         self._cell_key: tuple[CellSpec, WorkObjectSpec] | None = None
         self.flags = RoleFlags()
@@ -207,12 +210,22 @@ class WobjcalApp:
         if point_ids is not None:  # a point whose flag came or went is redrawn too
             moved = set(before.by_point) ^ set(self.flags.by_point)
             point_ids = [*point_ids, *(i for i in moved if i not in point_ids and i in doc.ids)]
+        self.cycle = self._cycle_time()
         # the table first, on its own: the page applies a batch of GUI messages at once, but a
         # batch with scene messages only in its next frame (0.2-1 s with software WebGL)
         self.points_panel.refresh()
         self.server.flush()
         self.scene.draw_points(doc, self.checks(), None, only=point_ids, flags=self.flags.by_point)
         self.server.flush()
+
+    def _cycle_time(self) -> CycleTime | None:
+        """The estimated cycle time of the plan as edited, from the latest checks (on the
+        worker: it reads the cell's robot), or ``None``."""
+        plan = plan_as_edited(self.state.doc)
+        if plan is None:  # no plan loaded, or an edit that breaks a plan rule
+            return None
+        checks = list(self.checks().values())
+        return self.worker.call(lambda s: None if s is None else s.cycle_time(plan, checks))
 
     def _on_change(self, change: Change[UiPlan]) -> None:
         source = change.doc.source

@@ -14,15 +14,17 @@ import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
+from calib.errors import InputError
 from calib.frames import invert_transform
 from calib.plan.file import Plan, PlanPoint, resolve_ref
-from planner.builtins import robot_urdf
 from planner.cell.cell import Cell
 from planner.cell.moves import MoveCheck, ViaPath, check_joint_move, check_via_path
 from planner.cell.ray_hit import RayHit, first_hit
 from planner.cell.workobject import load_work_object
 from planner.check import PointCheck, check_points
-from planner.plan_cell import open_cell
+from planner.check_cycle import plan_cycle_time
+from planner.plan_cell import open_cell, plan_robot_urdf
+from planner.program.cycle_time import CycleTime
 from planner.robot.kinematics.chain import KinematicChain
 
 logger = logging.getLogger(__name__)
@@ -104,14 +106,6 @@ class JogStatus:
         return "; ".join(parts)
 
 
-def resolve_robot_urdf(ref: str, plan_dir: Path) -> Path | None:
-    """The URDF file of ``plan.cell.robot.urdf`` (``builtin:NAME`` from the bundled assets)."""
-    resolved = resolve_ref(ref, plan_dir)
-    if isinstance(resolved, Path):
-        return resolved if resolved.is_file() else None
-    return Path(robot_urdf(ref))
-
-
 def load_mesh(ref: str, units: str, plan_dir: Path) -> trimesh.Trimesh:
     """A work-object or fixture mesh in metres, loaded and repaired by ``planner.cell.workobject``.
 
@@ -138,7 +132,7 @@ class CellSession:
         if cell.work_object is None:  # open_cell always loads the plan's work object
             raise RuntimeError("the plan's cell has no work object")
         self.view = CellView(
-            robot_urdf=resolve_robot_urdf(plan.cell.robot.urdf, self.plan_dir),
+            robot_urdf=plan_robot_urdf(plan, self.plan_dir),
             T_world_base=plan.cell.robot.T_world_base.matrix(),
             wobj_mesh=cell.work_object.mesh,
             T_world_wobj=plan.work_object.T_world_wobj.matrix(),
@@ -167,6 +161,17 @@ class CellSession:
         if not points or self.cell is None:
             return []
         return list(check_points(self.cell, plan or self.plan, points))
+
+    def cycle_time(self, plan: Plan, checks: list[PointCheck]) -> CycleTime | None:
+        """The estimated cycle time of ``plan``'s program (the default controller's) from the
+        poses of ``checks``: :func:`planner.check_cycle.plan_cycle_time`, what ``wobjcal check``
+        prints; ``None`` without a cell or a program."""
+        if self.cell is None:
+            return None
+        try:
+            return plan_cycle_time(plan, checks, self.cell)
+        except InputError:
+            return None
 
     # ---- jogging ---------------------------------------------------------------------------
     def T_world_tcp(self, q: ArrayLike, tcp: str) -> NDArray[np.float64]:

@@ -17,6 +17,7 @@ if TYPE_CHECKING:
 
     from calib.plan.file import Plan
     from planner.check import PointCheck
+    from planner.program.cycle_time import CycleTime
     from webui.backend import CellSession, CellView
     from webui.busy import BusyIndicator
     from webui.plan_doc import UiPlan
@@ -60,6 +61,7 @@ class AppContext(Protocol):
         flags: the points the procedure cannot use where they are (role or face), and why.
         click_mode: what a click on the 3D view does (a key of ``click_handlers``).
         click_handlers: ``{mode: handler(event)}`` of scene clicks; ``"place"`` places points.
+        cycle: the estimated cycle time of the plan as edited (``None``: not known yet).
     """
 
     server: viser.ViserServer
@@ -74,6 +76,7 @@ class AppContext(Protocol):
     flags: RoleFlags
     click_mode: str
     click_handlers: dict[str, Any]
+    cycle: CycleTime | None
 
     def tab(self, name: str) -> Any:
         """The control panel's tab ``name`` (a context for a panel's widgets)."""

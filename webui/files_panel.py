@@ -33,7 +33,8 @@ logger = logging.getLogger(__name__)
 
 #: Largest accepted upload, bytes (:mod:`calib.limits`).
 MAX_UPLOAD_BYTES = limits.MAX_UPLOAD_BYTES
-MESH_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".glb", ".gltf")
+#: A part upload: a mesh trimesh reads, or a CAD file (planner.cad: STEP, IGES) in its own unit.
+MESH_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".glb", ".gltf", ".step", ".stp", ".iges", ".igs")
 UPLOAD_DIR = Path.home() / ".cache" / "wobjcal" / "uploads"
 
 
@@ -261,9 +262,10 @@ class FilesPanel:
         work_object = msgspec.structs.replace(
             source.work_object,
             mesh=str(pending.path),
-            units=str(self.units.value),
+            units=pending.units or str(self.units.value),
             sha256=pending.digest,
             T_wobj_mesh=source.work_object.T_wobj_mesh if keep else msgspec.UNSET,
+            body=msgspec.UNSET,  # a multi-body CAD upload is refused: the plan file chooses
         )
         plan = msgspec.structs.replace(source, work_object=work_object)
         self._apply_source(plan, "new mesh", pending.path, pending.name)

@@ -19,6 +19,7 @@ import numpy as np
 import trimesh
 
 from calib.units import AUTO, metres_per_unit
+from planner.cad.occt_read import is_cad_path
 from planner.cell.workobject import load_work_object
 from webui import plan_doc
 from webui.plan_doc import UiPlan
@@ -37,23 +38,39 @@ class PendingPart:
         name: the file's name as the user uploaded it.
         path: where the upload is kept.
         digest: its SHA-256.
-        raw_extents: ``(3,)`` the mesh's extents in file units (numbers as in the file).
+        raw_extents: ``(3,)`` the mesh's extents in file units (numbers as in the file); for
+            a CAD file, metres.
+        cad_unit: for a CAD file (STEP/IGES), the length unit it declares (the units the
+            user picks do not apply); ``None`` for a mesh file.
     """
 
     name: str
     path: Path
     digest: str
     raw_extents: tuple[float, float, float]
+    cad_unit: str | None = None
 
     @classmethod
     def read(cls, name: str, path: Path, digest: str) -> PendingPart:
-        """Read the kept upload once (raises ``MeshError`` naming ``name`` when unreadable)."""
-        wobj = load_work_object(path, units="m", name=Path(name).stem)
+        """Read the kept upload once (raises ``MeshError`` naming ``name`` when unreadable,
+        or when a CAD file holds several bodies: the plan's ``work_object.body`` chooses)."""
+        cad = is_cad_path(path)
+        wobj = load_work_object(path, units=AUTO if cad else "m", name=Path(name).stem)
         e = np.asarray(wobj.mesh.extents, dtype=np.float64)
-        return cls(name, path, digest, (float(e[0]), float(e[1]), float(e[2])))
+        unit = wobj.report.units if cad else None
+        return cls(name, path, digest, (float(e[0]), float(e[1]), float(e[2])), unit)
+
+    @property
+    def units(self) -> str | None:
+        """The plan's ``units`` for this part when the file fixes them (``"auto"`` for a CAD
+        file), ``None`` when the user's choice applies."""
+        return None if self.cad_unit is None else AUTO
 
     def size_m(self, units: str) -> np.ndarray:
-        """``(3,)`` the part's size in metres if its file is in ``units`` (not ``auto``)."""
+        """``(3,)`` the part's size in metres if its file is in ``units`` (not ``auto``; a CAD
+        file's own unit whatever ``units``)."""
+        if self.cad_unit is not None:
+            return np.asarray(self.raw_extents)
         return np.asarray(self.raw_extents) * metres_per_unit(units)
 
     def auto_units(self, reach_m: float | None) -> str:
@@ -61,7 +78,11 @@ class PendingPart:
         return load_work_object(self.path, units=AUTO, reach_m=reach_m).report.units
 
     def describe(self, units: str, reach_m: float | None = None) -> str:
-        """E.g. ``plate.stl in mm: 300.0 x 200.0 x 20.0 mm``; ``auto`` names its pick."""
+        """E.g. ``plate.stl in mm: 300.0 x 200.0 x 20.0 mm``; ``auto`` names its pick; a CAD
+        file names the unit it declares."""
+        if self.cad_unit is not None:
+            size = " x ".join(f"{v * 1e3:.1f}" for v in self.size_m(AUTO))
+            return f"{self.name} in {self.cad_unit} (declared in the file): {size} mm"
         picked = self.auto_units(reach_m) if units == AUTO else units
         size = " x ".join(f"{v * 1e3:.1f}" for v in self.size_m(picked))
         how = f"auto picks {picked}" if units == AUTO else f"in {units}"

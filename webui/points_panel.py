@@ -131,6 +131,9 @@ class PointsPanel:
             rows.append("| - | - | - | no points yet | |")
         if flags.layout:  # what `wobjcal check` and `calibrate` would refuse, said while editing
             rows += ["", f"**Layout:** {flags.layout.replace('|', '/')}"]
+        if (cycle := self._app.cycle) is not None:  # `wobjcal check`'s, docs/cycle_time.md
+            untimed = f" (moves into {', '.join(cycle.untimed)} not timed)" if cycle.untimed else ""
+            rows += ["", f"cycle time ~ {cycle.total_s:.0f} s{untimed}"]
         content = "\n".join(rows)
         if self.status_md.content != content:
             self.status_md.content = content

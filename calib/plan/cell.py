@@ -7,6 +7,7 @@ file references are paths relative to the plan file or ``builtin:NAME``.
 from __future__ import annotations
 
 import math
+import re
 
 import msgspec
 import numpy as np
@@ -60,16 +61,59 @@ class RobotSpec(Strict, frozen=True, kw_only=True):
     """The robot: ``urdf`` is a path relative to the plan or ``builtin:irb4400``.
 
     Attributes:
-        urdf: URDF file or built-in name.
+        urdf: URDF file, xacro file (``.xacro``, expanded when the cell is built) or built-in
+            name.
         T_world_base: pose of the robot base in the cell (world) frame.
         base_link: URDF base link (``None``: the URDF's root).
         tip_link: URDF flange link (``None``: ``tool0`` or the single leaf).
+        package_path: where ``$(find pkg)`` and ``package://pkg/...`` look for ROS packages:
+            folders separated by ``:`` as in ``ROS_PACKAGE_PATH`` (relative ones from the
+            plan's folder). Left out (default): ``ROS_PACKAGE_PATH``. Read it through
+            :attr:`packages`.
+        xacro_args: values of the xacro file's ``<xacro:arg>`` arguments, as strings (as on
+            the ``xacro`` command line); only for a ``.xacro`` file. Left out (default): every
+            argument takes its default. Read it through :attr:`args`.
     """
 
     urdf: str = "builtin:irb4400"
     T_world_base: Pose = Pose()
     base_link: str | None = None
     tip_link: str | None = None
+    package_path: str | msgspec.UnsetType = msgspec.UNSET
+    xacro_args: dict[str, str] | msgspec.UnsetType = msgspec.UNSET
+
+    def __post_init__(self) -> None:
+        path = self.packages
+        if path is not None and (len(path) > 4096 or path.count(":") >= 64):
+            raise PlanError(
+                "package_path: at most 64 folders and 4,096 characters (a workspace names a "
+                f"few), got {path.count(':') + 1:,} folders, {len(path):,} characters"
+            )
+        args = self.args
+        if not args:
+            return
+        if not self.urdf.lower().endswith(".xacro"):
+            raise PlanError(f"xacro_args: given, but urdf {self.urdf!r} is not a .xacro file")
+        if len(args) > 64:
+            raise PlanError(f"xacro_args: {len(args):,} arguments, at most 64")
+        for name, value in args.items():
+            if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]{0,63}", name):
+                raise PlanError(
+                    f"xacro_args: {name!r} is not an argument name (letters, digits and _, "
+                    "not starting with a digit, at most 64)"
+                )
+            if len(value) > 4096:
+                raise PlanError(f"xacro_args.{name}: {len(value):,} characters, at most 4,096")
+
+    @property
+    def packages(self) -> str | None:
+        """``package_path`` when the plan sets it, else ``None`` (``ROS_PACKAGE_PATH``)."""
+        return self.package_path if isinstance(self.package_path, str) else None
+
+    @property
+    def args(self) -> dict[str, str]:
+        """``xacro_args`` when the plan sets them, else ``{}`` (every default)."""
+        return self.xacro_args if isinstance(self.xacro_args, dict) else {}
 
 
 class ToolSpec(Strict, frozen=True, kw_only=True):
@@ -151,12 +195,16 @@ class WorkObjectSpec(Strict, frozen=True, kw_only=True):
 
     Attributes:
         mesh: mesh file (relative to the plan) or ``builtin:stator_section``.
-        units: length unit of the mesh file (``auto`` lets the loader guess).
+        units: length unit of the mesh file (``auto`` lets the loader guess; a CAD file
+            declares its own, and ``units`` must be ``auto`` or that unit).
         sha256: hex digest of the mesh file; a mismatch on load is an error naming the file.
         T_world_wobj: nominal pose of the work-object frame (WOCS) in the world frame.
         T_wobj_mesh: the mesh file's frame in the work-object frame (metres, after ``units``),
             e.g. from a 3-point user frame taught on the part. Left out (default): identity,
             the work-object frame is the file's. Read it through :meth:`mesh_matrix`.
+        body: for a CAD file (STEP/IGES) of several bodies, the one that is the work object:
+            its name, its 0-based index, or ``"all"`` (the bodies as one rigid part). Left out
+            (default): the file must hold one body. Read it through :attr:`body_choice`.
     """
 
     mesh: str = "builtin:stator_section"
@@ -164,9 +212,20 @@ class WorkObjectSpec(Strict, frozen=True, kw_only=True):
     sha256: str | None = None
     T_world_wobj: Pose = Pose()
     T_wobj_mesh: Pose | msgspec.UnsetType = msgspec.UNSET
+    body: str | int | msgspec.UnsetType = msgspec.UNSET
 
     def __post_init__(self) -> None:
         check_sha256(self.sha256, self.mesh, "sha256")
+        body = self.body_choice
+        if isinstance(body, int) and body < 0:
+            raise PlanError(f"body: an index counts from 0, got {body}")
+        if isinstance(body, str) and not 0 < len(body) <= 200:
+            raise PlanError(f"body: a name of 1 to 200 characters, got {len(body)}")
+
+    @property
+    def body_choice(self) -> str | int | None:
+        """``body`` when the plan sets it, else ``None`` (the file must hold one body)."""
+        return None if isinstance(self.body, msgspec.UnsetType) else self.body
 
     @property
     def mesh_pose(self) -> Pose | None:

@@ -6,7 +6,10 @@ Defaults and their sources are in ``docs/simulation.md``.
 
 from __future__ import annotations
 
+import msgspec
+
 from calib.models import SensorSettings
+from calib.models.cycle import CycleSettings
 from calib.models.misplacement import Misplacement
 from calib.models.proximity import ProximitySensor
 from calib.models.robot_error import RobotErrorModel
@@ -31,6 +34,9 @@ class ValidationSpec(Strict, frozen=True, kw_only=True):
         report: points of interest, regions and confidence levels of the report.
         trials: number of simulated calibrations, 2 .. :data:`MAX_TRIALS`.
         seed: seed of the ``numpy.random.Generator``, 0 .. :data:`MAX_SEED`.
+        cycle: the timing figures of the measuring program's cycle-time model
+            (:class:`calib.models.cycle.CycleSettings`); left out of the file when not set, so
+            plans written before it keep their digest (:attr:`cycle_settings` reads both).
     """
 
     sensor: SensorSettings = ProximitySensor()
@@ -39,6 +45,12 @@ class ValidationSpec(Strict, frozen=True, kw_only=True):
     report: ReportSpec = ReportSpec()
     trials: int = 400
     seed: int = 20131023
+    cycle: CycleSettings | msgspec.UnsetType = msgspec.UNSET
+
+    @property
+    def cycle_settings(self) -> CycleSettings:
+        """The cycle-time figures (the defaults when the file sets none)."""
+        return CycleSettings() if isinstance(self.cycle, msgspec.UnsetType) else self.cycle
 
     def __post_init__(self) -> None:
         check_count(self.trials, "trials", minimum=2, maximum=MAX_TRIALS)

@@ -22,6 +22,10 @@ smaller than (1e-6 x the largest extent)^2) and duplicate faces
 and unreferenced vertices, and, for a watertight mesh only, make the winding consistent with
 outward normals. Open meshes (scans) keep their normals and load with a warning.
 
+A CAD file (STEP, IGES: :mod:`planner.cad`) is not guessed at: its unit is the one the file
+declares (``units`` must be ``auto`` or agree), one body is chosen (``body``), and its triangles
+keep the B-rep plane they lie on, which planar-face detection uses (:mod:`planner.faces.brep`).
+
 In PyBullet the work object is a *concave* static body (``GEOM_FORCE_CONCAVE_TRIMESH``, mass 0):
 without that flag PyBullet would use the convex hull and fill every hole and slot.
 """
@@ -31,16 +35,18 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
 from calib.errors import InputError
-from calib.limits import MAX_CELL_TRIANGLES, MAX_MESH_TRIANGLES
+from calib.limits import MAX_CAD_FILE_BYTES, MAX_CELL_TRIANGLES, MAX_MESH_TRIANGLES, MiB
 from calib.reading import MAX_MESH_BYTES, check_regular_file
 from calib.units import AUTO, METRES_PER_UNIT, canonical_unit
 from planner.builtins import builtin_mesh, is_builtin
+from planner.cad.occt_read import is_cad_path
 from planner.cell.bodies import BodyLinks, mesh_collision_shape, static_body
 from planner.cell.mesh_units import (
     DEFAULT_REACH_M,
@@ -49,6 +55,9 @@ from planner.cell.mesh_units import (
     unit_hint,
 )
 from planner.errors import MeshError
+
+if TYPE_CHECKING:
+    from planner.cad.part import CadInfo
 
 FloatArray = NDArray[np.float64]
 log = logging.getLogger(__name__)
@@ -157,20 +166,50 @@ def stl_triangle_count(path: Path, size: int) -> int | None:
 
 
 def _read(
-    source: str | Path | trimesh.Trimesh, limit: int = MAX_MESH_TRIANGLES
-) -> tuple[trimesh.Trimesh, str]:
+    source: str | Path | trimesh.Trimesh,
+    limit: int = MAX_MESH_TRIANGLES,
+    units: str = AUTO,
+    body: str | int | None = None,
+) -> tuple[trimesh.Trimesh, str, CadInfo | None]:
     if isinstance(source, trimesh.Trimesh):
         meta = source.metadata or {}
         if len(source.faces) > limit:
             raise _too_many(meta.get("name") or "work object", len(source.faces), limit)
-        return source.copy(), str(meta.get("name") or "work object")
+        return source.copy(), str(meta.get("name") or "work object"), None
     if is_builtin(source):
-        return builtin_mesh(str(source)), str(source)
+        return builtin_mesh(str(source)), str(source), None
     path = Path(source)
     try:
         size = check_regular_file(path, MAX_MESH_BYTES, "mesh file", MeshError)
     except FileNotFoundError:
         raise MeshError(f"mesh file not found: {path}") from None
+    if is_cad_path(path):  # STEP/IGES: planner.cad, in metres and the file's own unit
+        from planner.cad.part import load_cad_mesh
+
+        if size > MAX_CAD_FILE_BYTES:
+            raise MeshError(
+                f"{path}: {size / MiB:,.1f} MiB, at most {MAX_CAD_FILE_BYTES // MiB} MiB for a "
+                "CAD file (OpenCASCADE holds its model in memory, ~12 times the file; a "
+                "machined part's STEP is a few MB: export the one part, or simplify it)"
+            )
+
+        from planner.cell import disk_cache
+
+        part, cad = load_cad_mesh(path, body=body, units=units, cache=disk_cache)
+        if len(part.faces) > limit:
+            raise _too_many(path, len(part.faces), limit)
+        return part, str(path), cad
+    with path.open("rb") as handle:
+        if handle.read(64).lstrip().upper().startswith(b"ISO-10303-21"):
+            raise MeshError(
+                f"{path}: a STEP file (it starts with 'ISO-10303-21;') named {path.suffix!r}: "
+                "rename it .step (or .stp) to read it as CAD"
+            )
+    if body is not None:
+        raise MeshError(
+            f"work_object.body {body!r}: {path} is a mesh file, which has no bodies to choose "
+            "from (body is for STEP/IGES files)"
+        )
     if path.suffix.lower() == ".stl":
         n = stl_triangle_count(path, size)
         if n is not None and n > limit:
@@ -188,7 +227,7 @@ def _read(
         )
     if len(mesh.faces) > limit:
         raise _too_many(path, len(mesh.faces), limit)
-    return mesh, str(path)
+    return mesh, str(path), None
 
 
 def load_work_object(
@@ -197,29 +236,36 @@ def load_work_object(
     name: str | None = None,
     reach_m: float | None = None,
     max_triangles: int = MAX_MESH_TRIANGLES,
+    body: str | int | None = None,
 ) -> WorkObject:
     """Load, scale and lightly repair a work-object mesh.
 
     Args:
-        source: a mesh file (STL, OBJ, PLY, GLB, ... anything trimesh reads), a
+        source: a mesh file (STL, OBJ, PLY, GLB, ... anything trimesh reads), a CAD file
+            (STEP ``.step``/``.stp``, IGES ``.iges``/``.igs``: :mod:`planner.cad`), a
             ``trimesh.Trimesh``, or ``"builtin:<name>"`` (see :mod:`planner.builtins`).
         units: a unit of :mod:`calib.units` (``"m"``, ``"mm"``, ``"cm"``, ``"in"``, an alias
-            such as ``"inch"``) or ``"auto"`` (see the module docstring).
+            such as ``"inch"``) or ``"auto"`` (see the module docstring). A CAD file declares
+            its own: ``units`` must then be ``"auto"`` or that unit
+            (:func:`planner.cad.part.cad_units`).
         name: a short name; default the file stem.
         reach_m: the robot's reach, m, for ``auto`` and the size warning; default
             :data:`DEFAULT_REACH_M`.
         max_triangles: refuse a mesh of more triangles (before its geometry is parsed when
             it is a binary STL); default :data:`calib.limits.MAX_MESH_TRIANGLES`.
+        body: for a STEP/IGES file, the body to load: its name, its 0-based index or
+            ``"all"`` (the bodies as one rigid part); ``None``: the file must hold one body.
+            Must be ``None`` for a mesh file.
 
     Raises:
         MeshError: missing or unreadable file, empty mesh, NaN/infinite vertices, bad units;
             the message names the file.
     """
-    mesh, src = _read(source, max_triangles)
     try:
-        units = canonical_unit(units, f"units for {src}")
+        units = canonical_unit(units, f"units for {source}")
     except InputError as exc:
         raise MeshError(str(exc)) from None
+    mesh, src, cad = _read(source, max_triangles, units, body)
     if len(mesh.faces) == 0 or len(mesh.vertices) == 0:
         raise MeshError(f"mesh {src} is empty (no faces)")
     if not np.all(np.isfinite(mesh.vertices)):
@@ -227,8 +273,10 @@ def load_work_object(
     warnings: list[str] = []
     reach = DEFAULT_REACH_M if reach_m is None else float(reach_m)
     extent = float(np.max(mesh.extents))
-    detected = units == AUTO
-    if detected:
+    detected = units == AUTO and cad is None
+    if cad is not None:  # the file declares its unit (planner.cad.part.cad_units)
+        units, note = cad.unit, cad.note
+    elif detected:
         units, why = auto_units(extent, unit_hint(mesh, src), reach)
         note = f"units 'auto' read as {units!r}: {why}"
     else:
@@ -258,12 +306,15 @@ def load_work_object(
     boundary = len(trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1))
     if boundary:
         warnings.append(f"{src}: open mesh with {boundary} boundary edges; normals kept as given")
-    scale = METRES_PER_UNIT[units]
-    mesh.apply_scale(scale)
+    if cad is None:
+        scale = METRES_PER_UNIT[units]
+        mesh.apply_scale(scale)
+    else:  # already in metres; the scale the file's unit stands for
+        scale = METRES_PER_UNIT.get(units, float("nan"))
     ext = tuple(float(v) for v in mesh.extents)
     dims = " x ".join(f"{v:.3g}" for v in ext)
     note = f"{src}: {note}; the part is {dims} m"
-    if detected:
+    if detected or cad is not None:  # a unit wobjcal did not get from the plan: said
         warnings.insert(0, note)
     else:
         log.info(note)

@@ -21,6 +21,7 @@ from planner.program.controllers import CONTROLLERS, DEFAULT_CONTROLLER
 if TYPE_CHECKING:
     from calib.plan.file import Plan
     from planner.check import PlanCheck, PointCheck
+    from planner.program.cycle_time import CycleTime
     from planner.sim.quality import LayoutQuality
 
 _COLOUR = {"feasible": "green", "marginal": "yellow", "infeasible": "red"}
@@ -43,7 +44,10 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "plan's confidence levels; a weak layout is marginal, one that leaves a degree of\n"
         "freedom free fails. Points whose gross error calibrate could not detect (no other\n"
         "point fixes what they fix; a plain 3-2-1: all six) are named, with how many points to\n"
-        "add (wobjcal suggest PLAN --add N): said, not failed.\n\n"
+        "add (wobjcal suggest PLAN --add N): said, not failed. Last, the program's estimated\n"
+        "cycle time per visit (joint moves, linear moves, searches, settle, I/O; the search\n"
+        "time to the nominal face, and in brackets over the whole search length), with the\n"
+        "model's constants (docs/cycle_time.md).\n\n"
         "Both judge the measuring program the controller of --format runs (default rapid):\n"
         "every search from its safe start must reach its face wherever the part may lie, and\n"
         "executed on the ideal part misplaced as the validation misplaces it, no search may\n"
@@ -153,6 +157,45 @@ def quality_table(q: LayoutQuality, status: str) -> Table:
     return table
 
 
+def cycle_table(c: CycleTime) -> Table:
+    """The cycle time per visit of the program (joint move, linear moves, searches, settle,
+    I/O, total; s) and the total (:mod:`planner.program.cycle_time`)."""
+    table = Table(
+        title=f"cycle time (estimated, the program {c.program})",
+        caption="model: " + c.model_text() + "".join(f"; {n}" for n in c.notes),
+    )
+    for col in ("visit", "searches", "move", "linear", "search", "settle", "I/O", "total"):
+        table.add_column(col, justify="left" if col == "visit" else "right")
+
+    def s(x: float | None) -> str:
+        return "-" if x is None else f"{x:.1f}"
+
+    for r in c.rows:
+        search = f"{r.search_s:.1f} (<= {r.search_max_s:.1f})"
+        table.add_row(
+            r.key,
+            str(r.searches),
+            s(r.move_s),
+            s(r.linear_s),
+            search,
+            s(r.settle_s),
+            s(r.io_s),
+            s(r.total_s),
+        )
+    rows = c.rows
+    table.add_row(
+        "total",
+        str(sum(r.searches for r in rows)),
+        s(sum(r.move_s or 0.0 for r in rows)),
+        s(sum(r.linear_s for r in rows)),
+        f"{sum(r.search_s for r in rows):.1f} (<= {sum(r.search_max_s for r in rows):.1f})",
+        s(sum(r.settle_s for r in rows)),
+        s(sum(r.io_s for r in rows)),
+        f"{c.total_s:.1f} (<= {c.total_max_s:.1f})",
+    )
+    return table
+
+
 def cmd_check(args: argparse.Namespace) -> int:
     """Run the check; exit 0 when all points and paths are feasible, else 1."""
     from planner.check import check_plan  # PyBullet: not for ``wobjcal --help``
@@ -203,6 +246,8 @@ def cmd_check(args: argparse.Namespace) -> int:
             markup=False,
             style="red" if L.point_problems() else None,
         )
+    if check.cycle is not None:
+        out.print(cycle_table(check.cycle))
     n = len(check.points)
     out.print(
         f"{n - len(bad)} of {n} points feasible"

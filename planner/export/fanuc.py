@@ -63,7 +63,14 @@ from planner.export.fanuc_text import (
     wpr_deg,
     xyzwpr,
 )
-from planner.export.job import ExportJob, TargetPair, check_header, digest_text, safety_header
+from planner.export.job import (
+    ExportJob,
+    TargetPair,
+    check_header,
+    cycle_header,
+    digest_text,
+    safety_header,
+)
 from planner.export.text import fmt
 
 __all__ = [
@@ -271,6 +278,7 @@ def _header(prog: _Program, job: ExportJob, name: str) -> None:
         f"Save as {name}.ls (file name = program name).",
         digest_text(job),  # one comment line: what a results reader looks for
         check_header(job, "fanuc"),
+        cycle_header(job, "fanuc"),
         "Units mm, deg. W,P,R: fixed angles about x,y,z of the user frame, R = Rz(R) Ry(P) "
         "Rx(W) (the paper's Tait-Bryan z-y-x angles alpha,beta,gamma = R,P,W).",
         f"UFRAME[{UFRAME_NO}] = PR[{PR_UFRAME}] = nominal work object in WORLD, taken to be the "

@@ -14,13 +14,14 @@ import numpy as np
 from calib.frames import tait_bryan_zyx_from_matrix
 from planner.export.job import ArmPose
 from planner.export.text import fmt, identifier
+from planner.program.controllers import FANUC_JOINT_MOVE
 
 #: Program name, comment and position-comment lengths relied on.
 NAME_MAX = 36
 COMMENT_MAX = 32
 POS_COMMENT_MAX = 16
 #: Joint speed to the safe starts (%), linear speed of the moves that are no search (mm/sec).
-JOINT_PCT = 20
+JOINT_PCT = round(100 * FANUC_JOINT_MOVE.velocity_fraction)
 LINEAR_MM_S = 100
 #: The axes (1-based) whose turn numbers ``CONFIG`` lists, in order: the usual
 #: ``$SCR_GRP[1].$TURN_AXIS`` of 6-axis FANUC arms (check it on the controller).

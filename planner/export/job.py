@@ -22,6 +22,7 @@ from calib.probing import SearchCommand
 from planner.export.text import module_name
 from planner.program.build import AdaptiveSpec, adaptive_spec, measuring_program, safety_spec
 from planner.program.controllers import CONTROLLERS
+from planner.program.cycle_time import CycleTime
 from planner.program.model import MeasuringProgram
 from planner.program.safety import SafetySpec
 from planner.program.searches import safe_and_face_wobj
@@ -209,6 +210,9 @@ class ExportJob:
             made in code); every header carries it as ``plan digest <16 hex digits>``.
         check: what ``wobjcal check`` said about the program (:class:`CheckStatus`; the
             default: built without a check).
+        cycle_times: the estimated cycle time of each controller's program, by controller
+            name (:mod:`planner.check_cycle`; from the check's poses, so only with a check):
+            every header says it (:func:`cycle_header`).
     """
 
     name: str
@@ -224,6 +228,7 @@ class ExportJob:
     program_errors: Mapping[str, str] = field(default_factory=dict)
     plan_digest: str = ""
     check: CheckStatus = field(default_factory=CheckStatus)
+    cycle_times: Mapping[str, CycleTime] = field(default_factory=dict)
 
     def program(self, fmt: str) -> MeasuringProgram:
         """The measuring program the controller ``fmt`` runs for this job's plan.
@@ -369,6 +374,20 @@ def check_header(job: ExportJob, fmt: str) -> str:
         f"refuses {'; '.join(refused)}: fix the plan, or make sure by hand that those moves are "
         "safe, and run the program the first time at reduced speed."
     )
+
+
+def cycle_header(job: ExportJob, fmt: str) -> str:
+    """The estimated cycle time of the controller ``fmt``'s program as its header says it
+    (:meth:`planner.program.cycle_time.CycleTime.summary`), or why there is none (built
+    without a cell check: no joint values to time the moves with)."""
+    cycle = job.cycle_times.get(fmt)
+    if cycle is None:
+        return (
+            "Cycle time not estimated: built without a cell check (no joint values to time the "
+            f"moves with); `wobjcal check --format {fmt}` estimates it."
+        )
+    text = cycle.summary()
+    return text[0].upper() + text[1:] + "."
 
 
 def safety_header(job: ExportJob, fmt: str, prefix: str, width: int = 92) -> list[str]:

@@ -35,11 +35,15 @@ import numpy as np
 from calib.frames import rotvec_from_matrix
 from planner.export.job import TargetPair
 from planner.export.text import comment_text, fmt, literal_text
+from planner.program.controllers import URSCRIPT_JOINT_MOVE
 
 #: The standard digital input of the proximity sensor.
 SENSOR_IN = 0
 #: Joint-move and retreat speeds of every program: (a, v) of ``movej``, of ``movel``.
-MOVEJ = "a=1.4, v=1.05"
+MOVEJ = (  # from the controller's joint moves, which the cycle time times
+    f"a={fmt(URSCRIPT_JOINT_MOVE.acceleration_rad_s2 or 0.0, 3)}, "
+    f"v={fmt(URSCRIPT_JOINT_MOVE.velocity_rad_s or 0.0, 3)}"
+)
 MOVEL = "a=0.5, v=0.1"
 
 

@@ -16,6 +16,8 @@ tests in :mod:`planner.faces.footprint`), all vectorized:
    triangles); triangles whose normal leaves the plane normal by more than ``angle_tol_rad`` or
    with a vertex farther than ``max_deviation_m`` from the plane are peeled off, the rest is split
    into connected parts again, and this repeats until nothing changes (a few rounds);
+   A mesh triangulated from CAD (STEP/IGES) skips steps 1 and 2: its regions are its exact
+   B-rep planes (:mod:`planner.faces.brep`), curved B-rep faces are in none;
 3. a region is a *planar face* when its area is at least ``min_area_m2`` (default: the sensor
    footprint, pi x 9 mm^2) and its area-weighted RMS distance from its plane is at most
    ``flatness_tol_m``.
@@ -44,6 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 from calib.tolerances import FACE_ANGLE_TOL_RAD, FACE_FLATNESS_RMS_M, FACE_MAX_DEVIATION_M
 from calib.validation import check_points
 from planner.errors import MeshError
+from planner.faces.brep import brep_plane_labels, brep_regions
 from planner.faces.footprint import DEFAULT_FOOTPRINT_RADIUS_M, holds_footprint
 from planner.faces.footprint import N_RIM_SAMPLES as N_RIM_SAMPLES
 from planner.faces.footprint import RAY_LIFT_M as RAY_LIFT_M
@@ -189,8 +192,12 @@ def _detect(
     area = np.asarray(mesh.area_faces, dtype=np.float64)
     normals = np.asarray(mesh.face_normals, dtype=np.float64)
     adj = np.asarray(mesh.face_adjacency, dtype=np.int64).reshape(-1, 2)
-    edges = adj[np.asarray(mesh.face_adjacency_angles) <= angle_tol_rad]
-    labels = flat_regions(tris, area, normals, edges, angle_tol_rad, max_deviation_m)
+    planes = brep_plane_labels(mesh)
+    if planes is None:
+        edges = adj[np.asarray(mesh.face_adjacency_angles) <= angle_tol_rad]
+        labels = flat_regions(tris, area, normals, edges, angle_tol_rad, max_deviation_m)
+    else:  # a CAD part: its B-rep planes are the regions (planner.faces.brep)
+        labels = brep_regions(tris, area, normals, adj, planes)
     face_id = np.full(nf, -1, dtype=np.int64)
     if labels.max(initial=-1) < 0:
         return PlanarFaces(
@@ -230,9 +237,12 @@ _cache_lock = threading.Lock()
 
 
 def mesh_digest(mesh: trimesh.Trimesh) -> str:
-    """A content hash (sha1) of a mesh's vertices and faces."""
+    """A content hash (sha1) of a mesh's vertices and faces (and B-rep planes, if any)."""
     h = hashlib.sha1(np.ascontiguousarray(mesh.vertices, dtype=np.float64).tobytes())
     h.update(np.ascontiguousarray(mesh.faces, dtype=np.int64).tobytes())
+    planes = brep_plane_labels(mesh)
+    if planes is not None:  # a CAD part's B-rep planes decide its faces
+        h.update(b"brep" + np.ascontiguousarray(planes).tobytes())
     return h.hexdigest()
 
 

@@ -16,7 +16,9 @@ Owns:
     - :mod:`planner.program.execute`: :func:`execute` (a program against a probe) and
       :class:`ProgramProbe` (a procedure's search as the program runs it);
     - :mod:`planner.program.safety`: safe search starts under the plan's misplacement;
-    - :mod:`planner.program.searches`: the searches a program runs for one point.
+    - :mod:`planner.program.searches`: the searches a program runs for one point;
+    - :mod:`planner.program.cycle_time`: how long the program takes (joint moves, searches,
+      settle, I/O), from joint values and limits given to it.
 
 Imports only :mod:`calib`: no simulator, no cell, no language.
 """

@@ -192,6 +192,13 @@ class MeasuringProgram:
         return any(u.uses for u in self.updates)
 
     @property
+    def xoffset_run(self) -> Any:
+        """The paper's x-offset run (:class:`calib.paper.settings.XOffsetRun`) the program runs
+        after its frame is computed, or ``None``: only an adaptive program of a procedure whose
+        settings hold one runs it (the exporters write it from the calibrated frame)."""
+        return getattr(self.settings, "xoffset", None) if self.adaptive else None
+
+    @property
     def searches(self) -> tuple[SearchStep, ...]:
         """The search steps, in order."""
         return tuple(s for s in self.steps if isinstance(s, SearchStep))

@@ -58,6 +58,7 @@ import numpy as np
 from calib.limits import MAX_URDF_LINKS, MAX_URDF_MESH_BYTES, MiB
 from calib.reading import MAX_URDF_BYTES, read_bytes_capped
 from planner.errors import URDFError
+from planner.robot.prepared import prepared_roots
 from planner.robot.urdf_meshes import outside_problem, resolve_mesh
 from planner.robot.urdf_model import (
     JOINT_TYPES,
@@ -130,6 +131,10 @@ class URDFWarning(UserWarning):
 def load_urdf(path: str | Path, check_meshes: bool = True) -> URDFModel:
     """Read and validate a URDF file.
 
+    A robot description wobjcal prepared (:mod:`planner.robot.prepared`: an expanded xacro
+    file, or a URDF with its ``package://`` meshes found on a ROS package path) may read its
+    meshes in the ROS packages listed beside it too.
+
     Args:
         path: the ``.urdf`` file.
         check_meshes: raise when a referenced mesh file cannot be found.
@@ -145,7 +150,7 @@ def load_urdf(path: str | Path, check_meshes: bool = True) -> URDFModel:
         data = read_bytes_capped(p, MAX_URDF_BYTES, "URDF file", URDFError)
     except OSError as exc:
         raise URDFError(f"cannot read URDF file {p}: {exc}") from None
-    model = parse_urdf(data, source=p)
+    model = parse_urdf(data, source=p, allowed_roots=prepared_roots(p))
     missing = model.missing_meshes()
     if check_meshes and missing:
         listed = "; ".join(f"link {link!r}: {uri!r}" for link, uri in missing)
@@ -156,10 +161,14 @@ def load_urdf(path: str | Path, check_meshes: bool = True) -> URDFModel:
     return model
 
 
-def parse_urdf(text: str | bytes, source: Path | None = None) -> URDFModel:
+def parse_urdf(
+    text: str | bytes, source: Path | None = None, allowed_roots: tuple[Path, ...] = ()
+) -> URDFModel:
     """Parse URDF text; ``source`` (the file) names errors and anchors relative mesh paths.
 
     ``bytes`` are decoded as their XML declaration says (default UTF-8); ``str`` is taken as is.
+    ``allowed_roots``: folders (ROS packages) whose meshes the text may name besides the
+    source's own folder or package.
     """
     from yourdfpy import URDF  # pulls in trimesh: imported when a URDF is read
 
@@ -175,7 +184,10 @@ def parse_urdf(text: str | bytes, source: Path | None = None) -> URDFModel:
         if material.name and material.color is not None:
             colors[material.name] = _tuple(material.color.rgba)
     _check_sizes(root, where)
-    links = tuple(_link(e, URDF._parse_link, where, base_dir, colors) for e in root.findall("link"))
+    links = tuple(
+        _link(e, URDF._parse_link, where, (base_dir, allowed_roots), colors)
+        for e in root.findall("link")
+    )
     joints = tuple(_joint(e, URDF._parse_joint, where) for e in root.findall("joint"))
     return _validated(name, source, links, joints, where)
 
@@ -352,7 +364,7 @@ def _link(
     e: Any,
     parse: Callable[[Any], Any],
     where: str,
-    base_dir: Path,
+    base: tuple[Path, tuple[Path, ...]],
     colors: Mapping[str, tuple[float, float, float, float]],
 ) -> Link:
     name = e.get("name")
@@ -366,8 +378,8 @@ def _link(
     if inertial_e is not None:
         _check_numbers(inertial_e, _INERTIAL_NUMBERS, f"{what} <inertial>")
     yl = _parsed(parse, e, what)
-    visuals = tuple(_shape(v, f"{what} <visual>", base_dir, colors) for v in yl.visuals)
-    collisions = tuple(_shape(c, f"{what} <collision>", base_dir, {}) for c in yl.collisions)
+    visuals = tuple(_shape(v, f"{what} <visual>", base, colors) for v in yl.visuals)
+    collisions = tuple(_shape(c, f"{what} <collision>", base, {}) for c in yl.collisions)
     return Link(name, visuals, collisions, _inertial(yl.inertial, f"{what} <inertial>"))
 
 
@@ -385,9 +397,14 @@ def _check_shape(e: Any, what: str) -> None:
 
 
 def _shape(
-    ys: Any, what: str, base_dir: Path, colors: Mapping[str, tuple[float, float, float, float]]
+    ys: Any,
+    what: str,
+    base: tuple[Path, tuple[Path, ...]],
+    colors: Mapping[str, tuple[float, float, float, float]],
 ) -> Shape:
-    """Our :class:`Shape` of a yourdfpy ``Visual`` or ``Collision`` (checked by _check_shape)."""
+    """Our :class:`Shape` of a yourdfpy ``Visual`` or ``Collision`` (checked by _check_shape);
+    ``base``: the URDF's folder and the further folders its meshes may be read from."""
+    base_dir, allowed_roots = base
     g = ys.geometry
     if g.box is not None:
         geom = Geometry("box", size=_tuple(g.box.size))
@@ -398,7 +415,7 @@ def _shape(
         geom = Geometry("sphere", radius=float(g.sphere.radius))
     else:
         uri = g.mesh.filename
-        outside = outside_problem(uri, base_dir)
+        outside = outside_problem(uri, base_dir, allowed_roots)
         if outside:
             raise URDFError(
                 f"{what}: mesh {uri!r} {outside}: a URDF reads only files in its own folder or "

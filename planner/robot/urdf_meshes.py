@@ -53,11 +53,20 @@ def package_root(base_dir: Path) -> Path:
     return base_dir.parent if base_dir.name == "urdf" else base_dir
 
 
-def outside_problem(uri: str, base_dir: Path) -> str:
+def outside_problem(uri: str, base_dir: Path, extra_roots: tuple[Path, ...] = ()) -> str:
     """Why the mesh ``uri`` of a URDF in ``base_dir`` reads outside the URDF's own folder or
     package (see the module docstring), or ``""`` when it does not (a ``package://`` file
-    that is not found reads nothing; other paths are judged whether the file exists or not)."""
+    that is not found reads nothing; other paths are judged whether the file exists or not).
+
+    ``extra_roots``: further folders the URDF may read (the ROS packages a prepared robot
+    description's meshes were found in, :mod:`planner.robot.prepared`).
+    """
     own = package_root(base_dir).resolve()
+    if extra_roots:
+        p = Path(uri[len("file://") :] if uri.startswith("file://") else uri)
+        real = (p if p.is_absolute() else base_dir / p).resolve()
+        if any(real == r or r in real.parents for r in (r.resolve() for r in extra_roots)):
+            return ""
     roots = [own]
     if uri.startswith("package://"):
         pkg, _, sub = uri[len("package://") :].partition("/")
