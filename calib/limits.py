@@ -83,6 +83,27 @@ MAX_FIT_ITERATIONS: Final = 1_000
 #: Most rounds of the iterative best fit (each runs every search again; it settles in 2 or 3).
 MAX_ROUNDS: Final = 20
 
+# ---- placement sweeps (``wobjcal sweep``) ---------------------------------------------------
+#: Most placements of one sweep (``--samples``): each is a whole ``check`` (about 1 s for the
+#: plate, 3 s for the stator on one core) and a CSV row of ~150 bytes; 100,000 stator
+#: placements are about 40 core-hours, a night on a small cluster.
+MAX_SWEEP_SAMPLES: Final = 100_000
+#: Most worker processes of the local cluster (``--workers``): each holds its own cell
+#: (~0.3-0.5 GB, ``docs/sweep.md``); a larger cluster is a running scheduler (``--scheduler``).
+MAX_SWEEP_WORKERS: Final = 64
+#: Memory limit of each worker process of the local cluster, bytes: a worker holds ~0.45-0.5 GB
+#: after its first stator placement and grows ~45 MB a placement (each check's PyBullet client
+#: keeps the part's mesh arrays; measured, ``docs/sweep.md``); its nanny restarts it at 95 % of
+#: this, so 2 workers and the command itself (~0.2 GB) stay within the budget.
+SWEEP_WORKER_MEMORY_BYTES: Final = 896 * MiB
+#: Smallest and largest ``--memory-limit`` of a local sweep worker, MiB: below 512 a stator
+#: worker would restart after every placement; 64 GiB is more than a worker ever needs.
+MIN_SWEEP_WORKER_MIB: Final = 512
+MAX_SWEEP_WORKER_MIB: Final = 65_536
+#: Largest offset of a swept pose from the plan's, mm (``--base-x`` ...), and largest yaw, deg.
+MAX_SWEEP_OFFSET_MM: Final = 10_000.0
+MAX_SWEEP_YAW_DEG: Final = 180.0
+
 # ---- cycle time (plausibility, not memory: a typo such as ms given as s is refused) --------
 #: Longest settle time per search stop and longest I/O time per recorded point, s: a robot
 #: settles in 0.1-0.5 s and writes a measurement in milliseconds; a minute is a typo.
@@ -154,6 +175,11 @@ __all__ = [
     "MAX_SCAN_RAYS",
     "MAX_SEARCH_LENGTH_M",
     "MAX_SETTLE_S",
+    "MAX_SWEEP_OFFSET_MM",
+    "MAX_SWEEP_SAMPLES",
+    "MAX_SWEEP_WORKERS",
+    "MAX_SWEEP_WORKER_MIB",
+    "MAX_SWEEP_YAW_DEG",
     "MAX_UPLOADS_IN_FLIGHT_BYTES",
     "MAX_UPLOADS_KEPT_BYTES",
     "MAX_UPLOADS_PER_CLIENT",
@@ -167,6 +193,8 @@ __all__ = [
     "MAX_ZIP_RATIO",
     "MAX_ZIP_UNPACKED_BYTES",
     "MEMORY_BUDGET_BYTES",
+    "MIN_SWEEP_WORKER_MIB",
+    "SWEEP_WORKER_MEMORY_BYTES",
     "UPLOAD_IDLE_TIMEOUT_S",
     "MiB",
 ]

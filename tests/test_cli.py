@@ -20,7 +20,7 @@ from planner.plan_cell import nominal_T_base_wobj
 REPO = Path(__file__).resolve().parent.parent
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
 DATA = REPO / "tests" / "data" / "plans"
-COMMANDS = ["check", "validate", "calibrate", "export", "schema", "ui", "demo"]
+COMMANDS = ["check", "validate", "calibrate", "export", "sweep", "schema", "ui", "demo"]
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:

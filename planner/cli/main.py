@@ -86,6 +86,7 @@ def build_parser() -> argparse.ArgumentParser:
     import planner.cli.export as export
     import planner.cli.misc as misc
     import planner.cli.suggest as suggest
+    import planner.cli.sweep as sweep
     import planner.cli.validate as validate
 
     parser = argparse.ArgumentParser(
@@ -99,7 +100,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"wobjcal {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks and debug logs")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for module in (check, validate, calibrate, export, suggest, misc):
+    for module in (check, validate, calibrate, export, suggest, sweep, misc):
         module.register(sub, _add)
     return parser
 
