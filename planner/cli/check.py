@@ -15,7 +15,6 @@ from typing import TYPE_CHECKING, Any
 from rich.table import Table
 
 from planner.cli.common import print_json, read_plan, stdout
-from planner.plan_cell import default_cell_note
 from planner.program.controllers import CONTROLLERS, DEFAULT_CONTROLLER
 
 if TYPE_CHECKING:
@@ -200,9 +199,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     """Run the check; exit 0 when all points and paths are feasible, else 1."""
     from planner.check import check_plan  # PyBullet: not for ``wobjcal --help``
 
-    plan, plan_dir = read_plan(args.plan)
-    if note := default_cell_note(plan):
-        print(f"wobjcal check: note: {note}", file=sys.stderr)
+    plan, plan_dir = read_plan(args.plan, "check")
     if args.add_vias:
         plan, plan_dir, shown = _with_vias(plan, plan_dir, Path(args.add_vias))
         args.plan = shown

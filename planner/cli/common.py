@@ -141,10 +141,18 @@ def stderr() -> Console:
     return Console(file=sys.stderr, highlight=False, soft_wrap=True)
 
 
-def read_plan(path: str) -> tuple[Plan, Path]:
-    """Load the plan at ``path`` strictly; return it and its directory (for relative paths)."""
+def read_plan(path: str, command: str | None = None) -> tuple[Plan, Path]:
+    """Load the plan at ``path`` strictly; return it and its directory (for relative paths).
+
+    With ``command`` (a job that builds the plan's cell: ``"check"``, ...), a plan without a
+    ``cell`` section is said on stderr (:func:`planner.plan_cell.default_cell_note`)."""
+    from planner.plan_cell import default_cell_note
+
     p = Path(path)
-    return load_plan(p), p.resolve().parent
+    plan = load_plan(p)
+    if command is not None and (note := default_cell_note(plan)):
+        print(f"wobjcal {command}: note: {note}", file=sys.stderr)
+    return plan, p.resolve().parent
 
 
 def print_json(obj: Any) -> None:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -13,7 +12,6 @@ from calib.atomic_io import write_text_atomic
 from calib.plan.file import plan_to_json
 from planner.cli.common import read_plan, stderr
 from planner.export import FORMAT_CHOICES, FORMATS, export_file_stem
-from planner.plan_cell import default_cell_note
 
 
 def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
@@ -93,9 +91,7 @@ def output_paths(output: str | None, plan_name: str, fmt: str) -> list[Path]:
 
 def cmd_export(args: argparse.Namespace) -> int:
     """Write the export file(s)."""
-    plan, plan_dir = read_plan(args.plan)
-    if note := default_cell_note(plan):
-        print(f"wobjcal export: note: {note}", file=sys.stderr)
+    plan, plan_dir = read_plan(args.plan, "export")
     if args.format == "json":
         (out,) = output_paths(args.output, plan.name, "json")
         write_text_atomic(out, plan_to_json(plan))

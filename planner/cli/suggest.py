@@ -16,7 +16,6 @@ import numpy as np
 
 from calib.limits import MAX_REPORT_ROWS
 from planner.cli.common import count_arg, read_plan, stdout
-from planner.plan_cell import default_cell_note
 from planner.program.controllers import CONTROLLERS, DEFAULT_CONTROLLER
 
 
@@ -137,9 +136,7 @@ def cmd_suggest(args: argparse.Namespace) -> int:
     from planner.cli.check import quality_table
     from planner.suggest import suggest_plan
 
-    plan, plan_dir = read_plan(args.plan)
-    if note := default_cell_note(plan):
-        print(f"wobjcal suggest: note: {note}", file=sys.stderr)
+    plan, plan_dir = read_plan(args.plan, "suggest")
     out = stdout()
     res = suggest_plan(
         plan,

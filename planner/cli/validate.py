@@ -6,7 +6,6 @@ import argparse
 import json
 import math
 import re
-import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -18,7 +17,6 @@ from calib.limits import MAX_PROTOCOL_TRIALS
 from calib.plan.models import MAX_SEED, MAX_TRIALS
 from planner.cli.common import count_arg, read_plan, stderr, stdout
 from planner.errors import PlanRefused
-from planner.plan_cell import default_cell_note
 from planner.program.controllers import CONTROLLERS, DEFAULT_CONTROLLER
 
 #: Most worker processes a validation may start.
@@ -218,9 +216,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
     """Run the validation with a progress bar and print the report."""
     from planner.validate import check_simulatable, sensitivity_plan, validate_plan
 
-    plan, plan_dir = read_plan(args.plan)
-    if note := default_cell_note(plan):
-        print(f"wobjcal validate: note: {note}", file=sys.stderr)
+    plan, plan_dir = read_plan(args.plan, "validate")
     check_simulatable(plan)  # a clear error before the simulation's heavy imports
     trials = plan.validation.trials if args.trials is None else args.trials
     seed = plan.validation.seed if args.seed is None else args.seed
