@@ -302,9 +302,9 @@ def test_suggest_gives_a_layout_that_validates_or_says_what_stops_it(
 @pytest.mark.xfail(
     strict=True,
     reason=(
-        "bug: planner/suggest_order.py Sequencer.order_progressive returns every chosen point "
+        "bug: planner/suggest/order.py Sequencer.order_progressive returns every chosen point "
         "as stuck when none fits as the first (each grown by the whole 20 mm / 3 deg), and "
-        "planner/suggest_steps.py _select_feasible bans them and their neighbours for good, "
+        "planner/suggest/steps.py _select_feasible bans them and their neighbours for good, "
         "the end faces' only candidates among them: 'no layout fixes all 6 degrees of "
         "freedom', though the 3-2-1 suggestion's 6 points run as an adaptive best fit are "
         "feasible and validate"

@@ -17,7 +17,7 @@ import msgspec
 import numpy as np
 import pytest
 
-import planner.suggest as suggest_mod
+import planner.suggest.job as suggest_mod
 from calib.models import Misplacement
 from calib.plan.file import load_plan
 from planner.check_results import PlanCheck

@@ -7,16 +7,22 @@ and writes the plan atomically.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from calib.limits import MAX_REPORT_ROWS
 from planner.cli.common import count_arg, read_plan, stdout
 from planner.program.controllers import CONTROLLERS, DEFAULT_CONTROLLER
+
+if TYPE_CHECKING:
+    from rich.table import Table
+
+    from planner.suggest import SuggestResult
 
 
 def _points_mm(text: str) -> np.ndarray:
@@ -57,6 +63,17 @@ def _percent(text: str) -> float:
     return v
 
 
+def _plot_path(text: str) -> Path:
+    from planner.suggest.front_files import PLOT_SUFFIXES
+
+    path = Path(text)
+    if path.suffix.lower() not in PLOT_SUFFIXES:
+        raise argparse.ArgumentTypeError(
+            f"a plot file ending in {', '.join(PLOT_SUFFIXES)}, got {text!r}"
+        )
+    return path
+
+
 def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
     """Add ``suggest`` to the subparsers ``sub``."""
     p = add(
@@ -70,14 +87,20 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "information matrix), adding points until the target holds at the confidence or\n"
         "--max-points is reached. Writes the plan (atomically) and prints its predicted\n"
         "quality. With --add N the plan's points are kept and N are added (best fit; a 3-2-1\n"
-        "or A-H plan becomes a best fit of all its points, since those take exactly their own).\n\n"
+        "or A-H plan becomes a best fit of all its points, since those take exactly their own).\n"
+        "With --objective time (best fit, needs --target) every size from 6 to --max-points is\n"
+        "designed, written in its landing order and in the order of least joint-move time,\n"
+        "checked and timed as 'wobjcal check' does, and the plan of least cycle time that meets\n"
+        "the target is written; the accuracy-versus-time front is printed as a table, and with\n"
+        "--front FILE plotted (PNG, SVG or PDF; the table beside it as FILE.csv).\n\n"
         "exit codes: 0 target met (or none given) and the plan passes 'wobjcal check' for\n"
         "--format, 1 target not reached or check refuses the plan (named; the best plan found\n"
         "is still written), 2 bad input or no feasible layout (faces tried and why)",
         "wobjcal suggest plan.json --target 0.3 -o suggested.json\n"
         "wobjcal suggest plan.json --procedure three_two_one -o plan_321.json\n"
         "wobjcal suggest plan.json --at 0,-600,-150 --confidence 99 --target 0.2 -o out.json\n"
-        "wobjcal suggest suggested.json --add 1 -o plus_one.json",
+        "wobjcal suggest suggested.json --add 1 -o plus_one.json\n"
+        "wobjcal suggest plan.json --target 0.3 --objective time --front front.png -o fast.json",
     )
     p.add_argument("plan", metavar="PLAN", help="plan file (wobjcal.plan/1): cell, part, models")
     p.add_argument(
@@ -126,8 +149,52 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         f"{DEFAULT_CONTROLLER}; a nominal program lands every search anywhere the whole "
         "misplacement allows)",
     )
+    p.add_argument(
+        "--objective",
+        choices=("accuracy", "time"),
+        default="accuracy",
+        help="accuracy (default): the least error, points added until the target holds; time: "
+        "the least cycle time whose predicted error holds --target",
+    )
+    p.add_argument(
+        "--front",
+        type=_plot_path,
+        metavar="FILE",
+        help="plot the accuracy-versus-time front to FILE (.png, .svg or .pdf) and write its "
+        "table to FILE.csv (best fit)",
+    )
     p.add_argument("-o", "--output", metavar="OUT", required=True, help="plan file to write")
     p.set_defaults(handler=cmd_suggest)
+
+
+def front_table(res: SuggestResult) -> Table:
+    """The accuracy-versus-time front of ``res`` as a table (the written plan marked ``*``)."""
+    from rich.table import Table
+
+    t = Table(
+        title=f"accuracy versus cycle time (predicted error at {res.confidence_percent:g} %; "
+        "each plan written, checked and timed; * written)"
+    )
+    for name in ("points", "order", "error mm", "cycle time s", "target", "front", "check"):
+        t.add_column(
+            name, justify="right" if name in ("points", "error mm", "cycle time s") else "left"
+        )
+    for r in res.front:
+        if r.problems:
+            verdict = "; ".join(r.problems)
+            verdict = verdict if len(verdict) <= 70 else verdict[:69] + "…"
+        else:
+            verdict = "passes" if r.rating == "ok" else f"passes, layout {r.rating or 'unrated'}"
+        t.add_row(
+            f"{r.points}{' *' if r.plan is res.plan else ''}",
+            "least move time" if r.order == "time" else "landing",
+            f"{r.worst_m * 1e3:.3f}" if math.isfinite(r.worst_m) else "-",
+            f"{r.cycle_s:.1f}" if math.isfinite(r.cycle_s) else "-",
+            "meets" if r.meets_target else "misses",
+            "yes" if r.pareto else "",
+            verdict,
+        )
+    return t
 
 
 def cmd_suggest(args: argparse.Namespace) -> int:
@@ -148,6 +215,8 @@ def cmd_suggest(args: argparse.Namespace) -> int:
         procedure=args.procedure,
         add=args.add,
         fmt=args.format,
+        objective=args.objective,
+        front=args.front is not None,
         progress=lambda stage, done, total: print(
             f"wobjcal suggest: {stage} {done}/{total}", file=sys.stderr
         ),
@@ -167,6 +236,21 @@ def cmd_suggest(args: argparse.Namespace) -> int:
         out.print(
             quality_table(res.quality, "feasible" if res.quality.rating == "ok" else "marginal")
         )
+    if res.front:
+        out.print(front_table(res), markup=False)
+    if args.front is not None and res.front:
+        from planner.suggest.front_files import plot_front
+
+        chosen = next((r for r in res.front if r.plan is res.plan), None)
+        plot_front(
+            res.front,
+            args.front,
+            title=f"{Path(args.plan).name}: accuracy versus cycle time ({args.format})",
+            target_m=res.target_m,
+            level_percent=res.confidence_percent,
+            chosen=chosen,
+        )
+        out.print(f"front: {args.front} and {args.front.with_suffix('.csv')}", markup=False)
     kept = ", ".join(f"{k} {v}" for k, v in sorted(res.rejected.items()))
     out.print(
         f"{res.n_feasible} of {res.n_candidates} candidates feasible"

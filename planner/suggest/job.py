@@ -18,7 +18,7 @@ points of interest) and proposes the points:
    (:meth:`~planner.cell.cell.Cell.check_search`; a blocked one is dropped and the design redone);
 3. chosen by :func:`calib.estimators.design.select` (greedy plus exchange on the information
    matrix, minimising the largest error over the points of interest), ordered for measuring
-   (:mod:`planner.suggest_order`: each point's footprint, grown by the in-plane shift left by
+   (:mod:`planner.suggest.order`: each point's footprint, grown by the in-plane shift left by
    the points measured before it, the whole misplacement for the first ones, stays on its
    face; points that fit in no order are set aside and the design redone), growing the number of
    points until the predicted error at every point of interest holds ``target_m`` at the
@@ -33,6 +33,11 @@ points of interest) and proposes the points:
 
 ``add=N`` keeps the plan's points and adds the ``N`` best, by best fit (a 3-2-1 or A-H plan
 becomes a best fit of all its points: those procedures take exactly their own).
+
+``objective="time"`` (best fit, with a target) writes instead the plan of least estimated cycle
+time whose predicted error holds the target: every size from 6 to ``max_points`` designed, each
+in its landing order and in the order of least joint-move time, all written, checked and timed
+(:mod:`planner.suggest.front`); ``front=True`` returns that front with either objective.
 """
 
 from __future__ import annotations
@@ -67,8 +72,9 @@ from planner.program.controllers import CONTROLLERS, controller
 from planner.program.safety import SafetySpec
 from planner.sim.report_points import poi_rows
 from planner.sim.rows import RowSpec, z_values
-from planner.suggest_order import FLOOR_M, Sequencer
-from planner.suggest_steps import (
+from planner.suggest.front import OBJECTIVES, FrontRow, design_front, fastest
+from planner.suggest.order import FLOOR_M, Sequencer
+from planner.suggest.steps import (
     Context,
     SuggestProgress,
     best_fit_design,
@@ -118,6 +124,10 @@ class SuggestResult:
         problems: what ``wobjcal check`` (of the program of the chosen format) refuses in the
             written plan, one line per point: a move between points not cleared, a search that
             lands off its face too often; ``()`` when it passes. ``met`` is False then.
+        objective: ``"accuracy"`` or ``"time"``: what chose the plan.
+        front: the accuracy-versus-time front (:mod:`planner.suggest.front`), ``()`` when not
+            asked for.
+        cycle_s: the written plan's estimated cycle time, s (NaN: not timed).
     """
 
     plan: Plan
@@ -135,6 +145,9 @@ class SuggestResult:
     elapsed_s: float
     pool: Candidates | None = field(default=None, repr=False)
     problems: tuple[str, ...] = ()
+    objective: str = "accuracy"
+    front: tuple[FrontRow, ...] = field(default=(), repr=False)
+    cycle_s: float = math.nan
 
 
 def _pois(plan: Plan, mesh: object, at_m: FloatArray | None) -> list[RowSpec]:
@@ -182,6 +195,8 @@ def suggest_plan(
     cell: Cell | None = None,
     per_face: int = PER_FACE,
     fmt: str | None = None,
+    objective: str = "accuracy",
+    front: bool = False,
 ) -> SuggestResult:
     """Suggest the probe points of ``plan`` (see the module docstring).
 
@@ -203,6 +218,10 @@ def suggest_plan(
             default): a program that runs every search in the nominal frame lands each one
             anywhere the whole misplacement allows, so every footprint is grown by all of it;
             an adaptive one by what the earlier searches leave.
+        objective: ``"accuracy"`` (the least error: points added until the target holds, in
+            the order they land in) or ``"time"`` (the least cycle time under ``target_m``;
+            best fit only, not with ``add``).
+        front: also return the accuracy-versus-time front (best fit only, not with ``add``).
 
     Raises:
         SuggestError: no layout can be had (the message names faces and reasons).
@@ -216,6 +235,19 @@ def suggest_plan(
         raise InputError(f"target: a positive distance, got {target_m!r} m")
     if max_points < 6 and not add:
         raise InputError(f"max_points: a 6-DOF frame needs at least 6 searches, got {max_points}")
+    if objective not in OBJECTIVES:
+        raise InputError(f"objective: one of {', '.join(OBJECTIVES)}, got {objective!r}")
+    if objective == "time" and target_m is None:
+        raise InputError(
+            "--objective time: the least cycle time under an accuracy target needs the target "
+            "(--target MM)"
+        )
+    if (objective == "time" or front) and (add or procedure != "best_fit"):
+        what = "--add" if add else f"--procedure {procedure}"
+        raise InputError(
+            f"--objective time and --front design a best fit from 6 to --max-points points; "
+            f"{what} fixes the points (leave it out, or use --objective accuracy)"
+        )
     if cell is None:
         with open_cell(plan, plan_dir or Path.cwd()) as own:
             return suggest_plan(
@@ -230,6 +262,8 @@ def suggest_plan(
                 cell=own,
                 per_face=per_face,
                 fmt=fmt,
+                objective=objective,
+                front=front,
             )
     converted = ""
     if add and (why := plan.fixed_points()):
@@ -316,6 +350,11 @@ def suggest_plan(
     )
     ctx = Context(cell, plan, pool, safety, rows_poi, z, r, corners, sequencer, tuple(old))
     ctx.edge_start_m, ctx.edge_overtravel_m = edge_start, 2.0 * worst_shift + 0.02
+    if objective == "time":
+        return _fastest_plan(
+            ctx, plan, target_m, max_points, at_m, level, fmt, t0, tried, len(cands), rejected,
+            say,
+        )  # fmt: skip
     new_plan, design_note, check, history = _design_until_checked(
         ctx, plan, procedure, target_m, max_points, add, fixed, at_m, steered, fmt, tried, say
     )
@@ -354,6 +393,14 @@ def suggest_plan(
             f"; wobjcal check refuses it for the {target_controller.label} program: "
             + "; ".join(problems)
         )
+    rows: tuple[FrontRow, ...] = ()
+    if front:
+        rows = tuple(
+            design_front(
+                ctx, plan, max_points=max_points, fmt=fmt, at_m=at_m, level_percent=level,
+                target_m=target_m, say=say,
+            )
+        )  # fmt: skip
     return SuggestResult(
         plan=new_plan,
         quality=quality,
@@ -370,6 +417,85 @@ def suggest_plan(
         elapsed_s=time.perf_counter() - t0,
         pool=pool,
         problems=problems,
+        front=rows,
+        cycle_s=check.cycle.total_s if check.cycle is not None else math.nan,
+    )
+
+
+def _fastest_plan(
+    ctx: Context,
+    plan: Plan,
+    target_m: float | None,
+    max_points: int,
+    at_m: FloatArray | None,
+    level: float,
+    fmt: str | None,
+    t0: float,
+    tried: tuple[FaceTried, ...],
+    n_candidates: int,
+    rejected: dict[str, int],
+    say: SuggestProgress,
+) -> SuggestResult:
+    """``objective="time"``: the front, and its fastest row that meets the target (or, when
+    none does, the usable row of least error, else the first, with ``met`` False and why)."""
+    rows = design_front(
+        ctx, plan, max_points=max_points, fmt=fmt, at_m=at_m, level_percent=level,
+        target_m=target_m, say=say,
+    )  # fmt: skip
+    if not rows:
+        why = _no_layout(ctx, plan, ctx.sequencer is not None and ctx.sequencer.steered, fmt,
+                         tried, {})  # fmt: skip
+        raise SuggestError(why)
+    best = fastest(rows)
+    met = best is not None
+    if best is None:
+        usable = [r for r in rows if r.usable]
+        best = min(usable, key=lambda r: (r.worst_m, r.cycle_s)) if usable else rows[0]
+    same = [r for r in rows if r.points == best.points and r.order == "landing"]
+    was = (
+        f" (in the order it lands in: {same[0].cycle_s:.1f} s)"
+        if best.order == "time" and same and math.isfinite(same[0].cycle_s)
+        else ""
+    )
+    tgt = f"{(target_m or 0.0) * 1e3:.3f} mm"
+    if met:
+        msg = (
+            f"{best.points} points, the least cycle time under the target {tgt} at {level:g} %: "
+            f"{best.cycle_s:.1f} s{was}, predicted error at the points of interest "
+            f"{best.worst_m * 1e3:.3f} mm"
+        )
+    else:
+        msg = (
+            f"target {tgt} at {level:g} % not reached by any of the {len(rows)} plans of 6 to "
+            f"{max_points} points that check passes: the most accurate gives "
+            f"{best.worst_m * 1e3:.3f} mm in {best.cycle_s:.1f} s (more points: --max-points; or "
+            "a smaller noise or misplacement)"
+        )
+    problems = best.problems
+    if problems:
+        msg += f"; wobjcal check refuses it for the {controller(fmt).label} program: " + "; ".join(
+            problems
+        )
+    history = tuple((r.points, r.worst_m) for r in rows if r.order == "landing")
+    return SuggestResult(
+        plan=best.plan,
+        quality=best.quality,
+        target_m=target_m,
+        confidence_percent=level,
+        worst_m=best.worst_m,
+        met=met and not problems,
+        history=history,
+        faces=tried,
+        n_candidates=n_candidates,
+        n_feasible=len(ctx.pool),
+        rejected=rejected,
+        message=msg,
+        elapsed_s=time.perf_counter() - t0,
+        pool=ctx.pool,
+        problems=problems,
+        objective="time",
+        front=tuple(rows),
+        cycle_s=best.cycle_s,
     )
 
 

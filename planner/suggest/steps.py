@@ -30,7 +30,7 @@ from planner.faces.candidates import Candidates, FaceTried
 from planner.plan_cell import nominal_T_base_wobj
 from planner.program.safety import SafetySpec
 from planner.sim.rows import RowSpec, predicted_sigma
-from planner.suggest_order import Ordered, Sequencer
+from planner.suggest.order import Ordered, Sequencer
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
@@ -295,9 +295,11 @@ def best_fit_design(
     add: int,
     fixed: tuple[FloatArray, FloatArray] | None,
     say: SuggestProgress,
+    collect: list[tuple[int, Design]] | None = None,
 ) -> tuple[Design | None, list[tuple[int, float]]]:
     """The best-fit design: grown from 6 points (or ``add`` more) until the target holds, or up
-    to ``max_points`` (without a target, every size up to it is designed on the way).
+    to ``max_points`` (without a target, every size up to it is designed on the way; each
+    size's design, in its landing order, is appended to ``collect`` when given).
 
     Each size keeps the best (smallest worst half-width) of three designs: one from scratch,
     the smaller size's design grown by one point and exchanged, and that design grown by the
@@ -332,6 +334,8 @@ def best_fit_design(
         worst, _, d = kept
         history.append((n + (len(fixed[0]) if fixed is not None else 0), worst))
         best = d
+        if collect is not None:
+            collect.append((n, d))
         if target_m is not None and worst <= target_m and not ctx.weak(d.chosen):
             break  # a layout the check would call weak grows on
     return best, history
