@@ -652,9 +652,7 @@ def test_a_search_that_finds_nothing_takes_the_error_path(
     n_edge = sum(t.kind == "edge" for t in job.targets)
     assert len(edge_searches) == n_edge - (edge_search_runs is False)
     assert measured(machine, t) == [1.0, 0.0, 0.0, 0.0]
-    assert any(
-        msg == f"wobjcal/1 point {point} 1 0 0 0" for msg in machine.messages
-    )
+    assert any(msg == f"wobjcal/1 point {point} 1 0 0 0" for msg in machine.messages)
     for other in job.targets:  # every other point is measured as without the failure
         if other.point_id != point:
             want = expected_measurement(other, T_nom, search)

@@ -32,6 +32,7 @@ from planner.sim.xoffset import XOffsetSetup
 
 FloatArray = NDArray[np.float64]
 
+
 def default_settings(
     sensor: SensorModel, edge_inset_m: float = DEFAULT_EDGE_INSET_M, **kwargs: Any
 ) -> Hultman2013:
