@@ -70,7 +70,8 @@ def check_status(check: PlanCheck | None, layout: str = "") -> CheckStatus:
     problems = [f"error: {check.error}"] if check.error else []
     problems += [f"layout: {check.layout}"] if check.layout else []
     refused = tuple(p.point_id for p in check.infeasible)
-    return CheckStatus(checked=True, refused=refused, problems=tuple(problems))
+    reasons = tuple(f"{p.point_id}: {p.reason}" for p in check.infeasible)
+    return CheckStatus(checked=True, refused=refused, problems=tuple(problems), reasons=reasons)
 
 
 def export_job_for(

@@ -138,6 +138,9 @@ def test_force_writes_every_format_and_its_header_says_not_checked(
         ids = ", ".join(REFUSED[fmt])
         assert _said("NOT CHECKED: exported with --force", fmt) in head, name
         assert _said(f"wobjcal check refuses points {ids}", fmt) in head, (name, head[:600])
+        # and why, point by point (what "Export anyway" in the UI writes too)
+        first = REFUSED[fmt][0]
+        assert _said(f"({first}: ", fmt).split()[0] in head, (name, head[:900])
     if fmt == "fanuc":  # P1 has no checked pose: its targets keep the robot's configuration
         text = _comments((tmp_path / FILES[fmt][0]).read_text(), fmt)
         assert "NO CONFIG for points P1 (no checked robot pose)" in text

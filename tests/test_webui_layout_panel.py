@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from calib.errors import InputError
 from webui.app import WobjcalApp
 from webui.server import run
 from webui.testing import free_port
@@ -59,12 +60,27 @@ def test_error_map_paints_every_vertex(app: WobjcalApp, monkeypatch: pytest.Monk
     assert painted[-1] is None
 
 
-def test_suggest_replaces_the_points_in_one_undo_step(app: WobjcalApp) -> None:
+def test_suggest_keeps_the_procedure_and_applies_only_on_accept(app: WobjcalApp) -> None:
+    from webui.layout_panel import KEEP
+
     panel = app.layout_panel
     before = app.state.doc.ids
     panel.target.value = 0.3
+    assert panel.procedure.value == KEEP
+    with pytest.raises(InputError, match="procedure is hultman2013"):
+        panel.suggest()  # the A-H plan's own procedure: never switched silently
+    assert app.state.doc.ids == before and panel.pending is None
+    panel.procedure.value = "best fit"
     res = panel.suggest().result(300)
-    assert res.met
+    assert res.met and panel.pending is res
+    assert app.state.doc.ids == before, "shown, not applied"
+    shown = panel.compare_md.content
+    assert "| points | 8 | " in shown and "| procedure | hultman2013 | best_fit |" in shown
+    assert "| landing risk |" in shown and "| cycle time |" in shown
+    panel.discard()
+    assert panel.pending is None and app.state.doc.ids == before
+    res = panel.suggest().result(300)
+    panel.accept()
     doc = app.state.doc
     assert len(doc.points) >= 6 and all(p.role == "fit" for p in doc.points)
     assert panel.refresh().result(60) is not None

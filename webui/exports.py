@@ -31,10 +31,15 @@ class ExportResult:
     Attributes:
         files: ``(file name, content)`` pairs (KRL writes a ``.src`` and a ``.dat``).
         note: what the user should know (e.g. points not feasible, estimated tool mass).
+        refusals: why ``wobjcal check --format`` refuses the plan for this program, one line
+            each (``"P3: ..."``, ``"layout: ..."``, ``"error: ..."``); ``()`` when it passes.
+            The files are made all the same, their headers saying it (``NOT CHECKED``); the
+            files panel sends them only when the user asks again ("Export anyway").
     """
 
     files: tuple[tuple[str, bytes], ...]
     note: str = ""
+    refusals: tuple[str, ...] = ()
 
 
 def export_program(plan: Plan, fmt: str, plan_dir: Path, cell: Cell | None = None) -> ExportResult:
@@ -56,4 +61,11 @@ def export_program(plan: Plan, fmt: str, plan_dir: Path, cell: Cell | None = Non
     result = make(plan, plan_dir, FORMATS[fmt], cell=cell)
     stem = EXPORT_FORMATS[FORMATS[fmt]].file_stem(plan.name)
     out = tuple((f"{stem}{suffix}", text.encode("utf-8")) for suffix, text in result.files.items())
-    return ExportResult(out, "; ".join(result.notes))
+    refusals: list[str] = []
+    if result.check is not None:
+        if result.check.error:
+            refusals.append(f"error: {result.check.error}")
+        refusals += [f"{p.point_id}: {p.reason}" for p in result.check.infeasible]
+    if result.layout:
+        refusals.append(f"layout: {result.layout}")
+    return ExportResult(out, "; ".join(result.notes), tuple(refusals))

@@ -102,6 +102,8 @@ class FilesPanel:
             )
             self.download = gui.add_button("Download plan JSON")
             self.export_buttons = {fmt: gui.add_button(f"Download {fmt}") for fmt in FORMATS}
+            self.export_md = gui.add_markdown("")
+            self.export_anyway = gui.add_button("Export anyway", color="red", visible=False)
         self.plan_upload.on_upload(lambda ev: self._guard(ev, self.upload_plan, *_file(ev)))
         self.mesh_upload.on_upload(lambda ev: self._guard(ev, self.stage_mesh, *_file(ev)))
         self.units.on_update(lambda ev: self._guard(ev, self._show_pending, failure="Units"))
@@ -118,6 +120,12 @@ class FilesPanel:
         )
         for fmt, button in self.export_buttons.items():
             button.on_click(self._export_callback(fmt))
+        #: the format whose program check refused, waiting for "Export anyway"
+        self.refused_format: str | None = None
+        self.export_anyway.on_click(
+            lambda ev: self._guard(ev, self.download_anyway, ev.client, failure="Not exported")
+        )
+        app.state.subscribe(lambda change: self._clear_refusal())
 
     def _export_callback(self, fmt: str) -> Any:
         def callback(event: Any) -> None:
@@ -354,11 +362,55 @@ class FilesPanel:
             lambda s: export_program(plan, fmt, plan_dir, None if s is None else s.cell)
         )
 
-    def download_export(self, client: Any, fmt: str) -> str:
-        """Send the session plan as robot program(s) in ``fmt`` to ``client``."""
+    def download_export(self, client: Any, fmt: str, force: bool = False) -> str:
+        """Send the session plan as robot program(s) in ``fmt`` to ``client`` when ``wobjcal
+        check --format`` passes it; else show why in the panel, offer "Export anyway" and
+        raise (nothing is sent). ``force``: send it all the same (its header says why check
+        refuses it)."""
         result = self.export(fmt)
+        if result.refusals and not force:
+            self.refused_format = fmt
+            self.export_md.content = (
+                f"**{fmt} not downloaded**: `wobjcal check` refuses this plan for the {fmt} "
+                "program:\n\n"
+                + "\n".join(f"- {_md(r)}" for r in result.refusals)
+                + "\n\n**Export anyway** downloads it with these reasons in its header."
+            )
+            self.export_anyway.visible = True
+            n = len(result.refusals)
+            raise InputError(
+                f"wobjcal check refuses the plan for {fmt} ({n} problem{'s' if n > 1 else ''}, "
+                f"listed in the Files tab): {result.refusals[0]}"
+            )
         for name, data in result.files:
             client.send_file_download(name, data, save_immediately=True)
+        self._clear_refusal()
         if result.note:
             self._app.notify(f"{fmt} exported with a note", result.note, client=client)
+        if result.refusals:
+            return f"{fmt} exported although check refuses it: its header says why"
         return ""
+
+    def download_anyway(self, client: Any) -> str:
+        """ "Export anyway": the program check refused last, sent with the reasons in its
+        header."""
+        fmt = self.refused_format
+        if fmt is None:
+            raise InputError("nothing to export anyway: download a program first")
+        return self.download_export(client, fmt, force=True)
+
+    def _clear_refusal(self) -> None:
+        """Hide the last refusal (the plan changed, or a program was sent)."""
+        if self.refused_format is None:
+            return
+        self.refused_format = None
+        self.export_md.content = ""
+        self.export_anyway.visible = False
+
+
+def _md(text: str) -> str:
+    """``text`` safe in a Markdown list item (no markup, one line)."""
+    out = " ".join(text.split())
+    for c in "\\`*_[]<>#|":
+        out = out.replace(c, "\\" + c)
+    return out

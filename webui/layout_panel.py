@@ -9,13 +9,18 @@ gross errors calibrate could not detect with how many points to add
 predicted error is painted on the part (:func:`planner.sim.quality.error_radius`, green small
 to red large) and each point of interest carries a sphere of its predicted error (drawn 100
 times larger). "Suggest layout" and "Add best point" run :func:`planner.suggest.suggest_plan`
-in the cell's worker (it needs the cell) with a progress bar, and replace the points (one undo
-step).
+in the cell's worker (it needs the cell) with a progress bar, for the procedure the user picks
+(by default the plan's own: an A-H plan is refused with what to pick, never switched silently)
+and the objective (accuracy, or the least cycle time under the target). The suggestion is shown
+beside the current layout (:func:`comparison_markdown`: points, predicted error, landing risk,
+cycle time, what check refuses) and replaces the points (one undo step) only on "Accept
+suggestion"; "Discard" or any edit of the plan drops it.
 """
 
 from __future__ import annotations
 
 import logging
+import math
 import threading
 import time
 from concurrent.futures import Future
@@ -31,6 +36,7 @@ from webui.scene import heat_rgb
 from webui.worker import CellWorker
 
 if TYPE_CHECKING:
+    from planner.check_results import PlanCheck
     from planner.suggest import SuggestResult
     from webui.backend import CellSession
     from webui.context import AppContext
@@ -64,6 +70,57 @@ def quality_markdown(q: LayoutQuality | None, note: str = "") -> str:
         )
         lines.append(f"{p.label}: {hw}  ")
     return "\n".join(lines)
+
+
+#: The "Procedure" choices: the plan's own, or another the suggestion switches to.
+KEEP = "keep the plan's"
+PROCEDURE_CHOICES = {KEEP: "", "best fit": "best_fit", "3-2-1": "three_two_one"}
+OBJECTIVE_CHOICES = {"accuracy": "accuracy", "least cycle time": "time"}
+
+
+def _layout_line(
+    n: int, method: str, worst_m: float, level: float, check: PlanCheck | None
+) -> list[str]:
+    """One column of :func:`comparison_markdown`."""
+    landing = "-"
+    cycle = "-"
+    verdict = "not checked"
+    if check is not None:
+        if check.landing is not None:
+            landing = f"{check.landing.failed * 100:.1f} %"
+        if check.cycle is not None:
+            cycle = f"{check.cycle.total_s:.1f} s"
+        bad = len(check.infeasible) + bool(check.layout) + bool(check.error)
+        verdict = "passes" if not bad else f"refuses {bad}"
+    err = f"{worst_m * 1e3:.3f} mm" if math.isfinite(worst_m) else "-"
+    return [str(n), method, f"{err} at {level:g} %", landing, cycle, verdict]
+
+
+def comparison_markdown(
+    before_n: int,
+    before_method: str,
+    before_check: PlanCheck | None,
+    res: SuggestResult,
+) -> str:
+    """The current layout and the suggestion side by side (Markdown): points, procedure,
+    predicted error at the points of interest, landing risk (share of misplaced calibrations
+    with a search gone wrong), cycle time, check."""
+    level = res.confidence_percent
+    q = before_check.quality if before_check is not None else None
+    before_worst = q.worst_poi_m(level) if q is not None else math.nan
+    a = _layout_line(before_n, before_method, before_worst, level, before_check)
+    b = _layout_line(len(res.plan.points), res.plan.method, res.worst_m, level, res.check)
+    rows = (
+        "points",
+        "procedure",
+        "predicted error",
+        "landing risk",
+        "cycle time",
+        "check",
+    )
+    lines = ["| | now | suggested |", "|---|---|---|"]
+    lines += [f"| {r} | {x} | {y} |" for r, x, y in zip(rows, a, b, strict=True)]
+    return "**Suggestion (not applied)**\n\n" + "\n".join(lines)
 
 
 def redundancy_markdown(doc: UiPlan) -> str:
@@ -102,16 +159,31 @@ class LayoutPanel:
             self.show_map = gui.add_checkbox("Show predicted error on part", False)
             self.target = gui.add_number("Target (mm)", 0.3, min=0.001, max=100.0, step=0.01)
             self.max_points = gui.add_number("Max points", 8, min=6, max=40, step=1)
+            self.procedure = gui.add_dropdown(
+                "Suggested procedure", tuple(PROCEDURE_CHOICES), initial_value=KEEP
+            )
+            self.objective = gui.add_dropdown(
+                "Objective", tuple(OBJECTIVE_CHOICES), initial_value="accuracy"
+            )
             self.suggest_button = gui.add_button("Suggest layout", color="blue")
             self.add_button = gui.add_button("Add best point")
             self.progress = gui.add_progress_bar(0.0, visible=False, animated=True)
+            self.compare_md = gui.add_markdown("")
+            self.accept_button = gui.add_button("Accept suggestion", color="green", visible=False)
+            self.discard_button = gui.add_button("Discard suggestion", visible=False)
+        #: the suggestion shown and not yet accepted, and its label for the undo step
+        self.pending: SuggestResult | None = None
         self.suggest_button.on_click(lambda e: self._on_suggest(e, add=0))
         self.add_button.on_click(lambda e: self._on_suggest(e, add=1))
+        self.accept_button.on_click(lambda e: self._on_accept(e))
+        self.discard_button.on_click(lambda _e: self.discard())
         self.show_map.on_update(lambda _e: self._paint())
         app.state.subscribe(self._on_change)
 
     # ---- live quality ----------------------------------------------------------------------
-    def _on_change(self, _change: object) -> None:
+    def _on_change(self, change: object) -> None:
+        if self.pending is not None and getattr(change, "label", "") != "suggest layout":
+            self.discard()  # made for the plan as it was
         self.refresh()
 
     def refresh(self) -> Future[LayoutQuality | None]:
@@ -181,17 +253,38 @@ class LayoutPanel:
             self._app.notify("Not suggested", str(exc), client=client)
 
     def suggest(self, add: int = 0) -> Future[SuggestResult]:
-        """Suggest a layout (``add``: keep the points, add this many) in the cell's worker;
-        the returned future completes once the points are replaced.
+        """Suggest a layout (``add``: keep the points, add this many) in the cell's worker,
+        for the procedure and objective picked in the panel; the returned future completes once
+        the suggestion is shown beside the current layout (:meth:`accept` applies it).
 
         Raises:
-            InputError: a suggestion is already running, or there is no plan.
+            InputError: a suggestion is already running, there is no plan, or the plan's own
+                procedure (the default) is one Suggest cannot design (A-H): pick another.
         """
-        from planner.suggest import suggest_plan
+        from planner.check import check_plan
+        from planner.suggest import PROCEDURES, suggest_plan
 
         plan = plan_from_ui(self._app.state.doc)
         if self._suggesting.is_set():
             raise InputError("a suggestion is already running")
+        procedure = PROCEDURE_CHOICES.get(str(self.procedure.value), "") or plan.method
+        objective = OBJECTIVE_CHOICES.get(str(self.objective.value), "accuracy")
+        if add:
+            procedure = "best_fit"  # added points: a best fit of all (the message says so)
+        elif procedure not in PROCEDURES:
+            raise InputError(
+                f"the plan's procedure is {plan.method}, whose points Suggest cannot design: "
+                "pick best fit or 3-2-1 under Suggested procedure to suggest one instead (the "
+                "plan's points are replaced only when you accept)"
+            )
+        if add:
+            objective = "accuracy"
+        if objective == "time" and procedure != "best_fit":
+            raise InputError(
+                "the least cycle time is designed for a best fit: pick best fit under "
+                "Procedure, or accuracy under Objective"
+            )
+        self.discard()
         self._suggesting.set()
         self.suggest_button.disabled = self.add_button.disabled = True
         self.progress.value, self.progress.visible = 0.0, True
@@ -204,10 +297,14 @@ class LayoutPanel:
             k = stages.index(stage) if stage in stages else 0
             self.progress.value = 100.0 * (k + done / max(total, 1)) / len(stages)
 
-        def job(session: CellSession | None) -> SuggestResult:
+        def job(session: CellSession | None) -> tuple[PlanCheck | None, SuggestResult]:
             if session is None or session.cell is None:
                 raise InputError("no cell is loaded")
-            return suggest_plan(
+            try:
+                before = check_plan(plan, cell=session.cell) if plan.points else None
+            except InputError:
+                before = None  # the comparison says "not checked"
+            res = suggest_plan(
                 plan,
                 plan_dir,
                 target_m=None if add else target,
@@ -215,31 +312,78 @@ class LayoutPanel:
                 add=add,
                 progress=progress,
                 cell=session.cell,
+                procedure=procedure,
+                objective=objective,
             )
+            return before, res
 
-        done: Future[SuggestResult] = Future()  # set once the points are replaced
+        n_before, method_before = len(plan.points), plan.method
+        done: Future[SuggestResult] = Future()  # set once the suggestion is shown
         fut = self._app.worker.submit(job)
-        fut.add_done_callback(lambda f: self._suggested(f, done))
+        fut.add_done_callback(lambda f: self._suggested(f, done, n_before, method_before))
         return done
 
-    def _suggested(self, fut: Future[SuggestResult], done: Future[SuggestResult]) -> None:
+    def _suggested(
+        self,
+        fut: Future[tuple[PlanCheck | None, SuggestResult]],
+        done: Future[SuggestResult],
+        n_before: int,
+        method_before: str,
+    ) -> None:
+        self.progress.visible = False
+        self.suggest_button.disabled = self.add_button.disabled = False
+        self._suggesting.clear()  # before the future completes: its caller may suggest again
         try:
-            res = fut.result()
+            before, res = fut.result()
         except Exception as exc:  # the message names the faces tried and why
             if not isinstance(exc, InputError):
                 logger.exception("suggest failed")
             self._app.notify("No layout suggested", str(exc))
             done.set_exception(exc)
-        else:
-            doc = ui_plan_from_plan(res.plan, name=self._app.state.doc.name)
-            self._app.state.apply(doc, "suggest layout")
-            self._app.notify("Layout suggested", res.message, error=not res.met)
-            done.set_result(res)
-        finally:
-            self.progress.visible = False
-            self.suggest_button.disabled = self.add_button.disabled = False
-            self._suggesting.clear()
+            return
+        self.pending = res
+        self.compare_md.content = (
+            comparison_markdown(n_before, method_before, before, res)
+            + f"\n\n{_escape(res.message)}"
+        )
+        self.accept_button.visible = self.discard_button.visible = True
+        title = "Layout suggested: accept or discard it" if res.met else "Best layout found"
+        self._app.notify(title, res.message, error=not res.met)
+        done.set_result(res)
+
+    def _on_accept(self, event: Any) -> None:
+        try:
+            self.accept()
+        except InputError as exc:
+            self._app.notify("Not applied", str(exc), client=getattr(event, "client", None))
+
+    def accept(self) -> None:
+        """Replace the plan's points with the suggestion shown (one undo step).
+
+        Raises:
+            InputError: there is none (discarded, or the plan changed since).
+        """
+        res = self.pending
+        if res is None:
+            raise InputError("no suggestion to accept: suggest one first")
+        doc = ui_plan_from_plan(res.plan, name=self._app.state.doc.name)
+        self._app.state.apply(doc, "suggest layout")
+        self.discard()
+
+    def discard(self) -> None:
+        """Drop the suggestion shown (nothing changes in the plan)."""
+        self.pending = None
+        self.compare_md.content = ""
+        self.accept_button.visible = self.discard_button.visible = False
 
     def close(self) -> None:
         """Stop the panel's thread."""
         self._worker.close(timeout=1.0)
+
+
+def _escape(text: str) -> str:
+    """``text`` as plain Markdown (no markup)."""
+    out = " ".join(text.split())
+    for c in "\\`*_[]<>#|":
+        out = out.replace(c, "\\" + c)
+    return out

@@ -174,11 +174,14 @@ class CheckStatus:
         problems: what refuses the plan besides its points, one line each: the check's error
             (``"error: ..."``) and the procedure's layout problem (``"layout: ..."``, known
             without a check too).
+        reasons: why each refused point is refused, ``"P3: ..."``, in plan order (the headers
+            of a program exported anyway say them).
     """
 
     checked: bool = False
     refused: tuple[str, ...] = ()
     problems: tuple[str, ...] = ()
+    reasons: tuple[str, ...] = ()
 
     @property
     def passed(self) -> bool:
@@ -369,11 +372,22 @@ def check_header(job: ExportJob, fmt: str) -> str:
             f"in code): run `wobjcal check --format {fmt}` on the plan before the first run."
         )
         return text + (f" Refused: {'; '.join(refused)}." if refused else "")
+    why = "; ".join(_short(r) for r in status.reasons)
     return (
-        "NOT CHECKED: exported with --force (or downloaded from the UI) although wobjcal check "
-        f"refuses {'; '.join(refused)}: fix the plan, or make sure by hand that those moves are "
-        "safe, and run the program the first time at reduced speed."
+        "NOT CHECKED: exported with --force (or with \"Export anyway\" in the UI) although "
+        f"wobjcal check refuses {'; '.join(refused)}"
+        + (f" ({why})" if why else "")
+        + ": fix the plan, or make sure by hand that those moves are safe, and run the program "
+        "the first time at reduced speed."
     )
+
+
+#: Longest reason of one point a program header repeats, characters.
+REASON_CHARS = 160
+
+
+def _short(reason: str) -> str:
+    return reason if len(reason) <= REASON_CHARS else reason[: REASON_CHARS - 3] + "..."
 
 
 def cycle_header(job: ExportJob, fmt: str) -> str:

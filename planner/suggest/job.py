@@ -56,6 +56,7 @@ from numpy.typing import NDArray
 
 from calib.errors import InputError
 from calib.estimators.layout import search_constraint_set
+from calib.plan.bundle import rebased_plan
 from calib.plan.file import Plan, PlanError, PlanPoint
 from calib.plan.report_spec import PointOfInterest
 from calib.probing import ProbePoint, SearchSpec
@@ -128,6 +129,7 @@ class SuggestResult:
         front: the accuracy-versus-time front (:mod:`planner.suggest.front`), ``()`` when not
             asked for.
         cycle_s: the written plan's estimated cycle time, s (NaN: not timed).
+        check: the written plan's check (``wobjcal check --format``), or None.
     """
 
     plan: Plan
@@ -148,6 +150,7 @@ class SuggestResult:
     objective: str = "accuracy"
     front: tuple[FrontRow, ...] = field(default=(), repr=False)
     cycle_s: float = math.nan
+    check: PlanCheck | None = field(default=None, repr=False)
 
 
 def _pois(plan: Plan, mesh: object, at_m: FloatArray | None) -> list[RowSpec]:
@@ -419,6 +422,7 @@ def suggest_plan(
         problems=problems,
         front=rows,
         cycle_s=check.cycle.total_s if check.cycle is not None else math.nan,
+        check=check,
     )
 
 
@@ -496,6 +500,7 @@ def _fastest_plan(
         objective="time",
         front=tuple(rows),
         cycle_s=best.cycle_s,
+        check=best.check,
     )
 
 
@@ -712,28 +717,6 @@ def _no_layout(
 def moved_plan(plan: Plan, from_dir: Path, to_dir: Path) -> Plan:
     """``plan`` with its file references (robot, its ROS package path, tool, work object,
     fixture meshes) made relative to ``to_dir`` instead of ``from_dir`` (``builtin:``
-    references unchanged), so a plan written into another folder still finds its files."""
-    import os
-
-    from calib.plan.base import BUILTIN_PREFIX
-
-    def ref(r: str | None) -> str | None:
-        if not r or r.startswith(BUILTIN_PREFIX) or Path(r).is_absolute():
-            return r
-        return os.path.relpath((from_dir / r).resolve(), to_dir.resolve())
-
-    def packages(path: str | msgspec.UnsetType) -> str | msgspec.UnsetType:
-        if not isinstance(path, str):
-            return path
-        entries = (p.strip() for p in path.split(":"))  # as split_path reads them
-        return ":".join(p if p.startswith("~") else ref(p) or p for p in entries if p)
-
-    rep = msgspec.structs.replace
-    c = plan.cell
-    cell = rep(
-        c,
-        robot=rep(c.robot, urdf=ref(c.robot.urdf), package_path=packages(c.robot.package_path)),
-        tool=rep(c.tool, name=ref(c.tool.name)),
-        fixtures=[rep(f, mesh=ref(f.mesh)) for f in c.fixtures],
-    )
-    return rep(plan, cell=cell, work_object=rep(plan.work_object, mesh=ref(plan.work_object.mesh)))
+    references unchanged), so a plan written into another folder still finds its files:
+    :func:`calib.plan.bundle.rebased_plan`, under the name the CLI and scripts know."""
+    return rebased_plan(plan, from_dir, to_dir)

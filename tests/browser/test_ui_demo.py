@@ -160,3 +160,20 @@ def test_checks_run_while_validation_runs(demo: UiSession) -> None:
     finally:
         fut.result(300)
         demo.app.state.undo()
+
+
+def test_a_program_check_passes_downloads_at_once(demo: UiSession, tmp_path: Path) -> None:
+    """The demo's A-H plan passes check for RAPID: "Download RAPID" downloads it straight
+    away, its header says CHECKED, and no refusal or "Export anyway" shows."""
+    open_tab(demo.page, "Files")
+    button = demo.page.get_by_role("button", name="Download RAPID")
+    button.wait_for(state="visible")
+    with demo.page.expect_download(timeout=300_000) as dl:
+        button.click()
+    saved = tmp_path / dl.value.suggested_filename
+    dl.value.save_as(saved)
+    text = saved.read_text()
+    assert saved.suffix == ".mod" and "CHECKED: wobjcal check passed" in text
+    assert "NOT CHECKED" not in text
+    assert not demo.page.get_by_role("button", name="Export anyway").is_visible()
+    assert "not downloaded" not in demo.page.inner_text("body")

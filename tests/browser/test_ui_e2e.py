@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ui_helpers import UiSession, click_world, open_tab, set_camera, wait_for
+from ui_helpers import UiSession, click_world, open_tab, save_screenshot, set_camera, wait_for
 
 from calib.frames import transform_points
 from webui.testing import T_WORLD_WOBJ_BOX
@@ -164,13 +164,42 @@ def test_second_tab_sees_the_same_session(ui: UiSession, browser: Any) -> None:
         other.page.close()
 
 
-def test_rapid_download_is_the_server_export(ui: UiSession, tmp_path: Path) -> None:
+def test_a_program_check_refuses_is_not_downloaded_until_export_anyway(
+    ui: UiSession, tmp_path: Path
+) -> None:
+    """The box plan's searches are too short for the default misplacement and S1, S2 are out
+    of reach: check refuses the RAPID program, so "Download RAPID" downloads nothing and the
+    page lists why; "Export anyway" downloads it with the reasons in its header."""
     wait_for(lambda: "P1" in ui.page.content(), what="page ready")
     drop_points_without_role(ui)
+    downloads: list[Any] = []
+
+    def seen(download: Any) -> None:
+        downloads.append(download)
+
+    ui.page.on("download", seen)
+    open_folder(ui, "Download RAPID")
+    ui.page.get_by_role("button", name="Download RAPID").click()
+    shown = wait_for(
+        lambda: "RAPID not downloaded" in ui.page.inner_text("body") and ui.page.inner_text("body"),
+        what="the refusal in the Files tab",
+    )
+    assert "S1: out of reach" in shown and "P1: search:" in shown
+    assert "Not exported" in ui.notifications()
+    anyway = ui.page.get_by_role("button", name="Export anyway")
+    assert anyway.is_visible()
+    time.sleep(1.0)  # a download would have started by now
+    assert downloads == []
+    save_screenshot(ui.page, "export_refused.png", tmp_path)  # hides notifications: last test
     with ui.page.expect_download() as dl:
-        open_folder(ui, "Download RAPID")
-        ui.page.get_by_role("button", name="Download RAPID").click()
+        anyway.click()
     saved = tmp_path / dl.value.suggested_filename
     dl.value.save_as(saved)
-    assert saved.suffix == ".mod"
-    assert "MODULE" in saved.read_text()
+    text = saved.read_text()
+    assert saved.suffix == ".mod" and "MODULE" in text
+    head = " ".join(" ".join(line.lstrip("! ") for line in text.splitlines()[:40]).split())
+    assert 'NOT CHECKED: exported with --force (or with "Export anyway" in the UI)' in head
+    assert "(P1: search:" in head and "S1: out of reach" in head
+    wait_for(lambda: not anyway.is_visible(), what="the button hidden after the download")
+    assert "RAPID not downloaded" not in ui.page.inner_text("body")
+    ui.page.remove_listener("download", seen)

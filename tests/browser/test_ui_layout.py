@@ -6,9 +6,10 @@ plan's points) as well as the page."""
 from __future__ import annotations
 
 import threading
+from pathlib import Path
 
 import pytest
-from ui_helpers import UiSession, open_tab, wait_for
+from ui_helpers import UiSession, choose, open_tab, save_screenshot, wait_for
 
 from planner.sim.quality import LayoutQuality
 
@@ -71,8 +72,28 @@ def test_layout_tab_shows_the_quality_and_follows_a_moved_point(demo: UiSession)
     wait_for(lambda: _shown(demo, q2), what="the A-H quality in the page again")
 
 
+def test_suggest_keeps_the_plans_procedure_unless_another_is_picked(demo: UiSession) -> None:
+    """On the A-H plan, "Suggest layout" with the default "keep the plan's" procedure says
+    what to pick and changes nothing (it used to switch to a best fit silently)."""
+    app, page = demo.app, demo.page
+    open_tab(page, "Layout")
+    ah = app.state.doc
+    assert app.layout_panel.procedure.value == "keep the plan's"
+    page.get_by_role("button", name="Suggest layout", exact=True).click()
+    text = wait_for(
+        lambda: "Not suggested" in demo.notifications() and demo.notifications(),
+        what="the refusal",
+    )
+    assert (
+        "the plan's procedure is hultman2013" in text
+        and "pick best fit or 3-2-1 under Suggested procedure" in text
+    )
+    assert app.state.doc is ah
+    assert not page.get_by_role("button", name="Accept suggestion").is_visible()
+
+
 def test_suggest_shows_progress_and_replaces_the_points_in_one_undo_step(
-    demo: UiSession,
+    demo: UiSession, tmp_path: Path
 ) -> None:
     app, page = demo.app, demo.page
     panel = app.layout_panel
@@ -80,6 +101,8 @@ def test_suggest_shows_progress_and_replaces_the_points_in_one_undo_step(
     ah_ids = app.state.doc.ids
     assert ah_ids == ("A", "B", "C", "D", "E", "F", "G", "H")
     n_max = int(panel.max_points.value)
+    choose(page, "Suggested procedure", "best fit")
+    wait_for(lambda: panel.procedure.value == "best fit", what="best fit picked (server)")
     # hold the cell's worker so the suggestion waits in the queue: the progress bar and the
     # disabled buttons are then on screen for as long as the test needs to see them
     gate = threading.Event()
@@ -95,7 +118,19 @@ def test_suggest_shows_progress_and_replaces_the_points_in_one_undo_step(
         assert app.state.doc.ids == ah_ids, "nothing replaced before the suggestion is done"
     finally:
         gate.set()
+    # shown beside the current layout, applied only on accept
+    accept = page.get_by_role("button", name="Accept suggestion", exact=True)
+    accept.wait_for(state="visible")
+    body = page.inner_text("body")
+    assert "Suggestion (not applied)" in body and "hultman2013" in body and "best_fit" in body
+    for row in ("predicted error", "landing risk", "cycle time"):
+        assert row in body, row
+    assert app.state.doc.ids == ah_ids, "nothing replaced before accept"
+    accept.scroll_into_view_if_needed()
+    save_screenshot(page, "suggest_compare.png", tmp_path)
+    accept.click()
     wait_for(lambda: app.state.doc.ids != ah_ids, what="the suggested points on the server")
+    accept.wait_for(state="hidden")
     doc = app.state.doc
     assert doc.method == "best_fit" and all(p.role == "fit" for p in doc.points)
     assert 6 <= len(doc.points) <= n_max
@@ -109,8 +144,11 @@ def test_suggest_shows_progress_and_replaces_the_points_in_one_undo_step(
     wait_for(lambda: "Layout suggested" in demo.notifications(), what="the notification")
     suggested = doc.ids
 
-    # "Add best point": the suggested points kept, one more
+    # "Add best point": the suggested points kept, one more, on accept
     page.get_by_role("button", name="Add best point", exact=True).click()
+    accept.wait_for(state="visible")
+    assert app.state.doc.ids == suggested
+    accept.click()
     wait_for(lambda: len(app.state.doc.points) == len(suggested) + 1, what="one point added")
     added = app.state.doc.ids
     assert added[: len(suggested)] == suggested
