@@ -46,6 +46,8 @@ logger = logging.getLogger(__name__)
 
 #: The spheres at the points of interest are drawn this many times their predicted error.
 SPHERE_SCALE = 100.0
+#: Scene node of the suggestion's points while it waits for accept (wobj frame).
+SUGGESTED_NODE = "/wobj/suggested"
 
 
 def quality_markdown(q: LayoutQuality | None, note: str = "") -> str:
@@ -347,6 +349,7 @@ class LayoutPanel:
             + f"\n\n{_escape(res.message)}"
         )
         self.accept_button.visible = self.discard_button.visible = True
+        self._draw_pending(res)
         title = "Layout suggested: accept or discard it" if res.met else "Best layout found"
         self._app.notify(title, res.message, error=not res.met)
         done.set_result(res)
@@ -375,6 +378,22 @@ class LayoutPanel:
         self.pending = None
         self.compare_md.content = ""
         self.accept_button.visible = self.discard_button.visible = False
+        self._app.server.scene.remove_by_name(SUGGESTED_NODE)
+
+    def _draw_pending(self, res: SuggestResult) -> None:
+        """The suggested points as translucent green spheres on the part, beside the plan's
+        own markers (wobj frame)."""
+        scene = self._app.server.scene
+        scene.remove_by_name(SUGGESTED_NODE)
+        r = max(float(res.plan.validation.sensor.footprint_radius_m), 0.003)
+        for p in res.plan.points:
+            scene.add_icosphere(
+                f"{SUGGESTED_NODE}/{p.id}",
+                radius=r,
+                color=(40, 170, 80),
+                position=np.asarray(p.position_m, dtype=np.float64),
+                opacity=0.55,
+            )
 
     def close(self) -> None:
         """Stop the panel's thread."""
