@@ -10,7 +10,10 @@ Owns:
     - :mod:`calib.plan.json_io`: strict JSON decoding with errors naming the JSON path, and the
       generated JSON Schemas (``assets/schema/``);
     - :mod:`calib.plan.measurements`: the measured-points file (``wobjcal.measurements/1``);
-    - :mod:`calib.plan.base`: built-in references, mesh units, sha256 checks.
+    - :mod:`calib.plan.base`: built-in references, mesh units, sha256 checks;
+    - :mod:`calib.plan.bundle`: a plan with its files as one ZIP archive (:func:`plan_bundle`)
+      and which fields hold file references (:func:`file_refs`, :func:`rebased_plan`);
+      imported from there, not from ``calib.plan``.
 
 Pure: msgspec and numpy, no simulator. Public names are importable from ``calib.plan``.
 """
