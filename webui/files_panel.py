@@ -101,6 +101,11 @@ class FilesPanel:
                 "Upload robot URDF (.urdf, or .zip with meshes)", mime_type=".urdf,.zip"
             )
             self.download = gui.add_button("Download plan JSON")
+            self.download_bundle = gui.add_button(
+                "Download plan with its files (.zip)",
+                hint="the plan and every file it refers to (part, robot and its packages, "
+                "tool, fixture meshes), its references relative to the zip's folder",
+            )
             self.export_buttons = {fmt: gui.add_button(f"Download {fmt}") for fmt in FORMATS}
             self.export_md = gui.add_markdown("")
             self.export_anyway = gui.add_button("Export anyway", color="red", visible=False)
@@ -117,6 +122,9 @@ class FilesPanel:
         self.urdf_upload.on_upload(lambda ev: self._guard(ev, self.upload_urdf, *_file(ev)))
         self.download.on_click(
             lambda ev: self._guard(ev, self.download_plan, ev.client, failure="Not downloaded")
+        )
+        self.download_bundle.on_click(
+            lambda ev: self._guard(ev, self.download_zip, ev.client, failure="Not downloaded")
         )
         for fmt, button in self.export_buttons.items():
             button.on_click(self._export_callback(fmt))
@@ -352,6 +360,21 @@ class FilesPanel:
     def download_plan(self, client: Any) -> None:
         """Send the session plan JSON to ``client``."""
         name, data = self.plan_bytes()
+        client.send_file_download(name, data, save_immediately=True)
+
+    def bundle_bytes(self) -> tuple[str, bytes]:
+        """File name (after the plan's name) and the zip of the session plan with every file
+        it refers to (:func:`calib.plan.bundle.plan_bundle`): unpacked anywhere, its plan
+        loads and finds its part, robot, tool and fixtures, none in the server's upload cache."""
+        from calib.plan.bundle import plan_bundle
+
+        plan = plan_from_ui(self._app.state.doc)
+        stem = export_file_stem(plan.name, "json")
+        return f"{stem}.zip", plan_bundle(plan, self._app.plan_dir, stem)
+
+    def download_zip(self, client: Any) -> None:
+        """Send the session plan with its files as a zip to ``client``."""
+        name, data = self.bundle_bytes()
         client.send_file_download(name, data, save_immediately=True)
 
     def export(self, fmt: str) -> ExportResult:

@@ -132,8 +132,35 @@ def test_teach_as_via_point_in_the_page(demo: UiSession) -> None:
     wait_for(lambda: app.state.doc.get("B").vias == (), what="undo removes the via")
 
 
+def _the_zip_carries_the_uploaded_part(demo: UiSession, part: Path, tmp_path: Path) -> None:
+    """ "Download plan with its files": the plan, named after the session plan, refers to the
+    part inside the zip (not the server's upload cache), with the uploaded bytes."""
+    import zipfile
+
+    from calib.plan.base import resolve_ref
+    from calib.plan.file import load_plan
+
+    page = demo.page
+    open_tab(page, "Files")
+    with page.expect_download() as dl:
+        page.get_by_role("button", name="Download plan with its files (.zip)").click()
+    saved = tmp_path / dl.value.suggested_filename
+    dl.value.save_as(saved)
+    stem = saved.stem
+    assert saved.suffix == ".zip" and stem in demo.app.state.doc.name.replace(" ", "_")
+    out = tmp_path / "unpacked"
+    with zipfile.ZipFile(saved) as z:
+        z.extractall(out)
+    plan = load_plan(out / stem / f"{stem}.json")
+    mesh = plan.work_object.mesh
+    assert not Path(mesh).is_absolute() and ".cache" not in mesh
+    found = Path(resolve_ref(mesh, out / stem))
+    assert found.resolve().is_relative_to((out / stem).resolve())
+    assert found.read_bytes() == part.read_bytes()
+
+
 def test_uploading_a_part_shows_its_size_then_reframes_and_lists_points_off_it(
-    demo: UiSession, reference_dir: Path
+    demo: UiSession, reference_dir: Path, tmp_path: Path
 ) -> None:
     from webui import clients
 
@@ -157,6 +184,7 @@ def test_uploading_a_part_shows_its_size_then_reframes_and_lists_points_off_it(
     wait_for(lambda: not files.off, what="the points projected")
     for p in app.state.doc.points:
         assert app.picker.project(p.probe.position_m).distance_m < 1e-9
+    _the_zip_carries_the_uploaded_part(demo, reference_dir / "parts" / "plate_holes.STL", tmp_path)
     app.state.undo()
     app.state.undo()
     wait_for(lambda: app.state.doc.source is before.source, what="the demo back")
