@@ -136,6 +136,8 @@ def test_feasible_point_has_pose_and_search_path(app: WobjcalApp) -> None:
     assert check.q is not None and check.q_path is not None and len(check.q_path) >= 2
     app.select("Q")
     assert app.robot is not None
+    assert not np.allclose(app.robot.q, check.q), "the robot moves to a point only when asked"
+    app.robot_to_selected()
     np.testing.assert_allclose(app.robot.q, check.q)
 
 

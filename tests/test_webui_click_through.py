@@ -25,7 +25,8 @@ def _axis_ray(app: Any, point_id: str) -> tuple[np.ndarray, np.ndarray]:
 
 def test_a_click_through_the_robot_places_nothing_and_names_the_link(demo_app: Any) -> None:
     app = demo_app
-    app.select("A")  # every tab's robot at A's probe pose
+    app.select("A")
+    app.robot_to_selected()  # every tab's robot at A's probe pose
     check = app.check_of("A")
     assert check is not None and check.q is not None
     origin, direction = _axis_ray(app, "A")
@@ -52,7 +53,8 @@ def test_the_same_ray_reaches_the_part_when_the_robot_stands_elsewhere(demo_app:
     check = app.check_of("A")
     assert check is not None and check.q is not None
     origin, direction = _axis_ray(app, "A")
-    app.select("E")  # the robot at E's pose: nothing in front of the part along A's axis
+    app.select("E")
+    app.robot_to_selected()  # the robot at E's pose: nothing in front of the part along A's axis
     assert np.linalg.norm(app.robot.q - check.q) > 0.1
     obstacle = click_place.obstacle_on_ray(app, origin, direction, None)
     assert obstacle is None, obstacle
@@ -61,3 +63,22 @@ def test_the_same_ray_reaches_the_part_when_the_robot_stands_elsewhere(demo_app:
     click_place.click_place(app, event)
     assert app.selected == "A", "A's marker, no longer behind the sensor, is selected"
     assert app.state.doc is before
+
+
+@pytest.mark.parametrize("display", ["ghost", "hidden"])
+def test_a_ghost_or_hidden_robot_lets_the_click_through(demo_app: Any, display: str) -> None:
+    """The same click as above, with the robot drawn as a ghost or not at all: the robot no
+    longer stops it, so it reaches A's marker behind it and selects A."""
+    app = demo_app
+    app.select("A")
+    app.robot_to_selected()
+    origin, direction = _axis_ray(app, "A")
+    app.set_robot_display(display)
+    try:
+        assert app.robot.display == display
+        app.select(None)
+        event = SimpleNamespace(ray_origin=origin, ray_direction=direction, client=None)
+        click_place.click_place(app, event)
+        assert app.selected == "A"
+    finally:
+        app.set_robot_display("shown")

@@ -76,7 +76,9 @@ class WobjcalApp:
         self.server = server
         self.plan_dir = Path(plan_dir)
         self.busy = BusyIndicator(server.gui)
-        clients.add_view_bar(server, lambda: self.view, self.notify)
+        clients.add_view_bar(server, lambda: self.view, self.notify, self.set_robot_display)
+        #: how the robot is drawn (shown, ghost, hidden); kept when the cell is rebuilt
+        self.robot_display = "shown"
         self.tabs = AppTabs(server.gui)
         self.scene = PlanScene(server)
         self.state: SessionState[UiPlan] = SessionState(
@@ -91,6 +93,7 @@ class WobjcalApp:
         self.cycle: CycleTime | None = None
         self._lock = threading.RLock()
         self._cell_key: tuple[CellSpec, WorkObjectSpec] | None = None
+        self._part: tuple[str, str | None, str] | None = None
         self.flags = RoleFlags()
         #: Handlers of scene clicks by mode (``"place"``: click-to-place); a panel may set
         #: :attr:`click_mode` to its own (e.g. picking the points of a 3-point frame).
@@ -152,15 +155,18 @@ class WobjcalApp:
         if view.robot_urdf is not None:
             self.robot, why = tab_robots_or_reason(self.server, view)
             if self.robot is not None:  # tabs that connected while it was being built
+                self.robot.set_display(self.robot_display)
                 for client in list(self.server.get_clients().values()):
                     self.robot.add_client(client)
             if why:
                 logger.warning("%s", why)
                 self.notify("Robot not drawn", why, error=True)
         self.teach_panel.on_cell()
-        if old_part is None or old_part is not view.wobj_mesh:  # first cell or a new part: frame
+        part = _part_key(plan)
+        if old_part is None or part != self._part:  # first cell or a new part: frame it
             for client in self.server.get_clients().values():
                 clients.set_default_camera(client, view)
+        self._part = part  # moving, snapping or reframing the same part keeps the camera
         self.recheck(self.state.doc.ids)
         self.layout_panel.refresh()
 
@@ -246,7 +252,8 @@ class WobjcalApp:
             self._redraw(changed)
         self.recheck(changed)  # draws the changed points (one round trip per click)
         for cid in self.selection.follow(change.doc, set(changed)):  # tabs whose point changed
-            self._pose_robot(cid)
+            if self.points_panel.follow.value:
+                self._pose_robot(cid)
 
     def show_reachability(self, n_samples: int = 1000) -> None:
         """Start the reachability heat map (computed in chunks on the cell worker)."""
@@ -315,11 +322,39 @@ class WobjcalApp:
 
     def select(self, point_id: str | None, client: viser.ClientHandle | None = None) -> None:
         """Select a point in one tab (``client``) or in every tab (``None``, e.g. a script):
-        highlight it there and show that tab's robot at its probe pose."""
+        highlight it there, and show that tab's robot at its probe pose when "Robot follows
+        selection" is ticked (otherwise the robot stays where it is: :meth:`robot_to_selected`
+        moves it when asked)."""
         cid = None if client is None else client.client_id
         self.selection.select(point_id, cid)
-        self._pose_robot(cid)
+        if self.points_panel.follow.value:
+            self._pose_robot(cid)
         self.points_panel.refresh()  # the drag gizmo follows the latest selection
+
+    def set_robot_display(self, display: str) -> None:
+        """Draw the robot ``"shown"``, ``"ghost"`` or ``"hidden"`` in every tab; a ghost or
+        hidden robot does not stop a click on the part."""
+        self.robot_display = display
+        if self.robot is not None:
+            self.robot.set_display(display)
+
+    def robot_to_selected(self, client: viser.ClientHandle | None = None) -> None:
+        """Show the robot of one tab (``client``; every tab: ``None``) at its selected point's
+        probe pose.
+
+        Raises:
+            InputError: no point selected there, its check is still running, or it has no pose.
+        """
+        cid = None if client is None else client.client_id
+        point_id = self.selection.of(cid)
+        if point_id is None:
+            raise InputError("select a point first")
+        check = self.check_of(point_id)
+        if check is None:
+            raise InputError(f"{point_id} is still being checked")
+        if check.q is None:
+            raise InputError(f"{point_id} has no robot pose: {check.reason}")
+        self._pose_robot(cid)
 
     def _pose_robot(self, client_id: int | None) -> None:
         """Robot of tab ``client_id`` (every tab: ``None``) at its selected point's probe pose."""
@@ -390,3 +425,10 @@ class WobjcalApp:
 def _cell_key(plan: Plan) -> tuple[CellSpec, WorkObjectSpec]:
     """What decides the cell: when it changes, the cell is rebuilt."""
     return (plan.cell, plan.work_object)
+
+
+def _part_key(plan: Plan) -> tuple[str, str | None, str]:
+    """What makes a new part (the camera is framed on it): its file, digest and units, not its
+    pose nor its frame (moving, snapping or the 3-point frame keep the camera)."""
+    wo = plan.work_object
+    return (wo.mesh, wo.sha256, wo.units)

@@ -52,6 +52,9 @@ def obstacle_on_ray(
     o = np.asarray(origin_world, dtype=np.float64)
     d = np.asarray(direction_world, dtype=np.float64)
     hit = app.worker.call(lambda s: None if s is None else s.first_hit(o, d, q))
+    see_through = robot is not None and robot.display != "shown"
+    if hit is not None and hit.kind in ("robot", "tool") and see_through:
+        return None  # a ghost or hidden robot does not stop the click
     return None if hit is None or hit.kind == "work object" else hit
 
 

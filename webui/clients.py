@@ -148,8 +148,10 @@ def add_view_bar(
     server: viser.ViserServer,
     view_of: Callable[[], CellView | None],
     notify: Callable[..., None],
+    on_robot_display: Callable[[str], None] | None = None,
 ) -> None:
-    """The view buttons (front, top, side, fit: each tab's own camera) and the colour legend.
+    """The view buttons (front, top, side, fit: each tab's own camera), the robot's display
+    (shown, ghost, hidden: ``on_robot_display(display)``) and the colour legend.
 
     Args:
         server: the server whose control panel gets them.
@@ -169,5 +171,16 @@ def add_view_bar(
         frame_client(event.client, view, VIEWS[str(event.target.value)])
 
     bar.on_click(on_click)
+    if on_robot_display is not None:
+        from webui.robot_view import DISPLAYS
+
+        robot = gui.add_dropdown(
+            "Robot",
+            DISPLAYS,
+            initial_value="shown",
+            hint="ghost: translucent, hidden: not drawn; either way clicks go through it to the "
+            "part",
+        )
+        robot.on_update(lambda event: on_robot_display(str(event.target.value)))
     with gui.add_folder("Legend", expand_by_default=False):
         gui.add_html(legend_html())

@@ -111,6 +111,10 @@ class AppContext(Protocol):
     def select(self, point_id: str | None, client: viser.ClientHandle | None = None) -> None:
         """Select a point (or none) in the tab of ``client``, or in every tab (``None``)."""
 
+    def robot_to_selected(self, client: viser.ClientHandle | None = None) -> None:
+        """Show the robot of the tab of ``client`` (every tab: ``None``) at its selected
+        point's probe pose; raise ``InputError`` saying why not."""
+
     def place_at_ray(
         self,
         origin_world: ArrayLike,

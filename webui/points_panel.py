@@ -60,6 +60,13 @@ class PointsPanel:
             self.undo = gui.add_button("Undo")
             self.redo = gui.add_button("Redo")
             self.drag = gui.add_checkbox("Drag selected point", False)
+            self.follow = gui.add_checkbox(
+                "Robot follows selection",
+                False,
+                hint="ticked, the robot stands at each point you select or place; unticked it "
+                'stays where it is and "Robot to selected point" moves it',
+            )
+            self.robot_to = gui.add_button("Robot to selected point")
             self.play = gui.add_button("Play search path")
             self.heat = gui.add_checkbox("Reachability heat map", False)
             self.heat_legend = gui.add_html(
@@ -71,6 +78,7 @@ class PointsPanel:
         self.redo.on_click(lambda ev: self._guard(ev, self._app.state.redo))
         self.drag.on_update(lambda ev: self._guard(ev, self._update_gizmo))
         self.play.on_click(self._on_play)
+        self.robot_to.on_click(lambda ev: self._guard(ev, self._app.robot_to_selected, ev.client))
         self.heat.on_update(self._on_heat)
 
     # ---- helpers ---------------------------------------------------------------------------

@@ -17,6 +17,11 @@ from webui.scene import pose_kwargs
 
 logger = logging.getLogger(__name__)
 
+#: How the robot and its tool are drawn.
+DISPLAYS = ("shown", "ghost", "hidden")
+#: The ghost's colour and opacity (0-1).
+GHOST_RGBA = (0.72, 0.74, 0.80, 0.22)
+
 
 class RobotView:
     """The robot model drawn under ``/robot`` (posed at ``T_world_base``) and its tool under
@@ -28,6 +33,8 @@ class RobotView:
         urdf: the robot's model with its visual meshes loaded (shared by the tabs' views;
             posing it is serialized by ``lock``).
         lock: held while the shared model is posed.
+        display: ``"shown"``, ``"ghost"`` (translucent grey: the part and points behind it
+            show) or ``"hidden"``.
     """
 
     def __init__(
@@ -36,26 +43,40 @@ class RobotView:
         view: CellView,
         urdf: yourdfpy.URDF,
         lock: threading.Lock,
+        display: str = "shown",
     ) -> None:
+        if display not in DISPLAYS:
+            raise ValueError(f"robot display: one of {', '.join(DISPLAYS)}, got {display!r}")
         self._target = target
         self._view = view
         self._lock = lock
-        target.scene.add_frame("/robot", show_axes=False, **pose_kwargs(view.T_world_base))
+        self.display = display
+        ghost = GHOST_RGBA if display == "ghost" else None
+        root = target.scene.add_frame("/robot", show_axes=False, **pose_kwargs(view.T_world_base))
         with lock:  # the shared model is read while the meshes are added
-            self._urdf = ViserUrdf(target, urdf, root_node_name="/robot/urdf")
+            self._urdf = ViserUrdf(
+                target, urdf, root_node_name="/robot/urdf", mesh_color_override=ghost
+            )
         self._tool: ViserUrdf | None = None
         self._tool_frame: viser.FrameHandle | None = None
         if view.chain is not None and (view.tool_urdf is not None or view.tool_mesh is not None):
             self._tool_frame = target.scene.add_frame("/tool", show_axes=False)
             if view.tool_urdf is not None:
-                self._tool = ViserUrdf(target, view.tool_urdf, root_node_name="/tool/urdf")
+                self._tool = ViserUrdf(
+                    target, view.tool_urdf, root_node_name="/tool/urdf", mesh_color_override=ghost
+                )
             elif (mesh := view.tool_mesh) is not None:
                 target.scene.add_mesh_simple(
                     "/tool/mesh",
                     np.asarray(mesh.vertices, np.float32),
                     np.asarray(mesh.faces, np.uint32),
                     color=(90, 90, 100),
+                    opacity=GHOST_RGBA[3] if ghost else None,
                 )
+        if display == "hidden":
+            root.visible = False
+            if self._tool_frame is not None:
+                self._tool_frame.visible = False
         urdf_names = tuple(self._urdf.get_actuated_joint_names())
         #: joint names in the order of ``q`` (the chain's order when there is a chain)
         chain_names = () if view.chain is None else tuple(view.chain.joint_names)

@@ -96,6 +96,8 @@ class TabRobots:
         #: ``(n,)`` the pose the tabs share (the jog's, a script's), rad; a new tab starts there.
         self.q = np.clip(np.zeros(len(self.joint_names)), lo, hi)
         self._q_by_client: dict[int, np.ndarray] = {}
+        #: how every tab draws the robot (:data:`webui.robot_view.DISPLAYS`)
+        self.display = "shown"
         for client in server.get_clients().values():
             self.add_client(client)
 
@@ -105,10 +107,32 @@ class TabRobots:
         with self._lock:
             if client.client_id in self._views:
                 return
-            robot = RobotView(client, self._view, self._model, self._model_lock)
+            robot = RobotView(client, self._view, self._model, self._model_lock, self.display)
             robot.set_q(self.q)
             self._views[client.client_id] = robot
             self._q_by_client[client.client_id] = self.q.copy()
+
+    def set_display(self, display: str) -> None:
+        """Draw the robot in every tab ``"shown"``, ``"ghost"`` or ``"hidden"``
+        (:data:`webui.robot_view.DISPLAYS`); each tab keeps its pose."""
+        from webui.robot_view import DISPLAYS
+
+        if display not in DISPLAYS:
+            raise ValueError(f"robot display: one of {', '.join(DISPLAYS)}, got {display!r}")
+        with self._lock:
+            if display == self.display:
+                return
+            self.display = display
+            clients = self._server.get_clients()
+            for cid, old in list(self._views.items()):
+                client = clients.get(cid)
+                old.remove()
+                if client is None:
+                    del self._views[cid]
+                    continue
+                robot = RobotView(client, self._view, self._model, self._model_lock, display)
+                robot.set_q(self._q_by_client.get(cid, self.q))
+                self._views[cid] = robot
 
     def remove_client(self, client_id: int) -> None:
         """Forget a tab that disconnected (its scene went with it)."""

@@ -188,3 +188,45 @@ def test_uploading_a_part_shows_its_size_then_reframes_and_lists_points_off_it(
     app.state.undo()
     app.state.undo()
     wait_for(lambda: app.state.doc.source is before.source, what="the demo back")
+
+
+def test_the_robot_and_camera_move_only_when_asked(demo: UiSession, tmp_path: Path) -> None:
+    """Issue 22 item 5: selecting a point leaves the robot where it stands; "Robot to selected
+    point" moves it there; moving the part (Snap) keeps the camera where the user put it; the
+    Robot dropdown draws it as a ghost or hides it, and a ghost does not stop a click."""
+    from ui_helpers import choose
+
+    app, page = demo.app, demo.page
+    client = demo.client()
+    robot = app.robot
+    assert robot is not None and robot.display == "shown"
+    open_tab(page, "Points")
+    q0 = robot.q_of(client.client_id)
+    check = wait_for(lambda: app.check_of("C"), what="C's check")
+    assert check.q is not None and not np.allclose(check.q, q0)
+    choose(page, "Selected", "C")
+    wait_for(lambda: app.selection_of(client) == "C", what="C selected (server)")
+    assert np.allclose(robot.q_of(client.client_id), q0), "selecting does not move the robot"
+    page.get_by_role("button", name="Robot to selected point").click()
+    wait_for(lambda: np.allclose(robot.q_of(client.client_id), check.q), what="robot at C")
+    # the camera stays where the user put it when the part moves
+    set_camera(client, (3.0, -2.0, 2.5), (1.2, 0.0, 0.6))
+    cam = np.array(client.camera.position)
+    open_tab(page, "Cell")
+    T0 = pose_of(app.state.doc.source, WORK_OBJECT)
+    page.get_by_role("button", name="Snap part onto fixture").click()
+    wait_for(lambda: not np.allclose(pose_of(app.state.doc.source, WORK_OBJECT), T0), what="snap")
+    wait_for(lambda: len(app.checks()) == 8, what="the points checked in the moved cell")
+    assert np.allclose(client.camera.position, cam, atol=1e-6), "the camera did not jump"
+    app.state.undo()
+    wait_for(lambda: np.allclose(app.view.T_world_wobj, T0, atol=1e-12), what="undo")
+    # ghost: drawn translucent, clicks go through it
+    q1 = app.robot.q_of(client.client_id)
+    choose(page, "Robot", "ghost")
+    wait_for(lambda: app.robot is not None and app.robot.display == "ghost", what="ghost")
+    save_screenshot(page, "robot_ghost.png", tmp_path)
+    choose(page, "Robot", "hidden")
+    wait_for(lambda: app.robot is not None and app.robot.display == "hidden", what="hidden")
+    choose(page, "Robot", "shown")
+    wait_for(lambda: app.robot is not None and app.robot.display == "shown", what="shown")
+    assert np.allclose(app.robot.q_of(client.client_id), q1), "each tab keeps its pose"

@@ -63,6 +63,7 @@ def tabs(
     one, two = Tab(first.page, c1), Tab(second.page, c2)
     for tab in (one, two):
         open_tab(tab.page, "Points")
+    app.points_panel.follow.value = True  # each tab's robot stands at its selected point
     try:
         yield app, one, two
     finally:
