@@ -126,6 +126,27 @@ def test_moves_between_points_are_drawn_and_checked(demo_app: WobjcalApp) -> Non
     assert demo_app.server.scene.get_handle_by_name("/moves") is None
 
 
+def test_shown_moves_follow_the_plan(demo_app: WobjcalApp) -> None:
+    """While "Show moves" is ticked, an edit redraws the moves of the plan as it now is (a
+    deleted point's moves go, the move across it appears), and undo brings them back."""
+    from webui import plan_doc
+
+    panel = demo_app.teach_panel
+    panel.show_moves.value = True
+    try:
+        before = list(panel.moves)
+        a, b, c = demo_app.state.doc.ids[:3]
+        assert f"{a}->{b}" in before and f"{b}->{c}" in before
+        demo_app.state.update(lambda d: plan_doc.delete_point(d, b), f"delete {b}")
+        wait = list(panel.moves)
+        assert f"{a}->{b}" not in wait and f"{a}->{c}" in wait
+        assert demo_app.server.scene.get_handle_by_name(f"/moves/{a}_{b}_0") is None
+        demo_app.state.undo()
+        assert list(panel.moves) == before
+    finally:
+        panel.show_moves.value = False
+
+
 def test_teach_as_via_point_adds_one_undoable_autosaved_via(demo_app: WobjcalApp) -> None:
     import json
 

@@ -168,6 +168,7 @@ class WobjcalApp:
                 clients.set_default_camera(client, view)
         self._part = part  # moving, snapping or reframing the same part keeps the camera
         self.recheck(self.state.doc.ids)
+        self.teach_panel.after_checks(force=True)  # vias and moves in the new cell
         self.layout_panel.refresh()
 
     def replace_source(self, plan: Plan, label: str) -> None:
@@ -251,6 +252,7 @@ class WobjcalApp:
         if len(changed) > 2 or not changed:  # grey "pending" markers for bulk changes
             self._redraw(changed)
         self.recheck(changed)  # draws the changed points (one round trip per click)
+        self.teach_panel.after_checks()  # vias and shown moves of the plan as it now is
         for cid in self.selection.follow(change.doc, set(changed)):  # tabs whose point changed
             if self.points_panel.follow.value:
                 self._pose_robot(cid)

@@ -137,7 +137,9 @@ class PlanScene:
         return self.wobj_mesh_handle
 
     def draw_fixtures(self, fixtures: Mapping[str, tuple[trimesh.Trimesh, ArrayLike]]) -> None:
-        """Draw fixed obstacles ``{name: (mesh, T_world_fixture)}``."""
+        """Draw fixed obstacles ``{name: (mesh, T_world_fixture)}`` (the earlier cell's, even
+        ones of the same name, are removed first)."""
+        self._scene.remove_by_name("/fixtures")
         for name, (mesh, T) in fixtures.items():
             self._scene.add_mesh_simple(
                 f"/fixtures/{name}",

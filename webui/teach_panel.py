@@ -117,10 +117,17 @@ class TeachPanel:
 
     def _on_change(self) -> None:
         self._refresh_targets()
+
+    def after_checks(self, force: bool = False) -> None:
+        """Once the app has checked an edit (or a new cell: ``force``), redraw the vias (only
+        when they changed, unless ``force``) and, while "Show moves between points" is ticked,
+        the checked moves of the plan as it now is."""
         try:
-            self.via_view.draw()
+            self.via_view.draw(force=force)
+            if self.show_moves.value:
+                self.draw_moves()
         except Exception:  # a drawing problem must not break the edit
-            logger.exception("drawing the vias failed")
+            logger.exception("drawing the vias or moves failed")
 
     def _refresh_targets(self) -> None:
         options = (NEW_POINT, *self._app.state.doc.ids)
@@ -130,6 +137,9 @@ class TeachPanel:
     # ---- joints ----------------------------------------------------------------------------
     def on_cell(self) -> None:
         """Rebuild the joint sliders for the loaded cell's robot (its limits, in degrees)."""
+        self._build_sliders()
+
+    def _build_sliders(self) -> None:
         view = self._app.view
         for s in self.sliders:
             s.remove()
