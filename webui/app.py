@@ -26,6 +26,7 @@ from webui import click_place, clients, plan_doc
 from webui.autosave import AutosaveLock
 from webui.backend import CellSession, CellView
 from webui.busy import BusyIndicator
+from webui.heatmap import N_SAMPLES as HEAT_MAP_SAMPLES
 from webui.heatmap import HeatMap
 from webui.plan_adapter import autosave_bytes, plan_as_edited, plan_point, with_source
 from webui.plan_doc import UiPlan
@@ -257,8 +258,9 @@ class WobjcalApp:
             if self.points_panel.follow.value:
                 self._pose_robot(cid)
 
-    def show_reachability(self, n_samples: int = 1000) -> None:
-        """Start the reachability heat map (computed in chunks on the cell worker)."""
+    def show_reachability(self, n_samples: int = HEAT_MAP_SAMPLES) -> None:
+        """Start the reachability heat map of ``n_samples`` surface samples (500, as
+        documented), computed in chunks on the cell worker."""
         self.heatmap.stop()
         self.heatmap.start(n_samples)
 

@@ -172,10 +172,19 @@ def run(
     return app
 
 
-def serve(app: WobjcalApp) -> None:
-    """Serve until Ctrl-C or SIGTERM, then stop the app (server, worker, autosave lock)."""
+#: Exit codes of :func:`serve` (as ``docs/cli.md`` documents them: 128 + the signal).
+EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
+
+
+def serve(app: WobjcalApp) -> int:
+    """Serve until Ctrl-C or SIGTERM, then stop the app (server, worker, autosave lock).
+
+    Returns:
+        The exit code: 130 after Ctrl-C, 143 after SIGTERM.
+    """
     stop = threading.Event()
     previous = None
+    code = EXIT_TERMINATED
     if threading.current_thread() is threading.main_thread():
         previous = signal.signal(signal.SIGTERM, lambda *_: stop.set())
     try:
@@ -183,7 +192,9 @@ def serve(app: WobjcalApp) -> None:
             pass
     except KeyboardInterrupt:
         logger.info("stopping the wobjcal UI")
+        code = EXIT_INTERRUPTED
     finally:
         app.stop()
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
+    return code

@@ -125,5 +125,4 @@ def cmd_ui(args: argparse.Namespace) -> int:
         err.print(f"the session plan autosaves to {app.state.autosave_path}", markup=False)
     if app.autosave_note:
         err.print(app.autosave_note, markup=False)
-    serve(app)
-    return 0
+    return serve(app)  # 130 after Ctrl-C, 143 after SIGTERM (docs/cli.md)
