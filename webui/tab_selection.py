@@ -36,6 +36,10 @@ NONE = "(none)"
 NO_ROLE_LABEL = "(none)"
 #: Name of a tab's highlight node in its own scene.
 HIGHLIGHT = "/selection"
+#: A typed position or normal is applied this long after the last keystroke, s.
+TYPED_DELAY_S = 0.6
+#: A typed position farther than this from the part's surface is said when it is moved on, m.
+SNAP_NOTE_M = 0.0005
 
 
 def set_options(widget: Any, options: tuple[str, ...]) -> None:
@@ -65,6 +69,19 @@ class TabSelection:
         gui = client.gui
         with folder:
             self.selected = gui.add_dropdown("Selected", (NONE, *doc.ids), initial_value=NONE)
+            self.position_mm = gui.add_vector3(
+                "Position (mm)",
+                (0.0, 0.0, 0.0),
+                step=0.1,
+                hint="wobj frame; a typed position goes to the nearest spot of the part's "
+                "surface, with that face's normal",
+            )
+            self.normal = gui.add_vector3(
+                "Normal",
+                (0.0, 0.0, 1.0),
+                step=0.01,
+                hint="wobj frame, outward; the search runs against it (made unit length)",
+            )
             self.role = gui.add_dropdown("Role", (*doc.roles, NO_ROLE_LABEL))
             self.kind = gui.add_dropdown("Search", ("approach", "edge"), initial_value="approach")
             self.start_mm = gui.add_number("Start offset (mm)", 30.0, min=0.1, step=0.5)
@@ -75,6 +92,15 @@ class TabSelection:
         self.selected.on_update(self._on_selected)
         self.apply.on_click(lambda ev: self._guard(self.apply_settings))
         self.delete.on_click(lambda ev: self._guard(self.delete_selected))
+        self._timer: threading.Timer | None = None
+        self.position_mm.on_update(lambda _ev: self._typed())
+        self.normal.on_update(lambda _ev: self._typed())
+        #: the widgets that describe the selected point (hidden while none is selected)
+        self.settings = (
+            self.position_mm, self.normal, self.role, self.kind, self.start_mm, self.over_mm,
+            self.edge_dir, self.apply, self.delete,
+        )  # fmt: skip
+        self._show_fields(False)
 
     def _guard(self, fn: Any, *args: Any) -> None:
         try:
@@ -84,6 +110,22 @@ class TabSelection:
         except Exception as exc:  # never a traceback in the browser
             logger.exception("selection action failed")
             self._app.notify("Error", f"{type(exc).__name__}: {exc}", client=self.client)
+
+    def _show_fields(self, visible: bool) -> None:
+        for widget in self.settings:
+            if widget.visible != visible:
+                widget.visible = visible
+
+    def _typed(self) -> None:
+        """A position or normal typed: applied once the typing pauses (:data:`TYPED_DELAY_S`;
+        Enter or leaving the field ends it), one undo step for the whole entry."""
+        if self._syncing or self.point_id is None:
+            return
+        if self._timer is not None:
+            self._timer.cancel()
+        self._timer = threading.Timer(TYPED_DELAY_S, self._guard, (self.apply_pose,))
+        self._timer.daemon = True
+        self._timer.start()
 
     def _on_selected(self, event: Any) -> None:
         if self._syncing:
@@ -103,6 +145,7 @@ class TabSelection:
                 self.selected.value = value
             if settings and self.point_id in doc.ids:
                 self._show_settings(doc.get(self.point_id))
+            self._show_fields(self.point_id in doc.ids)
         finally:
             self._syncing = False
         self._highlight(doc)
@@ -113,6 +156,10 @@ class TabSelection:
         if role in self.role.options:
             self.role.value = role
         self.kind.value = s.kind
+        x, y, z = (round(v * 1000.0, 3) + 0.0 for v in point.probe.position_m)
+        self.position_mm.value = (x, y, z)
+        nx, ny, nz = (round(v, 6) + 0.0 for v in point.probe.normal)
+        self.normal.value = (nx, ny, nz)
         self.start_mm.value = round(s.start_offset_m * 1000.0, 3)
         self.over_mm.value = round(s.overtravel_m * 1000.0, 3)
         if s.edge_direction is not None:
@@ -159,6 +206,48 @@ class TabSelection:
             )
 
         self._app.state.update(edit, f"edit {sel}")
+
+    def apply_pose(self) -> None:
+        """Apply the Position and Normal fields to the tab's selected point (one undoable
+        step): a new position goes to the nearest spot of the part's surface with that face's
+        normal (said when that is more than :data:`SNAP_NOTE_M` from the typed one); a new
+        normal alone turns the point's search, the point staying where it is.
+
+        Raises:
+            InputError: nothing selected, no part loaded, or a zero normal.
+        """
+        sel = self.point_id
+        doc = self._app.state.doc
+        if sel is None or sel not in doc.ids:
+            raise InputError("select a point first")
+        probe = doc.get(sel).probe
+        typed = np.asarray(self.position_mm.value, dtype=np.float64) / 1000.0
+        n = np.asarray(self.normal.value, dtype=np.float64)
+        if not np.all(np.isfinite(typed)) or not np.all(np.isfinite(n)):
+            raise InputError("position and normal: numbers, please")
+        moved = not np.allclose(typed, probe.position_m, atol=5e-7)
+        turned = not np.allclose(n / max(float(np.linalg.norm(n)), 1e-300), probe.normal, atol=5e-7)
+        if not moved and not turned:
+            return
+        if moved:
+            picker = self._app.picker
+            if picker is None:
+                raise InputError("no work object is loaded")
+            hit = picker.project(typed)
+            pos, normal = hit.position_wobj, hit.normal_wobj
+            if hit.distance_m > SNAP_NOTE_M:
+                self._app.notify(
+                    f"{sel} put on the part",
+                    f"the typed position is {hit.distance_m * 1000:.2f} mm off the surface: "
+                    f"{sel} went to the nearest spot of the part, with its face's normal",
+                    client=self.client,
+                    error=False,
+                )
+        else:
+            if float(np.linalg.norm(n)) < 1e-9:
+                raise InputError("normal: a non-zero vector")
+            pos, normal = np.asarray(probe.position_m), n / float(np.linalg.norm(n))
+        self._app.state.update(lambda d: plan_doc.place_point(d, sel, pos, normal), f"move {sel}")
 
     def delete_selected(self) -> None:
         """Delete the tab's selected point (one undoable step)."""

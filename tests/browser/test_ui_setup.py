@@ -230,3 +230,42 @@ def test_the_robot_and_camera_move_only_when_asked(demo: UiSession, tmp_path: Pa
     choose(page, "Robot", "shown")
     wait_for(lambda: app.robot is not None and app.robot.display == "shown", what="shown")
     assert np.allclose(app.robot.q_of(client.client_id), q1), "each tab keeps its pose"
+
+
+def test_typing_a_points_position_moves_it_in_one_undo_step(demo: UiSession) -> None:
+    """Issue 22 item 6: the selected point's X/Y/Z (mm, wobj) and normal are fields; a typed
+    Y applied with Enter moves the point along its face (projected onto the part), one undo
+    step; with nothing selected the fields are not shown."""
+    from ui_helpers import choose
+
+    app, page = demo.app, demo.page
+    client = demo.client()
+    open_tab(page, "Points")
+    choose(page, "Selected", "(none)")
+    wait_for(lambda: app.selection_of(client) is None, what="nothing selected")
+    tab = app.selection.tab(client.client_id)
+    assert tab is not None
+    field = page.locator(f'[id="{tab.position_mm._impl.uuid}"]')
+    wait_for(lambda: not field.is_visible(), what="the fields hidden")
+    choose(page, "Selected", "B")
+    wait_for(field.is_visible, what="the fields shown")
+    p0 = np.array(app.state.doc.get("B").probe.position_m)
+    n0 = np.array(app.state.doc.get("B").probe.normal)
+    wait_for(lambda: np.allclose(tab.position_mm.value, p0 * 1000, atol=1e-3), what="B's X/Y/Z")
+    before = app.state.doc
+    y_field = field.locator("xpath=ancestor::*[count(.//input)>=3][1]//input").nth(1)
+    y_field.fill(f"{p0[1] * 1000 - 10.0:.3f}")  # along B's face (its normal is x)
+    y_field.press("Enter")
+
+    def moved() -> Any:
+        p = app.state.doc.get("B").probe
+        return p if abs(p.position_m[1] - p0[1] + 0.010) < 1e-4 else None
+
+    probe = wait_for(moved, what="B moved 10 mm along y")
+    # on the part (the nearest spot of the mesh: within 0.1 mm of the typed one here)
+    assert np.allclose(np.asarray(probe.position_m)[::2], p0[::2], atol=1e-4)
+    assert np.allclose(probe.normal, n0, atol=2e-3)  # the facet's normal, as a click gives
+    assert app.picker.project(probe.position_m).distance_m < 1e-9
+    open_tab(page, "Points")
+    page.get_by_role("button", name="Undo", exact=True).click()
+    wait_for(lambda: app.state.doc is before, what="the plan before the entry: one undo step")
