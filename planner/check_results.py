@@ -203,6 +203,15 @@ class PlanCheck:
         out += [f"point {p.point_id}: {p.reason or p.status}" for p in self.infeasible]
         return tuple(out)
 
+    def refusals(self) -> tuple[str, ...]:
+        """Why the plan is refused, one line each, as suggest, the front and the UI's export
+        show it: ``"<id>: <reason>"`` per infeasible point in plan order, then ``"layout:
+        ..."`` and ``"error: ..."`` (``()`` when it passes)."""
+        out = [f"{p.point_id}: {p.reason or p.status}" for p in self.infeasible]
+        out += [f"layout: {self.layout}"] if self.layout else []
+        out += [f"error: {self.error}"] if self.error else []
+        return tuple(out)
+
     def point(self, point_id: str) -> PointCheck:
         """The check of ``point_id``.
 

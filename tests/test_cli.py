@@ -244,7 +244,7 @@ def test_ui_passes_flags_to_webui(
         return SimpleNamespace(server=server, state=state, autosave_note="")
 
     monkeypatch.setattr(webui.server, "run", fake_run)
-    monkeypatch.setattr(webui.server, "serve", lambda app: None)
+    monkeypatch.setattr(webui.server, "serve", lambda app: 0)
     assert main(["ui", str(STATOR), "--host", "0.0.0.0", "--port", "8123"]) == 0
     assert main(["demo"]) == 0
     flags = {"block": False, "fresh": False}

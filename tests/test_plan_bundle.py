@@ -179,9 +179,11 @@ def test_a_link_out_of_the_robot_folder_is_not_followed(
         pytest.skip(f"cannot make symbolic links: {exc}")
     (robot / ".git").mkdir()
     (robot / ".git" / "HEAD").write_text("ref: refs/heads/main\n")
+    (robot / "ur5.zip").write_bytes(plan_bundle(plan, plan_dir, "ur5"))  # an earlier bundle
     with zipfile.ZipFile(io.BytesIO(plan_bundle(plan, plan_dir, "ur5"))) as archive:
         names = archive.namelist()
     assert not [n for n in names if "key.txt" in n or "/outside" in n or ".git" in n]
+    assert not [n for n in names if n.endswith(".zip")], "no bundle inside the next one"
     assert "ur5/files/robot/ur5/base.stl" in names  # a link inside: its file is copied
     assert "ur5/files/robot/ur5/shared/base.stl" in names  # and a folder's files
     assert not [n for n in names if "/again" in n]  # a link to a folder above it: a loop

@@ -186,3 +186,25 @@ def test_rows_are_finite_numbers_or_empty(fastest_stator: tuple[int, Path]) -> N
         for r in csv.DictReader(f):
             for key in ("error_mm", "cycle_time_s"):
                 assert r[key] == "" or math.isfinite(float(r[key]))
+
+
+def test_the_written_plan_is_marked_or_added() -> None:
+    """``--front`` with ``--objective accuracy``: the row of the plan written (same points in
+    the same order) is marked; a written plan no row has (a redesign) is added, marked."""
+    import msgspec
+
+    from planner.suggest.front import with_written
+
+    plan = load_plan(STATOR)
+    fewer = msgspec.structs.replace(plan, points=plan.points[:-1])
+
+    def row(p: object, err: float, t: float) -> FrontRow:
+        return FrontRow(6, "landing", err, t, "ok", (), True, p, None, None)  # type: ignore[arg-type]
+
+    rows = [row(fewer, 0.2e-3, 50.0), row(plan, 0.1e-3, 60.0)]
+    marked = with_written(rows, row(plan, 0.1e-3, 60.0))
+    assert [r.written for r in marked] == [False, True] and len(marked) == 2
+    other = msgspec.structs.replace(plan, points=list(reversed(plan.points)))
+    added = with_written(rows, row(other, 0.05e-3, 55.0))
+    assert [r.written for r in added] == [False, False, True]
+    assert [r.pareto for r in added] == [True, False, True], "the front redone with it"

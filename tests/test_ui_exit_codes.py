@@ -3,9 +3,11 @@
 
 from __future__ import annotations
 
+import queue
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -26,15 +28,24 @@ def test_ui_exit_code_after_a_signal(sig: signal.Signals, code: int, tmp_path: P
         stdout=subprocess.DEVNULL,
         text=True,
     )
-    try:
+    lines: queue.Queue[str] = queue.Queue()
+
+    def read() -> None:  # the pipe drained on its own thread: readline never blocks the test
         assert proc.stderr is not None
+        for text in proc.stderr:
+            lines.put(text)
+
+    threading.Thread(target=read, daemon=True).start()
+    try:
         deadline = time.monotonic() + 120.0
-        line = ""
-        while time.monotonic() < deadline:
-            line = proc.stderr.readline()
-            if "wobjcal UI on http://127.0.0.1:" in line or not line:
-                break
-        assert "wobjcal UI on http://127.0.0.1:" in line, line
+        seen = ""
+        while "wobjcal UI on http://127.0.0.1:" not in seen:
+            left = deadline - time.monotonic()
+            assert left > 0 and proc.poll() is None, f"no server: {seen!r}"
+            try:
+                seen += lines.get(timeout=min(left, 1.0))
+            except queue.Empty:
+                continue
         proc.send_signal(sig)
         assert proc.wait(timeout=60) == code
     finally:

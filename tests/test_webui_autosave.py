@@ -112,7 +112,7 @@ def test_the_cli_prints_the_port_actually_bound(
 ) -> None:  # type: ignore[no-untyped-def]
     import webui.server
 
-    monkeypatch.setattr(webui.server, "serve", lambda app: app.stop())
+    monkeypatch.setattr(webui.server, "serve", lambda app: (app.stop(), 0)[1])
     plan = box_plan(tmp_path)
     with socket.socket() as busy:
         busy.bind(("127.0.0.1", 0))

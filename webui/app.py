@@ -154,9 +154,8 @@ class WobjcalApp:
             self.robot.remove()
             self.robot = None
         if view.robot_urdf is not None:
-            self.robot, why = tab_robots_or_reason(self.server, view)
+            self.robot, why = tab_robots_or_reason(self.server, view, self.robot_display)
             if self.robot is not None:  # tabs that connected while it was being built
-                self.robot.set_display(self.robot_display)
                 for client in list(self.server.get_clients().values()):
                     self.robot.add_client(client)
             if why:

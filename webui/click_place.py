@@ -11,6 +11,7 @@ trimesh rays on the visual meshes (see ``bench/README.md``).
 
 from __future__ import annotations
 
+import dataclasses
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -41,6 +42,12 @@ def marker_at_ray(
     return None if k is None else doc.points[k].id
 
 
+#: Robot and tool bodies a click looks past, at most, when the robot is a ghost or hidden.
+SEE_THROUGH_HITS = 16
+#: How far past a see-through body the ray is cast again, m.
+SEE_THROUGH_STEP_M = 1e-4
+
+
 def obstacle_on_ray(
     app: AppContext, origin_world: ArrayLike, direction_world: ArrayLike, client: Any
 ) -> RayHit | None:
@@ -51,11 +58,21 @@ def obstacle_on_ray(
     q = None if robot is None else robot.q_of(cid)
     o = np.asarray(origin_world, dtype=np.float64)
     d = np.asarray(direction_world, dtype=np.float64)
-    hit = app.worker.call(lambda s: None if s is None else s.first_hit(o, d, q))
     see_through = robot is not None and robot.display != "shown"
-    if hit is not None and hit.kind in ("robot", "tool") and see_through:
-        return None  # a ghost or hidden robot does not stop the click
-    return None if hit is None or hit.kind == "work object" else hit
+    start = o
+    for _ in range(SEE_THROUGH_HITS):
+        hit = app.worker.call(lambda s, a=start: None if s is None else s.first_hit(a, d, q))
+        if hit is None or not (see_through and hit.kind in ("robot", "tool")):
+            break
+        # a ghost or hidden robot does not stop the click: look on past it, along the same ray
+        start = np.asarray(hit.position_world, dtype=np.float64) + SEE_THROUGH_STEP_M * d
+    else:
+        return None
+    if hit is None or hit.kind == "work object":
+        return None
+    if start is not o:  # the distance along the whole ray, from where the click started
+        hit = dataclasses.replace(hit, distance_m=float((np.asarray(hit.position_world) - o) @ d))
+    return hit
 
 
 def click_place(app: AppContext, event: Any) -> None:

@@ -61,11 +61,8 @@ def export_program(plan: Plan, fmt: str, plan_dir: Path, cell: Cell | None = Non
     result = make(plan, plan_dir, FORMATS[fmt], cell=cell)
     stem = EXPORT_FORMATS[FORMATS[fmt]].file_stem(plan.name)
     out = tuple((f"{stem}{suffix}", text.encode("utf-8")) for suffix, text in result.files.items())
-    refusals: list[str] = []
     if result.check is not None:
-        if result.check.error:
-            refusals.append(f"error: {result.check.error}")
-        refusals += [f"{p.point_id}: {p.reason}" for p in result.check.infeasible]
-    if result.layout:
-        refusals.append(f"layout: {result.layout}")
-    return ExportResult(out, "; ".join(result.notes), tuple(refusals))
+        refusals = result.check.refusals()
+    else:
+        refusals = (f"layout: {result.layout}",) if result.layout else ()
+    return ExportResult(out, "; ".join(result.notes), refusals)

@@ -21,6 +21,7 @@ from calib.units import MESH_UNITS
 from planner.export import export_file_stem
 from webui import autosave, uploads
 from webui.exports import FORMATS, ExportResult, export_program
+from webui.markdown_text import plain
 from webui.part_upload import PendingPart, drop_points, frame_note, off_surface, project_points
 from webui.plan_adapter import plan_from_ui, ui_plan_from_bytes, with_source
 from webui.state import atomic_write_bytes
@@ -28,6 +29,7 @@ from webui.urdf_zip import unpack_robot_zip
 
 if TYPE_CHECKING:
     from webui.context import AppContext
+    from webui.plan_doc import UiPlan
 
 logger = logging.getLogger(__name__)
 
@@ -128,8 +130,10 @@ class FilesPanel:
         )
         for fmt, button in self.export_buttons.items():
             button.on_click(self._export_callback(fmt))
-        #: the format whose program check refused, waiting for "Export anyway"
+        #: the format whose program check refused, waiting for "Export anyway", and the plan
+        #: the refusal shown is about
         self.refused_format: str | None = None
+        self._refused_doc: UiPlan | None = None
         self.export_anyway.on_click(
             lambda ev: self._guard(ev, self.download_anyway, ev.client, failure="Not exported")
         )
@@ -377,9 +381,10 @@ class FilesPanel:
         name, data = self.bundle_bytes()
         client.send_file_download(name, data, save_immediately=True)
 
-    def export(self, fmt: str) -> ExportResult:
-        """The session plan as robot program(s) in ``fmt``, made on the cell worker."""
-        plan = plan_from_ui(self._app.state.doc)
+    def export(self, fmt: str, doc: UiPlan | None = None) -> ExportResult:
+        """The session plan (or ``doc``) as robot program(s) in ``fmt``, made on the cell
+        worker."""
+        plan = plan_from_ui(self._app.state.doc if doc is None else doc)
         plan_dir = self._app.plan_dir
         return self._app.worker.call(
             lambda s: export_program(plan, fmt, plan_dir, None if s is None else s.cell)
@@ -390,13 +395,20 @@ class FilesPanel:
         check --format`` passes it; else show why in the panel, offer "Export anyway" and
         raise (nothing is sent). ``force``: send it all the same (its header says why check
         refuses it)."""
-        result = self.export(fmt)
+        doc = self._app.state.doc
+        if force and self._refused_doc is not doc:
+            self._clear_refusal()
+            raise InputError(
+                "the plan changed since check's reasons were shown: download it again to see "
+                "what check says now"
+            )
+        result = self.export(fmt, doc)
         if result.refusals and not force:
-            self.refused_format = fmt
+            self.refused_format, self._refused_doc = fmt, doc
             self.export_md.content = (
                 f"**{fmt} not downloaded**: `wobjcal check` refuses this plan for the {fmt} "
                 "program:\n\n"
-                + "\n".join(f"- {_md(r)}" for r in result.refusals)
+                + "\n".join(f"- {plain(r)}" for r in result.refusals)
                 + "\n\n**Export anyway** downloads it with these reasons in its header."
             )
             self.export_anyway.visible = True
@@ -426,14 +438,6 @@ class FilesPanel:
         """Hide the last refusal (the plan changed, or a program was sent)."""
         if self.refused_format is None:
             return
-        self.refused_format = None
+        self.refused_format = self._refused_doc = None
         self.export_md.content = ""
         self.export_anyway.visible = False
-
-
-def _md(text: str) -> str:
-    """``text`` safe in a Markdown list item (no markup, one line)."""
-    out = " ".join(text.split())
-    for c in "\\`*_[]<>#|":
-        out = out.replace(c, "\\" + c)
-    return out

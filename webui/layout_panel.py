@@ -31,6 +31,7 @@ import numpy as np
 from calib.errors import InputError, PlanError
 from planner.check import plan_detectability, plan_quality
 from planner.sim.quality import DOF_NAMES, LayoutQuality, error_radius
+from webui.markdown_text import plain
 from webui.plan_adapter import plan_from_ui, ui_plan_from_plan
 from webui.scene import heat_rgb
 from webui.worker import CellWorker
@@ -122,7 +123,10 @@ def comparison_markdown(
     )
     lines = ["| | now | suggested |", "|---|---|---|"]
     lines += [f"| {r} | {x} | {y} |" for r, x, y in zip(rows, a, b, strict=True)]
-    return "**Suggestion (not applied)**\n\n" + "\n".join(lines)
+    from planner.program.controllers import controller
+
+    label = controller(None).label
+    return f"**Suggestion (not applied)**, judged for the {label} program\n\n" + "\n".join(lines)
 
 
 def redundancy_markdown(doc: UiPlan) -> str:
@@ -175,6 +179,7 @@ class LayoutPanel:
             self.discard_button = gui.add_button("Discard suggestion", visible=False)
         #: the suggestion shown and not yet accepted, and its label for the undo step
         self.pending: SuggestResult | None = None
+        self._pending_for: UiPlan | None = None
         self.suggest_button.on_click(lambda e: self._on_suggest(e, add=0))
         self.add_button.on_click(lambda e: self._on_suggest(e, add=1))
         self.accept_button.on_click(lambda e: self._on_accept(e))
@@ -266,7 +271,8 @@ class LayoutPanel:
         from planner.check import check_plan
         from planner.suggest import PROCEDURES, suggest_plan
 
-        plan = plan_from_ui(self._app.state.doc)
+        made_for = self._app.state.doc  # a suggestion is for this plan only
+        plan = plan_from_ui(made_for)
         if self._suggesting.is_set():
             raise InputError("a suggestion is already running")
         procedure = PROCEDURE_CHOICES.get(str(self.procedure.value), "") or plan.method
@@ -284,7 +290,7 @@ class LayoutPanel:
         if objective == "time" and procedure != "best_fit":
             raise InputError(
                 "the least cycle time is designed for a best fit: pick best fit under "
-                "Procedure, or accuracy under Objective"
+                "Suggested procedure, or accuracy under Objective"
             )
         self.discard()
         self._suggesting.set()
@@ -293,7 +299,7 @@ class LayoutPanel:
         target = float(self.target.value) * 1e-3
         n_max = int(self.max_points.value)
         plan_dir = self._app.plan_dir
-        stages = ("planar faces", "candidates", "feasibility", "design", "prediction")
+        stages = ("planar faces", "candidates", "feasibility", "design", "front", "prediction")
 
         def progress(stage: str, done: int, total: int) -> None:
             k = stages.index(stage) if stage in stages else 0
@@ -322,7 +328,7 @@ class LayoutPanel:
         n_before, method_before = len(plan.points), plan.method
         done: Future[SuggestResult] = Future()  # set once the suggestion is shown
         fut = self._app.worker.submit(job)
-        fut.add_done_callback(lambda f: self._suggested(f, done, n_before, method_before))
+        fut.add_done_callback(lambda f: self._suggested(f, done, n_before, method_before, made_for))
         return done
 
     def _suggested(
@@ -331,6 +337,7 @@ class LayoutPanel:
         done: Future[SuggestResult],
         n_before: int,
         method_before: str,
+        made_for: UiPlan,
     ) -> None:
         self.progress.visible = False
         self.suggest_button.disabled = self.add_button.disabled = False
@@ -343,10 +350,14 @@ class LayoutPanel:
             self._app.notify("No layout suggested", str(exc))
             done.set_exception(exc)
             return
-        self.pending = res
+        if self._app.state.doc is not made_for:  # edited while it ran: it would undo that
+            why = "the plan changed while the suggestion ran: suggest again for the plan as it is"
+            self._app.notify("Suggestion dropped", why)
+            done.set_exception(InputError(why))
+            return
+        self.pending, self._pending_for = res, made_for
         self.compare_md.content = (
-            comparison_markdown(n_before, method_before, before, res)
-            + f"\n\n{_escape(res.message)}"
+            comparison_markdown(n_before, method_before, before, res) + f"\n\n{plain(res.message)}"
         )
         self.accept_button.visible = self.discard_button.visible = True
         self._draw_pending(res)
@@ -369,6 +380,9 @@ class LayoutPanel:
         res = self.pending
         if res is None:
             raise InputError("no suggestion to accept: suggest one first")
+        if self._app.state.doc is not self._pending_for:
+            self.discard()
+            raise InputError("the plan changed since the suggestion was made: suggest again")
         doc = ui_plan_from_plan(res.plan, name=self._app.state.doc.name)
         self._app.state.apply(doc, "suggest layout")
         self.discard()
@@ -398,11 +412,3 @@ class LayoutPanel:
     def close(self) -> None:
         """Stop the panel's thread."""
         self._worker.close(timeout=1.0)
-
-
-def _escape(text: str) -> str:
-    """``text`` as plain Markdown (no markup)."""
-    out = " ".join(text.split())
-    for c in "\\`*_[]<>#|":
-        out = out.replace(c, "\\" + c)
-    return out

@@ -40,7 +40,9 @@ def _read_model(path: str) -> yourdfpy.URDF:
     )
 
 
-def tab_robots_or_reason(server: viser.ViserServer, view: CellView) -> tuple[TabRobots | None, str]:
+def tab_robots_or_reason(
+    server: viser.ViserServer, view: CellView, display: str = "shown"
+) -> tuple[TabRobots | None, str]:
     """The robot of every tab, or ``None`` and why it cannot be drawn.
 
     The robot's visual meshes are only for the eye: a URDF whose visuals cannot be read (e.g.
@@ -48,7 +50,7 @@ def tab_robots_or_reason(server: viser.ViserServer, view: CellView) -> tuple[Tab
     reason names the file and the fix instead of an "internal error: ImportError".
     """
     try:
-        return TabRobots(server, view), ""
+        return TabRobots(server, view, display), ""
     except ImportError as exc:
         text = str(exc).lower()
         hint = " (pip install pycollada)" if "collada" in text and "pip" not in text else ""
@@ -67,13 +69,14 @@ class TabRobots:
     Args:
         server: the viser server (its connected tabs get a robot at once).
         view: the cell geometry (robot URDF and base pose, tool, chain).
+        display: how the tabs draw it (:data:`webui.robot_view.DISPLAYS`).
 
     Raises:
         ValueError: the cell has no robot URDF; ImportError or a mesh error: its visual
             meshes cannot be read.
     """
 
-    def __init__(self, server: viser.ViserServer, view: CellView) -> None:
+    def __init__(self, server: viser.ViserServer, view: CellView, display: str = "shown") -> None:
         if view.robot_urdf is None:
             raise ValueError("the cell has no robot URDF to draw")
         self._server = server
@@ -97,7 +100,7 @@ class TabRobots:
         self.q = np.clip(np.zeros(len(self.joint_names)), lo, hi)
         self._q_by_client: dict[int, np.ndarray] = {}
         #: how every tab draws the robot (:data:`webui.robot_view.DISPLAYS`)
-        self.display = "shown"
+        self.display = display
         for client in server.get_clients().values():
             self.add_client(client)
 

@@ -36,8 +36,6 @@ NONE = "(none)"
 NO_ROLE_LABEL = "(none)"
 #: Name of a tab's highlight node in its own scene.
 HIGHLIGHT = "/selection"
-#: A typed position or normal is applied this long after the last keystroke, s.
-TYPED_DELAY_S = 0.6
 #: A typed position farther than this from the part's surface is said when it is moved on, m.
 SNAP_NOTE_M = 0.0005
 
@@ -73,14 +71,15 @@ class TabSelection:
                 "Position (mm)",
                 (0.0, 0.0, 0.0),
                 step=0.1,
-                hint="wobj frame; a typed position goes to the nearest spot of the part's "
-                "surface, with that face's normal",
+                hint="wobj frame; Apply settings puts the point at the nearest spot of the "
+                "part's surface, with that facet's normal",
             )
             self.normal = gui.add_vector3(
                 "Normal",
                 (0.0, 0.0, 1.0),
                 step=0.01,
-                hint="wobj frame, outward; the search runs against it (made unit length)",
+                hint="wobj frame, outward; the search runs against it (made unit length; "
+                "applied with Apply settings)",
             )
             self.role = gui.add_dropdown("Role", (*doc.roles, NO_ROLE_LABEL))
             self.kind = gui.add_dropdown("Search", ("approach", "edge"), initial_value="approach")
@@ -92,9 +91,6 @@ class TabSelection:
         self.selected.on_update(self._on_selected)
         self.apply.on_click(lambda ev: self._guard(self.apply_settings))
         self.delete.on_click(lambda ev: self._guard(self.delete_selected))
-        self._timer: threading.Timer | None = None
-        self.position_mm.on_update(lambda _ev: self._typed())
-        self.normal.on_update(lambda _ev: self._typed())
         #: the widgets that describe the selected point (hidden while none is selected)
         self.settings = (
             self.position_mm, self.normal, self.role, self.kind, self.start_mm, self.over_mm,
@@ -115,17 +111,6 @@ class TabSelection:
         for widget in self.settings:
             if widget.visible != visible:
                 widget.visible = visible
-
-    def _typed(self) -> None:
-        """A position or normal typed: applied once the typing pauses (:data:`TYPED_DELAY_S`;
-        Enter or leaving the field ends it), one undo step for the whole entry."""
-        if self._syncing or self.point_id is None:
-            return
-        if self._timer is not None:
-            self._timer.cancel()
-        self._timer = threading.Timer(TYPED_DELAY_S, self._guard, (self.apply_pose,))
-        self._timer.daemon = True
-        self._timer.start()
 
     def _on_selected(self, event: Any) -> None:
         if self._syncing:
@@ -189,12 +174,18 @@ class TabSelection:
 
     # ---- actions ---------------------------------------------------------------------------
     def apply_settings(self) -> None:
-        """Apply the settings widgets to the tab's selected point (one undoable step)."""
+        """Apply the settings widgets to the tab's selected point, as one undoable step: its
+        Position and Normal (:meth:`typed_pose`) when they were changed, then its role and
+        search."""
         sel = self.point_id
-        if sel is None:
+        doc = self._app.state.doc
+        if sel is None or sel not in doc.ids:
             raise InputError("select a point first")
+        pose = self.typed_pose(doc.get(sel).probe)
 
         def edit(doc: UiPlan) -> UiPlan:
+            if pose is not None:
+                doc = plan_doc.place_point(doc, sel, pose[0], pose[1])
             return plan_doc.edit_search(
                 doc,
                 sel,
@@ -207,47 +198,42 @@ class TabSelection:
 
         self._app.state.update(edit, f"edit {sel}")
 
-    def apply_pose(self) -> None:
-        """Apply the Position and Normal fields to the tab's selected point (one undoable
-        step): a new position goes to the nearest spot of the part's surface with that face's
-        normal (said when that is more than :data:`SNAP_NOTE_M` from the typed one); a new
-        normal alone turns the point's search, the point staying where it is.
+    def typed_pose(self, probe: Any) -> tuple[np.ndarray, np.ndarray] | None:
+        """The position and normal (wobj, m) the Position and Normal fields give ``probe``, or
+        ``None`` when they were not changed: a new position goes to the nearest spot of the
+        part's surface with that facet's normal (said when that is more than
+        :data:`SNAP_NOTE_M` from the typed one); a new normal alone turns the search, the point
+        staying where it is.
 
         Raises:
-            InputError: nothing selected, no part loaded, or a zero normal.
+            InputError: not numbers, no part loaded, or a zero normal.
         """
-        sel = self.point_id
-        doc = self._app.state.doc
-        if sel is None or sel not in doc.ids:
-            raise InputError("select a point first")
-        probe = doc.get(sel).probe
         typed = np.asarray(self.position_mm.value, dtype=np.float64) / 1000.0
         n = np.asarray(self.normal.value, dtype=np.float64)
         if not np.all(np.isfinite(typed)) or not np.all(np.isfinite(n)):
             raise InputError("position and normal: numbers, please")
+        length = float(np.linalg.norm(n))
         moved = not np.allclose(typed, probe.position_m, atol=5e-7)
-        turned = not np.allclose(n / max(float(np.linalg.norm(n)), 1e-300), probe.normal, atol=5e-7)
-        if not moved and not turned:
-            return
+        turned = not np.allclose(n / max(length, 1e-300), probe.normal, atol=5e-7)
         if moved:
             picker = self._app.picker
             if picker is None:
                 raise InputError("no work object is loaded")
             hit = picker.project(typed)
-            pos, normal = hit.position_wobj, hit.normal_wobj
             if hit.distance_m > SNAP_NOTE_M:
                 self._app.notify(
-                    f"{sel} put on the part",
+                    f"{probe.id} put on the part",
                     f"the typed position is {hit.distance_m * 1000:.2f} mm off the surface: "
-                    f"{sel} went to the nearest spot of the part, with its face's normal",
+                    f"{probe.id} went to the nearest spot of the part, with its facet's normal",
                     client=self.client,
                     error=False,
                 )
-        else:
-            if float(np.linalg.norm(n)) < 1e-9:
+            return hit.position_wobj, hit.normal_wobj
+        if turned:
+            if length < 1e-9:
                 raise InputError("normal: a non-zero vector")
-            pos, normal = np.asarray(probe.position_m), n / float(np.linalg.norm(n))
-        self._app.state.update(lambda d: plan_doc.place_point(d, sel, pos, normal), f"move {sel}")
+            return np.asarray(probe.position_m, dtype=np.float64), n / length
+        return None
 
     def delete_selected(self) -> None:
         """Delete the tab's selected point (one undoable step)."""

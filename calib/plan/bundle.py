@@ -20,8 +20,8 @@ a ``package.xml``, else the parent of a folder named ``urdf``, else the file's o
 folder inside another one copied (a robot package inside a package-path folder) is not copied
 twice: the references point into the first copy. Bytes are copied unchanged, so the plan's
 ``sha256`` digests stay valid. Inside a copied folder, symbolic links are followed only to
-files and folders inside that folder, and ``.git``, ``.hg``, ``.svn`` and ``__pycache__`` are
-left out.
+files and folders inside that folder; archives (``.zip``, ``.tar``, ...: an earlier bundle of
+the same plan) and ``.git``, ``.hg``, ``.svn`` and ``__pycache__`` are left out.
 
 The archive is deterministic (sorted entries, every time stamp 1980-01-01 00:00, fixed
 permissions), so the same plan and files give the same bytes. Pure: standard library and
@@ -59,6 +59,9 @@ MAX_BUNDLE_BYTES: Final = 256 * MiB
 MAX_BUNDLE_FILES: Final = 10_000
 #: Folders never copied from a robot, tool or package folder.
 SKIPPED_FOLDERS: Final = frozenset({".git", ".hg", ".svn", "__pycache__"})
+#: Files never copied out of a folder: archives (an earlier bundle of the same plan would
+#: otherwise go into the next one; no URDF, mesh or tool reads one).
+SKIPPED_SUFFIXES: Final = frozenset({".zip", ".tar", ".gz", ".tgz", ".xz", ".bz2", ".7z"})
 #: The time stamp of every archive entry (the earliest a ZIP file can hold).
 ZIP_DATE_TIME: Final = (1980, 1, 1, 0, 0, 0)
 #: Where the copied files go inside the bundle folder.
@@ -280,6 +283,9 @@ def _copy_folder(contents: _Contents, root: Path, name: str, where: str) -> None
                     if entry.name not in SKIPPED_FOLDERS and real.resolve() not in seen:
                         below.append((real, rel / entry.name, (*seen, real.resolve())))
                 elif real.is_file():
+                    if real.suffix.lower() in SKIPPED_SUFFIXES:  # e.g. an earlier bundle
+                        log.info("plan bundle: left out %s: an archive", path)
+                        continue
                     contents.add(f"{name}/{rel / entry.name}", real, real.stat().st_size, where)
             except (OSError, RuntimeError) as exc:  # a dangling link, a link loop, a vanished file
                 log.info("plan bundle: skipping %s: %s", path, exc)

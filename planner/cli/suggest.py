@@ -71,6 +71,8 @@ def _plot_path(text: str) -> Path:
         raise argparse.ArgumentTypeError(
             f"a plot file ending in {', '.join(PLOT_SUFFIXES)}, got {text!r}"
         )
+    if not path.resolve().parent.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r}: its folder does not exist")
     return path
 
 
@@ -186,7 +188,7 @@ def front_table(res: SuggestResult) -> Table:
         else:
             verdict = "passes" if r.rating == "ok" else f"passes, layout {r.rating or 'unrated'}"
         t.add_row(
-            f"{r.points}{' *' if r.plan is res.plan else ''}",
+            f"{r.points}{' *' if r.written else ''}",
             "least move time" if r.order == "time" else "landing",
             f"{r.worst_m * 1e3:.3f}" if math.isfinite(r.worst_m) else "-",
             f"{r.cycle_s:.1f}" if math.isfinite(r.cycle_s) else "-",
@@ -241,14 +243,12 @@ def cmd_suggest(args: argparse.Namespace) -> int:
     if args.front is not None and res.front:
         from planner.suggest.front_files import plot_front
 
-        chosen = next((r for r in res.front if r.plan is res.plan), None)
         plot_front(
             res.front,
             args.front,
             title=f"{Path(args.plan).name}: accuracy versus cycle time ({args.format})",
             target_m=res.target_m,
             level_percent=res.confidence_percent,
-            chosen=chosen,
         )
         out.print(f"front: {args.front} and {args.front.with_suffix('.csv')}", markup=False)
     kept = ", ".join(f"{k} {v}" for k, v in sorted(res.rejected.items()))

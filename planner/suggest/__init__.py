@@ -6,14 +6,17 @@ the measuring order a design lands in (:mod:`.order`), the order that shortens t
 (:mod:`.time_order`) and the accuracy-versus-time front (:mod:`.front`).
 """
 
-from planner.suggest.job import (
-    PROCEDURES,
-    SuggestError,
-    SuggestResult,
-    as_best_fit,
-    moved_plan,
-    suggest_plan,
-)
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from planner.suggest.job import (
+        PROCEDURES,
+        SuggestError,
+        SuggestResult,
+        as_best_fit,
+        moved_plan,
+        suggest_plan,
+    )
 
 __all__ = [
     "PROCEDURES",
@@ -23,3 +26,13 @@ __all__ = [
     "moved_plan",
     "suggest_plan",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """The job's names, imported on first use (``--front``'s argument check and the CLI's help
+    do not load the cell and the design)."""
+    if name in __all__:
+        from planner.suggest import job
+
+        return getattr(job, name)
+    raise AttributeError(f"module 'planner.suggest' has no attribute {name!r}")

@@ -66,6 +66,7 @@ class FrontRow:
         check: its check.
         pareto: usable, and no other usable row is at least as good in both error and time
             and better in one.
+        written: the plan ``wobjcal suggest`` wrote.
     """
 
     points: int
@@ -79,6 +80,7 @@ class FrontRow:
     quality: LayoutQuality | None = field(repr=False, compare=False)
     check: PlanCheck = field(repr=False, compare=False)
     pareto: bool = False
+    written: bool = False
 
     @property
     def usable(self) -> bool:
@@ -145,6 +147,39 @@ def design_front(
     return _mark_pareto(rows)
 
 
+def with_written(rows: Sequence[FrontRow], row: FrontRow) -> list[FrontRow]:
+    """``rows`` with ``row`` (or the row of the same plan: same points, in the same order)
+    marked as the plan written; ``row`` is added, and the Pareto marks redone, when no row has
+    its plan."""
+    key = _points_key(row.plan)
+    out = [dataclasses.replace(r, written=_points_key(r.plan) == key) for r in rows]
+    if not any(r.written for r in out):
+        out = _mark_pareto([*out, dataclasses.replace(row, written=True)])
+    return out
+
+
+def _points_key(plan: Plan) -> tuple[tuple[object, ...], ...]:
+    return tuple((p.id, p.position_m, p.normal, p.search) for p in plan.points)
+
+
+def row_of(plan: Plan, check: PlanCheck, quality: LayoutQuality | None, level: float,
+           target_m: float | None) -> FrontRow:  # fmt: skip
+    """The front's row of a plan already written and checked (its order: ``landing``)."""
+    worst = quality.worst_poi_m(level) if quality is not None else math.nan
+    return FrontRow(
+        points=len(plan.points),
+        order="landing",
+        worst_m=worst,
+        cycle_s=check.cycle.total_s if check.cycle is not None else math.nan,
+        rating=quality.rating if quality is not None else "",
+        problems=check.refusals(),
+        meets_target=target_m is None or (math.isfinite(worst) and worst <= target_m),
+        plan=plan,
+        quality=quality,
+        check=check,
+    )
+
+
 def fastest(rows: Sequence[FrontRow]) -> FrontRow | None:
     """The usable row that meets the target with the least cycle time (ties: the smaller
     error, then fewer points); None when no row does."""
@@ -172,23 +207,8 @@ def _row(
     if check.layout:
         assert ctx.cell.work_object is not None
         quality, _ = plan_quality(written, ctx.cell.work_object.mesh, fmt)
-    worst = quality.worst_poi_m(level) if quality is not None else math.nan
-    problems = tuple(f"{p.point_id}: {p.reason}" for p in check.infeasible)
-    if check.layout:
-        problems += (f"layout: {check.layout}",)
-    cycle = check.cycle.total_s if check.cycle is not None else math.nan
-    meets = target_m is None or (math.isfinite(worst) and worst <= target_m)
-    return FrontRow(
-        points=n,
-        order=order,
-        worst_m=worst,
-        cycle_s=cycle,
-        rating=quality.rating if quality is not None else "",
-        problems=problems,
-        meets_target=meets,
-        plan=written,
-        quality=quality,
-        check=check,
+    return dataclasses.replace(
+        row_of(written, check, quality, level, target_m), points=n, order=order
     )
 
 

@@ -16,12 +16,12 @@ import io
 import math
 from collections.abc import Sequence
 from pathlib import Path
-
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
+from typing import TYPE_CHECKING
 
 from calib.atomic_io import write_bytes_atomic, write_text_atomic
-from planner.suggest.front import FrontRow
+
+if TYPE_CHECKING:
+    from planner.suggest.front import FrontRow
 
 #: The CSV's columns, as :meth:`FrontRow.to_json` names them.
 COLUMNS = (
@@ -38,14 +38,14 @@ COLUMNS = (
 PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 
 
-def front_csv(rows: Sequence[FrontRow], chosen: FrontRow | None) -> str:
+def front_csv(rows: Sequence[FrontRow]) -> str:
     """The front as CSV text: :data:`COLUMNS` and ``written`` (the plan written)."""
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow([*COLUMNS, "written"])
     for r in rows:
         j = r.to_json()
-        w.writerow([_cell(j[c]) for c in COLUMNS] + [_cell(r is chosen)])
+        w.writerow([_cell(j[c]) for c in COLUMNS] + [_cell(r.written)])
     return buf.getvalue()
 
 
@@ -66,10 +66,13 @@ def plot_front(
     title: str,
     target_m: float | None,
     level_percent: float,
-    chosen: FrontRow | None,
 ) -> Path:
-    """Draw the front to ``path`` (:data:`PLOT_SUFFIXES`) and its CSV beside it
-    (``path`` with ``.csv``); return the plot's path."""
+    """Draw the front to ``path`` (:data:`PLOT_SUFFIXES`; the plan written ringed) and its CSV
+    beside it (``path`` with ``.csv``); return the plot's path."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    chosen = next((r for r in rows if r.written), None)
     fig = Figure(figsize=(7.5, 5.0))
     FigureCanvasAgg(fig)
     ax = fig.subplots()
@@ -117,7 +120,7 @@ def plot_front(
         )
     if target_m is not None:
         ax.axhline(target_m * 1e3, c="tab:red", ls="--", lw=1.0, label="target")
-    if chosen is not None and chosen in timed:
+    if chosen is not None and math.isfinite(chosen.cycle_s) and math.isfinite(chosen.worst_m):
         ax.scatter(
             [chosen.cycle_s],
             [chosen.worst_m * 1e3],
@@ -137,5 +140,5 @@ def plot_front(
     buf = io.BytesIO()
     fmt = path.suffix.lower().lstrip(".")
     fig.savefig(buf, format=fmt, dpi=110)
-    write_text_atomic(path.with_suffix(".csv"), front_csv(rows, chosen))
+    write_text_atomic(path.with_suffix(".csv"), front_csv(rows))
     return write_bytes_atomic(path, buf.getvalue())

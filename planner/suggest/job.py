@@ -73,7 +73,14 @@ from planner.program.controllers import CONTROLLERS, controller
 from planner.program.safety import SafetySpec
 from planner.sim.report_points import poi_rows
 from planner.sim.rows import RowSpec, z_values
-from planner.suggest.front import OBJECTIVES, FrontRow, design_front, fastest
+from planner.suggest.front import (
+    OBJECTIVES,
+    FrontRow,
+    design_front,
+    fastest,
+    row_of,
+    with_written,
+)
 from planner.suggest.order import FLOOR_M, Sequencer
 from planner.suggest.steps import (
     Context,
@@ -113,7 +120,8 @@ class SuggestResult:
         worst_m: the largest predicted half-width over the points of interest, metres.
         met: the target holds (always True without a target).
         history: ``(points, worst half-width m)`` of the design at each size tried (the
-            least-squares model of the searches, before the exact prediction).
+            least-squares model of the searches, before the exact prediction; with
+            ``objective="time"``, the exact prediction of each size's plan).
         faces: every planar face tried and what its samples met.
         n_candidates: candidates whose grown footprint lies on their face.
         n_feasible: of those, feasible probe poses in the cell.
@@ -387,9 +395,7 @@ def suggest_plan(
     if note:
         msg += f" ({note})"
     msg += design_note + converted
-    problems = tuple(f"{p.point_id}: {p.reason}" for p in check.infeasible)
-    if check.layout:
-        problems += (f"layout: {check.layout}",)
+    problems = check.refusals()
     if problems:
         met = False
         msg += (
@@ -397,13 +403,12 @@ def suggest_plan(
             + "; ".join(problems)
         )
     rows: tuple[FrontRow, ...] = ()
-    if front:
-        rows = tuple(
-            design_front(
-                ctx, plan, max_points=max_points, fmt=fmt, at_m=at_m, level_percent=level,
-                target_m=target_m, say=say,
-            )
+    if front:  # the plan written marked (or added, when a redesign made it differ)
+        drawn = design_front(
+            ctx, plan, max_points=max_points, fmt=fmt, at_m=at_m, level_percent=level,
+            target_m=target_m, say=say,
         )  # fmt: skip
+        rows = tuple(with_written(drawn, row_of(new_plan, check, quality, level, target_m)))
     return SuggestResult(
         plan=new_plan,
         quality=quality,
@@ -452,9 +457,10 @@ def _fastest_plan(
         raise SuggestError(why)
     best = fastest(rows)
     met = best is not None
-    if best is None:
-        usable = [r for r in rows if r.usable]
-        best = min(usable, key=lambda r: (r.worst_m, r.cycle_s)) if usable else rows[0]
+    if best is None:  # the most accurate: of those check passes, else of those predicted
+        pool = [r for r in rows if r.usable] or [r for r in rows if math.isfinite(r.worst_m)]
+        best = min(pool or rows, key=lambda r: (r.worst_m, r.cycle_s, r.points))
+    rows = with_written(rows, best)
     same = [r for r in rows if r.points == best.points and r.order == "landing"]
     was = (
         f" (in the order it lands in: {same[0].cycle_s:.1f} s)"
@@ -469,11 +475,13 @@ def _fastest_plan(
             f"{best.worst_m * 1e3:.3f} mm"
         )
     else:
+        err = f"{best.worst_m * 1e3:.3f} mm" if math.isfinite(best.worst_m) else "no prediction"
+        took = f" in {best.cycle_s:.1f} s" if math.isfinite(best.cycle_s) else ""
         msg = (
             f"target {tgt} at {level:g} % not reached by any of the {len(rows)} plans of 6 to "
-            f"{max_points} points that check passes: the most accurate gives "
-            f"{best.worst_m * 1e3:.3f} mm in {best.cycle_s:.1f} s (more points: --max-points; or "
-            "a smaller noise or misplacement)"
+            f"{max_points} points written, checked and timed: the most accurate "
+            f"({best.points} points) gives {err}{took} (more points: --max-points; or a smaller "
+            "noise or misplacement)"
         )
     problems = best.problems
     if problems:

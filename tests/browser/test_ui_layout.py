@@ -121,6 +121,7 @@ def test_suggest_shows_progress_and_replaces_the_points_in_one_undo_step(
     # shown beside the current layout, applied only on accept
     accept = page.get_by_role("button", name="Accept suggestion", exact=True)
     accept.wait_for(state="visible")
+    wait_for(lambda: "Layout suggested" in demo.notifications(), what="the notification")
     body = page.inner_text("body")
     assert "Suggestion (not applied)" in body and "hultman2013" in body and "best_fit" in body
     for row in ("predicted error", "landing risk", "cycle time"):
@@ -141,7 +142,6 @@ def test_suggest_shows_progress_and_replaces_the_points_in_one_undo_step(
     q = _settled(demo)
     assert q is not None and q.rating == "ok"
     wait_for(lambda: _shown(demo, q), what="the suggested layout's quality in the page")
-    wait_for(lambda: "Layout suggested" in demo.notifications(), what="the notification")
     suggested = doc.ids
 
     # "Add best point": the suggested points kept, one more, on accept

@@ -234,8 +234,9 @@ def test_the_robot_and_camera_move_only_when_asked(demo: UiSession, tmp_path: Pa
 
 def test_typing_a_points_position_moves_it_in_one_undo_step(demo: UiSession) -> None:
     """Issue 22 item 6: the selected point's X/Y/Z (mm, wobj) and normal are fields; a typed
-    Y applied with Enter moves the point along its face (projected onto the part), one undo
-    step; with nothing selected the fields are not shown."""
+    Y applied with "Apply settings" moves the point along its face (projected onto the part),
+    one undo step; typing alone changes nothing; with nothing selected the fields are not
+    shown."""
     from ui_helpers import choose
 
     app, page = demo.app, demo.page
@@ -255,7 +256,10 @@ def test_typing_a_points_position_moves_it_in_one_undo_step(demo: UiSession) -> 
     before = app.state.doc
     y_field = field.locator("xpath=ancestor::*[count(.//input)>=3][1]//input").nth(1)
     y_field.fill(f"{p0[1] * 1000 - 10.0:.3f}")  # along B's face (its normal is x)
-    y_field.press("Enter")
+    y_field.press("Tab")
+    wait_for(lambda: abs(tab.position_mm.value[1] - (p0[1] * 1000 - 10.0)) < 1e-6, what="typed")
+    assert app.state.doc is before, "typing alone changes nothing"
+    page.get_by_role("button", name="Apply settings").click()
 
     def moved() -> Any:
         p = app.state.doc.get("B").probe
