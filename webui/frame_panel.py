@@ -33,6 +33,10 @@ MODE = "frame3"
 #: What each click picks, in order.
 STEPS = ("the origin", "a point on +x", "a point in the xy-plane (+y side)")
 LABEL = "define the work-object frame (3 points)"
+#: The frame's z axis is looked along from this far above its origin (off the surface), m ...
+Z_START_M = 0.0005
+#: ... for this far: the part or a fixture met within it means z points into it, m.
+Z_LOOK_M = 0.5
 
 
 class FramePanel:
@@ -148,3 +152,26 @@ class FramePanel:
             raise InputError("load a plan first: there is no work object to give a frame")
         app.load_cell(source, app.plan_dir)
         app.state.update(lambda d: cell_edits.reframed(d, T_old_new), LABEL)
+        into = self.z_points_into()
+        if into:
+            app.notify(
+                "Frame z points into " + into,
+                f"the new work-object frame's z axis points into {into}: programs and plans "
+                "usually take z out of the part. Pick the +x and xy-plane points the other "
+                "way round to turn z over (undo first)",
+            )
+
+    def z_points_into(self) -> str:
+        """What the work-object frame's +z axis runs into within :data:`Z_LOOK_M` of its
+        origin (``"the work object"``, ``"the fixture table"``), or ``""`` when nothing: a
+        frame picked the wrong way round has z into the part."""
+        view = self._app.view
+        if view is None:
+            return ""
+        T = np.asarray(view.T_world_wobj, dtype=np.float64)
+        z = T[:3, 2]
+        origin = T[:3, 3] + Z_START_M * z
+        hit = self._app.worker.call(lambda s: None if s is None else s.first_hit(origin, z, None))
+        if hit is None or hit.kind not in ("work object", "fixture") or hit.distance_m > Z_LOOK_M:
+            return ""
+        return "the work object" if hit.kind == "work object" else f"the fixture {hit.name}"

@@ -78,3 +78,31 @@ def test_three_clicks_define_the_frame_and_nothing_moves(ui: UiSession) -> None:
     assert ui.app.state.doc.source == source_before
     wait_for(lambda: ui.app.view is not None and np.allclose(
         ui.app.view.T_world_wobj, T_WORLD_WOBJ_BOX), what="the old cell")  # fmt: skip
+    assert "Frame z points into" not in ui.notifications(), "z out of the top face: no warning"
+
+
+def test_a_frame_with_z_into_the_part_is_warned(ui: UiSession) -> None:
+    """Issue 22 item 7: the third point on the -y side turns z into the part; the frame is
+    made (the user's choice), and the page says that z points into the work object."""
+    page = ui.page
+    wait_for(lambda: ui.app.view is not None, what="the cell")
+    centre = transform_points(T_WORLD_WOBJ_BOX, [0.0, 0.0, 0.0])
+    set_camera(ui.client(), centre + np.array([0.04, -0.06, 1.3]), centre)  # not the last one
+    source_before = ui.app.state.doc.source
+    open_tab(page, "Cell")
+    page.get_by_role("button", name="Define frame by 3 points").click()
+    wait_for(lambda: ui.app.click_mode == MODE, what="the 3-point mode")
+    _click(ui, [-0.10, -0.05, 0.0], lambda: len(ui.app.frame_panel.picked) == 1)
+    _click(ui, [0.10, 0.10, 0.0], lambda: len(ui.app.frame_panel.picked) == 2)
+    _click(ui, [0.10, -0.12, 0.0], lambda: ui.app.click_mode == "place")
+    plan = ui.app.state.doc.source
+    assert isinstance(plan, Plan)
+    z = np.linalg.inv(plan.work_object.mesh_matrix())[:3, 2]
+    np.testing.assert_allclose(z, [0, 0, -1], atol=0.02)  # into the box
+    text = wait_for(
+        lambda: "Frame z points into the work object" in ui.notifications() and ui.notifications(),
+        what="the warning on the page",
+    )
+    assert "turn z over" in text
+    ui.app.state.undo()
+    assert ui.app.state.doc.source == source_before
