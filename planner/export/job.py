@@ -374,7 +374,7 @@ def check_header(job: ExportJob, fmt: str) -> str:
         return text + (f" Refused: {'; '.join(refused)}." if refused else "")
     why = "; ".join(_short(r) for r in status.reasons)
     return (
-        "NOT CHECKED: exported with --force (or with \"Export anyway\" in the UI) although "
+        'NOT CHECKED: exported with --force (or with "Export anyway" in the UI) although '
         f"wobjcal check refuses {'; '.join(refused)}"
         + (f" ({why})" if why else "")
         + ": fix the plan, or make sure by hand that those moves are safe, and run the program "
