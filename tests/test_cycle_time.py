@@ -312,6 +312,8 @@ def test_the_ui_status_says_the_cycle_time(plate: tuple[Plan, PlanCheck]) -> Non
     assert check.cycle is not None
     app = run(PLANS / "plate_holes_321.json", port=free_port(), block=False, autosave_path=None)
     try:
+        assert app.cycle_future is not None
+        app.cycle_future.result(120)  # estimated on the cell worker, after the rows are drawn
         assert app.cycle is not None and app.cycle.program == check.cycle.program
         assert app.cycle.total_s == pytest.approx(check.cycle.total_s, rel=1e-9)
         want = f"cycle time ~ {check.cycle.total_s:.0f} s"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -300,6 +301,8 @@ def test_the_points_table_says_when_the_layout_would_be_refused(app: WobjcalApp)
 
     original = app.plan_dir / "box_plan.json"
     app.files_panel.upload_plan(original.name, original.read_bytes())  # drop the extra points
+    assert app.cycle_future is not None
+    app.cycle_future.result(60)  # the status table's cycle-time line comes after the rows
     before = app.points_panel.status_md.content
     app.state.apply(plan_doc.delete_point(app.state.doc, "T1"), "delete T1")
     try:
@@ -307,4 +310,8 @@ def test_the_points_table_says_when_the_layout_would_be_refused(app: WobjcalApp)
         assert want and f"**Layout:** {want}" in app.points_panel.status_md.content
     finally:
         app.state.undo()
+    app.cycle_future.result(60)
+    deadline = time.monotonic() + 10.0  # its callback refreshes the table just after
+    while app.points_panel.status_md.content != before and time.monotonic() < deadline:
+        time.sleep(0.02)
     assert app.points_panel.status_md.content == before

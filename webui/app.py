@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import logging
 import threading
+from concurrent.futures import Future
 from pathlib import Path
 from typing import Any
 
@@ -92,6 +93,8 @@ class WobjcalApp:
         self._checks: dict[str, tuple[ProbePoint, PointCheck]] = {}
         #: the estimated cycle time of the plan as edited, from the latest checks
         self.cycle: CycleTime | None = None
+        #: the latest cycle-time estimate (:meth:`update_cycle_time`)
+        self.cycle_future: Future[CycleTime | None] | None = None
         self._lock = threading.RLock()
         self._cell_key: tuple[CellSpec, WorkObjectSpec] | None = None
         self._part: tuple[str, str | None, str] | None = None
@@ -217,22 +220,42 @@ class WobjcalApp:
         if point_ids is not None:  # a point whose flag came or went is redrawn too
             moved = set(before.by_point) ^ set(self.flags.by_point)
             point_ids = [*point_ids, *(i for i in moved if i not in point_ids and i in doc.ids)]
-        self.cycle = self._cycle_time()
         # the table first, on its own: the page applies a batch of GUI messages at once, but a
         # batch with scene messages only in its next frame (0.2-1 s with software WebGL)
         self.points_panel.refresh()
         self.server.flush()
         self.scene.draw_points(doc, self.checks(), None, only=point_ids, flags=self.flags.by_point)
         self.server.flush()
+        self.update_cycle_time()  # after the rows: a click or undo does not wait for it
 
-    def _cycle_time(self) -> CycleTime | None:
-        """The estimated cycle time of the plan as edited, from the latest checks (on the
-        worker: it reads the cell's robot), or ``None``."""
-        plan = plan_as_edited(self.state.doc)
+    def update_cycle_time(self) -> Future[CycleTime | None]:
+        """Estimate the cycle time of the plan as edited, from the latest checks, on the cell
+        worker (it reads the cell's robot); once done, and only if the plan is still the same,
+        :attr:`cycle` is set and the status table says it. Returns the estimate's future."""
+        doc = self.state.doc
+        plan = plan_as_edited(doc)
         if plan is None:  # no plan loaded, or an edit that breaks a plan rule
-            return None
+            self.cycle = None
+            done: Future[CycleTime | None] = Future()
+            done.set_result(None)
+            self.cycle_future = done
+            return done
         checks = list(self.checks().values())
-        return self.worker.call(lambda s: None if s is None else s.cycle_time(plan, checks))
+        fut = self.worker.submit(lambda s: None if s is None else s.cycle_time(plan, checks))
+
+        def show(f: Future[CycleTime | None]) -> None:
+            if self.state.doc is not doc:  # a later edit's estimate follows
+                return
+            try:
+                self.cycle = f.result()
+            except Exception:  # the status table goes without it; checks are not affected
+                logger.exception("the cycle time estimate failed")
+                self.cycle = None
+            self.points_panel.refresh()
+
+        fut.add_done_callback(show)
+        self.cycle_future = fut
+        return fut
 
     def _on_change(self, change: Change[UiPlan]) -> None:
         source = change.doc.source

@@ -14,6 +14,7 @@ from ui_helpers import (
     act_until,
     canvas_point,
     choose,
+    close_notifications,
     open_tab,
     save_screenshot,
     set_camera,
@@ -115,6 +116,7 @@ def test_a_click_on_empty_space_says_why(demo: UiSession) -> None:
     demo.page.get_by_role("button", name="Top", exact=True).click()  # look down: sky is floor
     demo.page.get_by_role("button", name="Front", exact=True).click()
     wait_for(lambda: _camera_direction(demo)[1] > 0.9, what="the front view")
+    close_notifications(demo.page)
     act_until(  # the sky above the cell: clicking it again places nothing either
         lambda: demo.page.mouse.click(box["x"] + 15, box["y"] + 15),
         lambda: "nothing placed" in demo.notifications(),

@@ -158,6 +158,19 @@ def rendered(page: Any) -> None:
     page.evaluate("new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))")
 
 
+def close_notifications(page: Any) -> None:
+    """Close every notification on the page (the page shows a few at a time and queues the
+    rest: a test that waits for a new one must not find the stack full of earlier ones)."""
+    for _ in range(50):
+        buttons = page.locator(".mantine-Notification-root button")
+        if buttons.count() == 0:
+            return
+        try:
+            buttons.first.click(timeout=5000)
+        except Exception:  # it closed on its own meanwhile
+            continue
+
+
 def open_tab(page: Any, name: str) -> None:
     """Show the control panel's tab ``name`` (Points, Cell, Teach, Validate, Files)."""
     tab = page.get_by_role("tab", name=name, exact=True)
