@@ -25,7 +25,7 @@ import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -180,6 +180,17 @@ def row_of(plan: Plan, check: PlanCheck, quality: LayoutQuality | None, level: f
     )
 
 
+def checked_quality(
+    plan: Plan, check: PlanCheck, mesh: Any, fmt: str | None
+) -> tuple[LayoutQuality | None, str]:
+    """The predicted quality of ``plan`` for the program ``fmt`` and why there is none: the
+    one ``check`` made, or, when check refused the layout (it then predicts nothing), the
+    prediction itself (:func:`planner.check.plan_quality`, work object ``mesh``, wobj, m)."""
+    if check.layout:
+        return plan_quality(plan, mesh, fmt)
+    return check.quality, check.quality_note
+
+
 def fastest(rows: Sequence[FrontRow]) -> FrontRow | None:
     """The usable row that meets the target with the least cycle time (ties: the smaller
     error, then fewer points); None when no row does."""
@@ -203,10 +214,8 @@ def _row(
     written = suggested_plan(plan, ctx, d, "best_fit", 0, at_m)
     written, _ = plan_with_vias(written, ctx.cell)
     check = check_plan(written, cell=ctx.cell, fmt=fmt)
-    quality = check.quality
-    if check.layout:
-        assert ctx.cell.work_object is not None
-        quality, _ = plan_quality(written, ctx.cell.work_object.mesh, fmt)
+    assert ctx.cell.work_object is not None
+    quality, _ = checked_quality(written, check, ctx.cell.work_object.mesh, fmt)
     return dataclasses.replace(
         row_of(written, check, quality, level, target_m), points=n, order=order
     )

@@ -61,7 +61,7 @@ from calib.plan.file import Plan, PlanError, PlanPoint
 from calib.plan.report_spec import PointOfInterest
 from calib.probing import ProbePoint, SearchSpec
 from calib.procedures import BestFit
-from planner.check import check_plan, plan_quality
+from planner.check import check_plan
 from planner.check_results import PlanCheck
 from planner.faces.candidates import Candidates, FaceTried, face_candidates
 from planner.faces.detection import find_planar_faces
@@ -76,6 +76,7 @@ from planner.sim.rows import RowSpec, z_values
 from planner.suggest.front import (
     OBJECTIVES,
     FrontRow,
+    checked_quality,
     design_front,
     fastest,
     row_of,
@@ -370,12 +371,7 @@ def suggest_plan(
         ctx, plan, procedure, target_m, max_points, add, fixed, at_m, steered, fmt, tried, say
     )
     say("prediction", 0, 1)
-    # check predicted the written plan's quality for the same program already (unless it
-    # refused the layout, when it predicts nothing)
-    if check.layout:
-        quality, note = plan_quality(new_plan, mesh, fmt)
-    else:
-        quality, note = check.quality, check.quality_note
+    quality, note = checked_quality(new_plan, check, mesh, fmt)
     worst = quality.worst_poi_m(level) if quality is not None else math.nan
     met = target_m is None or (math.isfinite(worst) and worst <= target_m)
     n = len(new_plan.points)
