@@ -13,6 +13,11 @@ is then searched off its nominal spot by the in-plane part of that error's motio
 ``delta = (t, w)`` (``|t| <= a`` about the misplacement pivot, ``|w| <= b``; ``S`` converts it
 to the scaled coordinates), with ``E`` ``(3, 2)`` the face's in-plane basis.
 
+:func:`normal_shift_maps` gives the same error's part along the normal, ``n^T [I, -[p - c]x / L]
+(I - pinv(J_k) J_k) S delta``: how far from its nominal height the face lies in the frame the
+search is commanded in, which an adaptive program's later searches are sized by
+(:mod:`planner.program.steered_searches`).
+
 :func:`inplane_shift_maps` gives the two ``(2, 3)`` maps of ``t`` and ``w``; :func:`shift_outline`
 the outline of every shift they allow (support points of ``G_t a B + G_w b B``, exact for
 balls), which the footprint check grows the footprint by. With ``k = 0`` it is the whole
@@ -51,6 +56,37 @@ def _skew(v: FloatArray) -> FloatArray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
+def _residual_motion(
+    point_m: ArrayLike,
+    earlier_m: ArrayLike,
+    earlier_normals: ArrayLike,
+    centroid_m: ArrayLike,
+    scale_m: float,
+    pivot_m: ArrayLike,
+) -> FloatArray:
+    """``(3, 6)``: the displacement at ``point_m`` of the estimate's error after the
+    ``earlier`` searches, for a misplacement ``(t, w)`` about ``pivot_m`` (module docstring)."""
+    p = np.asarray(point_m, dtype=np.float64).reshape(3)
+    X = np.asarray(earlier_m, dtype=np.float64).reshape(-1, 3)
+    Nn = np.asarray(earlier_normals, dtype=np.float64).reshape(-1, 3)
+    if X.shape != Nn.shape:
+        raise ShapeError(f"earlier points {X.shape} and normals {Nn.shape} differ")
+    c = np.asarray(centroid_m, dtype=np.float64).reshape(3)
+    m = np.asarray(pivot_m, dtype=np.float64).reshape(3)
+    L = max(float(scale_m), MIN_SCALE_M)
+    S = np.eye(6)
+    S[:3, 3:] = -_skew(c - m)
+    S[3:, 3:] *= L
+    if len(X):
+        J = np.hstack([Nn, np.cross(X - c, Nn) / L])
+        residual = np.eye(6) - np.linalg.pinv(J, rcond=FIXED_RCOND) @ J
+    else:
+        residual = np.eye(6)
+    motion = np.hstack([np.eye(3), -_skew(p - c) / L])
+    out: FloatArray = motion @ residual @ S
+    return out
+
+
 def inplane_shift_maps(
     point_m: ArrayLike,
     normal: ArrayLike,
@@ -77,25 +113,89 @@ def inplane_shift_maps(
         ``normal`` is ``G_t @ t + G_w @ w`` for a misplacement translation ``t`` (m) and
         rotation vector ``w`` (rad) about ``pivot_m``.
     """
+    M = _residual_motion(point_m, earlier_m, earlier_normals, centroid_m, scale_m, pivot_m)
+    G = plane_basis(normal).T @ M
+    return G[:, :3], G[:, 3:]
+
+
+def normal_shift_maps(
+    point_m: ArrayLike,
+    normal: ArrayLike,
+    earlier_m: ArrayLike,
+    earlier_normals: ArrayLike,
+    centroid_m: ArrayLike,
+    scale_m: float,
+    pivot_m: ArrayLike,
+) -> tuple[FloatArray, FloatArray]:
+    """The shift along the face normal of a search at ``point_m`` after the ``earlier``
+    searches: how far from its nominal height the face lies in the frame the search is
+    commanded in (the arguments as :func:`inplane_shift_maps`).
+
+    Returns:
+        ``(g_t, g_w)``, each ``(3,)``: the shift along ``normal`` is ``g_t @ t + g_w @ w``
+        (m) for a misplacement translation ``t`` (m) and rotation vector ``w`` (rad) about
+        ``pivot_m``; its largest size is ``a |g_t| + b |g_w|`` (:func:`normal_shift_bound`).
+        With no earlier search it is the whole misplacement's shift of the face.
+    """
+    n = np.asarray(normal, dtype=np.float64).reshape(3)
+    g = (n / np.linalg.norm(n)) @ _residual_motion(
+        point_m, earlier_m, earlier_normals, centroid_m, scale_m, pivot_m
+    )
+    return g[:3], g[3:]
+
+
+def normal_shift_bound(g_t: FloatArray, g_w: FloatArray, a: float, b: float) -> float:
+    """The largest shift along the normal, metres: ``a |g_t| + b |g_w|`` for ``|t| <= a``,
+    ``|w| <= b`` (exact: the two balls are independent)."""
+    return float(a * np.linalg.norm(g_t) + b * np.linalg.norm(g_w))
+
+
+def _noise_gain(
+    point_m: ArrayLike,
+    earlier_m: ArrayLike,
+    earlier_normals: ArrayLike,
+    centroid_m: ArrayLike,
+    scale_m: float,
+) -> FloatArray:
+    """``(3, K)``: the displacement at ``point_m`` of the estimate per metre of error in each
+    of the ``K`` earlier searches (the min-norm update's gain)."""
     p = np.asarray(point_m, dtype=np.float64).reshape(3)
     X = np.asarray(earlier_m, dtype=np.float64).reshape(-1, 3)
     Nn = np.asarray(earlier_normals, dtype=np.float64).reshape(-1, 3)
-    if X.shape != Nn.shape:
-        raise ShapeError(f"earlier points {X.shape} and normals {Nn.shape} differ")
     c = np.asarray(centroid_m, dtype=np.float64).reshape(3)
-    m = np.asarray(pivot_m, dtype=np.float64).reshape(3)
     L = max(float(scale_m), MIN_SCALE_M)
-    S = np.eye(6)
-    S[:3, 3:] = -_skew(c - m)
-    S[3:, 3:] *= L
-    if len(X):
-        J = np.hstack([Nn, np.cross(X - c, Nn) / L])
-        residual = np.eye(6) - np.linalg.pinv(J, rcond=FIXED_RCOND) @ J
-    else:
-        residual = np.eye(6)
-    motion = np.hstack([np.eye(3), -_skew(p - c) / L])
-    G = plane_basis(normal).T @ motion @ residual @ S
-    return G[:, :3], G[:, 3:]
+    J = np.hstack([Nn, np.cross(X - c, Nn) / L])
+    out: FloatArray = np.hstack([np.eye(3), -_skew(p - c) / L]) @ np.linalg.pinv(
+        J, rcond=FIXED_RCOND
+    )
+    return out
+
+
+def _variances(var_m2: ArrayLike, k: int) -> FloatArray:
+    v = np.asarray(var_m2, dtype=np.float64).reshape(-1)
+    if v.shape != (k,):
+        raise ShapeError(f"var_m2 must be ({k},), got {v.shape}")
+    return v
+
+
+def normal_noise_var(
+    point_m: ArrayLike,
+    normal: ArrayLike,
+    earlier_m: ArrayLike,
+    earlier_normals: ArrayLike,
+    centroid_m: ArrayLike,
+    scale_m: float,
+    var_m2: ArrayLike,
+) -> float:
+    """Variance, m^2, of the shift along the normal that the earlier searches' errors
+    (variances ``var_m2`` ``(K,)``, m^2) leave through the min-norm estimate (0 with none)."""
+    X = np.asarray(earlier_m, dtype=np.float64).reshape(-1, 3)
+    if len(X) == 0:
+        return 0.0
+    v = _variances(var_m2, len(X))
+    n = np.asarray(normal, dtype=np.float64).reshape(3)
+    k = (n / np.linalg.norm(n)) @ _noise_gain(point_m, X, earlier_normals, centroid_m, scale_m)
+    return float(np.sum(k * k * v))
 
 
 def inplane_noise_cov(
@@ -110,22 +210,11 @@ def inplane_noise_cov(
     """``(2, 2)`` covariance of the in-plane shift, m^2, that the earlier searches' noise
     (variances ``var_m2`` ``(K,)``, m^2) leaves through the min-norm estimate: what a weak set
     of earlier points (two points close together fixing a rotation) amplifies."""
-    p = np.asarray(point_m, dtype=np.float64).reshape(3)
     X = np.asarray(earlier_m, dtype=np.float64).reshape(-1, 3)
-    Nn = np.asarray(earlier_normals, dtype=np.float64).reshape(-1, 3)
-    v = np.asarray(var_m2, dtype=np.float64).reshape(-1)
     if len(X) == 0:
         return np.zeros((2, 2))
-    if v.shape != (len(X),):
-        raise ShapeError(f"var_m2 must be ({len(X)},), got {v.shape}")
-    c = np.asarray(centroid_m, dtype=np.float64).reshape(3)
-    L = max(float(scale_m), MIN_SCALE_M)
-    J = np.hstack([Nn, np.cross(X - c, Nn) / L])
-    K = (
-        plane_basis(normal).T
-        @ np.hstack([np.eye(3), -_skew(p - c) / L])
-        @ np.linalg.pinv(J, rcond=FIXED_RCOND)
-    )
+    v = _variances(var_m2, len(X))
+    K = plane_basis(normal).T @ _noise_gain(point_m, X, earlier_normals, centroid_m, scale_m)
     return (K * v[None, :]) @ K.T
 
 

@@ -232,8 +232,18 @@ class PlanPoint(Strict, frozen=True, kw_only=True):
         )
 
 
+#: How a plan's searches are sized: ``whole``: each for the whole misplacement (every
+#: controller's program runs them); ``steered``: a search an adaptive program commands in its
+#: estimate only for what the earlier points leave (:mod:`planner.program.steered_searches`).
+SearchSizing = Literal["whole", "steered"]
+
+
 class Plan(Strict, frozen=True, kw_only=True):
-    """A complete measurement plan (file format ``wobjcal.plan/1``)."""
+    """A complete measurement plan (file format ``wobjcal.plan/1``).
+
+    ``search_sizing`` (:data:`SearchSizing`) is left out of the file when not set: a plan
+    written before it keeps its digest, and reads as ``whole`` (:attr:`steered_searches`).
+    """
 
     schema: Literal["wobjcal.plan/1"] = PLAN_SCHEMA
     name: PlanName = ""
@@ -243,6 +253,12 @@ class Plan(Strict, frozen=True, kw_only=True):
     points: list[PlanPoint] = []  # noqa: RUF012 (msgspec copies empty defaults)
     procedure: ProcedureSettings
     validation: ValidationSpec = ValidationSpec()
+    search_sizing: SearchSizing | msgspec.UnsetType = msgspec.UNSET
+
+    @property
+    def steered_searches(self) -> bool:
+        """The searches are sized for an adaptive program (``search_sizing: "steered"``)."""
+        return self.search_sizing == "steered"
 
     def __post_init__(self) -> None:
         check_length(self.points, "points", MAX_PLAN_POINTS, "points", POINTS_WHY)
@@ -312,6 +328,7 @@ _CHOICES = {
     "search.kind": ("approach", "edge"),
     "sensor.kind": SENSOR_KINDS,
     "components": COMPONENTS,
+    "search_sizing": get_args(SearchSizing),
 }
 
 

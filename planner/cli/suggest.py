@@ -92,6 +92,8 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "or A-H plan becomes a best fit of all its points, since those take exactly their own).\n"
         "With --objective time (best fit, needs --target) every size from 6 to --max-points is\n"
         "designed, written in its landing order and in the order of least joint-move time,\n"
+        "and, when the --format controller runs a best fit adaptively, once more with its later\n"
+        "searches started nearer (search_sizing steered: only an adaptive program runs it),\n"
         "checked and timed as 'wobjcal check' does, and the plan of least cycle time that meets\n"
         "the target is written; the accuracy-versus-time front is printed as a table, and with\n"
         "--front FILE plotted (PNG, SVG or PDF; the table beside it as FILE.csv).\n\n"
@@ -189,7 +191,8 @@ def front_table(res: SuggestResult) -> Table:
             verdict = "passes" if r.rating == "ok" else f"passes, layout {r.rating or 'unrated'}"
         t.add_row(
             f"{r.points}{' *' if r.written else ''}",
-            "least move time" if r.order == "time" else "landing",
+            ("least move time" if r.order == "time" else "landing")
+            + (", steered searches" if r.searches == "steered" else ""),
             f"{r.worst_m * 1e3:.3f}" if math.isfinite(r.worst_m) else "-",
             f"{r.cycle_s:.1f}" if math.isfinite(r.cycle_s) else "-",
             "meets" if r.meets_target else "misses",

@@ -48,16 +48,21 @@ from planner.program.steering import STEERED_METHODS, layout_pivot_scale, update
 def safety_spec(plan: Plan) -> SafetySpec:
     """The misplacement tolerance and sensing distance of ``plan``'s validation settings.
 
-    The rotation pivot is the centroid of the probe points, as in ``wobjcal validate``.
+    The rotation pivot is the centroid of the probe points, as in ``wobjcal validate``. A plan
+    whose searches are sized for an adaptive program (``search_sizing: "steered"``) gets the
+    bounds of its later searches (:func:`planner.program.steered_searches.steered_safety`).
     """
+    from planner.program.steered_searches import steered_safety
+
     v = plan.validation
     pivot = np.mean([p.position_m for p in plan.points], axis=0) if plan.points else np.zeros(3)
-    return SafetySpec(
+    whole = SafetySpec(
         max_translation_m=v.misplacement.max_translation_m,
         max_angle_rad=v.misplacement.max_angle_rad,
         pivot_wobj_m=(float(pivot[0]), float(pivot[1]), float(pivot[2])),
         sensing_distance_m=v.sensor.standoff_m,
     )
+    return steered_safety(plan, whole) if plan.steered_searches else whole
 
 
 def plan_settings(plan: Plan) -> Any:
@@ -122,6 +127,18 @@ def build_program(
             why = "the plan lacks a role the update needs"
         if adaptive:
             steps = _adaptive_steps(points, kind.method, settings, vias or {})
+    if safety.steered and not (adaptive and kind.method in STEERED_METHODS):
+        runs = (
+            f"the {target.label} program runs every search in the nominal frame ({why})"
+            if not adaptive
+            else f"its {kind.label} program is not steered search by search"
+        )
+        raise InputError(
+            "the plan's searches are sized for an adaptive best-fit or 3-2-1 program "
+            f'(search_sizing "steered": later searches start nearer), but {runs}: set '
+            'search_sizing to "whole" and give each search the start offset and overtravel '
+            "wobjcal check then asks for (or wobjcal suggest --objective accuracy)"
+        )
     note = "" if adaptive else f"every search once, in the nominal frame: {why}"
     if not adaptive:
         steps = _nominal_steps(points, vias or {})

@@ -33,12 +33,18 @@ def search_problems(
         edge_offset_m: how far past an edge the sensor reports it, m.
     """
     out: dict[str, str] = {}
-    bound = (
+    whole = (
         f" (misplaced up to {safety.max_translation_m * 1e3:.1f} mm and "
         f"{math.degrees(safety.max_angle_rad):.2f} deg)"
     )
     for p in points:
-        shift = safety.surface_shift_bound_m(p.position_m)
+        shift = safety.surface_shift_bound_m(p.position_m, p.id)
+        bound = (
+            whole
+            if shift >= safety.surface_shift_bound_m(p.position_m)
+            else " in the frame the adaptive program estimates from the points before it "
+            '(search_sizing "steered")'
+        )
         s = p.search
         why = []
         if s.kind == "approach":

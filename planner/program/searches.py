@@ -42,13 +42,13 @@ def safe_and_face_wobj(point: ProbePoint, safety: SafetySpec) -> tuple[FloatArra
     n = np.asarray(point.normal, dtype=float)
     # the face point the first approach search looks for: the point, or the edge start
     face = np.asarray(point.position_m, float) if point.search.kind == "approach" else cmd.start_m
-    clear = safety.start_clearance_m(face)
+    clear = safety.start_clearance_m(face, point.id)
     if point.search.kind == "approach":
         safe = face + max(clear, point.search.start_offset_m) * n
         face_end = cmd.start_m + cmd.length_m * cmd.direction
     else:
         safe = face + clear * n
-        face_end = face - safety.overtravel_m(face) * n
+        face_end = face - safety.overtravel_m(face, point.id) * n
     return safe, face_end
 
 

@@ -13,6 +13,12 @@ exported as it stands:
   starts (:func:`planner.suggest.time_order.shortest_order`) that still lands every point on
   its face; edge searches stay last, nearest first.
 
+Both are written with every search sized for the whole misplacement. When the controller runs
+a best fit adaptively, a third plan of each size takes the faster of the two orders with its
+searches ``steered`` (:func:`planner.suggest.search_sizing.steered_plan`): the searches after
+the first start nearer and run shorter, sized for what the estimate before them leaves. Only
+an adaptive program runs such a plan (a FANUC TP export refuses it), so its row says so.
+
 Each row carries the check's predicted error at the confidence (the controller's program
 linearised, :func:`planner.check.plan_quality`) and its estimated cycle time
 (:mod:`planner.check_cycle`). ``--objective time`` writes the row of least cycle time whose
@@ -36,7 +42,9 @@ from planner.check import check_plan, plan_quality
 from planner.check_cycle import cell_motion_limits
 from planner.check_results import PlanCheck
 from planner.move_vias import plan_with_vias
+from planner.program.controllers import controller
 from planner.program.cycle_time import JointMotionLimits, joint_move_time
+from planner.suggest.search_sizing import steered_plan
 from planner.suggest.steps import Context, SuggestProgress, best_fit_design, suggested_plan
 from planner.suggest.time_order import shortest_order
 
@@ -45,6 +53,7 @@ if TYPE_CHECKING:
 
 FloatArray = NDArray[np.float64]
 Order = Literal["landing", "time"]
+Searches = Literal["whole", "steered"]
 OBJECTIVES = ("accuracy", "time")
 
 
@@ -55,6 +64,8 @@ class FrontRow:
     Attributes:
         points: its number of points.
         order: ``"landing"`` (the design's order) or ``"time"`` (least move time).
+        searches: ``"whole"`` (sized for the whole misplacement) or ``"steered"`` (for an
+            adaptive program, :func:`planner.suggest.search_sizing.steered_plan`).
         worst_m: the predicted error at the points of interest at the confidence, metres
             (NaN: no prediction).
         cycle_s: its program's estimated cycle time, s (NaN: not timed).
@@ -81,6 +92,7 @@ class FrontRow:
     check: PlanCheck = field(repr=False, compare=False)
     pareto: bool = False
     written: bool = False
+    searches: Searches = "whole"
 
     @property
     def usable(self) -> bool:
@@ -97,6 +109,7 @@ class FrontRow:
         return {
             "points": self.points,
             "order": self.order,
+            "searches": self.searches,
             "error_mm": round(self.worst_m * 1e3, 6) if math.isfinite(self.worst_m) else None,
             "cycle_time_s": round(self.cycle_s, 3) if math.isfinite(self.cycle_s) else None,
             "rating": self.rating,
@@ -118,7 +131,8 @@ def design_front(
     say: SuggestProgress,
 ) -> list[FrontRow]:
     """The front's rows (module docstring), sizes ascending, ``landing`` before ``time`` (a
-    ``time`` row only where its order differs).
+    ``time`` row only where its order differs), then the steered row (only when the controller
+    ``fmt`` runs a best fit adaptively).
 
     Args:
         ctx: the suggestion's context (pool, sequencer, cell; its search sizing is reset for
@@ -134,15 +148,24 @@ def design_front(
     designs: list[tuple[int, Design]] = []
     best_fit_design(ctx, None, max_points, 0, None, say, collect=designs)
     limits = cell_motion_limits(ctx.cell, plan, fmt)
+    steers = "best_fit" in controller(fmt).adaptive_methods
     rows: list[FrontRow] = []
     for k, (n, d) in enumerate(designs):
         say("front", k, len(designs))
         landing = _row(ctx, plan, d, n, "landing", fmt, at_m, level_percent, target_m)
         rows.append(landing)
         order = _time_order(ctx, d.chosen, landing.check, limits)
+        fast = (landing, d)
         if order is not None and order != tuple(d.chosen):
             timed = dataclasses.replace(d, chosen=order)
-            rows.append(_row(ctx, plan, timed, n, "time", fmt, at_m, level_percent, target_m))
+            fast = (_row(ctx, plan, timed, n, "time", fmt, at_m, level_percent, target_m), timed)
+            rows.append(fast[0])
+        if steers and not ctx.pool.is_edge[list(d.chosen)].any():
+            row, design = fast
+            rows.append(
+                _row(ctx, plan, design, n, row.order, fmt, at_m, level_percent, target_m,
+                     steered=True)
+            )  # fmt: skip
     say("front", len(designs), len(designs))
     return _mark_pareto(rows)
 
@@ -169,6 +192,7 @@ def row_of(plan: Plan, check: PlanCheck, quality: LayoutQuality | None, level: f
     return FrontRow(
         points=len(plan.points),
         order="landing",
+        searches="steered" if plan.steered_searches else "whole",
         worst_m=worst,
         cycle_s=check.cycle.total_s if check.cycle is not None else math.nan,
         rating=quality.rating if quality is not None else "",
@@ -208,16 +232,23 @@ def _row(
     at_m: FloatArray | None,
     level: float,
     target_m: float | None,
+    *,
+    steered: bool = False,
 ) -> FrontRow:
-    """Write ``d`` as a plan, add its vias, check, predict and time it."""
+    """Write ``d`` as a plan (its searches ``steered`` or for the whole misplacement), add its
+    vias, check, predict and time it."""
     ctx.size_searches(tuple(d.chosen))  # the searches sized about this layout's centroid
     written = suggested_plan(plan, ctx, d, "best_fit", 0, at_m)
+    if steered:
+        written = steered_plan(written)
     written, _ = plan_with_vias(written, ctx.cell)
     check = check_plan(written, cell=ctx.cell, fmt=fmt)
     assert ctx.cell.work_object is not None
     quality, _ = checked_quality(written, check, ctx.cell.work_object.mesh, fmt)
     return dataclasses.replace(
-        row_of(written, check, quality, level, target_m), points=n, order=order
+        row_of(written, check, quality, level, target_m),
+        points=n,
+        order=order,
     )
 
 

@@ -3,10 +3,11 @@
 
 The plot puts each written plan of the front (:class:`planner.suggest.front.FrontRow`) at its
 estimated cycle time (s, x) and predicted error at the points of interest (mm, y): the plans
-in their landing order as circles, in the order of least move time as triangles, each
-labelled with its number of points; the Pareto front as a line, the target as a dashed line,
-the plan written ringed, and plans check refuses as crosses. Drawn with matplotlib's Agg
-canvas (no display, no global pyplot state); both files are written atomically.
+in their landing order as circles, in the order of least move time as triangles, with their
+searches steered (an adaptive program only) as squares, each labelled with its number of
+points; the Pareto front as a line, the target as a dashed line, the plan written ringed,
+and plans check refuses as crosses. Drawn with matplotlib's Agg canvas (no display, no global
+pyplot state); both files are written atomically.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ if TYPE_CHECKING:
 COLUMNS = (
     "points",
     "order",
+    "searches",
     "error_mm",
     "cycle_time_s",
     "rating",
@@ -47,6 +49,11 @@ def front_csv(rows: Sequence[FrontRow]) -> str:
         j = r.to_json()
         w.writerow([_cell(j[c]) for c in COLUMNS] + [_cell(r.written)])
     return buf.getvalue()
+
+
+def _style(row: FrontRow) -> str:
+    """The row's marker: its searches when steered, else its order."""
+    return "steered" if row.searches == "steered" else row.order
 
 
 def _cell(v: object) -> str:
@@ -77,11 +84,19 @@ def plot_front(
     FigureCanvasAgg(fig)
     ax = fig.subplots()
     timed = [r for r in rows if math.isfinite(r.cycle_s) and math.isfinite(r.worst_m)]
-    styles = {"landing": ("o", "tab:blue"), "time": ("^", "tab:orange")}
-    names = {"landing": "landing order", "time": "least move time"}
+    styles = {
+        "landing": ("o", "tab:blue"),
+        "time": ("^", "tab:orange"),
+        "steered": ("s", "tab:purple"),
+    }
+    names = {
+        "landing": "landing order",
+        "time": "least move time",
+        "steered": "steered searches (adaptive only)",
+    }
     for order, (marker, colour) in styles.items():
-        ok = [r for r in timed if r.order == order and r.usable]
-        bad = [r for r in timed if r.order == order and not r.usable]
+        ok = [r for r in timed if _style(r) == order and r.usable]
+        bad = [r for r in timed if _style(r) == order and not r.usable]
         if ok:
             ax.scatter(
                 [r.cycle_s for r in ok],

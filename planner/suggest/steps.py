@@ -31,6 +31,7 @@ from planner.plan_cell import nominal_T_base_wobj
 from planner.program.safety import SafetySpec
 from planner.sim.rows import RowSpec, predicted_sigma
 from planner.suggest.order import Ordered, Sequencer
+from planner.suggest.search_sizing import MIN_OVERTRAVEL_M, MIN_START_M
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
@@ -134,8 +135,8 @@ class Context:
             )
         search = SearchSpec(
             "approach",
-            start_offset_m=max(0.015, self.safety.start_clearance_m(p)),
-            overtravel_m=max(0.010, self.safety.overtravel_m(p)),
+            start_offset_m=max(MIN_START_M, self.safety.start_clearance_m(p)),
+            overtravel_m=max(MIN_OVERTRAVEL_M, self.safety.overtravel_m(p)),
         )
         return ProbePoint(pid, tuple(float(c) for c in p), tuple(self.pool.normals[i]), search)  # type: ignore[arg-type]
 
