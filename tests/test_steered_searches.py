@@ -258,3 +258,28 @@ def test_validate_runs_the_tight_steered_program_without_a_failed_search() -> No
     assert report.failures == {}
     assert report.n_ok == 40
     assert "adaptive" in report.program
+
+
+def test_steering_shortens_nothing_when_the_floors_hold_every_search() -> None:
+    """The shipped plate's misplacement (3 mm, 1 deg) needs less than the floors everywhere:
+    a suggestion's whole searches and its steered ones are the same (so suggest offers no
+    steered row for it), while under 20 mm / 3 deg most searches get shorter."""
+    def floored(plan: Plan, steer: bool) -> list[tuple[float, float]]:
+        safety = safety_spec(msgspec.structs.replace(plan, search_sizing="whole"))
+        if steer:
+            return [
+                (p.search.start_offset_m, p.search.overtravel_m) for p in steered_plan(plan).points
+            ]
+        return [
+            (
+                max(MIN_START_M, safety.start_clearance_m(p.position_m)),
+                max(MIN_OVERTRAVEL_M, safety.overtravel_m(p.position_m)),
+            )
+            for p in plan.points
+        ]
+
+    plate = load_plan(PLATE)
+    assert floored(plate, True) == floored(plate, False)
+    hard = _hard_plate(tight=False)
+    pairs = zip(floored(hard, True), floored(hard, False), strict=True)
+    assert sum(a[0] < b[0] - 1e-3 for a, b in pairs) >= 5

@@ -162,10 +162,10 @@ def design_front(
             rows.append(fast[0])
         if steers and not ctx.pool.is_edge[list(d.chosen)].any():
             row, design = fast
-            rows.append(
-                _row(ctx, plan, design, n, row.order, fmt, at_m, level_percent, target_m,
-                     steered=True)
-            )  # fmt: skip
+            steered = _steered_row(ctx, plan, design, n, row.order, fmt, at_m, level_percent,
+                                   target_m)  # fmt: skip
+            if steered is not None:
+                rows.append(steered)
     say("front", len(designs), len(designs))
     return _mark_pareto(rows)
 
@@ -232,23 +232,52 @@ def _row(
     at_m: FloatArray | None,
     level: float,
     target_m: float | None,
-    *,
-    steered: bool = False,
 ) -> FrontRow:
-    """Write ``d`` as a plan (its searches ``steered`` or for the whole misplacement), add its
-    vias, check, predict and time it."""
+    """Write ``d`` as a plan (every search for the whole misplacement), add its vias, check,
+    predict and time it."""
     ctx.size_searches(tuple(d.chosen))  # the searches sized about this layout's centroid
     written = suggested_plan(plan, ctx, d, "best_fit", 0, at_m)
-    if steered:
-        written = steered_plan(written)
+    return _judged(ctx, written, n, order, fmt, level, target_m)
+
+
+def _steered_row(
+    ctx: Context,
+    plan: Plan,
+    d: Design,
+    n: int,
+    order: Order,
+    fmt: str | None,
+    at_m: FloatArray | None,
+    level: float,
+    target_m: float | None,
+) -> FrontRow | None:
+    """:func:`_row` with the searches steered (:func:`planner.suggest.search_sizing.
+    steered_plan`); None when that shortens no search (the floors already hold every one: the
+    same program, which only an adaptive controller would run)."""
+    ctx.size_searches(tuple(d.chosen))
+    whole = suggested_plan(plan, ctx, d, "best_fit", 0, at_m)
+    written = steered_plan(whole)
+    if [p.search for p in written.points] == [p.search for p in whole.points]:
+        return None
+    return _judged(ctx, written, n, order, fmt, level, target_m)
+
+
+def _judged(
+    ctx: Context,
+    written: Plan,
+    n: int,
+    order: Order,
+    fmt: str | None,
+    level: float,
+    target_m: float | None,
+) -> FrontRow:
+    """The row of ``written`` with its vias added: checked, predicted and timed."""
     written, _ = plan_with_vias(written, ctx.cell)
     check = check_plan(written, cell=ctx.cell, fmt=fmt)
     assert ctx.cell.work_object is not None
     quality, _ = checked_quality(written, check, ctx.cell.work_object.mesh, fmt)
     return dataclasses.replace(
-        row_of(written, check, quality, level, target_m),
-        points=n,
-        order=order,
+        row_of(written, check, quality, level, target_m), points=n, order=order
     )
 
 
