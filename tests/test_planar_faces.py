@@ -73,6 +73,29 @@ def test_detection_is_cached_by_mesh_content() -> None:
     assert find_planar_faces(box) is not find_planar_faces(box, flatness_tol_m=1e-5)
 
 
+def test_detection_is_shared_by_callers_that_name_the_mesh_differently(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """check names the part, the landing risk does not: one detection serves both (the name
+    is for messages only), each answer carrying its caller's name."""
+    import planner.faces.detection as detection
+
+    calls: list[str] = []
+    real = detection._detect
+
+    def counted(mesh: trimesh.Trimesh, name: str, **tols: float) -> object:
+        calls.append(name)
+        return real(mesh, name, **tols)
+
+    monkeypatch.setattr(detection, "_detect", counted)
+    box = trimesh.creation.box(extents=(0.31, 0.17, 0.09))  # a size no other test uses
+    a = find_planar_faces(box, name="part A")
+    b = find_planar_faces(box)
+    assert calls == ["part A"]
+    assert (a.name, b.name) == ("part A", "work object")
+    assert np.array_equal(a.face_id, b.face_id) and len(a.faces) == 6
+
+
 def test_sphere_has_no_planar_face_and_says_so() -> None:
     sphere = trimesh.creation.icosphere(subdivisions=4, radius=0.2)
     sphere.metadata["name"] = "ball"

@@ -37,7 +37,7 @@ import hashlib
 import math
 import threading
 from collections import OrderedDict
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import trimesh
@@ -287,12 +287,12 @@ def find_planar_faces(
         if not (math.isfinite(val) and val > 0):
             raise MeshError(f"{tol_name} must be a positive number, got {val!r}")
     label = name or str((mesh.metadata or {}).get("name") or "work object")
-    key = (mesh_digest(mesh), label, *tols.values())
+    key = (mesh_digest(mesh), *tols.values())  # the name is for messages only
     with _cache_lock:
         hit = _cache.get(key)
         if hit is not None:
             _cache.move_to_end(key)
-            return hit
+            return hit if hit.name == label else replace(hit, name=label)
     found = _detect(mesh, label, **tols)
     with _cache_lock:
         _cache[key] = found
