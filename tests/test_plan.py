@@ -21,6 +21,7 @@ from calib.plan.file import (
     Search,
     file_sha256,
     load_plan,
+    plan_digest,
     plan_from_json,
     plan_to_json,
     resolve_ref,
@@ -225,3 +226,15 @@ def test_a_plan_from_before_the_touch_probe_loads_its_proximity_sensor() -> None
     plan = plan_from_json(json.dumps(raw))
     assert plan.validation.sensor == ProximitySensor(n_rays=64)
     assert json.loads(plan_to_json(plan))["validation"]["sensor"]["kind"] == "proximity"
+
+
+def test_plan_files_are_written_without_negative_zeros() -> None:
+    """A zero the arithmetic signed (``-0.0``) is written ``0.0``: the same plan gives the same
+    file whichever code path made it (the digest already ignored the sign)."""
+    plan = load_plan(SCHEMA_FILE.parent / "plans" / "plate_holes_321.json")
+    p = plan.points[0]
+    signed = msgspec.structs.replace(p, position_m=(-0.0, p.position_m[1], p.position_m[2]))
+    again = msgspec.structs.replace(plan, points=[signed, *plan.points[1:]])
+    text = plan_to_json(again)
+    assert "-0.0," not in text and "-0.0\n" not in text
+    assert plan_digest(again) == plan_digest(plan_from_json(text))

@@ -52,6 +52,7 @@ from calib.plan.json_io import (
     convert_strict,
     parse_json_text,
     read_text_file,
+    unsigned_zeros,
 )
 from calib.plan.models import ValidationSpec
 from calib.plan.report_spec import COMPONENTS
@@ -371,23 +372,13 @@ def plan_digest(plan: Plan) -> str:
     so results measured with another plan's program are named, not used.
     """
     text = json.dumps(
-        _unsigned_zeros(msgspec.to_builtins(plan)),
+        unsigned_zeros(msgspec.to_builtins(plan)),
         sort_keys=True,
         separators=(",", ":"),
         ensure_ascii=False,
         allow_nan=False,
     )
     return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
-
-
-def _unsigned_zeros(value: Any) -> Any:
-    if isinstance(value, float):
-        return 0.0 if value == 0.0 else value
-    if isinstance(value, dict):
-        return {k: _unsigned_zeros(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_unsigned_zeros(v) for v in value]
-    return value
 
 
 def check_plan_files(plan: Plan, plan_dir: str | Path, source: str = "plan") -> None:

@@ -214,13 +214,30 @@ def convert_strict(
 
 
 def canonical_json(obj: Any) -> str:
-    """The canonical text of a struct: sorted keys, indent 2, trailing newline."""
+    """The canonical text of a struct: sorted keys, indent 2, trailing newline, every ``-0.0``
+    written ``0.0`` (a file is the same whichever arithmetic made its zeros; floats otherwise
+    as Python's shortest round-trip ``repr``)."""
     return (
         json.dumps(
-            msgspec.to_builtins(obj), sort_keys=True, indent=2, ensure_ascii=False, allow_nan=False
+            unsigned_zeros(msgspec.to_builtins(obj)),
+            sort_keys=True,
+            indent=2,
+            ensure_ascii=False,
+            allow_nan=False,
         )
         + "\n"
     )
+
+
+def unsigned_zeros(value: Any) -> Any:
+    """``value`` (JSON builtins) with every float ``-0.0`` replaced by ``0.0``."""
+    if isinstance(value, float):
+        return 0.0 if value == 0.0 else value
+    if isinstance(value, dict):
+        return {k: unsigned_zeros(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [unsigned_zeros(v) for v in value]
+    return value
 
 
 def json_schema(type_: Any) -> str:
