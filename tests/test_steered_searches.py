@@ -264,6 +264,7 @@ def test_steering_shortens_nothing_when_the_floors_hold_every_search() -> None:
     """The shipped plate's misplacement (3 mm, 1 deg) needs less than the floors everywhere:
     a suggestion's whole searches and its steered ones are the same (so suggest offers no
     steered row for it), while under 20 mm / 3 deg most searches get shorter."""
+
     def floored(plan: Plan, steer: bool) -> list[tuple[float, float]]:
         safety = safety_spec(msgspec.structs.replace(plan, search_sizing="whole"))
         if steer:
