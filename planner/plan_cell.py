@@ -150,8 +150,12 @@ def open_cell(plan: Plan, plan_dir: Path) -> Cell:
         left = MAX_CELL_TRIANGLES - len(wobj.mesh.faces)  # the cell's meshes share one budget
         for f in plan.cell.fixtures:
             T = f.T_world_fixture.matrix()
+            cylinder = f.cylinder
             if f.box_size_m is not None:
                 cell.add_fixture(f.name, size_m=f.box_size_m, T_world_fixture=T)
+            elif cylinder is not None:
+                radius, length = cylinder
+                cell.add_fixture(f.name, radius_m=radius, height_m=length, T_world_fixture=T)
             else:
                 mesh = resolve_ref(f.mesh or "", plan_dir)
                 fixture = cell.add_fixture(

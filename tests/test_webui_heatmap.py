@@ -1,12 +1,18 @@
-"""The heat map's colours (issue 14, item 6): coloured by what fails, spread smoothly over a
-refined surface."""
+"""The heat map's colours (issue 14, item 6): coloured by what fails, spread over a refined
+surface; issue 22, item 7: one colour per face, never blended across a face."""
 
 from __future__ import annotations
 
 import numpy as np
 import trimesh
 
-from webui.heatmap import CATEGORY_RGB, category_of, refined, smooth_vertex_colours
+from webui.heatmap import (
+    CATEGORY_RGB,
+    category_of,
+    face_colours,
+    refined,
+    smooth_vertex_colours,
+)
 from webui.testing import box_mesh
 
 
@@ -47,3 +53,23 @@ def test_colours_are_voted_never_mixed_and_match_the_samples_near_them() -> None
     left = fine.vertices[top][:, 0] < -0.01
     right = fine.vertices[top][:, 0] > 0.01
     assert np.all(col[top][left, 0] == 255) and np.all(col[top][right, 2] == 255)
+
+
+def test_each_face_has_one_colour_so_the_renderer_blends_nothing() -> None:
+    """Vertex colours are interpolated across a face: a face whose corners voted apart drew a
+    stripe of a colour that means nothing (seen between "reach" and "footprint")."""
+    plane = trimesh.creation.box(extents=(1.0, 1.0, 0.01))
+    fine = refined(plane)
+    rng = np.random.default_rng(3)
+    pts = np.column_stack([rng.uniform(-0.5, 0.5, (40, 2)), np.full(40, 0.005)])
+    nrm = np.tile([0.0, 0.0, 1.0], (40, 1))
+    palette = np.array(list(CATEGORY_RGB.values()), dtype=np.uint8)
+    rgb = palette[rng.integers(0, len(palette), 40)]
+    col = smooth_vertex_colours(fine, pts, nrm, rgb)
+    corners = col[fine.faces]  # (F, 3 corners, 3)
+    assert np.all(corners == corners[:, :1, :]), "a face with two colours would be blended"
+    assert {tuple(c) for c in col} <= {tuple(c) for c in palette}
+    per_face = face_colours(fine, pts, nrm, rgb)
+    np.testing.assert_array_equal(corners[:, 0, :], per_face)
+    top = fine.face_normals[:, 2] > 0.9
+    assert len({tuple(c) for c in per_face[top]}) > 3, "the borders follow the samples"

@@ -33,6 +33,7 @@ from webui.plan_adapter import autosave_bytes, plan_as_edited, plan_point, with_
 from webui.plan_doc import UiPlan
 from webui.role_check import RoleFlags, role_flags
 from webui.scene import PlanScene
+from webui.search_room import new_point_overtravel_cap_m
 from webui.state import DEFAULT_AUTOSAVE, Change, SessionState
 from webui.surface import SurfacePicker
 from webui.tab_robots import TabRobots, tab_robots_or_reason
@@ -170,7 +171,8 @@ class WobjcalApp:
             for client in self.server.get_clients().values():
                 clients.set_default_camera(client, view)
         self._part = part  # moving, snapping or reframing the same part keeps the camera
-        self.recheck(self.state.doc.ids)
+        # the points checked as the plan will be (its tool's TCP, its sensor) in the new cell
+        self.recheck(self.state.doc.ids, with_source(self.state.doc, plan))
         self.teach_panel.after_checks(force=True)  # vias and moves in the new cell
         self.layout_panel.refresh()
 
@@ -192,9 +194,14 @@ class WobjcalApp:
         with self._lock:
             return {pid: c for pid, (_, c) in self._checks.items()}
 
-    def recheck(self, point_ids: tuple[str, ...] | list[str]) -> list[PointCheck]:
-        """Check the given points in the cell (on the worker), store and draw the results."""
-        doc = self.state.doc
+    def recheck(
+        self, point_ids: tuple[str, ...] | list[str], doc: UiPlan | None = None
+    ) -> list[PointCheck]:
+        """Check the given points in the cell (on the worker), store and draw the results.
+
+        ``doc``: the plan to check them in (default the session's; a new cell's plan before
+        the session takes it, :meth:`load_cell`)."""
+        doc = self.state.doc if doc is None else doc
         points = [doc.get(pid) for pid in point_ids if pid in doc.ids]
         if not points:
             return []
@@ -269,6 +276,14 @@ class WobjcalApp:
             return
         before = {p.id: p for p in change.previous.points}
         changed = [p.id for p in change.doc.points if before.get(p.id) != p]
+        previous = change.previous.source
+        sensor_changed = (
+            isinstance(source, Plan)
+            and isinstance(previous, Plan)
+            and source.validation.sensor != previous.validation.sensor
+        )
+        if sensor_changed:  # the checks read it (footprint, standoff): all checked again
+            changed = list(change.doc.ids)
         with self._lock:
             for pid in [*changed, *(set(before) - set(change.doc.ids))]:
                 self._checks.pop(pid, None)
@@ -309,9 +324,14 @@ class WobjcalApp:
         if hit is None:
             raise InputError("the click missed the work object")
         pid = point_id or self.points_panel.target_id()
+        cap = new_point_overtravel_cap_m(
+            self.view, picker, self.state.doc.source, hit.position_wobj, hit.normal_wobj
+        )  # a new point's default overtravel stops short of the table behind it
 
         def edit(doc: UiPlan) -> UiPlan:
-            return plan_doc.place_point(doc, pid, hit.position_wobj, hit.normal_wobj)
+            return plan_doc.place_point(
+                doc, pid, hit.position_wobj, hit.normal_wobj, max_overtravel_m=cap
+            )
 
         self.state.update(edit, f"place {pid}")
         self.select(pid, client)

@@ -148,6 +148,8 @@ class CellSession:
         for f in self.plan.cell.fixtures:
             if f.box_size_m is not None:
                 mesh = trimesh.creation.box(extents=f.box_size_m)
+            elif (cylinder := f.cylinder) is not None:  # about z, centred: as the cell's
+                mesh = trimesh.creation.cylinder(radius=cylinder[0], height=cylinder[1])
             else:
                 mesh = load_mesh(f.mesh or "", f.units, self.plan_dir)
             out[f.name] = (mesh, f.T_world_fixture.matrix())

@@ -1,9 +1,11 @@
 """The "Cell" panel: set up the cell: move and rotate the work object, the robot base and the
-fixtures with numeric fields (mm, deg) or a gizmo, and snap the part onto a fixture.
+fixtures with numeric fields (mm, deg) or a gizmo, and snap the part onto a fixture; below, the
+tool and its TCP (:mod:`webui.cell_tool`), the sensor and the search speed
+(:mod:`webui.cell_sensor`), and fixtures added or deleted (:mod:`webui.cell_fixtures`).
 
-Each change is a new plan source (:mod:`webui.cell_edits`): its cell is built first, and only
-when that works does the session change, in one undoable, autosaved step; every point is then
-checked again in the new cell.
+Each change is a new plan source (:mod:`webui.cell_edits`, :mod:`webui.cell_setup_edits`): its
+cell is built first, and only when that works does the session change, in one undoable,
+autosaved step; every point is then checked again in the new cell.
 """
 
 from __future__ import annotations
@@ -18,6 +20,9 @@ from calib.frames import make_transform, matrix_from_quat_wxyz, quat_wxyz_from_m
 from calib.plan.file import Plan
 from webui import cell_edits
 from webui.cell_edits import ROBOT_BASE, WORK_OBJECT
+from webui.cell_fixtures import FixturesSection
+from webui.cell_sensor import SensorSection
+from webui.cell_tool import ToolSection
 
 if TYPE_CHECKING:
     from webui.context import AppContext
@@ -50,6 +55,9 @@ class CellPanel:
             self.use_gizmo = gui.add_checkbox("Move with gizmo", False)
             self.snap_to = gui.add_dropdown("Snap onto", (NO_FIXTURE,))
             self.snap = gui.add_button("Snap part onto fixture")
+            self.tool = ToolSection(app, self._guard)
+            self.sensor = SensorSection(app, self._guard)
+            self.fixtures = FixturesSection(app, self._guard, self._show_target)
         self.target.on_update(lambda _ev: self.refresh())
         self.apply.on_click(lambda ev: self._guard(ev, self.apply_fields))
         self.use_gizmo.on_update(lambda ev: self._guard(ev, self._update_gizmo))
@@ -72,11 +80,20 @@ class CellPanel:
             raise InputError("load a plan first: there is no cell to set up")
         return source
 
+    def _show_target(self, target: str) -> None:
+        """Choose ``target`` under Move (e.g. a fixture just added) and show its pose."""
+        self.refresh()
+        self.target.value = target
+
     def refresh(self) -> None:
         """Show the current plan's things and the chosen one's pose."""
-        source = self._app.state.doc.source
+        doc = self._app.state.doc
+        source = doc.source
         if not isinstance(source, Plan):
             return
+        self.tool.refresh(source)
+        self.sensor.refresh(doc)
+        self.fixtures.refresh(source)
         options = cell_edits.movable(source)
         if tuple(self.target.options) != options:
             self.target.options = options

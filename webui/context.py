@@ -43,6 +43,18 @@ class SelectionControl(Protocol):
         """The point tab ``client_id`` has selected (``None``: the latest anywhere)."""
 
 
+class UploadStore(Protocol):
+    """Where the session keeps uploaded files (:class:`webui.files_panel.FilesPanel`): the
+    folder, the folders this session created, and the file references its plans still use."""
+
+    upload_dir: Path
+    created: set[Path]
+
+    def in_use(self) -> list[str]:
+        """The file references of the session's plans (undo history included)."""
+        ...
+
+
 class AppContext(Protocol):
     """The app, as the panels see it.
 
@@ -62,6 +74,8 @@ class AppContext(Protocol):
         click_mode: what a click on the 3D view does (a key of ``click_handlers``).
         click_handlers: ``{mode: handler(event)}`` of scene clicks; ``"place"`` places points.
         cycle: the estimated cycle time of the plan as edited (``None``: not known yet).
+        files_panel: the Files panel, which owns the upload folder (tool and fixture uploads
+            of the Cell tab are kept there too; built after the Cell tab, used on upload).
     """
 
     server: viser.ViserServer
@@ -77,6 +91,11 @@ class AppContext(Protocol):
     click_mode: str
     click_handlers: dict[str, Any]
     cycle: CycleTime | None
+
+    @property
+    def files_panel(self) -> UploadStore:
+        """The Files panel, which owns the upload folder (the Cell tab keeps its uploads there)."""
+        ...
 
     def tab(self, name: str) -> Any:
         """The control panel's tab ``name`` (a context for a panel's widgets)."""

@@ -7,6 +7,12 @@ and ``work_object.T_wobj_mesh``), so nothing moves in the world; its cell is bui
 the session changes in one undoable, autosaved step. A click that misses the part, or a point
 that coincides with or lies on a line with the ones before, is refused with a message and the
 panel waits for that point again.
+
+While the points are picked, each pick is a dot (red origin, green +x, blue xy-plane) and, once
+the origin and +x are picked, the frame they define is drawn as a triad at the origin
+(:func:`preview_frame`: x towards the +x point, z out of the face clicked at the origin, y = z
+cross x; red, green, blue): a third point on its green (+y) side keeps that z. The triad goes when
+the frame is applied (the work object's own axes then show it) or the mode is cancelled.
 """
 
 from __future__ import annotations
@@ -22,6 +28,7 @@ from calib.frames import transform_points
 from calib.plan.file import Plan
 from calib.user_frame import MIN_SEPARATION_M, three_point_frame
 from webui import cell_edits
+from webui.scene import pose_kwargs
 
 if TYPE_CHECKING:
     from webui.context import AppContext
@@ -37,6 +44,33 @@ LABEL = "define the work-object frame (3 points)"
 Z_START_M = 0.0005
 #: ... for this far: the part or a fixture met within it means z points into it, m.
 Z_LOOK_M = 0.5
+#: The preview triad's axes: this share of the part's largest extent, within the bounds, m.
+TRIAD_SHARE = 0.25
+TRIAD_MIN_M, TRIAD_MAX_M = 0.03, 0.3
+#: Scene node of the preview triad.
+TRIAD_NODE = "/frame3/triad"
+
+
+def preview_frame(
+    origin_wobj: ArrayLike, x_point_wobj: ArrayLike, origin_normal_wobj: ArrayLike
+) -> NDArray[np.float64] | None:
+    """``(4, 4)`` the frame the 3-point method gives, wobj frame (m), for a third point on the
+    face clicked at the origin, on the +y side: x from the origin to ``x_point_wobj``, z the
+    origin's face normal made perpendicular to x, y = z cross x. ``None`` when the normal runs
+    along x (the third point alone decides z then)."""
+    o = np.asarray(origin_wobj, dtype=np.float64).reshape(3)
+    x = np.asarray(x_point_wobj, dtype=np.float64).reshape(3) - o
+    n = np.asarray(origin_normal_wobj, dtype=np.float64).reshape(3)
+    if float(np.linalg.norm(x)) < MIN_SEPARATION_M:
+        return None
+    x = x / np.linalg.norm(x)
+    z = n - float(n @ x) * x
+    if float(np.linalg.norm(z)) < 1e-6:
+        return None
+    z = z / np.linalg.norm(z)
+    T = np.eye(4)
+    T[:3, 0], T[:3, 1], T[:3, 2], T[:3, 3] = x, np.cross(z, x), z, o
+    return T
 
 
 class FramePanel:
@@ -50,6 +84,10 @@ class FramePanel:
         self._app = app
         #: The points picked so far, wobj frame (the frame before the new one), m.
         self.picked: list[NDArray[np.float64]] = []
+        #: The face normal at the picked origin, wobj frame (``None``: not picked yet).
+        self.origin_normal: NDArray[np.float64] | None = None
+        #: The preview triad drawn (wobj frame), or ``None``.
+        self.triad: NDArray[np.float64] | None = None
         gui = app.server.gui
         with app.tab("Cell"):
             self.start = gui.add_button("Define frame by 3 points")
@@ -72,14 +110,14 @@ class FramePanel:
         """Start picking: the next clicks on the part are the origin, +x, the xy-plane."""
         if not isinstance(self._app.state.doc.source, Plan) or self._app.picker is None:
             raise InputError("load a plan first: there is no work object to give a frame")
-        self.picked = []
+        self.picked, self.origin_normal = [], None
         self._app.click_mode = MODE
         self.start.visible, self.cancel.visible = False, True
         self._show()
 
     def stop(self) -> None:
         """Leave the 3-point mode without changing anything; clicks place points again."""
-        self.picked = []
+        self.picked, self.origin_normal = [], None
         if self._app.click_mode == MODE:
             self._app.click_mode = "place"
         self.start.visible, self.cancel.visible = True, False
@@ -90,6 +128,8 @@ class FramePanel:
         view = self._app.view
         for i in range(3):
             scene.remove_by_name(f"/frame3/p{i}")
+        scene.remove_by_name(TRIAD_NODE)
+        self.triad = None
         if self._app.click_mode != MODE:
             self.status.content = ""
             return
@@ -100,9 +140,22 @@ class FramePanel:
         for i, p in enumerate(self.picked):
             scene.add_icosphere(
                 f"/frame3/p{i}",
-                radius=0.006,
+                radius=0.008,
                 color=colours[i],
                 position=tuple(transform_points(view.T_world_wobj, p)),
+            )
+        if len(self.picked) == 2 and self.origin_normal is not None:
+            self.triad = preview_frame(self.picked[0], self.picked[1], self.origin_normal)
+        if self.triad is not None:
+            size = float(np.max(view.wobj_mesh.extents)) * TRIAD_SHARE
+            T = view.T_world_wobj @ self.triad
+            scene.add_frame(
+                TRIAD_NODE, axes_length=float(np.clip(size, TRIAD_MIN_M, TRIAD_MAX_M)),
+                axes_radius=0.005, origin_radius=0.008, **pose_kwargs(T),
+            )  # fmt: skip
+            self.status.content += (
+                " The triad shows the frame (x red, y green, z blue): click the third point "
+                "on its green (+y) side to keep this z."
             )
 
     def _on_click(self, event: Any) -> None:
@@ -113,10 +166,12 @@ class FramePanel:
                 f"3-point frame: the click missed the work object; click {STEPS[len(self.picked)]}"
                 " on the part (or Cancel 3-point frame in the Cell tab)"
             )
-        self.pick(hit.position_wobj)
+        self.pick(hit.position_wobj, hit.normal_wobj)
 
-    def pick(self, point_wobj: ArrayLike) -> None:
+    def pick(self, point_wobj: ArrayLike, normal_wobj: ArrayLike | None = None) -> None:
         """Take the next of the three points (wobj frame, m); the third defines the frame.
+        ``normal_wobj``: the face normal there (default: of the nearest surface point), which
+        the preview triad takes as z at the origin.
 
         Raises:
             InputError: not in the 3-point mode, or the point coincides with or is collinear
@@ -133,6 +188,8 @@ class FramePanel:
                     f"({d * 1000:.3f} mm apart); click {STEPS[len(self.picked)]} again"
                 )
         if len(self.picked) < 2:
+            if not self.picked:
+                self.origin_normal = self._normal_at(p, normal_wobj)
             self.picked.append(p)
             self._show()
             return
@@ -142,6 +199,14 @@ class FramePanel:
             raise InputError(f"3-point frame: {exc}") from None
         self.apply(T_old_new)
         self.stop()
+
+    def _normal_at(
+        self, p: NDArray[np.float64], normal_wobj: ArrayLike | None
+    ) -> NDArray[np.float64] | None:
+        if normal_wobj is not None:
+            return np.asarray(normal_wobj, dtype=np.float64).reshape(3)
+        picker = self._app.picker
+        return None if picker is None else picker.project(p).normal_wobj
 
     def apply(self, T_old_new: ArrayLike) -> None:
         """Make ``T_old_new`` (the new frame in the current one) the work-object frame: one

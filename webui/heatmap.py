@@ -10,8 +10,8 @@ clicks from any tab slip in between chunks, the map grows on screen as chunks fi
 unticking the box stops it. A chunk's size adapts so that it takes about
 :data:`CHUNK_SECONDS`. Each sample is coloured by what fails (:data:`CATEGORY_RGB`: out of
 reach, joint limit or singular wrist, collision, sensor footprint off a planar face) or by its
-status; at the end the colours are spread smoothly over a refined copy of the surface
-(:func:`smooth_vertex_colours`).
+status; at the end each face of a refined copy of the surface takes one of those colours by a
+vote of the samples near it (:func:`face_colours`): one colour per face, never a blend.
 """
 
 from __future__ import annotations
@@ -72,7 +72,7 @@ MAX_CHUNK = 512
 REFINE_SHARE = 0.02
 #: A mesh with at least this many triangles is dense enough as it is (not refined).
 DENSE_FACES = 20_000
-#: Samples blended per vertex.
+#: Samples that vote on each face's colour.
 BLEND_K = 6
 
 
@@ -119,28 +119,43 @@ def refined(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
     return out
 
 
+def face_colours(
+    mesh: trimesh.Trimesh,
+    points: NDArray[np.float64],
+    normals: NDArray[np.float64],
+    rgb: NDArray[np.uint8],
+) -> NDArray[np.uint8]:
+    """``(F, 3)`` one colour per face of ``mesh``: the colour that wins a vote, at the face's
+    centre, of the :data:`BLEND_K` nearest similarly facing samples, each weighted by inverse
+    squared distance. Colours are never mixed (a mix of "reach" and "footprint" would read as
+    another category)."""
+    centres = np.asarray(mesh.triangles_center, dtype=np.float64)
+    fn = np.asarray(mesh.face_normals, dtype=np.float64)
+    k = min(BLEND_K, len(points))
+    dist, idx = cKDTree(_features(points, normals)).query(_features(centres, fn), k=k)
+    dist, idx = dist.reshape(len(centres), k), idx.reshape(len(centres), k)
+    palette, label = np.unique(np.asarray(rgb, dtype=np.uint8), axis=0, return_inverse=True)
+    votes = np.zeros((len(centres), len(palette)))
+    w = 1.0 / np.maximum(dist, 1e-6) ** 2
+    np.add.at(votes, (np.arange(len(centres))[:, None], label.reshape(-1)[idx]), w)
+    return np.asarray(palette[np.argmax(votes, axis=1)], dtype=np.uint8)
+
+
 def smooth_vertex_colours(
     mesh: trimesh.Trimesh,
     points: NDArray[np.float64],
     normals: NDArray[np.float64],
     rgb: NDArray[np.uint8],
 ) -> NDArray[np.uint8]:
-    """``(V, 3)`` colours of ``mesh``'s vertices: the colour that wins a vote of the
-    :data:`BLEND_K` nearest similarly facing samples, each weighted by inverse squared
-    distance. Colours are never mixed (a mix of "reach" and "footprint" would read as another
-    category); on a refined surface the borders between them are smooth curves."""
-    vn = np.repeat(np.asarray(mesh.face_normals), 3, axis=0)
-    corner = np.asarray(mesh.faces).reshape(-1)
-    verts = np.asarray(mesh.vertices)[corner]
-    k = min(BLEND_K, len(points))
-    dist, idx = cKDTree(_features(points, normals)).query(_features(verts, vn), k=k)
-    dist, idx = dist.reshape(len(verts), k), idx.reshape(len(verts), k)
-    palette, label = np.unique(np.asarray(rgb, dtype=np.uint8), axis=0, return_inverse=True)
-    votes = np.zeros((len(verts), len(palette)))
-    w = 1.0 / np.maximum(dist, 1e-6) ** 2
-    np.add.at(votes, (np.arange(len(verts))[:, None], label.reshape(-1)[idx]), w)
+    """``(V, 3)`` colours of ``mesh``'s vertices: every corner of a face takes that face's
+    colour (:func:`face_colours`), so the renderer, which interpolates vertex colours across a
+    face, never blends two categories into a stripe of a colour that means nothing. ``mesh``
+    must have unshared vertices (:func:`refined` makes them); a vertex shared by faces of
+    different colours takes the last one's. On a refined surface the borders between colours
+    follow its small triangles (edges at most :data:`REFINE_SHARE` of the part's size)."""
+    per_face = face_colours(mesh, points, normals, rgb)
     out = np.zeros((len(mesh.vertices), 3), dtype=np.uint8)
-    out[corner] = palette[np.argmax(votes, axis=1)]
+    out[np.asarray(mesh.faces).reshape(-1)] = np.repeat(per_face, 3, axis=0)
     return out
 
 

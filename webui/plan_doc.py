@@ -172,11 +172,31 @@ def _search_for_normal(search: SearchSpec, normal: ArrayLike) -> SearchSpec:
     return dataclasses.replace(search, edge_direction=_tuple3(d / norm))
 
 
-def _sized_search(plan: UiPlan, position_wobj: ArrayLike) -> SearchSpec:
-    """The approach search of a new point: the default, started and run far enough for the
-    plan's misplacement (``wobjcal check`` refuses a search that cannot reach its face wherever
-    the part may lie). The rotation's lever is taken to the farthest other point, at least the
-    lever to the points' centroid, the misplacement's pivot."""
+def _sized_search(
+    plan: UiPlan, position_wobj: ArrayLike, max_overtravel_m: float | None = None
+) -> SearchSpec:
+    """The approach search of a new point, sized to the plan's misplacement, its sensor and
+    the part.
+
+    - Start offset: the default (30 mm), or more when the misplacement needs it
+      (``wobjcal check`` refuses a search that cannot reach its face wherever the part may
+      lie); that need includes the sensor's sensing distance and a margin, so the search
+      never starts with the surface already in the sensor's range.
+    - Overtravel: the default (20 mm), shortened to ``max_overtravel_m`` (what the part's
+      material and a fixture or table behind the point leave, less the sensor's clearance:
+      :func:`webui.search_room.overtravel_cap_m`), but never shorter than the misplacement
+      needs. When the misplacement needs more than the part allows, the misplacement's value
+      is kept: the check then reports the collision, which is the truth about this plan.
+
+    The rotation's lever is taken to the farthest other point, at least the lever to the
+    points' centroid, the misplacement's pivot. Without a plan file (``source``) the default.
+
+    Args:
+        plan: the plan the point goes into.
+        position_wobj: ``(3,)`` the new point, wobj frame, m.
+        max_overtravel_m: the longest overtravel the cell leaves behind the point, m
+            (``None``: not limited).
+    """
     default = SearchSpec()
     src = plan.source
     if src is None:
@@ -187,9 +207,13 @@ def _sized_search(plan: UiPlan, position_wobj: ArrayLike) -> SearchSpec:
     safety = dataclasses.replace(
         safety_spec(src), pivot_wobj_m=(float(far[0]), float(far[1]), float(far[2]))
     )
+    start_need = safety.sensing_distance_m + safety.margin_m
+    overtravel = default.overtravel_m
+    if max_overtravel_m is not None:
+        overtravel = min(overtravel, float(max_overtravel_m))
     return SearchSpec(
-        start_offset_m=max(default.start_offset_m, safety.start_clearance_m(p)),
-        overtravel_m=max(default.overtravel_m, safety.overtravel_m(p)),
+        start_offset_m=max(default.start_offset_m, start_need, safety.start_clearance_m(p)),
+        overtravel_m=max(overtravel, safety.overtravel_m(p)),
     )
 
 
@@ -199,14 +223,16 @@ def place_point(
     position_wobj: ArrayLike,
     normal_wobj: ArrayLike,
     role: str | None = None,
+    max_overtravel_m: float | None = None,
 ) -> UiPlan:
     """Put point ``point_id`` at a surface point with that face's normal (add it if new).
 
     An existing point keeps its role and search settings (an edge direction is projected into the
-    new face); a new one gets an approach search sized for the plan's misplacement
-    (:func:`_sized_search`) and the role ``role`` (default: its id when the
-    procedure has such a role and it is free, else the first role not yet full, else
-    :data:`NO_ROLE`: never a duplicate, see :func:`next_free_role`).
+    new face); a new one gets an approach search sized for the plan's misplacement, its sensor
+    and the room behind the point (:func:`_sized_search`; ``max_overtravel_m``, m: the longest
+    overtravel the cell leaves there, ``None``: not limited) and the role ``role`` (default:
+    its id when the procedure has such a role and it is free, else the first role not yet
+    full, else :data:`NO_ROLE`: never a duplicate, see :func:`next_free_role`).
     """
     if not point_id:
         raise InputError("point id must not be empty")
@@ -215,7 +241,7 @@ def place_point(
     existing = {p.id: p for p in plan.points}
     old = existing.get(point_id)
     search = (
-        _sized_search(plan, position_wobj)
+        _sized_search(plan, position_wobj, max_overtravel_m)
         if old is None
         else _search_for_normal(old.probe.search, n)
     )

@@ -1,4 +1,6 @@
-"""The "Points" panel: which point a click places, the selected point's settings, status list."""
+"""The "Points" panel: which point a click places, Undo and Redo (also Ctrl+Z, Ctrl+Shift+Z),
+the status table (:mod:`webui.status_table`: one row per point, above the fold), each tab's
+selected point (:mod:`webui.tab_selection`), drag, playback and the heat map."""
 
 from __future__ import annotations
 
@@ -16,7 +18,8 @@ from webui import heatmap, plan_doc
 from webui.plan_adapter import with_procedure
 from webui.plan_doc import PAPER_IDS
 from webui.scene import legend_html
-from webui.tab_selection import NO_ROLE_LABEL, set_options
+from webui.status_table import HINT, table_rows
+from webui.tab_selection import NO_ROLE_LABEL, Selections, set_options
 
 if TYPE_CHECKING:
     from webui.context import AppContext
@@ -55,10 +58,12 @@ class PointsPanel:
                 "Click the work object to place the point on its surface; click a marker to "
                 "select it."
             )
-            #: each tab's own Selected dropdown and settings (:mod:`webui.tab_selection`)
+            self.undo = gui.add_button("Undo", hint="Ctrl+Z")
+            self.redo = gui.add_button("Redo", hint="Ctrl+Shift+Z")
+            #: one row per point: icon and status, id, role, first cause (above the fold)
+            self.status_md = gui.add_markdown("")
+            #: each tab's own Selected dropdown, details and settings (:mod:`webui.tab_selection`)
             self.selection_folder = gui.add_folder("Selected point")
-            self.undo = gui.add_button("Undo")
-            self.redo = gui.add_button("Redo")
             self.drag = gui.add_checkbox("Drag selected point", False)
             self.follow = gui.add_checkbox(
                 "Robot follows selection",
@@ -72,10 +77,19 @@ class PointsPanel:
             self.heat_legend = gui.add_html(
                 legend_html(heatmap.CATEGORY_MEANING, heatmap.CATEGORY_RGB), visible=False
             )
-            self.status_md = gui.add_markdown("")
         self.procedure.on_update(self._on_procedure)
         self.undo.on_click(lambda ev: self._guard(ev, self._app.state.undo))
         self.redo.on_click(lambda ev: self._guard(ev, self._app.state.redo))
+        # the keys, through viser's command palette (its hotkeys are ignored while a text or
+        # number field has the focus: there Ctrl+Z undoes the typing)
+        self.undo_key = gui.add_command(
+            "Undo", description="undo the last edit of the plan", hotkey="Z", modifier="cmd/ctrl"
+        )
+        self.redo_key = gui.add_command(
+            "Redo", description="redo the edit undone last", hotkey="Z", modifier="cmd/ctrl+shift"
+        )
+        self.undo_key.on_trigger(lambda ev: self._guard(ev, self._app.state.undo))
+        self.redo_key.on_trigger(lambda ev: self._guard(ev, self._app.state.redo))
         self.drag.on_update(lambda ev: self._guard(ev, self._update_gizmo))
         self.play.on_click(self._on_play)
         self.robot_to.on_click(lambda ev: self._guard(ev, self._app.robot_to_selected, ev.client))
@@ -124,19 +138,9 @@ class PointsPanel:
         if self.procedure_md.content != summary:
             self.procedure_md.content = summary
         flags = self._app.flags
-        rows = ["| point | role | x, y, z (mm) | status | reason |", "|---|---|---|---|---|"]
-        for p in doc.points:
-            c = checks.get(p.id)
-            status: str = "checking..." if c is None else c.status
-            reason = "" if c is None else c.reason
-            if p.id in flags.by_point:  # the procedure cannot use it: said at once
-                status = f"**role** / {status}"
-                reason = "; ".join(r for r in (flags.by_point[p.id], reason) if r)
-            xyz = ", ".join(f"{v * 1e3:.1f}" for v in p.probe.position_m)
-            role = p.role or NO_ROLE_LABEL
-            rows.append(f"| {p.id} | {role} | {xyz} | {status} | {reason.replace('|', '/')} |")
-        if not doc.points:
-            rows.append("| - | - | - | no points yet | |")
+        rows = table_rows(doc, checks, flags.by_point, NO_ROLE_LABEL)
+        if doc.points:
+            rows += ["", HINT]
         if flags.layout:  # what `wobjcal check` and `calibrate` would refuse, said while editing
             rows += ["", f"**Layout:** {flags.layout.replace('|', '/')}"]
         if (cycle := self._app.cycle) is not None:  # `wobjcal check`'s, docs/cycle_time.md
@@ -145,6 +149,9 @@ class PointsPanel:
         content = "\n".join(rows)
         if self.status_md.content != content:
             self.status_md.content = content
+        selections = self._app.selection
+        if isinstance(selections, Selections):  # each tab's details of its selected point
+            selections.show_details(doc)
         self._update_gizmo()
 
     def gizmo_geometry(self) -> tuple[float, float]:

@@ -36,7 +36,7 @@ STATUS_MEANING: dict[str, str] = {
     "feasible": "reachable, search path clear",
     "marginal": "little clearance or near a joint limit",
     "infeasible": "out of reach, at a limit, colliding or off a planar face",
-    "role": "the procedure cannot use the point there (its role or face)",
+    "role": "the procedure cannot use the point there (its role or face); red if infeasible",
     "pending": "being checked",
 }
 WOBJ_RGB = (170, 185, 200)
@@ -169,8 +169,10 @@ class PlanScene:
         only: list[str] | None = None,
         flags: Mapping[str, str] | None = None,
     ) -> None:
-        """Draw the points of ``plan`` (or just those in ``only``), coloured by their check,
-        or in the ``role`` colour when ``flags`` names them (their procedure cannot use them).
+        """Draw the points of ``plan`` (or just those in ``only``), coloured by their check;
+        the marker of a point ``flags`` names (its procedure cannot use it) is in the ``role``
+        colour unless the point is infeasible (red wins: the role must not hide it), and its
+        arrow and search line keep the check's colour.
 
         Points no longer in the plan are removed.
         """
@@ -198,9 +200,10 @@ class PlanScene:
         short labels next to their marker, hidden behind the part (depth-tested).
         """
         status: str = "pending" if check is None else check.status
-        if flagged and status != "pending":
-            status = "role"
-        rgb = STATUS_RGB.get(status, STATUS_RGB["unknown"])
+        rgb = STATUS_RGB.get(status, STATUS_RGB["unknown"])  # the arrow and the search line
+        marker_rgb = rgb
+        if flagged and status not in ("pending", "infeasible"):  # infeasible stays red
+            marker_rgb = STATUS_RGB["role"]
         p = np.asarray(point.probe.position_m, dtype=np.float64)
         n = np.asarray(point.probe.normal, dtype=np.float64)
         base = f"/wobj/points/{point.id}"
@@ -211,7 +214,7 @@ class PlanScene:
             self._scene.add_icosphere(
                 f"{base}/marker",
                 radius=MARKER_RADIUS_M * (1.5 if selected else 1.0),
-                color=SELECTED_RGB if selected else rgb,
+                color=SELECTED_RGB if selected else marker_rgb,
                 subdivisions=2,
                 position=p,
             ),

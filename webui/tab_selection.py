@@ -1,14 +1,14 @@
 """Each browser tab's own selection: the selected point, its settings widgets and its highlight.
 
 The plan (points, edits, statuses, undo) is shared by every tab; what depends on the
-selection is per tab: the **Selected** dropdown and the selected point's settings (Role,
-Search, Start offset, Overtravel, Edge direction, Apply settings, Delete point) are widgets of
-the tab's own GUI (``client.gui``) inside the Points tab's shared "Selected point" folder, and
-the highlight (a blue sphere over the marker) is a node of the tab's own scene
-(``client.scene``). :class:`Selections` keeps them, follows every edit of the plan (a point
-deleted in another tab clears this tab's selection; a point moved there moves the highlight),
-and answers which point a tab has selected. The robot's pose per tab is
-:class:`webui.tab_robots.TabRobots`'s.
+selection is per tab: the **Selected** dropdown, the selected point's details (every cause of
+its status, :func:`webui.status_table.details_markdown`) and its settings (Role, Search, Start
+offset, Overtravel, Edge direction, Apply settings, Delete point) are widgets of the tab's own
+GUI (``client.gui``) inside the Points tab's shared "Selected point" folder, and the highlight
+(a blue sphere over the marker) is a node of the tab's own scene (``client.scene``).
+:class:`Selections` keeps them, follows every edit of the plan (a point deleted in another tab
+clears this tab's selection; a point moved there moves the highlight), and answers which point
+a tab has selected. The robot's pose per tab is :class:`webui.tab_robots.TabRobots`'s.
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ from calib.frames import transform_points
 from webui import plan_doc
 from webui.plan_doc import NO_ROLE, UiPlan
 from webui.scene import MARKER_RADIUS_M, SELECTED_RGB
+from webui.status_table import details_markdown
 
 if TYPE_CHECKING:
     from webui.context import AppContext
@@ -67,6 +68,8 @@ class TabSelection:
         gui = client.gui
         with folder:
             self.selected = gui.add_dropdown("Selected", (NONE, *doc.ids), initial_value=NONE)
+            #: every cause of the selected point's status, its position and search
+            self.details = gui.add_markdown("")
             self.position_mm = gui.add_vector3(
                 "Position (mm)",
                 (0.0, 0.0, 0.0),
@@ -93,8 +96,8 @@ class TabSelection:
         self.delete.on_click(lambda ev: self._guard(self.delete_selected))
         #: the widgets that describe the selected point (hidden while none is selected)
         self.settings = (
-            self.position_mm, self.normal, self.role, self.kind, self.start_mm, self.over_mm,
-            self.edge_dir, self.apply, self.delete,
+            self.details, self.position_mm, self.normal, self.role, self.kind, self.start_mm,
+            self.over_mm, self.edge_dir, self.apply, self.delete,
         )  # fmt: skip
         self._show_fields(False)
 
@@ -133,7 +136,19 @@ class TabSelection:
             self._show_fields(self.point_id in doc.ids)
         finally:
             self._syncing = False
+        self.show_details(doc)
         self._highlight(doc)
+
+    def show_details(self, doc: UiPlan) -> None:
+        """Show every cause of the selected point's status (its latest check and role flag),
+        its position and its search (:func:`webui.status_table.details_markdown`)."""
+        pid = self.point_id
+        content = ""
+        if pid is not None and pid in doc.ids:
+            flag = self._app.flags.by_point.get(pid, "")
+            content = details_markdown(doc.get(pid), self._app.check_of(pid), flag)
+        if self.details.content != content:
+            self.details.content = content
 
     def _show_settings(self, point: plan_doc.UiPoint) -> None:
         s = point.probe.search
@@ -309,6 +324,13 @@ class Selections:
                 tab.point_id = point_id
         for tab in tabs:
             tab.show(doc, settings=True)
+
+    def show_details(self, doc: UiPlan) -> None:
+        """Refresh every tab's details of its selected point (after new checks)."""
+        with self._lock:
+            tabs = list(self._tabs.values())
+        for tab in tabs:
+            tab.show_details(doc)
 
     def follow(self, doc: UiPlan, changed: set[str]) -> list[int]:
         """Follow an edit of the plan in every tab: a deleted point is no longer selected, a

@@ -1,6 +1,7 @@
 """The "Teach" panel: jog the robot and teach its pose as a probe point's approach or a via.
 
-Joint sliders (deg, within the URDF's limits) and a TCP gizmo driven by the inverse kinematics
+Joint sliders (deg, within the URDF's limits; coarse), a typed value and fine steps per joint
+(:mod:`webui.joint_jog`) and a TCP gizmo driven by the inverse kinematics
 (the solution nearest the current joint values, so the arm keeps its branch) move the drawn
 robot; after every move the joint limits and the clearance of the whole robot are checked in
 the cell (on the cell worker) and shown at once. **Teach pose** puts a probe point where the
@@ -36,7 +37,9 @@ from calib.plan.cell import Pose
 from calib.plan.vias import ViaPoint
 from webui import plan_doc
 from webui.backend import JogStatus
+from webui.joint_jog import FineJog
 from webui.moves_view import ViaView, draw_moves
+from webui.search_room import new_point_overtravel_cap_m
 
 if TYPE_CHECKING:
     from webui.context import AppContext
@@ -68,6 +71,7 @@ class TeachPanel:
         with app.tab("Teach"):
             gui.add_markdown("Jog the robot; teach the pose as a point's approach.")
             self.joints = gui.add_folder("Joints (deg)")
+            self.fine = FineJog(app, self.jog, lambda: self.q)
             self.status_md = gui.add_markdown("")
             self.from_point = gui.add_button("Jog to selected point")
             self.drag_tcp = gui.add_checkbox("Drag TCP (IK)", False)
@@ -145,6 +149,7 @@ class TeachPanel:
             s.remove()
         self.sliders = []
         if view is None or view.chain is None:
+            self.fine.build(None, np.zeros(0))
             return
         chain = view.chain
         robot = self._app.robot
@@ -162,6 +167,7 @@ class TeachPanel:
                 slider.on_update(self._on_slider)
                 self.sliders.append(slider)
         self.q = np.asarray(q0, dtype=np.float64)
+        self.fine.build(chain, self.q)
         self._refresh_targets()
 
     def _on_slider(self, event: Any) -> None:
@@ -184,6 +190,7 @@ class TeachPanel:
             for s, v in zip(self.sliders, np.degrees(qa), strict=True):
                 if abs(float(s.value) - v) > 1e-6:
                     s.value = float(np.clip(round(v, 3), s.min, s.max))
+        self.fine.show(qa)
         with self._app.busy("checking the jogged pose"):
             status: JogStatus = self._app.worker.call(lambda s: s.jog_status(qa))
         self.last_status = status
@@ -322,8 +329,14 @@ class TeachPanel:
         doc = self._app.state.doc
         pid = plan_doc.next_id(doc) if target == NEW_POINT else target
 
+        cap = new_point_overtravel_cap_m(
+            view, picker, doc.source, hit.position_wobj, hit.normal_wobj
+        )
+
         def edit(d: plan_doc.UiPlan) -> plan_doc.UiPlan:
-            d = plan_doc.place_point(d, pid, hit.position_wobj, hit.normal_wobj)
+            d = plan_doc.place_point(
+                d, pid, hit.position_wobj, hit.normal_wobj, max_overtravel_m=cap
+            )
             s = d.get(pid).probe.search
             if start < MIN_START_M:  # the TCP is at or inside the surface: keep the offset
                 return d

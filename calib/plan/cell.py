@@ -140,15 +140,20 @@ class ToolSpec(Strict, frozen=True, kw_only=True):
 
 
 class FixtureSpec(Strict, frozen=True, kw_only=True):
-    """A fixed obstacle (table, fixture) for collision checks: a mesh or a box.
+    """A fixed obstacle (table, fixture) for collision checks: a mesh, a box or a cylinder.
 
     Attributes:
         name: unique fixture name.
-        mesh: mesh file (relative to the plan) or ``builtin:NAME``; ``None`` for a box.
-        box_size_m: ``(3,)`` edge lengths of a box centred on its frame, m; ``None`` for a mesh.
+        mesh: mesh file (relative to the plan) or ``builtin:NAME``; ``None`` for a box or a
+            cylinder.
+        box_size_m: ``(3,)`` edge lengths of a box centred on its frame, m; ``None`` for a mesh
+            or a cylinder.
         units: length unit of the mesh file.
         sha256: hex digest of the mesh file, checked on load (``None``: not checked).
-        T_world_fixture: pose of the mesh (or box centre) frame in the world frame.
+        T_world_fixture: pose of the mesh (or box or cylinder centre) frame in the world frame.
+        cylinder_m: ``(radius, length)`` of a cylinder about its frame's z axis, centred on its
+            frame, m. Left out (default) for a mesh or a box, so plans written before it keep
+            their bytes and digest. Read it through :attr:`cylinder`.
     """
 
     name: str
@@ -157,20 +162,42 @@ class FixtureSpec(Strict, frozen=True, kw_only=True):
     units: MeshUnits = "m"
     sha256: str | None = None
     T_world_fixture: Pose = Pose()
+    cylinder_m: tuple[float, float] | msgspec.UnsetType = msgspec.UNSET
 
     def __post_init__(self) -> None:
-        if (self.mesh is None) == (self.box_size_m is None):
-            raise PlanError("mesh: give exactly one of mesh and box_size_m")
+        given = [self.mesh is not None, self.box_size_m is not None, self.cylinder is not None]
+        if sum(given) != 1:
+            raise PlanError("mesh: give exactly one of mesh, box_size_m and cylinder_m")
+        if self.mesh is not None:
+            check_sha256(self.sha256, self.mesh, "sha256")
+            return
         if self.box_size_m is not None:
-            if not all(math.isfinite(v) and 0 < v <= COORDINATE_LIMIT_M for v in self.box_size_m):
-                raise PlanError(
-                    f"box_size_m: must be 3 lengths > 0 and <= {COORDINATE_LIMIT_M:g} m, "
-                    f"got {list(self.box_size_m)}"
-                )
-            if self.sha256 is not None:
-                raise PlanError("sha256: must be null for a box")
-        else:
-            check_sha256(self.sha256, self.mesh or "", "sha256")
+            _check_lengths(self.box_size_m, "box_size_m", "3 lengths")
+        if self.cylinder is not None:
+            _check_lengths(self.cylinder, "cylinder_m", "(radius, length)")
+        if self.sha256 is not None:
+            raise PlanError(f"sha256: must be null for a {self.shape}")
+
+    @property
+    def cylinder(self) -> tuple[float, float] | None:
+        """``(radius, length)``, m, when the fixture is a cylinder, else ``None``."""
+        return None if isinstance(self.cylinder_m, msgspec.UnsetType) else self.cylinder_m
+
+    @property
+    def shape(self) -> str:
+        """``"mesh"``, ``"box"`` or ``"cylinder"``."""
+        if self.mesh is not None:
+            return "mesh"
+        return "box" if self.box_size_m is not None else "cylinder"
+
+
+def _check_lengths(values: tuple[float, ...], field: str, what: str) -> None:
+    """Raise :class:`PlanError` unless every value is a length > 0 and at most the coordinate
+    limit, m."""
+    if not all(math.isfinite(v) and 0 < v <= COORDINATE_LIMIT_M for v in values):
+        raise PlanError(
+            f"{field}: must be {what} > 0 and <= {COORDINATE_LIMIT_M:g} m, got {list(values)}"
+        )
 
 
 class CellSpec(Strict, frozen=True, kw_only=True):

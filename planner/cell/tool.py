@@ -26,16 +26,22 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
+from typing import Any
 
+import msgspec
 import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
+from calib.errors import InputError
 from calib.frames import check_transform, make_transform, matrix_from_rotvec
+from calib.plan.cell import Pose
+from calib.plan.json_io import reword_validation_error
 from calib.reading import MAX_JSON_BYTES, read_bytes_capped
 from calib.tolerances import ROLE_NORMAL_TOL_RAD
 from planner.builtins import is_builtin, tool_description
 from planner.cell.bodies import BodyLinks, load_urdf_body, mesh_collision_shape, static_body
+from planner.cell.workobject import load_work_object
 from planner.errors import MeshError, ToolMountError, UnknownFrameError, URDFError
 from planner.robot.kinematics.chain import KinematicChain
 from planner.robot.urdf import load_urdf
@@ -233,16 +239,42 @@ class Tool:
         return static_body(client, shape, np.eye(4), self.name)
 
 
+#: The tool description's schema tag (optional in the file).
+TOOL_SCHEMA = "wobjcal.tool/1"
+#: The keys a tool description JSON may hold (any other is refused, naming it).
+DESCRIPTION_KEYS = (
+    "schema",
+    "name",
+    "urdf",
+    "tcps",
+    "sensor_tcp",
+    "sensor_links",
+    "mesh",
+    "units",
+    "tcp_frames",
+)
+
+
 def load_tool(spec: str | Path | Tool) -> Tool:
     """A tool from ``"builtin:<name>"``, a tool description ``.json``, a ``.urdf`` or a Tool.
 
-    A description JSON holds ``urdf`` (relative to the JSON), ``tcps``, ``sensor_tcp``,
-    and ``sensor_links``. The sensor itself (sensing distance, face) is the plan's
+    A description JSON (``"schema": "wobjcal.tool/1"``, optional) describes either
+
+    - a URDF tool: ``urdf`` (relative to the JSON), ``tcps`` (link names), ``sensor_tcp``
+      and ``sensor_links``; or
+    - a mesh tool (:meth:`Tool.from_mesh`): ``mesh`` (a file in the JSON's folder, in the
+      flange frame), ``units`` (``m`` default, ``mm``, ``cm``, ``in``, ``auto``),
+      ``tcp_frames`` (``{name: {"position_m": [x, y, z], "quat_wxyz": [w, x, y, z]}}``,
+      ``T_flange_tcp``), ``sensor_tcp``, and ``sensor_links`` (empty, or the tool's
+      ``name``: its whole convex hull may then touch the work object, as a sensor does).
+
+    The sensor itself (sensing distance, face) is the plan's
     :class:`calib.models.ProximitySensor`, not part of the tool.
 
     Raises:
-        UnknownFrameError: unknown built-in name.
-        URDFError: the file is missing or malformed.
+        UnknownFrameError: unknown built-in name, or a ``sensor_tcp`` that is not a TCP.
+        URDFError: the file is missing or malformed (the message names the key).
+        MeshError: a mesh tool's mesh is missing, unreadable or empty.
     """
     if isinstance(spec, Tool):
         return spec
@@ -251,16 +283,138 @@ def load_tool(spec: str | Path | Tool) -> Tool:
         return Tool.from_urdf(path)
     if not path.exists():
         raise URDFError(f"tool description not found: {path}")
+    desc = _read_description(path)
+    if "mesh" in desc:
+        return _mesh_tool(path, desc)
     try:
-        desc = json.loads(read_bytes_capped(path, MAX_JSON_BYTES, "tool description", URDFError))
         tool = Tool.from_urdf(
             path.parent / desc["urdf"],
             tcps=list(desc["tcps"]),
             sensor_tcp=desc.get("sensor_tcp"),
             sensor_links=tuple(desc.get("sensor_links", ())),
         )
-    except (json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
+    except (KeyError, TypeError, ValueError) as exc:
         if isinstance(exc, URDFError):
             raise
         raise URDFError(f"malformed tool description {path}: {exc!r}") from None
     return Tool(**{**tool.__dict__, "name": desc.get("name", tool.name)})
+
+
+def _read_description(path: Path) -> dict[str, Any]:
+    """The JSON object of a tool description, its keys checked."""
+    try:
+        desc = json.loads(read_bytes_capped(path, MAX_JSON_BYTES, "tool description", URDFError))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise URDFError(f"tool description {path} is not JSON: {exc}") from None
+    if not isinstance(desc, dict):
+        raise URDFError(f"tool description {path} must hold a JSON object, got {type(desc)}")
+    unknown = sorted(set(desc) - set(DESCRIPTION_KEYS))
+    sensor_keys = [k for k in unknown if k.startswith("sens")]
+    if sensor_keys:
+        raise URDFError(
+            f"tool description {path}: {sensor_keys[0]!r}: the sensor's numbers are the plan's "
+            "validation.sensor (the UI's Cell tab, Sensor), not the tool's; leave it out"
+        )
+    if unknown:
+        raise URDFError(
+            f"tool description {path}: unknown key {unknown[0]!r} (known: "
+            f"{', '.join(DESCRIPTION_KEYS)})"
+        )
+    if desc.get("schema", TOOL_SCHEMA) != TOOL_SCHEMA:
+        raise URDFError(
+            f"tool description {path}: schema {desc['schema']!r} is not {TOOL_SCHEMA!r}"
+        )
+    if "mesh" in desc and ("urdf" in desc or "tcps" in desc):
+        raise URDFError(
+            f"tool description {path}: give either urdf (with tcps) or mesh (with tcp_frames), "
+            "not both"
+        )
+    if "mesh" not in desc and "urdf" not in desc:
+        raise URDFError(
+            f"tool description {path}: needs urdf (with tcps) or mesh (with tcp_frames)"
+        )
+    return desc
+
+
+def _mesh_tool(path: Path, desc: dict[str, Any]) -> Tool:
+    """A mesh tool from its description ``desc`` read from ``path`` (see :func:`load_tool`)."""
+    where = f"tool description {path}"
+    ref = desc["mesh"]
+    if not isinstance(ref, str) or not ref or Path(ref).is_absolute() or ".." in Path(ref).parts:
+        raise URDFError(
+            f"{where}: mesh must be a file name relative to the description's folder (its "
+            f"folder travels with it), got {ref!r}"
+        )
+    name = desc.get("name", path.stem)
+    if not isinstance(name, str) or not name:
+        raise URDFError(f"{where}: name must be a non-empty string, got {name!r}")
+    frames = desc.get("tcp_frames")
+    if not isinstance(frames, dict) or not frames:
+        raise URDFError(
+            f'{where}: tcp_frames must map TCP names to poses ({{"sensor": {{"position_m": '
+            f'[x, y, z], "quat_wxyz": [w, x, y, z]}}}}), got {frames!r}'
+        )
+    tcps = {}
+    for tcp, raw in frames.items():
+        try:
+            pose = msgspec.convert(raw, Pose, strict=True)
+        except msgspec.ValidationError as exc:
+            raise URDFError(f"{where}: tcp_frames.{tcp}: {reword_validation_error(exc)}") from None
+        except InputError as exc:
+            raise URDFError(f"{where}: tcp_frames.{tcp}: {exc}") from None
+        if tcp == FLANGE:
+            raise URDFError(f"{where}: tcp_frames: {FLANGE!r} is the flange itself, always a TCP")
+        tcps[tcp] = pose.matrix()
+    sensor_tcp = desc.get("sensor_tcp")
+    if sensor_tcp is not None and sensor_tcp not in tcps:
+        raise UnknownFrameError(
+            f"{where}: sensor_tcp {sensor_tcp!r} is not one of tcp_frames {sorted(tcps)}"
+        )
+    links = desc.get("sensor_links", [])
+    if not isinstance(links, list) or any(link != name for link in links):
+        raise URDFError(
+            f"{where}: sensor_links of a mesh tool may only name the tool ({name!r}: one body), "
+            f"got {links!r}"
+        )
+    units = desc.get("units", "m")
+    if not isinstance(units, str):
+        raise URDFError(f"{where}: units must be a string such as 'mm', got {units!r}")
+    mesh = load_work_object(path.parent / ref, units=units, name=name).mesh
+    tool = Tool.from_mesh(mesh, tcps, name=name, sensor_tcp=sensor_tcp)
+    return Tool(**{**tool.__dict__, "sensor_links": tuple(links)})
+
+
+def mesh_tool_description(
+    mesh: str,
+    tcps: Mapping[str, ArrayLike],
+    units: str = "m",
+    sensor_tcp: str | None = None,
+    name: str | None = None,
+    sensor_links: tuple[str, ...] = (),
+) -> str:
+    """The JSON text of a mesh tool's description (:func:`load_tool` reads it back).
+
+    Args:
+        mesh: the mesh file's name, relative to where the description is written.
+        tcps: TCP name -> ``T_flange_tcp`` (4, 4), m.
+        units: the mesh file's length unit.
+        sensor_tcp: the proximity-sensor TCP (one of ``tcps``), if any.
+        name: the tool's name (default: the description file's stem).
+        sensor_links: ``()`` or ``(name,)`` (see :func:`load_tool`).
+
+    Raises:
+        ShapeError, NonFiniteError, DegenerateGeometryError: a TCP frame is not a transform.
+    """
+    frames = {
+        k: msgspec.to_builtins(Pose.from_matrix(check_transform(T, f"tcps[{k!r}]")))
+        for k, T in tcps.items()
+    }
+    desc: dict[str, Any] = {"schema": TOOL_SCHEMA, "mesh": mesh, "units": units}
+    desc["tcp_frames"] = frames
+    if sensor_tcp is not None:
+        desc["sensor_tcp"] = sensor_tcp
+    if name is not None:
+        desc["name"] = name
+    if sensor_links:
+        desc["sensor_links"] = list(sensor_links)
+    return json.dumps(desc, sort_keys=True, indent=2) + "\n"

@@ -92,7 +92,13 @@ def test_unreachable_spot_is_infeasible_with_reason(ui: UiSession) -> None:
     click_until_placed(ui, "Z", target, (target_wobj, [0, -1, 0]))
     check = wait_for(lambda: ui.app.check_of("Z"), what="Z's check")
     assert check.status == "infeasible" and check.reason
-    wait_for(lambda: check.reason in ui.page.inner_text("body"), what="the reason on the page")
+    from webui.status_table import causes, part_note
+
+    # the row's first cause; every cause in the selected point's details, the part's note once
+    for cause in causes(check.reason):
+        wait_for(lambda cause=cause: cause in ui.page.inner_text("body"), what=f"'{cause}'")
+    note = part_note(check.reason)
+    assert not note or ui.page.inner_text("body").count(note) == 1
 
 
 def test_validate_refuses_a_plan_that_cannot_work_naming_the_point(ui: UiSession) -> None:

@@ -198,10 +198,13 @@ def save_screenshot(page: Any, name: str, tmp_path: Path) -> Path:
 
     from calib.atomic_io import write_bytes_atomic
 
-    page.add_style_tag(content=".mantine-Notification-root { display: none !important; }")
+    hidden = page.add_style_tag(content=".mantine-Notification-root { display: none !important; }")
     rendered(page)
     shot = tmp_path / name
     page.screenshot(path=str(shot))
+    # shown again: a hidden notification cannot be closed (close_notifications then waited
+    # 5 s on each of 50 tries) and fills the page's stack
+    hidden.evaluate("e => e.remove()")
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     write_bytes_atomic(ARTIFACTS / name, shot.read_bytes())
     if os.environ.get("WOBJCAL_UPDATE_SCREENSHOTS") == "1":

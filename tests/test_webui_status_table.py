@@ -1,0 +1,96 @@
+"""The points' status table (issue 22, item 6): one row per point with an icon, a short first
+cause without the part's repeated size note, details on demand; the role flag never hides an
+infeasible point."""
+
+from __future__ import annotations
+
+import math
+
+from calib.probing import ProbePoint
+from planner.check import PointCheck
+from webui.plan_doc import UiPlan, UiPoint
+from webui.scene import STATUS_RGB
+from webui.status_table import (
+    SHORT_CHARS,
+    causes,
+    details_markdown,
+    first_cause,
+    part_note,
+    shorten,
+    status_cell,
+    strip_part_note,
+    table_rows,
+)
+
+NOTE = "work object plate: 0.203 x 0.305 x 0.0127 m (file units 'm', given)"
+REACH = f"out of reach (2.87 m from the shoulder) ({NOTE})"
+PATH = (
+    "search path: search from the safe start at 46.0 mm: sensor_body is too near table "
+    "(clearance 4.7 mm)"
+)
+
+
+def _check(pid: str, status: str, reason: str) -> PointCheck:
+    return PointCheck(
+        point_id=pid, role="primary", kind="approach", status=status,  # type: ignore[arg-type]
+        reason=reason, pose_status=status, pose_reason="",  # type: ignore[arg-type]
+        path_feasible=True, path_reason="", path_fail_at_m=math.nan, face_reason="",
+        clearance_m=0.0123, clearance_pair=("link_6", "table"), clearance_is_lower_bound=False,
+        confdata=None, ik_kind="opw", q=None, q_path=None, T_base_flange=None,
+    )  # fmt: skip
+
+
+def _doc() -> UiPlan:
+    pts = tuple(
+        UiPoint(ProbePoint(pid, (0.01 * k, 0.0, 0.0), (0.0, 0.0, 1.0)), role=role)
+        for k, (pid, role) in enumerate((("P1", "primary"), ("P2", "primary"), ("S1", "")))
+    )
+    return UiPlan(points=pts, roles=("primary", "secondary", "tertiary"))
+
+
+def test_the_part_note_is_said_once_not_in_every_reason() -> None:
+    assert strip_part_note(REACH) == "out of reach (2.87 m from the shoulder)"
+    assert part_note(REACH) == NOTE
+    assert causes(f"{REACH}; {PATH}") == ["out of reach (2.87 m from the shoulder)", PATH]
+    assert part_note(PATH) == ""
+
+
+def test_the_first_cause_is_short_and_cut_at_a_word() -> None:
+    short = shorten(PATH)
+    assert len(short) <= SHORT_CHARS + 2 and short.endswith(" …")
+    assert PATH.startswith(short[:-2])
+    assert shorten("joint 3 at limit (joint_3)") == "joint 3 at limit (joint_3)"
+
+
+def test_rows_have_an_icon_a_short_cause_and_infeasible_wins_over_the_role_flag() -> None:
+    doc = _doc()
+    checks = {
+        "P1": _check("P1", "infeasible", f"{REACH}; {PATH}"),
+        "P2": _check("P2", "feasible", ""),
+    }
+    flags = {"P1": "role P1 is odd", "P2": "three_two_one: P2 must have normal (0, 0, 1)"}
+    rows = table_rows(doc, checks, flags, "(none)")
+    assert len(rows) == 2 + 3, "one row per point"
+    p1, p2, s1 = rows[2:]
+    assert "✗</span> infeasible" in p1 and "**role**" in p1
+    assert "| P1 | primary | out of reach (2.87 m from the shoulder) |" in p1
+    assert "file units" not in "\n".join(rows)
+    assert "✓</span> feasible" in p2 and "must have normal" in p2, "the flag says why"
+    assert "| S1 | (none) |" in s1 and "checking..." in s1
+    r, g, b = STATUS_RGB["infeasible"]
+    assert f"rgb({r},{g},{b})'>✗" in status_cell(checks["P1"], flags["P1"])
+    assert first_cause(checks["P2"], "") == ""
+
+
+def test_details_give_every_cause_the_note_once_and_the_point() -> None:
+    doc = _doc()
+    check = _check("P1", "infeasible", f"{REACH}; {PATH}")
+    md = details_markdown(doc.get("P1"), check, "")
+    lines = md.splitlines()
+    assert lines[0].startswith("**P1**: ") and "infeasible" in lines[0]
+    assert "- out of reach (2.87 m from the shoulder)" in lines
+    assert any("sensor\\_body is too near table" in line for line in lines)
+    assert md.count("file units") == 1 and f"- part: {NOTE}".replace("_", "\\_") in lines
+    assert "- clearance 12.3 mm (link\\_6 – table)" in lines
+    assert "- at (0.0, 0.0, 0.0) mm, normal (0.000, 0.000, 1.000), wobj frame" in lines
+    assert "- approach search: start 30.0 mm, overtravel 20.0 mm" in lines
