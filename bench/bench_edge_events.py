@@ -83,7 +83,7 @@ def _events(n_rays: int, between: bool, angles: np.ndarray) -> dict[str, float]:
 
 def _thin_box(trials: int) -> dict[str, Any]:
     from planner.suggest import suggest_plan
-    from planner.validate import validate_plan
+    from planner.validate.job import validate_plan
 
     folder = Path(tempfile.mkdtemp(prefix="wobjcal_bench_"))
     box = trimesh.creation.box(extents=(200.0, 300.0, 10.0))

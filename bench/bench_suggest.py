@@ -2,7 +2,7 @@
 
 1. Speed: ``suggest_plan`` of the shipped A-H plan's cell (target 0.3 mm), against the
    reference measured in the same run: one ``check_plan`` of the same plan (its cell opened
-   the same way). Also the live layout quality (``planner.check.plan_quality``, what the UI
+   the same way). Also the live layout quality (``planner.check.job.plan_quality``, what the UI
    runs after a point moves): ms per change over ``--moves`` moved points.
 2. The stator comparison at the paper's eight points: the suggestion (best fit, 8 points)
    against the hand-placed A-H, predicted (the procedure linearised) and simulated
@@ -31,9 +31,9 @@ import numpy as np
 
 from bench.result_file import write_result
 from calib.plan.file import load_plan
-from planner.check import check_plan, plan_quality
+from planner.check.job import check_plan, plan_quality
 from planner.suggest import suggest_plan
-from planner.validate import validate_plan
+from planner.validate.job import validate_plan
 
 ROOT = Path(__file__).resolve().parent.parent
 PLANS = ROOT / "assets" / "plans"
@@ -122,7 +122,7 @@ def _plate(trials: int) -> dict[str, Any]:
     """The machined plate (``plate_holes_best_fit.json``, touch probe, 10 hand-placed points):
     the suggestion at the same number of points against the hand-made plan, predicted and
     simulated (``validate_plan``, ``trials``), at the plan's point of interest."""
-    from planner.validate_checks import check_simulatable, work_object_mesh
+    from planner.check.simulatable import check_simulatable, work_object_mesh
 
     hand = load_plan(PLANS / "plate_holes_best_fit.json")
     mesh = work_object_mesh(hand, PLANS, check_simulatable(hand))
@@ -172,7 +172,7 @@ def main(argv: list[str] | None = None) -> int:
     out["large_part"] = _large_part(ah)
 
     # live quality: move one point of the A-H plan by a few mm, as a drag in the UI
-    from planner.validate_checks import check_simulatable, work_object_mesh
+    from planner.check.simulatable import check_simulatable, work_object_mesh
 
     mesh = work_object_mesh(ah, PLANS, check_simulatable(ah))
     rng = np.random.default_rng(13)

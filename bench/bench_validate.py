@@ -41,7 +41,7 @@ from planner.parts.stator_demo import nominal_T_base_wobj, stator_ah_points
 from planner.parts.stator_mesh import build_stator_mesh
 from planner.sim.montecarlo import validate
 from planner.sim.raycast import MeshRayCaster
-from planner.validate import validate_plan
+from planner.validate.job import validate_plan
 
 RESULTS = Path(__file__).resolve().parent / "results"
 PLATE_PLAN = (

@@ -66,8 +66,8 @@ def stator_plan() -> Plan:
 
 def stator_plan_text() -> str:
     """The canonical JSON of :func:`stator_plan` with the via points its moves between points
-    need in the demo cell (:func:`planner.move_vias.plan_with_vias`; opens the cell)."""
-    from planner.move_vias import plan_with_vias
+    need in the demo cell (:func:`planner.check.vias.plan_with_vias`; opens the cell)."""
+    from planner.check.vias import plan_with_vias
     from planner.plan_cell import open_cell
 
     plan = stator_plan()

@@ -2,7 +2,7 @@
 
 The cell (PyBullet) is opened only by :func:`open_cell`, which imports it there: the command
 line imports this module, and ``wobjcal --help`` must not load PyBullet. The calibration from
-measured points is in :mod:`planner.calibrate`.
+measured points is in :mod:`planner.calibrate.job`.
 """
 
 from __future__ import annotations

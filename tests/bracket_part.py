@@ -204,7 +204,7 @@ def bracket_plans(
     Made as a user makes them: the shipped plate plan loaded as the template, its work
     object, sensor, misplacement, points and procedure replaced (``msgspec.structs.replace``);
     with ``vias``, the via points ``wobjcal check --add-vias`` adds where a joint move between
-    points collides (:func:`planner.move_vias.plan_with_vias`: the check names those moves and
+    points collides (:func:`planner.check.vias.plan_with_vias`: the check names those moves and
     says to); saved beside the mesh and loaded back (digest checked).
 
     Returns:
@@ -253,7 +253,7 @@ def bracket_plans(
 def with_vias(plan: Plan, folder: Path) -> Plan:
     """``plan`` with the vias ``wobjcal check --add-vias`` adds (its cell opened from
     ``folder``)."""
-    from planner.move_vias import plan_with_vias
+    from planner.check.vias import plan_with_vias
     from planner.plan_cell import open_cell
 
     with open_cell(plan, folder) as cell:

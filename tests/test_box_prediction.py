@@ -14,7 +14,7 @@ from __future__ import annotations
 import pytest
 
 from bench.box_plans import POINT_SENSOR, agreement, box_mesh, box_plans
-from planner.validate import validate_plan
+from planner.validate.job import validate_plan
 
 TRIALS = 800
 #: Three standard errors of a standard deviation from TRIALS trials.

@@ -80,7 +80,7 @@ class _Runs:
         return self._cache[key]
 
     def check(self, procedure: str, fmt: str) -> Any:
-        from planner.check import check_plan
+        from planner.check.job import check_plan
 
         plan = self.plans[procedure]
         return self._once(("check", procedure, fmt), lambda: check_plan(plan, self.folder, fmt=fmt))
@@ -91,7 +91,7 @@ class _Runs:
         )
 
     def validate_plan(self, plan: Plan, fmt: str) -> Any:
-        from planner.validate import validate_plan
+        from planner.validate.job import validate_plan
 
         return validate_plan(
             plan, trials=TRIALS, seed=SEED, workers=1, plan_dir=self.folder, fmt=fmt
@@ -288,7 +288,7 @@ def test_suggest_gives_a_layout_that_validates_or_says_what_stops_it(
             or "no layout exists" in msg
         )
         return
-    from planner.check import check_plan
+    from planner.check.job import check_plan
 
     check = check_plan(res.plan, runs.folder, fmt=fmt)
     assert check.feasible, [(p.point_id, p.reason) for p in check.points if not p.feasible]
@@ -311,7 +311,7 @@ def test_suggest_gives_a_layout_that_validates_or_says_what_stops_it(
     ),
 )
 def test_suggest_finds_a_best_fit_for_the_adaptive_program(runs: _Runs) -> None:
-    from planner.check import check_plan
+    from planner.check.job import check_plan
 
     three = runs.suggest("three_two_one", "rapid")
     as_fit = msgspec.structs.replace(

@@ -1,4 +1,4 @@
-"""Tests of planner.check: the procedure's preconditions, and the facts the check shows."""
+"""Tests of planner.check.job: the procedure's preconditions, and the facts the check shows."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from calib.plan.file import load_plan
-from planner.check import check_plan, layout_problem
+from planner.check.job import check_plan, layout_problem
 from planner.cli.main import main
 
 REPO = Path(__file__).resolve().parent.parent

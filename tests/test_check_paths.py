@@ -1,4 +1,4 @@
-"""``wobjcal check`` walks the searches the exported program runs (:mod:`planner.check_paths`):
+"""``wobjcal check`` walks the searches the exported program runs (:mod:`planner.check.paths`):
 from the safe start, with the probe pose's orientation and configuration."""
 
 from __future__ import annotations
@@ -12,9 +12,9 @@ import pytest
 
 from calib.frames import transform_points
 from calib.plan import Plan, load_plan
-from planner.check import check_plan
-from planner.check_paths import check_program_path, measured_starts_wobj
-from planner.export_plan import export_job_for, with_arm_poses
+from planner.check.job import check_plan
+from planner.check.paths import check_program_path, measured_starts_wobj
+from planner.export_plan.job import export_job_for, with_arm_poses
 from planner.plan_cell import nominal_T_base_wobj, open_cell
 from planner.program.build import safety_spec
 from planner.program.searches import program_searches, safe_and_face_wobj

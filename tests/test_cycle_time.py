@@ -27,9 +27,9 @@ from calib.plan.file import Plan, load_plan, plan_digest, plan_from_json, plan_t
 from calib.probing import ProbePoint, SearchSpec
 from calib.procedures import RolePoint
 from calib.procedures.best_fit import BestFit
-from planner.check import PlanCheck, check_plan
-from planner.check_cycle import urdf_joint_velocities
-from planner.export_plan import export_program
+from planner.check.cycle import urdf_joint_velocities
+from planner.check.job import PlanCheck, check_plan
+from planner.export_plan.job import export_program
 from planner.program.build import build_program
 from planner.program.controllers import CONTROLLERS
 from planner.program.cycle_time import (

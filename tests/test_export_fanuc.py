@@ -33,7 +33,7 @@ from planner.export.job import (
     build_job,
     default_sensor_rotation,
 )
-from planner.export_plan import export_job_for
+from planner.export_plan.job import export_job_for
 from tests.box_part import BoxProbe, distance_to_box
 from tests.fanuc_interp import (
     COMMENT,
@@ -511,8 +511,8 @@ def test_fanuc_config_of_a_fanuc_arm_in_fanuc_joint_directions(tmp_path: Path) -
 def test_fanuc_config_comes_from_the_checked_pose(tmp_path: Path) -> None:
     """The shipped plan: every position's CONFIG is its own IK solution's next to the checked
     pose, the same flags as the check's ABB confdata on this ABB-like arm (cfx bits)."""
-    from planner.check import check_plan
-    from planner.export_plan import export_program
+    from planner.check.job import check_plan
+    from planner.export_plan.job import export_program
 
     plan = _no_vias(load_plan(STATOR))
     result = export_program(plan, STATOR.parent, "fanuc")

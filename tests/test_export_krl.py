@@ -135,8 +135,8 @@ def test_krl_targets_carry_the_status_and_turn_of_the_checked_pose() -> None:
     import re
 
     from calib.plan.file import load_plan
-    from planner.check import check_plan
-    from planner.export_plan import export_program
+    from planner.check.job import check_plan
+    from planner.export_plan.job import export_program
 
     plan = load_plan(STATOR)
     dat = export_program(plan, STATOR.parent, "krl").files[".dat"]

@@ -6,7 +6,7 @@ wobjcal version, for which plan (its name and digest).
 
 One mutated plate plan (P1 moved 1 m out of reach: no pose at all; S1's overtravel cut to
 0.5 mm: a pose, but a search that may stop short of the part) is checked in one cell shared by
-every export here: ``wobjcal export`` opens it through ``planner.export_plan.open_cell``.
+every export here: ``wobjcal export`` opens it through ``planner.export_plan.job.open_cell``.
 """
 
 from __future__ import annotations
@@ -71,7 +71,7 @@ def infeasible(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Path,
         def shared(*_: Any) -> Iterator[Any]:
             yield cell
 
-        mp.setattr("planner.export_plan.open_cell", shared)
+        mp.setattr("planner.export_plan.job.open_cell", shared)
         yield path, plan, cell
 
 

@@ -6,14 +6,18 @@ under ``TYPE_CHECKING`` all count. ``docs/ARCHITECTURE.md`` draws the same layer
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from tests.import_graph import Edge, cycles, edges, modules
 
-#: Plan-level jobs: the modules directly in ``planner/`` that the CLI, the UI and scripts call.
-JOBS = "planner.<jobs>"
-#: What each part may import (besides itself). A part is a subpackage, a top-level module of
-#: ``planner``, or one of the groups below.
+#: The jobs: one package (or the demo module) each, called by the CLI, the UI and scripts.
+#: ``check`` is the verdict every other job must give the program the robot will run (one
+#: program, many faces): it sits below them, and is the only job another job imports.
+CHECK = "planner.check"
+JOB_NAMES = ("validate", "suggest", "calibrate", "export_plan", "sweep", "demo")
+JOBS = tuple(f"planner.{name}" for name in JOB_NAMES)
 #: Everything below the jobs: what a job may import.
 BELOW_JOBS = {
     "calib",
@@ -27,6 +31,8 @@ BELOW_JOBS = {
     "planner.program",
     "planner.sim",
     "planner.export",
+    "planner.results",
+    "planner.plan_cell",
 }
 ALLOWED: dict[str, set[str]] = {
     "calib": set(),
@@ -41,14 +47,29 @@ ALLOWED: dict[str, set[str]] = {
     "planner.program": {"calib", "planner.errors"},
     "planner.sim": {"calib", "planner.errors", "planner.parts", "planner.faces", "planner.program"},
     "planner.export": {"calib", "planner.errors", "planner.program"},
-    JOBS: BELOW_JOBS,
-    "planner.cli": BELOW_JOBS | {JOBS},
+    "planner.results": {"calib", "planner.errors", "planner.export", "planner.plan_cell"},
+    "planner.plan_cell": {
+        "calib",
+        "planner.errors",
+        "planner.builtins",
+        "planner.robot",
+        "planner.cell",
+        "planner.export",
+    },
+    CHECK: BELOW_JOBS,
+    **{job: BELOW_JOBS | {CHECK} for job in JOBS},
+    "planner.cli": BELOW_JOBS | {CHECK, *JOBS},
     "planner.__main__": {"planner.cli"},
-    "webui": BELOW_JOBS | {JOBS},
+    "webui": BELOW_JOBS | {CHECK, *JOBS},
 }
-SUBPACKAGES = ("robot", "cad", "cell", "faces", "program", "sim", "parts", "export", "cli")
+SUBPACKAGES = (
+    "robot", "cad", "cell", "faces", "program", "sim", "parts", "export", "results", "cli",
+)  # fmt: skip
+TOP_MODULES = ("errors", "builtins", "plan_cell", "__main__")
 #: The one allowed upward import: ``wobjcal ui`` starts the web app, lazily, in one function.
 LAZY_UI = ("planner.cli.misc", "webui", "cmd_ui")
+#: At most this many modules directly in ``planner/`` (``__init__`` and ``__main__`` included).
+MAX_TOP_MODULES = 8
 
 
 def part_of(module: str) -> str:
@@ -59,11 +80,9 @@ def part_of(module: str) -> str:
     if not rest:
         return "planner"
     first = rest.split(".")[0]
-    if first in SUBPACKAGES:
+    if first in (*SUBPACKAGES, *TOP_MODULES, "check", *JOB_NAMES):
         return f"planner.{first}"
-    if first in ("errors", "builtins", "__main__"):
-        return f"planner.{first}"
-    return JOBS
+    raise AssertionError(f"{module}: a module of no known layer (add it to the layers above)")
 
 
 @pytest.fixture(scope="module")
@@ -111,5 +130,19 @@ def test_the_checker_finds_a_circle_and_an_upward_import() -> None:
     ]
     assert cycles(fake) == [["planner.cell.a", "planner.cell.b"]]
     assert part_of("planner.cell.cell") == "planner.cell"
-    assert part_of("planner.check") == JOBS
-    assert JOBS not in ALLOWED[part_of("planner.cell.cell")]  # the cell may not import a job
+    assert part_of("planner.check.job") == CHECK
+    assert part_of("planner.validate.job") == "planner.validate"
+    assert CHECK not in ALLOWED[part_of("planner.cell.cell")]  # the cell may not import a job
+    assert "planner.suggest" not in ALLOWED[part_of("planner.validate.job")]  # nor a job another
+
+
+def test_jobs_are_packages_and_the_top_level_is_small() -> None:
+    """Each job is its own package; ``planner/`` holds at most :data:`MAX_TOP_MODULES` modules."""
+    planner = Path(__file__).resolve().parents[1] / "planner"
+    top = sorted(p.name for p in planner.glob("*.py"))
+    assert len(top) <= MAX_TOP_MODULES, top
+    for name in ("check", *JOB_NAMES):
+        if name != "demo":
+            assert (planner / name / "__init__.py").is_file(), name
+    known = {f"{m}.py" for m in (*TOP_MODULES, "__init__", "demo")}
+    assert set(top) <= known, f"a module of no known layer: {sorted(set(top) - known)}"

@@ -12,10 +12,10 @@ import pytest
 
 from calib.plan.file import Plan, PlanError, load_plan
 from calib.probing import ProbePoint, SearchSpec
-from planner.check import plan_landing_risk
+from planner.check.job import plan_landing_risk
 from planner.program.build import safety_spec
 from planner.program.reach import search_problems
-from planner.validate import check_simulatable, preflight, validate_plan, work_object_mesh
+from planner.validate.job import check_simulatable, preflight, validate_plan, work_object_mesh
 
 PLANS = Path(__file__).resolve().parents[1] / "assets" / "plans"
 PLATE_321 = PLANS / "plate_holes_321.json"

@@ -1,4 +1,4 @@
-"""Layout quality (planner.sim.quality through planner.check.plan_quality): real numbers on
+"""Layout quality (planner.sim.quality through planner.check.job.plan_quality): real numbers on
 the shipped plate plans, a weak layout named as such, a free degree of freedom refused."""
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ import pytest
 
 from calib.estimators.layout import constraint_jacobian
 from calib.plan.file import Plan, load_plan
-from planner.check import plan_quality
-from planner.validate_checks import check_simulatable, work_object_mesh
+from planner.check.job import plan_quality
+from planner.check.simulatable import check_simulatable, work_object_mesh
 
 PLANS = Path(__file__).resolve().parent.parent / "assets" / "plans"
 
@@ -69,7 +69,7 @@ def test_least_squares_closed_form_is_the_linearised_procedure(plate: tuple) -> 
 
 
 def _setup(plan: Plan) -> Any:
-    from planner.validate import prediction_setup
+    from planner.validate.job import prediction_setup
 
     return prediction_setup(plan, check_simulatable(plan))
 
@@ -77,7 +77,7 @@ def _setup(plan: Plan) -> Any:
 def test_poi_half_width_is_the_validation_reports_prediction(plate: tuple) -> None:
     """The quality's error at the point of interest is the number ``wobjcal validate`` puts
     in its predicted column (one definition)."""
-    from planner.validate import validate_plan
+    from planner.validate.job import validate_plan
 
     p321, _, mesh = plate
     q, _ = plan_quality(p321, mesh)

@@ -1,6 +1,6 @@
 """The live layout quality's speed-ups leave its numbers as they were (issue 13).
 
-``planner.check.plan_quality`` of an A-H plan linearises the whole A-H run by central
+``planner.check.job.plan_quality`` of an A-H plan linearises the whole A-H run by central
 differences (21 runs of the procedure). Four cuts made it faster (24.4 -> 13.1 ms of CPU per
 change): the best fit is no longer linearised beside it when only the procedure's covariance is
 wanted, a search command for one frame is built with one product per kind of vector, the ideal
@@ -23,10 +23,10 @@ from calib.plan.file import Plan, load_plan
 from calib.probing import Probe, ProbePoint, ProbeResult, SearchCommand, SearchSpec
 from calib.procedures import procedure_kind
 from calib.procedures.linearize import PlaneProbe, RunFunction, linearize
-from planner.check import plan_quality
+from planner.check.job import plan_quality
+from planner.check.simulatable import check_simulatable, work_object_mesh
 from planner.sim.setup import SimulationSetup
-from planner.validate import prediction_setup
-from planner.validate_checks import check_simulatable, work_object_mesh
+from planner.validate.job import prediction_setup
 
 PLANS = Path(__file__).resolve().parent.parent / "assets" / "plans"
 

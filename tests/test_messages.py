@@ -24,9 +24,9 @@ from calib.frames import make_transform, transform_points
 from calib.plan.file import load_plan, plan_from_json
 from calib.plan.measurements import Measurements, MeasurementsError, measurements_from_json
 from calib.probing import ProbePoint
-from planner.calibrate import calibrate_plan
-from planner.check import base_in_part, plan_detectability
-from planner.check_results import PlanCheck
+from planner.calibrate.job import calibrate_plan
+from planner.check.job import base_in_part, plan_detectability
+from planner.check.results import PlanCheck
 from planner.errors import URDFError
 from planner.plan_cell import default_cell_note, nominal_T_base_wobj
 from planner.robot.urdf import load_urdf

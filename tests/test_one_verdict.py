@@ -25,15 +25,15 @@ import pytest
 from calib.errors import WobjcalError
 from calib.plan.file import Plan, plan_from_json
 from calib.probing import SearchCommand
-from planner.check import check_plan
+from planner.check.job import check_plan
 from planner.cli import main
 from planner.errors import PlanRefused
-from planner.export_plan import export_program
+from planner.export_plan.job import export_program
 from planner.plan_cell import nominal_T_base_wobj, open_cell
 from planner.program import measuring_program
 from planner.program.model import search_keys
 from planner.sim.search_events import ProgramPose, program_search_hook
-from planner.validate import validate_plan
+from planner.validate.job import validate_plan
 
 PLANS = Path(__file__).resolve().parents[1] / "assets" / "plans"
 BASES = ("plate_holes_best_fit.json", "plate_holes_321.json", "stator_section_ah.json")
@@ -285,7 +285,7 @@ def test_the_vetting_turns_the_sensor_with_the_frame_the_search_is_commanded_in(
     for is named, not vetted with a pose no program runs; the x-offset run's searches take D's
     pose (the A-H programs command them with D's orientation)."""
     from calib.frames import make_transform, matrix_from_rotvec
-    from planner.export_plan import export_job_for
+    from planner.export_plan.job import export_job_for
 
     base = "plate_holes_best_fit.json"
     plan, cell = _plan(base, None), cells[base]

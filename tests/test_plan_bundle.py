@@ -282,7 +282,7 @@ def test_file_refs_and_rebased_plan(tmp_path: Path) -> None:
 
 @pytest.mark.slow
 def test_check_gives_the_same_statuses_unpacked(tmp_path: Path, reference_dir: Path) -> None:
-    from planner.check import check_plan
+    from planner.check.job import check_plan
 
     plan = load_plan(PLATE_PLAN)
     unpacked, folder = _unpack(

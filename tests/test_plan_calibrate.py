@@ -1,4 +1,4 @@
-"""Tests of planner.calibrate: calibration from measured points with all three methods."""
+"""Tests of planner.calibrate.job: calibration from measured points with all three methods."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from calib.frames import invert_transform, motion_between, random_transform, tra
 from calib.plan.file import PlanError, load_plan
 from calib.plan.measurements import Measurements, MeasurementsError
 from calib.procedures.three_two_one import THREE_TWO_ONE, pick_roles
-from planner.calibrate import calibrate_plan
+from planner.calibrate.job import calibrate_plan
 from planner.plan_cell import nominal_T_base_wobj
 
 REPO = Path(__file__).resolve().parent.parent
@@ -172,7 +172,7 @@ def test_a_point_1_m_off_is_named_with_best_fit() -> None:
 def test_noise_the_plan_expects_is_not_flagged(method: str, rng: np.random.Generator) -> None:
     """No false alarm: 25 calibrations with Gaussian noise at the plan's sensor and robot
     sigma plus 0.1 mm of face flatness, part misplaced within the plan's bound."""
-    from planner.calibrate import expected_sigma_m
+    from planner.calibrate.job import expected_sigma_m
 
     plan = _ideal_stator()
     T_nom = nominal_T_base_wobj(plan)
@@ -192,7 +192,7 @@ def test_simulated_calibrations_of_the_bulged_stator_are_trusted() -> None:
     """No false alarm on realistic data: the simulated sensor (ray bundle), robot errors and
     the bolted stator's bulged side face of `wobjcal validate`, 12 trials."""
     from planner.sim.trial import TrialRunner
-    from planner.validate import simulation_setup, validation_models, work_object_mesh
+    from planner.validate.job import simulation_setup, validation_models, work_object_mesh
 
     plan = load_plan(STATOR)
     from planner.program import execute

@@ -64,8 +64,8 @@ def test_a_bad_mesh_pose_names_the_field() -> None:
 
 
 def test_check_and_validate_see_the_part_in_the_new_frame(reference_dir: Path) -> None:
-    from planner.check import check_plan
-    from planner.validate_checks import check_simulatable, preflight, work_object_mesh
+    from planner.check.job import check_plan
+    from planner.check.simulatable import check_simulatable, preflight, work_object_mesh
 
     plan = load_plan(PLATE)
     new = plan_in_frame(plan, _frame())

@@ -1,4 +1,4 @@
-"""Tests of ``planner.validate``: the one validation entry point of the CLI and the UI, for any
+"""Tests of ``planner.validate.job``: the one validation entry point of the CLI and the UI, for any
 plan (procedure, sensor, part), and the plans it refuses before the run."""
 
 from __future__ import annotations
@@ -15,7 +15,12 @@ from calib.procedures import BestFit, Iterative
 from planner.cli.main import main
 from planner.cli.validate import report_json
 from planner.program.settings import DEFAULT_EDGE_INSET_M
-from planner.validate import check_simulatable, sensitivity_plan, validate_plan, validation_models
+from planner.validate.job import (
+    check_simulatable,
+    sensitivity_plan,
+    validate_plan,
+    validation_models,
+)
 
 REPO = Path(__file__).resolve().parent.parent
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"

@@ -49,7 +49,7 @@ def test_shipped_plate_plans_equal_the_generator(reference_dir: Path) -> None:
 
 
 def test_every_plate_point_is_reachable_on_its_face(reference_dir: Path) -> None:
-    from planner.check import check_plan
+    from planner.check.job import check_plan
 
     for name in plate_plans():
         res = check_plan(load_plan(PLANS / name), PLANS)

@@ -74,7 +74,7 @@ def test_the_adaptive_order_comes_from_the_procedure_itself() -> None:
 
 
 def test_every_writer_names_its_own_program() -> None:
-    from planner.export_plan import export_program
+    from planner.export_plan.job import export_program
     from planner.plan_cell import open_cell
 
     plan = load_plan(STATOR)
@@ -172,7 +172,7 @@ def test_the_adaptive_rapid_program_measures_what_the_executed_program_measures(
 
 
 def test_a_validate_trial_executes_the_program_of_the_chosen_controller() -> None:
-    from planner.validate import validate_plan
+    from planner.validate.job import validate_plan
 
     plan = load_plan(PLATE_FIT)
     report = validate_plan(plan, trials=4, seed=3, workers=1, plan_dir=PLANS, fmt="fanuc")

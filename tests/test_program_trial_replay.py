@@ -27,7 +27,7 @@ from planner.export import export_files
 from planner.export.job import ToolData, build_job
 from planner.program import execute
 from planner.sim.trial import TrialRunner
-from planner.validate import check_simulatable, simulation_setup, work_object_mesh
+from planner.validate.job import check_simulatable, simulation_setup, work_object_mesh
 from tests.krl_interp import KrlMachine
 from tests.rapid_interp import Machine, _vec
 

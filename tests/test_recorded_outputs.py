@@ -28,7 +28,7 @@ TOL = 1e-9
 #: Fields that differ from run to run (timing, process count) or name the caller's paths.
 VOLATILE = {"elapsed_s", "workers", "plan"}
 #: Fields added on purpose since the recording, allowed in new output only: the one plan check
-#: (``planner.check``) also reports the IK kind, the pose and face parts of the status, where a
+#: (``planner.check.job``) also reports the IK kind, the pose and face parts of the status, where a
 #: path fails and the pair that limits the clearance. Every recorded field must still match.
 ADDED = {
     "ik_kind",

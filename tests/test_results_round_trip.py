@@ -25,7 +25,7 @@ import pytest
 
 from calib.plan.file import Plan, load_plan, plan_digest
 from calib.plan.measurements import Measurements
-from planner.calibrate import calibrate_plan
+from planner.calibrate.job import calibrate_plan
 from planner.export import export_files
 from planner.export.job import ToolData, build_job
 from planner.program import execute

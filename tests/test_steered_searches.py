@@ -252,7 +252,7 @@ def test_validate_runs_the_tight_steered_program_without_a_failed_search() -> No
     """The same tight program simulated on the plate's mesh with the touch probe and the robot's
     noise (``wobjcal validate``): no search starts touching or runs short in any trial (X1 and
     X3 may land near the plate's edges under 20 mm: landings are counted, not failed)."""
-    from planner.validate import validate_plan
+    from planner.validate.job import validate_plan
 
     report = validate_plan(_hard_plate(), trials=40, seed=5, workers=1, plan_dir=PLATE.parent)
     assert report.failures == {}

@@ -223,7 +223,7 @@ def _box_plan(folder: Path, mesh: str, units: str, body: str | None, vias: bool)
         validation=validation,
     )
     if vias:
-        from planner.move_vias import plan_with_vias
+        from planner.check.vias import plan_with_vias
         from planner.plan_cell import open_cell
 
         with open_cell(plan, folder) as cell:
@@ -255,7 +255,7 @@ def box_plans(cad_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Iterat
 
 
 def test_a_plan_on_the_step_box_checks_as_on_its_stl_export(box_plans: dict) -> None:
-    from planner.check import check_plan
+    from planner.check.job import check_plan
 
     folder = box_plans["folder"]
     on_step = check_plan(load_plan(box_plans["step"]), folder)
@@ -268,7 +268,7 @@ def test_a_plan_on_the_step_box_checks_as_on_its_stl_export(box_plans: dict) -> 
 
 
 def test_validate_runs_on_the_step_box(box_plans: dict) -> None:
-    from planner.validate import validate_plan
+    from planner.validate.job import validate_plan
 
     report = validate_plan(
         load_plan(box_plans["step"]), trials=4, seed=3, workers=1, plan_dir=box_plans["folder"]

@@ -26,8 +26,8 @@ def suggested(ah: Plan) -> SuggestResult:
 
 
 def test_suggested_plan_meets_its_target_checked_and_simulated(suggested: SuggestResult) -> None:
-    from planner.check import check_plan
-    from planner.validate import validate_plan
+    from planner.check.job import check_plan
+    from planner.validate.job import validate_plan
 
     res = suggested
     assert res.met and res.worst_m <= 0.3e-3
@@ -91,8 +91,8 @@ def test_plate_suggestion_lands_on_its_faces(reference_dir: Path) -> None:
     (6.35 mm) holds a search only once the top's points have fixed the height and the tilts,
     so the suggestion measures the top first; the plan checks, meets its target, and no
     simulated search lands off its face or partly over an edge or a hole."""
-    from planner.check import check_plan
-    from planner.validate import validate_plan
+    from planner.check.job import check_plan
+    from planner.validate.job import validate_plan
 
     plan = load_plan(ASSETS / "plate_holes_best_fit.json")
     res = suggest_plan(plan, ASSETS, target_m=0.1e-3, max_points=10)

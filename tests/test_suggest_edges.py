@@ -80,9 +80,9 @@ def test_edge_candidates_lie_on_the_top_edges_and_point_out(tmp_path: Path) -> N
 def test_thin_box_is_fixed_by_edge_searches(box_plan: Plan) -> None:
     """The suggestion fixes all six DOF with edge searches, checks, and its Monte Carlo
     agrees with the prediction within 25 % on every row."""
-    from planner.check import check_plan
+    from planner.check.job import check_plan
     from planner.suggest import suggest_plan
-    from planner.validate import validate_plan
+    from planner.validate.job import validate_plan
 
     res = suggest_plan(box_plan, ASSETS, max_points=8)
     pts = res.plan.points

@@ -124,7 +124,7 @@ def fastest_stator(tmp_path_factory: pytest.TempPathFactory) -> tuple[int, Path]
 def test_the_fastest_plan_is_the_program_check_and_export_time(
     fastest_stator: tuple[int, Path],
 ) -> None:
-    from planner.check import check_plan
+    from planner.check.job import check_plan
 
     code, out = fastest_stator
     assert code == 0

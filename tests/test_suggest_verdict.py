@@ -20,7 +20,7 @@ import pytest
 import planner.suggest.job as suggest_mod
 from calib.models import Misplacement
 from calib.plan.file import load_plan
-from planner.check_results import PlanCheck
+from planner.check.results import PlanCheck
 from planner.suggest import SuggestError, suggest_plan
 
 PLANS = Path(__file__).resolve().parents[1] / "assets" / "plans"

@@ -14,7 +14,7 @@ from calib.frames import make_transform, matrix_from_rotvec
 from calib.plan.file import Pose, load_plan
 from planner.builtins import robot_urdf
 from planner.cell.tool import MOUNT_FIELD, flange_axis, tool_mount
-from planner.check import check_plan
+from planner.check.job import check_plan
 from planner.errors import ToolMountError
 from planner.robot.kinematics.chain import KinematicChain
 

@@ -21,9 +21,9 @@ import pytest
 
 from calib.errors import InputError
 from calib.plan import Plan, PlanError, ViaPoint, load_plan, plan_from_json, plan_to_json
-from planner.check import check_plan
+from planner.check.job import check_plan
 from planner.export import FORMATS
-from planner.export_plan import export_program
+from planner.export_plan.job import export_program
 from planner.plan_cell import open_cell
 
 PLANS = Path(__file__).resolve().parents[1] / "assets" / "plans"

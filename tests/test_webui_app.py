@@ -295,7 +295,7 @@ def test_gizmo_sits_outside_the_part_and_a_drag_back_to_the_start_records_nothin
 def test_the_points_table_says_when_the_layout_would_be_refused(app: WobjcalApp) -> None:
     """Issue 10, item 3: the UI shows what `wobjcal check` (and `calibrate`) would refuse, the
     same words as the check's ``layout``."""
-    from planner.check import layout_problem
+    from planner.check.job import layout_problem
     from webui import plan_doc
     from webui.plan_adapter import plan_from_ui
 

@@ -103,7 +103,7 @@ def test_a_new_points_search_stops_short_of_the_table(tmp_path: Path) -> None:
     """With a small misplacement (3 mm, 1 deg) the default overtravel is what the plate and
     the sensor leave (14.7 mm for 12.7 mm, 8 mm sensing), not 20 mm, and the check passes;
     the old 20 mm ran the sensor into the table."""
-    from planner.check import check_points
+    from planner.check.job import check_points
     from planner.plan_cell import open_cell
 
     plan = _plan(tmp_path, Misplacement(max_translation_m=0.003, max_angle_rad=math.radians(1)))

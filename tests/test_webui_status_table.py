@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 
 from calib.probing import ProbePoint
-from planner.check import PointCheck
+from planner.check.job import PointCheck
 from webui.plan_doc import UiPlan, UiPoint
 from webui.scene import STATUS_RGB
 from webui.status_table import (

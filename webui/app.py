@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike
 from calib.errors import InputError
 from calib.plan.file import CellSpec, Plan, WorkObjectSpec
 from calib.probing import ProbePoint
-from planner.check import PointCheck
+from planner.check.job import PointCheck
 from planner.program.cycle_time import CycleTime
 from webui import click_place, clients, plan_doc
 from webui.autosave import AutosaveLock

@@ -21,8 +21,8 @@ from planner.cell.cell import Cell
 from planner.cell.moves import MoveCheck, ViaPath, check_joint_move, check_via_path
 from planner.cell.ray_hit import RayHit, first_hit
 from planner.cell.workobject import load_work_object
-from planner.check import PointCheck, check_points
-from planner.check_cycle import plan_cycle_time
+from planner.check.cycle import plan_cycle_time
+from planner.check.job import PointCheck, check_points
 from planner.plan_cell import open_cell, plan_robot_urdf
 from planner.program.cycle_time import CycleTime
 from planner.robot.kinematics.chain import KinematicChain
@@ -157,7 +157,7 @@ class CellSession:
 
     def check_points(self, points: list[PlanPoint], plan: Plan | None = None) -> list[PointCheck]:
         """Check the probe poses, search paths and planar faces of ``points`` (the session
-        plan's, possibly edited) in the cell: :func:`planner.check.check_points`, the check
+        plan's, possibly edited) in the cell: :func:`planner.check.job.check_points`, the check
         ``wobjcal check`` runs. ``plan``: the plan as edited now (its points set the safe
         starts' pivot; default the session's)."""
         if not points or self.cell is None:
@@ -166,7 +166,7 @@ class CellSession:
 
     def cycle_time(self, plan: Plan, checks: list[PointCheck]) -> CycleTime | None:
         """The estimated cycle time of ``plan``'s program (the default controller's) from the
-        poses of ``checks``: :func:`planner.check_cycle.plan_cycle_time`, what ``wobjcal check``
+        poses of ``checks``: :func:`planner.check.cycle.plan_cycle_time`, what ``wobjcal check``
         prints; ``None`` without a cell or a program."""
         if self.cell is None:
             return None

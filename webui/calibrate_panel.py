@@ -1,6 +1,6 @@
 """The "Calibrate" panel: upload points measured on the robot, see the calibrated WOCS frame.
 
-Thin over ``planner.calibrate.calibrate_plan`` (what ``wobjcal calibrate`` runs): the
+Thin over ``planner.calibrate.job.calibrate_plan`` (what ``wobjcal calibrate`` runs): the
 calibrated frame is drawn beside the nominal one, with the shift, 1 sigma per degree of freedom
 and the residual per point. A result the gross-error screen does not trust (a point off its
 face beyond the plan's noise, a frame beyond the misplacement bound) is not drawn: the panel
@@ -17,7 +17,7 @@ import numpy as np
 from calib.errors import InputError
 from calib.frames import motion_between
 from calib.plan.measurements import measurements_from_json
-from planner.calibrate import CalibrationOutput, calibrate_plan
+from planner.calibrate.job import CalibrationOutput, calibrate_plan
 from webui.files_panel import check_upload
 from webui.plan_adapter import plan_from_ui
 

@@ -16,7 +16,7 @@ if TYPE_CHECKING:
     import viser
 
     from calib.plan.file import Plan
-    from planner.check import PointCheck
+    from planner.check.job import PointCheck
     from planner.program.cycle_time import CycleTime
     from webui.backend import CellSession, CellView
     from webui.busy import BusyIndicator

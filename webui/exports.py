@@ -1,7 +1,7 @@
-"""Between the files panel and :mod:`planner.export_plan`: robot programs of the session plan.
+"""Between the files panel and :mod:`planner.export_plan.job`: robot programs of the session plan.
 
 The program is made exactly as ``wobjcal export`` makes it
-(:func:`planner.export_plan.export_program`: orientations and configurations from the plan
+(:func:`planner.export_plan.job.export_program`: orientations and configurations from the plan
 check in the session's cell). Call :func:`export_program` on the cell worker. The files are
 named as ``wobjcal export -o DIR`` names them: after the session plan's name
 (:func:`planner.export.export_file_stem`; KRL and FANUC after the program's name).
@@ -54,7 +54,7 @@ def export_program(plan: Plan, fmt: str, plan_dir: Path, cell: Cell | None = Non
     Raises:
         InputError: unknown format, or the plan cannot be exported (the message says why).
     """
-    from planner.export_plan import export_program as make
+    from planner.export_plan.job import export_program as make
 
     if fmt not in FORMATS:
         raise InputError(f"unknown export format {fmt!r}; known: {', '.join(FORMATS)}")

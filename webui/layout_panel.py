@@ -1,7 +1,7 @@
 """The "Layout" panel: the layout's predicted quality, live, and the Suggest buttons.
 
 After every edit of the points the plan's quality is predicted again
-(:func:`planner.check.plan_quality`, what ``wobjcal check`` prints) on this panel's own thread,
+(:func:`planner.check.job.plan_quality`, what ``wobjcal check`` prints) on this panel's own thread,
 the latest edit only (edits that arrive meanwhile are skipped): 1 sigma per degree of freedom,
 noise gain, the weakest motion in words, the error at the points of interest, and which points'
 gross errors calibrate could not detect with how many points to add
@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from calib.errors import InputError, PlanError
-from planner.check import plan_detectability, plan_quality
+from planner.check.job import plan_detectability, plan_quality
 from planner.sim.quality import DOF_NAMES, LayoutQuality, error_radius
 from webui.markdown_text import plain
 from webui.plan_adapter import plan_from_ui, ui_plan_from_plan
@@ -37,7 +37,7 @@ from webui.scene import heat_rgb
 from webui.worker import CellWorker
 
 if TYPE_CHECKING:
-    from planner.check_results import PlanCheck
+    from planner.check.results import PlanCheck
     from planner.suggest import SuggestResult
     from webui.backend import CellSession
     from webui.context import AppContext
@@ -131,7 +131,7 @@ def comparison_markdown(
 
 def redundancy_markdown(doc: UiPlan) -> str:
     """Which points' gross errors calibrate could not detect, and how many points to add
-    (what ``wobjcal check`` says, :func:`planner.check.plan_detectability`), or ``""``."""
+    (what ``wobjcal check`` says, :func:`planner.check.job.plan_detectability`), or ``""``."""
     try:
         d = plan_detectability(plan_from_ui(doc))
     except PlanError:
@@ -268,7 +268,7 @@ class LayoutPanel:
             InputError: a suggestion is already running, there is no plan, or the plan's own
                 procedure (the default) is one Suggest cannot design (A-H): pick another.
         """
-        from planner.check import check_plan
+        from planner.check.job import check_plan
         from planner.suggest import PROCEDURES, suggest_plan
 
         made_for = self._app.state.doc  # a suggestion is for this plan only

@@ -1,7 +1,7 @@
 """Which points break their procedure's roles or layout, said at once while editing.
 
 :func:`role_flags` runs the procedure's own preconditions on the edited points (the naming
-role check of :func:`webui.plan_doc.role_refusal`, then :func:`planner.check.layout_problem`,
+role check of :func:`webui.plan_doc.role_refusal`, then :func:`planner.check.job.layout_problem`,
 the dry run ``wobjcal check`` and ``calibrate`` do) and names the points the message is about,
 so that, e.g., the A-H procedure's point B moved onto the top face is flagged on its row and
 marker when it is moved, not when a validation is started.
@@ -59,7 +59,7 @@ def _role_conflicts(doc: UiPlan) -> dict[str, str]:
 
 def role_flags(doc: UiPlan) -> RoleFlags:
     """The procedure's objection to the edited points and the points it names."""
-    from planner.check import layout_problem
+    from planner.check.job import layout_problem
     from webui.plan_adapter import plan_from_ui
 
     refusal = role_refusal(doc)

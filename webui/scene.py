@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from calib.frames import quat_wxyz_from_matrix
 from calib.probing import SearchCommand
-from planner.check import PointCheck
+from planner.check.job import PointCheck
 from webui.plan_doc import UiPlan, UiPoint
 
 #: RGB colour of each feasibility status (``pending``: being computed; ``role``: the point is

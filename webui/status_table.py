@@ -16,7 +16,7 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping
 
-from planner.check import PointCheck
+from planner.check.job import PointCheck
 from webui.markdown_text import plain
 from webui.plan_doc import NO_ROLE, UiPlan, UiPoint
 from webui.scene import STATUS_RGB

@@ -28,7 +28,7 @@ import numpy as np
 from calib.errors import InputError, PlanError
 from planner.sim.budget import check_run_size, run_size
 from planner.sim.report import ValidationReport
-from planner.validate import check_simulatable
+from planner.validate.job import check_simulatable
 from webui import validation
 from webui.plan_adapter import plan_from_ui
 from webui.worker import CellWorker

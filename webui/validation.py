@@ -1,4 +1,4 @@
-"""Between the validate panel and ``planner.validate``: run it, shape its report for the UI.
+"""Between the validate panel and ``planner.validate.job``: run it, shape its report for the UI.
 
 Besides the report's Markdown and histograms, :func:`error_colours` paints the simulated error
 over the part onto the work object's vertices (each vertex takes the error of the nearest
@@ -19,7 +19,7 @@ from scipy.spatial import cKDTree
 
 from calib.plan.file import Plan
 from planner.sim.report import ValidationReport
-from planner.validate import validate_plan
+from planner.validate.job import validate_plan
 from webui.scene import heat_rgb
 
 Progress = Callable[[int, int], None]
@@ -30,7 +30,7 @@ class ValidationSummary:
     """What the validate panel shows.
 
     Attributes:
-        report: the report :func:`planner.validate.validate_plan` returned.
+        report: the report :func:`planner.validate.job.validate_plan` returned.
         markdown: the report's rows (simulated, predicted, bias), per-point outcomes, failures.
         histograms: ``(title, unit, bin_edges (B+1,), counts (B,))`` for each error
             histogram: edges in ``unit`` (``"mm"`` or ``"deg"``), counts of samples.
@@ -50,7 +50,7 @@ def run_validation(
 ) -> ValidationSummary:
     """Simulate the plan's calibration ``trials`` times with its error models and seed.
 
-    The same :func:`planner.validate.validate_plan` as ``wobjcal validate`` (the same mesh,
+    The same :func:`planner.validate.job.validate_plan` as ``wobjcal validate`` (the same mesh,
     loaded from the plan, the same check first), with one in-process worker (no ``fork()`` of
     a threaded server). A plan ``wobjcal check`` refuses is simulated anyway, as
     ``validate --force`` does: the report and the headline say check refuses it and why.

@@ -60,7 +60,7 @@ class ProcedureRun:
 
 #: ``{point id: (k, 3)}`` the measurements of each point in order (retakes after the first),
 #: base frame, metres. Looking up a point that was not measured raises an ``InputError`` that
-#: names it (see :class:`planner.calibrate.MeasuredPoints`).
+#: names it (see :class:`planner.calibrate.job.MeasuredPoints`).
 Measured = Mapping[str, FloatArray]
 
 

@@ -2,7 +2,7 @@
 
 The one move check. The Teach tab draws the moves between points with it
 (:meth:`webui.backend.CellSession.check_move`), and ``wobjcal check`` checks the moves through a
-point's via points with it (:func:`check_via_path`, called by :func:`planner.check.check_plan`).
+point's via points with it (:func:`check_via_path`, called by :func:`planner.check.job.check_plan`).
 A joint move (RAPID ``MoveAbsJ``/``MoveJ``, KRL ``PTP``, URScript ``movej``, FANUC ``J``) is
 linear in joint space on every controller when all axes are synchronised, so the poses checked
 here are those the robot passes (up to the controller's blending, which the exported programs

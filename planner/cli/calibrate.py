@@ -14,7 +14,7 @@ from rich.table import Table
 from calib.estimators.gross_errors import K_SIGMA
 from calib.frames import motion_between, quat_wxyz_from_matrix, tait_bryan_zyx_from_matrix
 from calib.procedures import METHODS
-from planner.calibrate import CalibrationOutput, calibrate_plan
+from planner.calibrate.job import CalibrationOutput, calibrate_plan
 from planner.cli.common import print_json, read_plan, stdout
 from planner.export.krl import BASE_NO, frame_text
 from planner.export.rapid import pose_text

@@ -1,6 +1,6 @@
 """``wobjcal check``: reachability and collision of every probe point and its search path.
 
-A table or ``--json`` of :func:`planner.check.check_plan` (the same check the web UI runs).
+A table or ``--json`` of :func:`planner.check.job.check_plan` (the same check the web UI runs).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from planner.program.controllers import CONTROLLERS, DEFAULT_CONTROLLER
 
 if TYPE_CHECKING:
     from calib.plan.file import Plan
-    from planner.check import PlanCheck, PointCheck
+    from planner.check.job import PlanCheck, PointCheck
     from planner.program.cycle_time import CycleTime
     from planner.sim.quality import LayoutQuality
 
@@ -78,10 +78,10 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
 
 
 def _with_vias(plan: Plan, plan_dir: Path, target: Path) -> tuple[Plan, Path, str]:
-    """The plan with vias added (:func:`planner.move_vias.plan_with_vias`), written to
+    """The plan with vias added (:func:`planner.check.vias.plan_with_vias`), written to
     ``target``; what was done is printed on stderr."""
     from calib.plan.file import save_plan
-    from planner.move_vias import plan_with_vias
+    from planner.check.vias import plan_with_vias
     from planner.plan_cell import open_cell
     from planner.suggest import moved_plan
 
@@ -197,7 +197,7 @@ def cycle_table(c: CycleTime) -> Table:
 
 def cmd_check(args: argparse.Namespace) -> int:
     """Run the check; exit 0 when all points and paths are feasible, else 1."""
-    from planner.check import check_plan  # PyBullet: not for ``wobjcal --help``
+    from planner.check.job import check_plan  # PyBullet: not for ``wobjcal --help``
 
     plan, plan_dir = read_plan(args.plan, "check")
     if args.add_vias:

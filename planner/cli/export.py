@@ -97,7 +97,7 @@ def cmd_export(args: argparse.Namespace) -> int:
         write_text_atomic(out, plan_to_json(plan))
         stderr().print(f"wrote {out}")
         return 0
-    from planner.export_plan import export_program  # PyBullet: not for ``wobjcal --help``
+    from planner.export_plan.job import export_program  # PyBullet: not for ``wobjcal --help``
 
     result = export_program(plan, plan_dir, args.format, run_check=not args.no_check)
     refused = result.layout or (result.check is not None and not result.check.feasible)

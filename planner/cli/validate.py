@@ -214,7 +214,7 @@ def _bar() -> Progress:
 
 def cmd_validate(args: argparse.Namespace) -> int:
     """Run the validation with a progress bar and print the report."""
-    from planner.validate import check_simulatable, sensitivity_plan, validate_plan
+    from planner.validate.job import check_simulatable, sensitivity_plan, validate_plan
 
     plan, plan_dir = read_plan(args.plan, "validate")
     check_simulatable(plan)  # a clear error before the simulation's heavy imports

@@ -214,7 +214,7 @@ class ExportJob:
         check: what ``wobjcal check`` said about the program (:class:`CheckStatus`; the
             default: built without a check).
         cycle_times: the estimated cycle time of each controller's program, by controller
-            name (:mod:`planner.check_cycle`; from the check's poses, so only with a check):
+            name (:mod:`planner.check.cycle`; from the check's poses, so only with a check):
             every header says it (:func:`cycle_header`).
     """
 

@@ -30,7 +30,7 @@ last one, the time the controller computes (the estimate updates: milliseconds),
 moves' acceleration ramps and the controller's own path planning (zone data, blending, speed
 overrides; see ``docs/cycle_time.md``).
 
-Pure: this module takes joint values and limits; :mod:`planner.check_cycle` gathers them from
+Pure: this module takes joint values and limits; :mod:`planner.check.cycle` gathers them from
 the check and the robot's URDF.
 """
 
@@ -462,7 +462,7 @@ def cycle_time(
     Args:
         program: the measuring program.
         q_safe: ``{point id: (n,)}`` joint values at each point's safe start, rad (the check's
-            :attr:`planner.check_results.PointCheck.q_safe`; ``None``: no pose).
+            :attr:`planner.check.results.PointCheck.q_safe`; ``None``: no pose).
         vias_q: ``{point id: [(n,), ...]}`` the point's vias, in order, rad.
         speeds_m_s: ``{point id: search speed}``, m/s.
         limits: the joint limits.

@@ -24,5 +24,5 @@ Owns:
 
 The physical models themselves (sensors, robot error, misplacement) are in :mod:`calib.models`;
 a cell, when a trial vets its searches in one, is passed in explicitly. The plan-level entry
-point is :func:`planner.validate.validate_plan`. ``docs/simulation.md`` has the models.
+point is :func:`planner.validate.job.validate_plan`. ``docs/simulation.md`` has the models.
 """

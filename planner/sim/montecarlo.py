@@ -252,7 +252,7 @@ def validate(
 
     The script-level form of :func:`simulate` for ``points`` A-H (wobj frame, e.g.
     :func:`planner.parts.stator_demo.stator_ah_points`) on ``geometry``'s mesh; a plan of any
-    procedure on any part validates with :func:`planner.validate.validate_plan`.
+    procedure on any part validates with :func:`planner.validate.job.validate_plan`.
 
     Args:
         points: nominal probe points A-H, keyed by role.

@@ -2,7 +2,7 @@
 
 For every size the design grows through (6 points up to ``max_points``,
 :func:`planner.suggest.steps.best_fit_design`), two plans are written and judged as
-``wobjcal check --format`` judges them, with their vias (:func:`planner.move_vias.
+``wobjcal check --format`` judges them, with their vias (:func:`planner.check.vias.
 plan_with_vias`), so every number in the front describes a plan that can be written and
 exported as it stands:
 
@@ -20,8 +20,8 @@ the first start nearer and run shorter, sized for what the estimate before them 
 an adaptive program runs such a plan (a FANUC TP export refuses it), so its row says so.
 
 Each row carries the check's predicted error at the confidence (the controller's program
-linearised, :func:`planner.check.plan_quality`) and its estimated cycle time
-(:mod:`planner.check_cycle`). ``--objective time`` writes the row of least cycle time whose
+linearised, :func:`planner.check.job.plan_quality`) and its estimated cycle time
+(:mod:`planner.check.cycle`). ``--objective time`` writes the row of least cycle time whose
 plan check passes, whose layout is not weak and whose error holds the target.
 """
 
@@ -38,10 +38,10 @@ from numpy.typing import NDArray
 
 from calib.estimators.design import Design
 from calib.plan.file import Plan
-from planner.check import check_plan, plan_quality
-from planner.check_cycle import cell_motion_limits
-from planner.check_results import PlanCheck
-from planner.move_vias import plan_with_vias
+from planner.check.cycle import cell_motion_limits
+from planner.check.job import check_plan, plan_quality
+from planner.check.results import PlanCheck
+from planner.check.vias import plan_with_vias
 from planner.program.controllers import controller
 from planner.program.cycle_time import JointMotionLimits, joint_move_time
 from planner.suggest.search_sizing import steered_plan
@@ -209,7 +209,7 @@ def checked_quality(
 ) -> tuple[LayoutQuality | None, str]:
     """The predicted quality of ``plan`` for the program ``fmt`` and why there is none: the
     one ``check`` made, or, when check refused the layout (it then predicts nothing), the
-    prediction itself (:func:`planner.check.plan_quality`, work object ``mesh``, wobj, m)."""
+    prediction itself (:func:`planner.check.job.plan_quality`, work object ``mesh``, wobj, m)."""
     if check.layout:
         return plan_quality(plan, mesh, fmt)
     return check.quality, check.quality_note

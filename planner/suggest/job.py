@@ -24,8 +24,8 @@ points of interest) and proposes the points:
    points until the predicted error at every point of interest holds ``target_m`` at the
    confidence, or ``max_points`` is reached (3-2-1: six points, every ordered triple of faces);
 4. via points where a joint move between two of the points would collide
-   (:func:`planner.move_vias.plan_with_vias`: retract, or turn the shoulder or elbow);
-5. the written plan's quality predicted exactly (:func:`planner.check.plan_quality`: the
+   (:func:`planner.check.vias.plan_with_vias`: retract, or turn the shoulder or elbow);
+5. the written plan's quality predicted exactly (:func:`planner.check.job.plan_quality`: the
    program of the chosen format linearised), which is what the result reports;
 6. the written plan checked as ``wobjcal check --format`` checks it (poses, paths, moves, search
    reach, landing risk): anything it refuses is named in the message and the result does not
@@ -61,13 +61,13 @@ from calib.plan.file import Plan, PlanError, PlanPoint
 from calib.plan.report_spec import PointOfInterest
 from calib.probing import ProbePoint, SearchSpec
 from calib.procedures import BestFit
-from planner.check import check_plan
-from planner.check_results import PlanCheck
+from planner.check.job import check_plan
+from planner.check.results import PlanCheck
+from planner.check.vias import plan_with_vias
 from planner.faces.candidates import Candidates, FaceTried, face_candidates
 from planner.faces.detection import find_planar_faces
 from planner.faces.edges import edge_candidates
 from planner.faces.outline import FaceOutlines
-from planner.move_vias import plan_with_vias
 from planner.plan_cell import open_cell
 from planner.program.controllers import CONTROLLERS, controller
 from planner.program.safety import SafetySpec

@@ -189,7 +189,7 @@ class Context:
 
     def paths_ok(self, chosen: tuple[int, ...]) -> bool:
         """Check the search paths of the chosen candidates not yet checked."""
-        from planner.check_paths import check_program_path
+        from planner.check.paths import check_program_path
 
         if not self.check_paths:
             return all(self.path_ok.get(i, True) for i in chosen)

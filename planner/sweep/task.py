@@ -5,7 +5,7 @@ JSON text and its folder (so a task is a few kilobytes and any worker with wobjc
 the plan's files at the same path can run it), parses and checks the plan once per process
 (:data:`_PLANS`, keyed by the digest of text and folder), moves the base and the part
 (:func:`planner.sweep.space.placed_plan`) and runs the one plan check,
-:func:`planner.check.check_plan`, which opens its own cell (PyBullet is per process) and closes
+:func:`planner.check.job.check_plan`, which opens its own cell (PyBullet is per process) and closes
 it. A placement the check refuses with a :class:`~calib.errors.WobjcalError` (the part out of
 the robot's reach, a mesh the moved cell cannot hold) is a row with the error, not a failure of
 the sweep.
@@ -20,8 +20,8 @@ from pathlib import Path
 
 from calib.errors import WobjcalError
 from calib.plan.file import Plan, check_plan_files, plan_from_json
-from planner.check import check_plan
-from planner.check_results import PlanCheck
+from planner.check.job import check_plan
+from planner.check.results import PlanCheck
 from planner.sweep.space import Placement, placed_plan
 
 #: Parsed plans of this process, by :func:`plan_key` (a worker parses each plan once).

@@ -131,8 +131,8 @@ def plate_plans() -> dict[str, Plan]:
 
 def _with_vias(plan: Plan) -> Plan:
     """The plan with the via points its moves between points need in its cell
-    (:func:`planner.move_vias.plan_with_vias`)."""
-    from planner.move_vias import plan_with_vias
+    (:func:`planner.check.vias.plan_with_vias`)."""
+    from planner.check.vias import plan_with_vias
     from planner.plan_cell import open_cell
 
     with open_cell(plan, PLANS) as cell:

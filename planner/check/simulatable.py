@@ -5,7 +5,7 @@ all six degrees of freedom, the sensor has a simulator and can run the plan's se
 x-offset run asks for a part with slot holes. :func:`preflight` checks the plan on the part's
 mesh (:func:`work_object_mesh`): every point on a planar face with the sensor's footprint on it,
 every search long enough to reach its face under the plan's misplacement. Both raise
-:class:`calib.plan.file.PlanError` naming the point and why; :mod:`planner.validate` runs them
+:class:`calib.plan.file.PlanError` naming the point and why; :mod:`planner.validate.job` runs them
 before any trial.
 """
 

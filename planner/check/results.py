@@ -1,4 +1,4 @@
-"""The results of the one plan check (:mod:`planner.check`): a point's and a whole plan's.
+"""The results of the one plan check (:mod:`planner.check.job`): a point's and a whole plan's.
 
 Frozen dataclasses that the command line prints (table and ``--json``), the web UI colours its
 markers and table with, and ``wobjcal export`` takes orientations and configurations from.
@@ -53,7 +53,7 @@ class PointCheck:
         ik_kind: the cell's IK: ``"opw"`` (analytic) or ``"numeric"``.
         q: ``(n,)`` joint values of the chosen (or least-bad) pose, rad; ``None`` when no IK.
         q_path: ``(M, n)`` joint values along the path samples that passed, rad, or ``None``:
-            the program's searches in order (:mod:`planner.check_paths`).
+            the program's searches in order (:mod:`planner.check.paths`).
         T_base_flange: ``(4, 4)`` flange pose of ``q``, robot base frame, m, or ``None``.
         elapsed_s: time this point's check took, s.
         T_base_tcp: ``(4, 4)`` the probing TCP at ``q`` (through the tool's mount), robot base
@@ -154,7 +154,7 @@ class PlanCheck:
             and how many points to add so it sees one in every point
             (:func:`calib.estimators.gross_errors.detectability`); ``None`` when the points
             fix no frame. Said, not a failure: a plain 3-2-1 has no redundancy by design.
-        cycle: the estimated cycle time of the judged program (:mod:`planner.check_cycle`),
+        cycle: the estimated cycle time of the judged program (:mod:`planner.check.cycle`),
             ``None`` when the controller has no program for the plan.
         part_units: the length unit the work object's file was read in (``"mm"``, ``"in"``,
             ...: as given, detected for ``auto``, or declared by a CAD file), ``""``: not known.

@@ -1,6 +1,6 @@
 """An exact sensor on the nominal part: the probe of the procedure's dry run.
 
-:func:`planner.check.layout_problem` runs the plan's procedure against this probe: each search
+:func:`planner.check.job.layout_problem` runs the plan's procedure against this probe: each search
 is answered where its line meets the true plane it looks for, the face of an approach search or
 the face an edge search runs off (the command's ``nominal_m`` and ``stop_normal``, moved from
 the estimate it was commanded in onto the part where it truly lies). A search commanded off the

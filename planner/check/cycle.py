@@ -2,7 +2,7 @@
 
 :func:`plan_cycle_time` gathers what the pure model (:mod:`planner.program.cycle_time`) takes:
 the joint values the check chose at every point's safe start
-(:attr:`planner.check_results.PointCheck.q_safe`, the poses every exported program is written
+(:attr:`planner.check.results.PointCheck.q_safe`, the poses every exported program is written
 with), the plan's vias and search speeds, the joint velocity limits of the robot's URDF
 (:func:`urdf_joint_velocities`), the plan's ``validation.cycle`` figures, and for the A-H
 program's x-offset run the joint values at each of its starts (IK next to D's checked pose, with
@@ -21,8 +21,8 @@ from numpy.typing import NDArray
 from calib.errors import InputError
 from calib.frames import invert_transform, make_transform
 from calib.plan.file import Plan
-from planner.check_paths import measured_starts_wobj
-from planner.check_results import PointCheck
+from planner.check.paths import measured_starts_wobj
+from planner.check.results import PointCheck
 from planner.plan_cell import nominal_T_base_wobj
 from planner.program.build import measuring_program
 from planner.program.controllers import controller

@@ -1,7 +1,7 @@
 """Via points for a plan's colliding moves between points (``wobjcal check --add-vias``).
 
 :func:`plan_with_vias` checks the plan's points and the moves between them, and for every
-point whose move in collides (:func:`planner.check.check_via_moves`) and that has no vias yet,
+point whose move in collides (:func:`planner.check.job.check_via_moves`) and that has no vias yet,
 asks :func:`planner.cell.via_search.suggest_vias` for vias clearing the moves from every point a
 program may come from (:func:`planner.program.build.predecessors`), and returns the plan with
 them. Vias the engineer taught are never replaced; a point the search cannot clear is named.
@@ -15,7 +15,7 @@ import msgspec
 
 from calib.plan.file import Plan, ViaPoint
 from planner.cell.via_search import suggest_vias
-from planner.check import check_points, check_via_moves
+from planner.check.job import check_points, check_via_moves
 from planner.program.build import predecessors
 
 if TYPE_CHECKING:

@@ -9,7 +9,7 @@ filled in from the sensor model when unset) and its report settings go into
 both call it, so a plan validates the same way everywhere.
 
 A plan that cannot work is refused *before* the run, with a message naming the point and why
-(:mod:`planner.validate_checks`, whose checks are re-exported here): roles that do not fit the
+(:mod:`planner.check.simulatable`, whose checks are re-exported here): roles that do not fit the
 procedure, a layout that leaves a degree of freedom free, an edge search with a touch probe, a
 point off its planar face or with the sensor's footprint over a hole or an edge, a search too
 short to reach its face (or starting too close to it) under the plan's misplacement. A run
@@ -18,7 +18,7 @@ never crashes half-way: a search that fails in a trial is counted with its reaso
 Example::
 
     from calib.plan.file import load_plan
-    from planner.validate import validate_plan
+    from planner.validate.job import validate_plan
 
     report = validate_plan(load_plan("assets/plans/stator_section_ah.json"), trials=50, seed=1)
     print(report.to_markdown())
@@ -35,6 +35,16 @@ import trimesh
 
 from calib.errors import InputError
 from calib.plan.file import Plan
+from planner.check.simulatable import (
+    SIMULATED_PARTS,
+    ProgressCallback,
+    ValidationModels,
+    check_simulatable,
+    preflight,
+    validation_models,
+    work_object_mesh,
+)
+from planner.check.simulation_setup import prediction_setup, simulation_setup
 from planner.errors import PlanRefused
 from planner.plan_cell import nominal_T_base_wobj, open_cell
 from planner.program.build import measuring_program
@@ -45,16 +55,6 @@ from planner.sim.report import PAPER_TABLE1, ValidationReport
 from planner.sim.report_points import report_rows
 from planner.sim.search_events import ProgramPose, program_search_hook
 from planner.sim.sensitivity import SensitivityTable, sensitivity
-from planner.validate_checks import (
-    SIMULATED_PARTS,
-    ProgressCallback,
-    ValidationModels,
-    check_simulatable,
-    preflight,
-    validation_models,
-    work_object_mesh,
-)
-from planner.validate_setup import prediction_setup, simulation_setup
 
 __all__ = [
     "SIMULATED_PARTS",
@@ -161,7 +161,7 @@ def _validate_in_cell(
 ) -> ValidationReport:
     """Check the plan in its open ``cell`` (check's verdict, and the poses the vetting uses),
     then simulate."""
-    from planner.check import check_plan
+    from planner.check.job import check_plan
 
     checked = check_plan(plan, cell=cell, fmt=fmt)
     problems = checked.problems()

@@ -1,6 +1,6 @@
 """Export a plan as robot programs: the one export job the command line and the UI share.
 
-:func:`export_program` checks the plan (:func:`planner.check.check_plan`, unless told not to),
+:func:`export_program` checks the plan (:func:`planner.check.job.check_plan`, unless told not to),
 builds the :class:`planner.export.job.ExportJob` with each target's sensor orientation and ABB
 configuration from the check, and the robot's joint values and configuration at every target
 (:func:`with_arm_poses`: IK next to the checked pose; FANUC ``CONFIG`` and KUKA ``S``/``T`` come
@@ -11,7 +11,7 @@ which they are, and the job's :class:`planner.export.job.CheckStatus` (:func:`ch
 makes every program's header say it (``CHECKED`` / ``NOT CHECKED``, with the plan's digest),
 and the estimated cycle time of each program (:func:`with_cycle_times`) too.
 
-The plan's layout is checked even without the cell check (:func:`planner.check.layout_problem`):
+The plan's layout is checked even without the cell check (:func:`planner.check.job.layout_problem`):
 an A-H plan that lacks a role would otherwise become a program that runs every search in the
 nominal frame, silently not the paper's procedure; the result's ``layout`` says so and the
 command line refuses it unless ``--force``.
@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 
 from calib.frames import invert_transform
 from calib.plan.file import Plan
-from planner.check import ConfData, PlanCheck, check_plan, layout_problem
+from planner.check.job import ConfData, PlanCheck, check_plan, layout_problem
 from planner.export import export_files
 from planner.export.job import TARGET_KINDS, ArmPose, CheckStatus, ExportJob, build_job
 from planner.plan_cell import nominal_T_base_wobj, open_cell, tool_data
@@ -141,9 +141,9 @@ def export_program(
 
 def with_cycle_times(job: ExportJob, plan: Plan, check: PlanCheck, cell: Cell) -> ExportJob:
     """``job`` with the estimated cycle time of every controller's program
-    (:func:`planner.check_cycle.plan_cycle_time`, from the poses of ``check`` in ``cell``),
+    (:func:`planner.check.cycle.plan_cycle_time`, from the poses of ``check`` in ``cell``),
     which every program's header says."""
-    from planner.check_cycle import plan_cycle_time
+    from planner.check.cycle import plan_cycle_time
 
     times = {}
     for name in job.programs:

@@ -4,7 +4,7 @@ run's targets, what every trial shares (:func:`simulation_setup`).
 
 Below both jobs that use it: ``wobjcal check`` predicts the layout's quality and landing risk
 from :func:`prediction_setup`, ``wobjcal validate`` simulates from :func:`simulation_setup`
-(and checks the plan first, so it imports :mod:`planner.check`; this module imports neither).
+(and checks the plan first, so it imports :mod:`planner.check.job`; this module imports neither).
 """
 
 from __future__ import annotations
@@ -16,12 +16,12 @@ import trimesh
 
 from calib.plan.file import Plan, PlanError
 from calib.procedures import RolePoint
+from planner.check.simulatable import ValidationModels
 from planner.plan_cell import nominal_T_base_wobj
 from planner.program.build import build_program, safety_spec
 from planner.program.controllers import controller
 from planner.sim.setup import SimulationSetup, default_pivot, face_lookup
 from planner.sim.xoffset import xoffset_setup
-from planner.validate_checks import ValidationModels
 
 __all__ = ["prediction_setup", "simulation_setup"]
 

@@ -9,7 +9,7 @@ Per point, three checks:
 
 1. the probe pose (:func:`planner.cell.feasibility.check_probes`): IK, joint limits, wrist
    singularity, collisions with clearance; ``marginal`` when little clearance or near a limit;
-2. the search path (:func:`planner.check_paths.check_program_path`): the searches the exported
+2. the search path (:func:`planner.check.paths.check_program_path`): the searches the exported
    program runs, from the point's safe start to the end of travel, with the pose's orientation
    and IK branch (what the program writes), in the nominal work-object frame;
 3. the planar face (:func:`planner.faces.checks.plan_face_reasons`): the point lies on a planar
@@ -33,7 +33,7 @@ a plan that ``calibrate`` would refuse fails at ``check``, before the robot has 
 Then which points' gross errors ``calibrate``'s screen could see at all
 (:func:`plan_detectability`; a plain 3-2-1 has no redundancy: none), and how many points to
 add so it sees one in every point: said, not failed. Last, the program's estimated cycle time
-(:func:`planner.check_cycle.plan_cycle_time`, the model of :mod:`planner.program.cycle_time`).
+(:func:`planner.check.cycle.plan_cycle_time`, the model of :mod:`planner.program.cycle_time`).
 """
 
 from __future__ import annotations
@@ -54,10 +54,10 @@ from calib.plan.file import Plan, PlanPoint
 from calib.procedures import procedure_kind
 from calib.procedures.base import edge_offset_of
 from calib.tolerances import FACE_MAX_DEVIATION_M
-from planner.check_cycle import plan_cycle_time
-from planner.check_paths import ProgramPath, check_program_path, measured_starts_wobj
-from planner.check_results import ConfData, PlanCheck, PointCheck, Status
-from planner.dry_run import nominal_part_probe
+from planner.check.cycle import plan_cycle_time
+from planner.check.dry_run import nominal_part_probe
+from planner.check.paths import ProgramPath, check_program_path, measured_starts_wobj
+from planner.check.results import ConfData, PlanCheck, PointCheck, Status
 from planner.plan_cell import nominal_T_base_wobj, open_cell
 from planner.program.build import measuring_program, plan_settings, safety_spec
 from planner.program.controllers import controller
@@ -105,7 +105,7 @@ def check_plan(
         cell: an open cell of the plan (the UI's); ``None`` opens the plan's cell and closes
             it afterwards.
         fmt: the controller whose program the quality, the landing risk and the cycle time
-            (:mod:`planner.check_cycle`) judge (``None``: the default, RAPID); the poses, paths
+            (:mod:`planner.check.cycle`) judge (``None``: the default, RAPID); the poses, paths
             and moves are those of every program.
 
     Raises:
@@ -215,11 +215,11 @@ def plan_landing_risk(
     """How often each search of the program of ``fmt`` (``None``: the default) misses, starts
     too close or lands off its face under the plan's misplacement (:mod:`planner.sim.landing`),
     on the work object ``mesh`` (wobj, metres); ``None`` when the plan cannot be simulated."""
+    from planner.check.simulatable import check_simulatable
+    from planner.check.simulation_setup import prediction_setup
     from planner.faces.checks import check_plan_faces
     from planner.faces.detection import NoPlanarFaceError, find_planar_faces
     from planner.sim.landing import landing_risk
-    from planner.validate_checks import check_simulatable
-    from planner.validate_setup import prediction_setup
 
     try:
         setup = prediction_setup(plan, check_simulatable(plan), fmt)
@@ -335,10 +335,10 @@ def plan_quality(
     """
     from calib.estimators.layout import search_constraint_set
     from calib.estimators.observability import analyze_layout
+    from planner.check.simulatable import check_simulatable
+    from planner.check.simulation_setup import prediction_setup
     from planner.sim.quality import layout_quality, unobservable_quality
     from planner.sim.report_points import poi_rows
-    from planner.validate_checks import check_simulatable
-    from planner.validate_setup import prediction_setup
 
     try:
         probes = [p.to_probe_point() for p in plan.points]
@@ -360,8 +360,8 @@ def layout_problem(plan: Plan, fmt: str | None = None) -> str:
     """Why the plan's procedure would refuse its points, ``""`` when it would not.
 
     A dry run of the measuring program of the controller ``fmt`` (``None``: the default) on the
-    nominal part with an exact sensor (:func:`planner.dry_run.nominal_part_probe`): every search
-    commanded as the program does (nominal or in the frame estimated so far), and
+    nominal part with an exact sensor (:func:`planner.check.dry_run.nominal_part_probe`): every
+    search commanded as the program does (nominal or in the frame estimated so far), and
     answered where it meets the nominal face or edge (an edge search started off the face by
     ``edge_start_offset_m`` switches that far off it; the sensor's edge-event offset is added).
     It must accept them (roles, faces, observability) and give back the nominal frame: a
