@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import planner.cell.acl as acl_module
 from planner.cell.acl import AllowedCollisions, pair, sample_configurations
@@ -18,6 +19,7 @@ def test_builtin_acl_allows_adjacent_links_and_the_tool_mount(cell: Cell) -> Non
     assert acl.n_samples == 1000
 
 
+@pytest.mark.slow
 def test_ur5_acl_keeps_real_self_collisions_checked(ur5: Cell) -> None:
     """Base vs upper arm touch in ~37 % of random samples: a real collision, not an artefact."""
     acl = ur5.checker.acl

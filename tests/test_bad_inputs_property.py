@@ -247,6 +247,7 @@ def _write(folder: Path, name: str, text: str) -> Path:
 # --- plans --------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @settings(max_examples=150, suppress_health_check=[HealthCheck.too_slow])
 @given(case=mutated_plans(), fmt=st.sampled_from(["json", "rapid", "krl", "urscript", "fanuc"]))
 def test_a_mutated_plan_exports_or_is_refused_with_a_message(
@@ -278,6 +279,7 @@ def test_a_mutated_plan_is_checked_or_refused_with_a_message(case: tuple[str, st
 MEASURED = json.loads((RESULTS / "wobjcal_measured.json").read_text())
 
 
+@pytest.mark.slow
 @settings(max_examples=120, suppress_health_check=[HealthCheck.too_slow])
 @given(case=mutated_documents(MEASURED))
 def test_mutated_measurements_calibrate_or_are_refused(case: tuple[str, str]) -> None:
@@ -341,6 +343,7 @@ def mutated_results(draw: Callable[[Any], Any]) -> tuple[str, str, str, str]:
     return fmt, name, mutant, done
 
 
+@pytest.mark.slow
 @settings(max_examples=60, suppress_health_check=[HealthCheck.too_slow])
 @given(case=mutated_results())
 def test_mutated_controller_files_calibrate_or_are_refused(case: tuple[str, str, str, str]) -> None:
@@ -354,6 +357,7 @@ def test_mutated_controller_files_calibrate_or_are_refused(case: tuple[str, str,
         assert_handled(run, f"calibrate --from {fmt} with {name}: {done}")
 
 
+@pytest.mark.slow
 def test_the_unmutated_inputs_pass() -> None:
     """The generator's bases are valid: a mutant's refusal is the mutation's doing."""
     with tempfile.TemporaryDirectory() as tmp:

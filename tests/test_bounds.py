@@ -69,6 +69,7 @@ def _many_points(n: int) -> str:
     return json.dumps(doc)
 
 
+@pytest.mark.slow
 def test_a_plan_of_10000_points_is_refused_before_any_work(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -189,6 +190,7 @@ def test_trials_times_rays_is_bounded() -> None:
     check_run_size(run_size(plan, trials=400))
 
 
+@pytest.mark.slow
 def test_report_samples_are_made_a_few_points_at_a_time() -> None:
     """Before: a row's error vectors were made all at once: 2,000 trials x 2,000 points held
     ~400 MB of transients per row (a 4,000-trial run peaked at 1,066 MB)."""
@@ -384,6 +386,7 @@ def _zip(name: str, size: int) -> bytes:
     return buf.getvalue()
 
 
+@pytest.mark.slow
 def test_a_zip_bomb_is_refused_before_unpacking(tmp_path: Path) -> None:
     """Before: a 513 KB zip that unpacks to 450 MiB was accepted (the limit was 500 MiB, and
     each file was read whole into memory)."""
@@ -435,6 +438,7 @@ def _edited_autosave(plan: Path, port: int) -> Path:
     return path
 
 
+@pytest.mark.slow
 def test_an_autosave_whose_restore_crashed_is_not_restored_again(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -26,6 +26,7 @@ def mesh():  # type: ignore[no-untyped-def]
     return box_mesh()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["hultman2013", "three_two_one", "best_fit", "iterative"])
 def test_simulated_equals_predicted_on_a_box(method: str, mesh) -> None:  # type: ignore[no-untyped-def]
     plan = box_plans(POINT_SENSOR)[method]

@@ -154,6 +154,7 @@ def _cases(xfail_nominal: str | None) -> list[Any]:
 
 
 # --------------------------------------------------------------------------- the part
+@pytest.mark.slow
 def test_the_bracket_is_a_closed_l_of_the_stated_size(plans: dict[str, Plan]) -> None:
     mesh = bracket_mesh()
     assert mesh.is_watertight and mesh.is_volume
@@ -197,6 +198,7 @@ def _trouble(report: Any) -> set[str]:
     return {k.split("@")[0].split(":")[0] for k in report.failures} | bad
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("procedure", "fmt"), _cases(None))
 def test_check_and_the_validation_give_one_verdict(runs: _Runs, procedure: str, fmt: str) -> None:
     """Check rates the plan feasible for the program and its validation then agrees with the
@@ -218,6 +220,7 @@ def test_check_and_the_validation_give_one_verdict(runs: _Runs, procedure: str, 
             assert any(w in p.search_reason for w in ("move the point", "misplacement bound"))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("procedure", "points"), [("three_two_one", {"T1"}), ("best_fit", {"E1", "E2", "E3"})]
 )
@@ -233,6 +236,7 @@ def test_check_refuses_the_nominal_program_naming_the_point_and_what_to_change(
         assert "adaptive program" in why and "misplacement bound" in why, why
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("procedure", "points"), [("three_two_one", {"P1", "P2"}), ("best_fit", {"T1", "T2"})]
 )
@@ -251,6 +255,7 @@ def test_check_sees_the_sensor_run_into_the_upright(
 
 
 # --------------------------------------------------------------------------- validate
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("procedure", "fmt"),
     _cases(
@@ -267,6 +272,7 @@ def test_validation_agrees_with_the_prediction_on_every_row(
 
 
 # --------------------------------------------------------------------------- suggest
+@pytest.mark.slow
 @pytest.mark.parametrize(("procedure", "fmt"), _cases(None))
 def test_suggest_gives_a_layout_that_validates_or_says_what_stops_it(
     runs: _Runs, procedure: str, fmt: str
@@ -299,6 +305,7 @@ def test_suggest_gives_a_layout_that_validates_or_says_what_stops_it(
         assert "not reached" in res.message and "misplacement" in res.message, res.message
 
 
+@pytest.mark.slow
 @pytest.mark.xfail(
     strict=True,
     reason=(

@@ -56,6 +56,7 @@ def configurations(cell: Cell, rng: np.random.Generator) -> tuple[np.ndarray, np
     return q, cell.chain.fk(q)
 
 
+@pytest.mark.slow
 def test_clear_and_below_margin_parts_agree_with_bullet(cell: Cell) -> None:
     rng = np.random.default_rng(5)
     q, T_bf = configurations(cell, rng)

@@ -62,6 +62,7 @@ def test_an_a_h_layout_off_its_assumptions_is_named() -> None:
     assert layout_problem(_moved(plan, "A", (a[0], a[1], a[2] + 2e-4))) == ""
 
 
+@pytest.mark.slow
 def test_check_reports_the_layout_problem_and_fails(tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
     plan = load_plan(SMALL)
     s1 = next(p for p in plan.points if p.id == "S1")
@@ -72,6 +73,7 @@ def test_check_reports_the_layout_problem_and_fails(tmp_path: Path, capsys) -> N
 
 
 # ---- facts shown (item 10): IK kind and clearance pair, in the table and the JSON -----------
+@pytest.mark.slow
 def test_ik_kind_and_clearance_pair_are_shown(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["check", str(STATOR), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
@@ -85,6 +87,7 @@ def test_ik_kind_and_clearance_pair_are_shown(capsys: pytest.CaptureFixture[str]
     assert f"({a} - {b})" in table
 
 
+@pytest.mark.slow
 def test_numeric_ik_is_named_with_why(reference_dir: Path, tmp_path: Path) -> None:
     """A vendor UR5 (offset wrist) runs on the numeric IK, and the check says so and why."""
     plan = load_plan(SMALL)
@@ -99,6 +102,7 @@ def test_numeric_ik_is_named_with_why(reference_dir: Path, tmp_path: Path) -> No
     assert np.isfinite([p.clearance_m for p in result.points if p.q is not None]).all()
 
 
+@pytest.mark.slow
 def test_a_part_in_the_wrong_units_is_named_with_its_size(reference_dir: Path) -> None:
     """Item 4: the plate in mm loaded as metres put points metres off, with no word of size or
     units; now every reason about the part says how big it came out and in which units."""

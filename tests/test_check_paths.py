@@ -34,6 +34,7 @@ def demo_cell(demo: Plan) -> Iterator[object]:
         yield cell
 
 
+@pytest.mark.slow
 def test_the_checked_path_is_the_programs(demo: Plan, demo_cell) -> None:  # type: ignore[no-untyped-def]
     """Every demo point: the checked path starts at the program's safe start, keeps the probe
     pose's sensor orientation all along, and its first joint values are the exported program's
@@ -61,6 +62,7 @@ def test_the_checked_path_is_the_programs(demo: Plan, demo_cell) -> None:  # typ
         assert kinds == (edge if p.search.kind == "edge" else ["approach"])
 
 
+@pytest.mark.slow
 def test_a_safe_start_out_of_reach_makes_the_point_infeasible(demo: Plan, demo_cell) -> None:  # type: ignore[no-untyped-def]
     """A misplacement tolerance of 0.6 m puts every safe start more than half a metre off the
     part: the plan's own searches (5 cm out) are reachable, the program's are not, and the
@@ -82,6 +84,7 @@ def test_a_safe_start_out_of_reach_makes_the_point_infeasible(demo: Plan, demo_c
     ]
 
 
+@pytest.mark.slow
 def test_an_edge_points_path_is_approach_edge_and_retreat(demo: Plan, demo_cell) -> None:  # type: ignore[no-untyped-def]
     """F: the face approach from the safe start down to the nominal face (not its overtravel
     into the part), the edge search from the edge start up to the edge (where it stops), and
@@ -106,6 +109,7 @@ def test_an_edge_points_path_is_approach_edge_and_retreat(demo: Plan, demo_cell)
     )
 
 
+@pytest.mark.slow
 def test_the_adaptive_programs_edge_start_at_the_measured_point_is_walked_too(
     demo: Plan,
     demo_cell,  # type: ignore[no-untyped-def]
@@ -145,6 +149,7 @@ def test_the_adaptive_programs_edge_start_at_the_measured_point_is_walked_too(
     assert path.q_safe is not None  # the face-approach program's, which passes
 
 
+@pytest.mark.slow
 def test_a_point_without_a_usable_pose_has_no_safe_start(demo: Plan, demo_cell) -> None:  # type: ignore[no-untyped-def]
     far = msgspec.structs.replace(demo.points[0], position_m=(3.0, 3.0, 3.0))
     plan = msgspec.structs.replace(demo, points=[far, *demo.points[1:]])

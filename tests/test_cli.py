@@ -87,6 +87,7 @@ def test_schema_matches_checked_in_files(capsys: pytest.CaptureFixture[str]) -> 
     assert out == (REPO / "assets" / "schema" / "wobjcal.measurements-1.schema.json").read_text()
 
 
+@pytest.mark.slow
 def test_shipped_plan_equals_regenerated(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -267,6 +268,7 @@ def test_unwritable_output_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture
     assert err.strip().splitlines()[-1] == f"wobjcal export: error: {want}"
 
 
+@pytest.mark.slow
 def test_python_m_planner_runs() -> None:
     res = subprocess.run(
         [sys.executable, "-m", "planner", "--version"], capture_output=True, text=True, check=False
@@ -274,6 +276,7 @@ def test_python_m_planner_runs() -> None:
     assert res.returncode == 0 and res.stdout.startswith("wobjcal ")
 
 
+@pytest.mark.slow
 def test_validate_small_run_writes_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     report = tmp_path / "report.json"
     args = ["validate", str(STATOR), "--trials", "3", "--seed", "7", "--json", str(report)]
@@ -292,6 +295,7 @@ def test_validate_small_run_writes_json(tmp_path: Path, capsys: pytest.CaptureFi
     assert again["rows"] == data["rows"]
 
 
+@pytest.mark.slow
 def test_validate_refuses_a_plan_that_cannot_work_naming_its_points(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
@@ -327,6 +331,7 @@ def _moved_copy(tmp_path: Path, point_id: str, offset_m: tuple[float, float, flo
     return path
 
 
+@pytest.mark.slow
 def test_check_names_a_point_moved_5_m_away(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -342,12 +347,14 @@ def test_check_names_a_point_moved_5_m_away(
     assert re.search(r"point F: infeasible: out of reach", out)
 
 
+@pytest.mark.slow
 def test_check_shipped_plan_passes(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, _ = run(capsys, "check", str(STATOR))
     assert code == 0, out
     assert "8 of 8 points feasible" in out
 
 
+@pytest.mark.slow
 def test_export_takes_orientation_and_confdata_from_check(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -36,6 +36,7 @@ def _point(raw: dict[str, Any], point_id: str) -> dict[str, Any]:
     return next(p for p in raw["points"] if p["id"] == point_id)
 
 
+@pytest.mark.slow
 def test_shipped_plan_points_all_lie_on_planar_faces(capsys: pytest.CaptureFixture[str]) -> None:
     plan = load_plan(STATOR)
     wo = load_work_object(plan.work_object.mesh, units=plan.work_object.units)
@@ -48,6 +49,7 @@ def test_shipped_plan_points_all_lie_on_planar_faces(capsys: pytest.CaptureFixtu
     assert not any(w in r["reason"] for r in rows for w in ("face", "footprint", "surface"))
 
 
+@pytest.mark.slow
 def test_footprint_over_a_slot_hole_is_infeasible(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -62,6 +64,7 @@ def test_footprint_over_a_slot_hole_is_infeasible(
     assert all(rows[k]["feasible"] for k in "ABCEFGH")
 
 
+@pytest.mark.slow
 def test_normal_disagreeing_with_the_face_is_infeasible(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -74,6 +77,7 @@ def test_normal_disagreeing_with_the_face_is_infeasible(
     assert "point A: infeasible" in out and "8.0 deg from the face normal" in out
 
 
+@pytest.mark.slow
 def test_plan_on_a_raw_scan_fails_with_no_planar_face(
     tmp_path: Path, reference_dir: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -11,6 +11,7 @@ from planner.cell.cell import Cell
 from planner.cell.fixtures import table
 
 
+@pytest.mark.slow
 def test_ur5_upper_arm_into_the_base_is_a_self_collision(ur5: Cell) -> None:
     with ur5.saved_state():
         ur5.set_joint_positions([0, 0, 0, 0, 0, 0])  # arm stretched out horizontally
@@ -22,6 +23,7 @@ def test_ur5_upper_arm_into_the_base_is_a_self_collision(ur5: Cell) -> None:
     assert cl.clearance_m < 0 and "hits" in cl.describe()
 
 
+@pytest.mark.slow
 def test_clearance_names_the_pair_and_distance(cell: Cell) -> None:
     with cell.saved_state():
         cell.set_joint_positions(cell.home_q)
@@ -64,6 +66,7 @@ def test_sensor_may_approach_the_work_object_within_its_standoff(cell: Cell) -> 
         assert skipped.pair is None or skipped.pair[1] != "work object"
 
 
+@pytest.mark.slow
 def test_static_base_on_a_table_is_not_a_collision() -> None:
     with Cell(use_acl_cache=False) as c:
         c.add_fixture(table(top_z_m=0.0, size_m=(1.0, 1.0, 0.05)))
@@ -75,6 +78,7 @@ def test_static_base_on_a_table_is_not_a_collision() -> None:
         assert not cl.ok and cl.pair[1] == "table"
 
 
+@pytest.mark.slow
 def test_base_pose_moves_everything(cell: Cell) -> None:
     T = make_transform(p=[2.0, 0, 0])
     with Cell(T_world_base=T, use_acl_cache=False) as moved:

@@ -154,6 +154,7 @@ def plate() -> tuple[Plan, PlanCheck]:
     return plan, check_plan(plan, PLANS)
 
 
+@pytest.mark.slow
 def test_the_stator_program_takes_minutes_as_in_the_paper(
     stator: tuple[Plan, PlanCheck],
 ) -> None:
@@ -184,6 +185,7 @@ def test_the_stator_program_takes_minutes_as_in_the_paper(
     assert out["cycle_time"]["searches"] == sum(r["searches"] for r in rows)
 
 
+@pytest.mark.slow
 def test_the_plate_program_takes_seconds(plate: tuple[Plan, PlanCheck]) -> None:
     _, check = plate
     c = check.cycle
@@ -192,6 +194,7 @@ def test_the_plate_program_takes_seconds(plate: tuple[Plan, PlanCheck]) -> None:
     assert 5.0 < c.total_s < 120.0
 
 
+@pytest.mark.slow
 def test_every_program_header_says_its_cycle_time(plate: tuple[Plan, PlanCheck]) -> None:
     plan, check = plate
     assert check.cycle is not None

@@ -10,6 +10,7 @@ import pytest
 from tests.test_cli import STATOR, _moved_copy, run
 
 
+@pytest.mark.slow
 def test_export_of_infeasible_plan_exits_1_naming_the_point(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -26,6 +27,7 @@ def test_export_of_infeasible_plan_exits_1_naming_the_point(
         out.unlink()
 
 
+@pytest.mark.slow
 def test_export_of_feasible_plan_checks_and_writes(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -84,6 +86,7 @@ def test_every_writer_escapes_ids_and_names(fmt: str) -> None:
                 assert body.count('"') % 2 == 0, line  # no literal left open
 
 
+@pytest.mark.slow
 def test_an_incomplete_a_h_plan_is_refused_unless_forced(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

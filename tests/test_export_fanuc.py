@@ -428,6 +428,7 @@ def test_program_name_limits() -> None:
         assert re.fullmatch(COMMENT, "!" + line) and len(line) <= 32
 
 
+@pytest.mark.slow
 def test_cli_export_and_help(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "X.ls"
     # the TP program runs A-H nominal: D, E, G land over the slot holes in about a quarter of
@@ -508,6 +509,7 @@ def test_fanuc_config_of_a_fanuc_arm_in_fanuc_joint_directions(tmp_path: Path) -
     assert {g[4] for g in got} == {"T", "B"} and len(got) == 8  # eight branches, eight configs
 
 
+@pytest.mark.slow
 def test_fanuc_config_comes_from_the_checked_pose(tmp_path: Path) -> None:
     """The shipped plan: every position's CONFIG is its own IK solution's next to the checked
     pose, the same flags as the check's ABB confdata on this ABB-like arm (cfx bits)."""

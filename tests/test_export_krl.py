@@ -6,6 +6,7 @@ import re
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from calib.frames import (
     make_transform,
@@ -128,6 +129,7 @@ def test_status_and_turn_bits() -> None:
     assert ",S " not in e6pos_text(np.eye(4), None)
 
 
+@pytest.mark.slow
 def test_krl_targets_carry_the_status_and_turn_of_the_checked_pose() -> None:
     """Before: E6POS without S and T. Now each target has them, from its own IK solution next
     to the checked pose: S matches the check's ABB cfx bits on this ABB-like arm, T the signs of

@@ -69,6 +69,7 @@ VARIANTS = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", range(8))
 @pytest.mark.parametrize("variant", sorted(VARIANTS))
 def test_program_frame_equals_the_procedure(seed: int, variant: str) -> None:

@@ -99,6 +99,7 @@ def _said(text: str, fmt: str) -> str:
     return text
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", list(FORMATS))
 def test_every_format_refuses_naming_each_point(
     fmt: str,
@@ -186,6 +187,7 @@ def test_file_names_follow_the_plan_name(
     assert export_file_stem("", "fanuc") == "WOBJCALPLAN"
 
 
+@pytest.mark.slow
 def test_ui_downloads_are_named_after_the_plan_and_say_not_checked(
     infeasible: tuple[Path, Plan, Any],
 ) -> None:

@@ -95,6 +95,7 @@ def test_small_clearance_is_marginal(cell: Cell) -> None:
     assert res.clearance_m == pytest.approx(0.007, abs=1e-4)
 
 
+@pytest.mark.slow
 def test_a_probe_into_a_slot_is_not_blocked_as_by_a_convex_hull() -> None:
     """A U-shaped block: the slot (40 mm wide, 15 mm deep) is open for the 18 mm sensor."""
     base = trimesh.creation.box([0.3, 0.3, 0.1])
@@ -160,6 +161,7 @@ def test_tcp_frames_point_into_the_surface(rng) -> None:
     np.testing.assert_allclose(cos, np.cos(np.radians(15)), atol=1e-12)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("which", ["ur5", "kuka"])
 def test_vendor_robots_answer_through_numeric_ik(which, reference_dir) -> None:
     path = (
@@ -259,6 +261,7 @@ def demo() -> Iterator[Cell]:
         yield c
 
 
+@pytest.mark.slow
 def test_demo_points_that_collide_in_every_pose_keep_their_answers(demo: Cell) -> None:
     """Stator points whose every candidate collides (the slow case of the web UI), a
     feasible yoke point, and a point the table blocks: staged answers equal the plain ones."""

@@ -90,6 +90,7 @@ def graph() -> list[Edge]:
     return edges()
 
 
+@pytest.mark.slow
 def test_no_import_circles(graph: list[Edge]) -> None:
     assert cycles(graph) == []
 

@@ -12,6 +12,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from planner.cell.kernel_cache import SOURCES, source_key
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -32,6 +34,7 @@ def _run(env_extra: dict[str, str]) -> list[str]:
     return out.stdout.strip().splitlines()
 
 
+@pytest.mark.slow
 def test_kernels_cached_under_wobjcal_cache_root_by_source_key(tmp_path: Path) -> None:
     stale = tmp_path / "numba" / ("0" * 16)  # another version's kernels
     stale.mkdir(parents=True)
@@ -73,6 +76,7 @@ def test_unwritable_root_leaves_numba_defaults(tmp_path: Path) -> None:
     assert lines == ["None", "None", "''"]
 
 
+@pytest.mark.slow
 def test_kernels_load_from_the_cache_in_a_new_process(tmp_path: Path) -> None:
     """A kernel compiled by one process is loaded, not recompiled, by the next."""
     code = (

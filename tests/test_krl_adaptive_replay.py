@@ -69,6 +69,7 @@ def failing_at(search: SearchFn, k: int, answer: str = "ERR_WHLSEARCH") -> Searc
 
 
 # ------------------------------------------------------------------ the replay
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("name", "seed"),
     [("plate_holes_best_fit.json", 1), ("plate_holes_321.json", 2), ("stator_section_ah.json", 3)],

@@ -63,6 +63,7 @@ def as_saved(dat: str) -> str:
     return "\n".join(out)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", list(CASES))
 def test_the_program_parses(case: str) -> None:
     files = _files(CASES[case]())
@@ -70,6 +71,7 @@ def test_the_program_parses(case: str) -> None:
     assert krl_errors(files[".dat"]) == [], case
 
 
+@pytest.mark.slow
 def test_a_program_of_90_points_parses() -> None:
     """2,770 lines of ``.src`` and 4,250 of ``.dat``: about 4 s."""
     files = _files(ninety())

@@ -26,6 +26,7 @@ def _mesh(plan: Plan):  # type: ignore[no-untyped-def]
     return work_object_mesh(plan, PLANS, check_simulatable(plan))
 
 
+@pytest.mark.slow
 def test_a_nominal_program_on_narrow_faces_is_flagged_the_adaptive_one_is_not() -> None:
     """The plate's 3-2-1: its secondary and tertiary points sit on 12.7 mm side faces. Measured
     after the primary face has fixed height and tilts (RAPID) they land on them; measured in
@@ -45,6 +46,7 @@ def test_a_nominal_program_on_narrow_faces_is_flagged_the_adaptive_one_is_not() 
     assert again is not None and again.searches == tp.searches
 
 
+@pytest.mark.slow
 def test_the_risk_is_what_the_validation_simulates_on_the_real_mesh() -> None:
     """The share of calibrations in which D, E and G of the stator's nominal (FANUC TP) A-H program
     land over a slot hole, from the ideal part's planes and the faces' outlines, is the share

@@ -121,6 +121,7 @@ def test_one_face_only_leaves_motions_free(plate: tuple) -> None:
     assert math.isinf(q.noise_gain)
 
 
+@pytest.mark.slow
 def test_check_cli_shows_quality_marginal_and_fails_free_layout(
     plate: tuple, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -51,6 +51,7 @@ def test_best_fit_prediction_is_the_estimators_covariance(rng: np.random.Generat
     np.testing.assert_allclose(C_robot, C, rtol=1e-12)
 
 
+@pytest.mark.slow
 def test_three_two_one_prediction_matches_a_monte_carlo(rng: np.random.Generator) -> None:
     layout = random_face_layout(rng)
     pts = [

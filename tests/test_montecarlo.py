@@ -43,6 +43,7 @@ def test_noise_free_flat_part_gives_the_true_pose() -> None:
     assert np.abs(report.delta_best_fit).max() < 1e-9
 
 
+@pytest.mark.slow
 def test_seeded_run_is_repeatable_across_workers_and_sane() -> None:
     a = validate(POINTS, GEOM, T_NOM, 200, np.random.default_rng(11), workers=2)
     b = validate(POINTS, GEOM, T_NOM, 200, np.random.default_rng(11), workers=1)
@@ -64,6 +65,7 @@ def test_seeded_run_is_repeatable_across_workers_and_sane() -> None:
     assert "WOCS yz-plane at epsilon" in text and "± 0.40 mm" in text
 
 
+@pytest.mark.slow
 def test_the_program_starts_from_the_safe_start_not_the_plans_start() -> None:
     """A plan start 8 mm out is inside the sensor's reach of a part misplaced by 20 mm; the
     program starts every search at its safe start (``planner.program.safety``), so no search
@@ -93,6 +95,7 @@ def test_bad_arguments_are_named() -> None:
         validate({"A": POINTS["A"]}, GEOM, T_NOM, 10, np.random.default_rng(0))
 
 
+@pytest.mark.slow
 def test_cell_vets_every_search_and_counts_unreachable_ones() -> None:
     from planner.demo import make_demo_cell
 

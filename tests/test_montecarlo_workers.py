@@ -58,6 +58,7 @@ def _gone(pids: set[int], timeout_s: float = 120.0) -> bool:
     return False
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="needs Linux /proc")
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGKILL])
 def test_workers_stop_with_the_validation(sig: signal.Signals) -> None:

@@ -40,6 +40,7 @@ def cell(bare: Plan) -> Iterator[object]:
         yield c
 
 
+@pytest.mark.slow
 def test_a_colliding_move_between_points_makes_the_point_infeasible(bare: Plan, cell) -> None:  # type: ignore[no-untyped-def]
     """Without vias the demo's program would drag the guide tube through the table on its way
     from C to D: the check says so at D (and at C, reached from B too near the table)."""
@@ -54,6 +55,7 @@ def test_a_colliding_move_between_points_makes_the_point_infeasible(bare: Plan, 
     assert shipped.feasible  # the shipped plan carries the vias
 
 
+@pytest.mark.slow
 def test_the_via_search_clears_the_moves_from_every_predecessor(bare: Plan, cell) -> None:  # type: ignore[no-untyped-def]
     check = {c.point_id: c for c in check_plan(bare, PLANS, cell=cell).points}
     tcp = bare.cell.tool.tcp
@@ -65,6 +67,7 @@ def test_the_via_search_clears_the_moves_from_every_predecessor(bare: Plan, cell
     assert suggest_vias(cell, [check["A"].q_safe], check["B"].q_safe, tcp) == []  # clear
 
 
+@pytest.mark.slow
 def test_add_vias_writes_a_plan_that_passes_and_keeps_taught_vias(
     bare: Plan,
     cell,  # type: ignore[no-untyped-def]

@@ -34,6 +34,7 @@ def _coverage(chain: KinematicChain, rng: np.random.Generator, n: int = 150) -> 
     return float(res.valid.any(axis=1).mean())
 
 
+@pytest.mark.slow
 def test_ur5_reaches_95_percent(reference_dir: Path, rng: np.random.Generator) -> None:
     chain = KinematicChain.from_urdf(reference_dir / "robots/ur5/ur5.urdf")
     assert _coverage(chain, rng) >= 0.95

@@ -216,6 +216,7 @@ def test_check_validate_and_export_give_one_verdict(cells: dict[str, Any]) -> No
     assert seen[True] >= 6 and seen[False] >= 10, seen  # both verdicts well represented
 
 
+@pytest.mark.slow
 def test_validate_refuses_what_check_refuses_naming_every_problem(tmp_path: Path) -> None:
     """The plate's 3-2-1 as the nominal FANUC program lands S1, S2 and T1 off the 12.7 mm side
     faces (check refuses it): validate exits 1 naming all three, writes nothing; with --force
@@ -236,6 +237,7 @@ def test_validate_refuses_what_check_refuses_naming_every_problem(tmp_path: Path
     assert json.loads(out.read_text())["check_problems"] == []
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("base", ["plate_holes_best_fit.json", "stator_section_ah.json"])
 def test_the_vetting_passes_at_the_nominal_pose_what_check_passes(
     base: str, cells: dict[str, Any]

@@ -116,6 +116,7 @@ def test_every_file_output_writes_a_device_or_fifo_in_place(tmp_path: Path) -> N
     assert stat.S_ISFIFO(fifo.lstat().st_mode)
 
 
+@pytest.mark.slow
 def test_dev_stdout_redirected_to_a_file_gets_the_output(tmp_path: Path) -> None:
     """``export -o /dev/stdout >> out.txt``. Before: out.txt stayed empty (or was replaced)
     and the plan went to wherever stderr pointed."""
@@ -164,6 +165,7 @@ def test_a_failed_sync_names_the_file_and_leaves_the_old_one(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["plan.json"]
 
 
+@pytest.mark.slow
 def test_schema_into_a_full_device_exits_2_naming_standard_output(tmp_path: Path) -> None:
     """Standard output itself is the full device (file descriptor 1 of a fresh process).
     Before: "error: [Errno 28] No space left on device", not saying it was the output."""

@@ -43,6 +43,7 @@ def _measure(plan, T_true, units="m"):  # type: ignore[no-untyped-def]
     return Measurements.from_points_m(pts, units=units)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["hultman2013", "three_two_one", "best_fit"])
 @pytest.mark.parametrize("units", ["m", "mm"])
 def test_known_motion_is_recovered(method: str, units: str, rng: np.random.Generator) -> None:
@@ -168,6 +169,7 @@ def test_a_point_1_m_off_is_named_with_best_fit() -> None:
     assert out.screen.remeasure == ("G",)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["hultman2013", "three_two_one", "best_fit"])
 def test_noise_the_plan_expects_is_not_flagged(method: str, rng: np.random.Generator) -> None:
     """No false alarm: 25 calibrations with Gaussian noise at the plan's sensor and robot
@@ -188,6 +190,7 @@ def test_noise_the_plan_expects_is_not_flagged(method: str, rng: np.random.Gener
         assert out.trusted, out.problems
 
 
+@pytest.mark.slow
 def test_simulated_calibrations_of_the_bulged_stator_are_trusted() -> None:
     """No false alarm on realistic data: the simulated sensor (ray bundle), robot errors and
     the bolted stator's bulged side face of `wobjcal validate`, 12 trials."""

@@ -63,6 +63,7 @@ def test_a_bad_mesh_pose_names_the_field() -> None:
         plan_from_json(msgspec.json.encode(raw).decode())
 
 
+@pytest.mark.slow
 def test_check_and_validate_see_the_part_in_the_new_frame(reference_dir: Path) -> None:
     from planner.check.job import check_plan
     from planner.check.simulatable import check_simulatable, preflight, work_object_mesh

@@ -56,6 +56,7 @@ def test_plan_edge_offset_overrides_the_sensor_model() -> None:
     assert models.settings.edge_event_offset_m == 0.0042
 
 
+@pytest.mark.slow
 def test_same_seed_same_report_other_seed_differs() -> None:
     plan = load_plan(STATOR)
     a = validate_plan(plan, trials=TRIALS, seed=11, workers=1)
@@ -67,6 +68,7 @@ def test_same_seed_same_report_other_seed_differs() -> None:
     assert not np.array_equal(a.delta_procedure, c.delta_procedure)
 
 
+@pytest.mark.slow
 def test_progress_reaches_the_trial_count() -> None:
     calls: list[tuple[int, int]] = []
     validate_plan(
@@ -75,6 +77,7 @@ def test_progress_reaches_the_trial_count() -> None:
     assert calls and calls[-1] == (2, 2)
 
 
+@pytest.mark.slow
 def test_cli_and_function_agree(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "report.json"
     argv = ["validate", str(STATOR), "--trials", str(TRIALS), "--seed", "5", "--workers", "1"]
@@ -85,6 +88,7 @@ def test_cli_and_function_agree(tmp_path: Path, capsys: pytest.CaptureFixture[st
     assert from_cli["failures"] == report.failures and from_cli["seed"] == 5
 
 
+@pytest.mark.slow
 def test_stator_report_has_the_papers_rows_and_the_x_offset() -> None:
     r = validate_plan(load_plan(STATOR), trials=40, seed=2)
     assert r.row("yz_epsilon", 99.9).paper == 0.66 and r.row("yz_slots", 99.9999).paper == 0.69
@@ -96,6 +100,7 @@ def test_stator_report_has_the_papers_rows_and_the_x_offset() -> None:
     assert len(px) == 1 and px[0].searches == 40 * 42  # 21 teeth x 2 levels a trial
 
 
+@pytest.mark.slow
 def test_plate_plans_validate_from_the_cli(
     reference_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -139,6 +144,7 @@ def test_iterative_validates_the_best_fit_plan(plate_fit) -> None:  # type: igno
     assert all(o.searches == 40 for o in r.outcomes)
 
 
+@pytest.mark.slow
 def test_paper_protocol_stands_beside_the_default(plate_fit) -> None:  # type: ignore[no-untyped-def]
     r = validate_plan(plate_fit, trials=30, seed=4, protocol=(5, 4), plan_dir=PLATE_FIT.parent)
     assert r.protocol == "5 positions x 4 repeats" and r.n_trials == 30
@@ -147,6 +153,7 @@ def test_paper_protocol_stands_beside_the_default(plate_fit) -> None:  # type: i
     assert "paper protocol" in r.to_markdown()
 
 
+@pytest.mark.slow
 def test_sensitivity_names_a_dominant_term(plate_fit) -> None:  # type: ignore[no-untyped-def]
     table = sensitivity_plan(plate_fit, trials=60, seed=1, plan_dir=PLATE_FIT.parent)
     assert table.terms[0] == "all on" and "robot repeatability off" in table.terms
@@ -225,6 +232,7 @@ def test_a_missing_mesh_file_is_named() -> None:
         validate_plan(plan, trials=2, seed=0, plan_dir=Path("/nonexistent"))
 
 
+@pytest.mark.slow
 def test_reach_checked_trials_draw_the_same_numbers() -> None:
     """Vetting the first trials in the cell changes what is checked, not what is drawn."""
     plan = load_plan(STATOR)

@@ -7,6 +7,8 @@ import math
 from pathlib import Path
 from typing import Any
 
+import pytest
+
 from calib.plan.file import load_plan, plan_to_json
 from tests.data.plans.make_plate_plans import PLANS, plate_plans
 
@@ -39,6 +41,7 @@ def test_the_comparison_sees_a_changed_number_but_not_the_sign_of_zero() -> None
     assert _same({"q": 1}, {"r": 1}) != [] and _same({"s": "a"}, {"s": "b"}) != []
 
 
+@pytest.mark.slow
 def test_shipped_plate_plans_equal_the_generator(reference_dir: Path) -> None:
     for name, plan in plate_plans().items():
         shipped, made = json.loads((PLANS / name).read_text()), json.loads(plan_to_json(plan))
@@ -48,6 +51,7 @@ def test_shipped_plate_plans_equal_the_generator(reference_dir: Path) -> None:
         assert load_plan(PLANS / name) == plan  # files found, digests match
 
 
+@pytest.mark.slow
 def test_every_plate_point_is_reachable_on_its_face(reference_dir: Path) -> None:
     from planner.check.job import check_plan
 

@@ -21,6 +21,7 @@ def report():
     )
 
 
+@pytest.mark.slow
 def test_plots_are_written_as_png(report, tmp_path) -> None:
     paths = save_validation_plots(report, tmp_path / "plots")
     assert [p.name for p in paths] == ["histograms.png", "scatter.png", "error_map.png"]
@@ -30,6 +31,7 @@ def test_plots_are_written_as_png(report, tmp_path) -> None:
     assert not list((tmp_path / "plots").glob("*.tmp*"))  # atomic: no leftovers
 
 
+@pytest.mark.slow
 def test_scatter_shows_every_calibration_about_the_mean(report) -> None:
     fig = scatter_figure(report, np.asarray(EPSILON_M))
     ax_origin, ax_eps = fig.axes

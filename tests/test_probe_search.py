@@ -70,6 +70,7 @@ def same(a, b) -> bool:  # type: ignore[no-untyped-def]
     )
 
 
+@pytest.mark.slow
 def test_the_default_path_answers_as_the_exact_check(cell: Cell) -> None:
     rng = np.random.default_rng(3)
     pts, nrm, _ = sample_surface(cell.work_object.mesh, 500, rng)
@@ -102,6 +103,7 @@ def test_a_moved_part_is_checked_where_it_lies(cell: Cell) -> None:
     assert all(same(a, b) for a, b in zip(fast, exact))
 
 
+@pytest.mark.slow
 def test_self_collision_near_misses_answer_as_the_exact_check() -> None:
     """On the benchmark's box, the points whose answer is the forearm near the tool mount (the
     self part decides them) and a random share of the rest, to the last bit of the clearance's
@@ -119,6 +121,7 @@ def test_self_collision_near_misses_answer_as_the_exact_check() -> None:
     assert all(fast[i].clearance_m == e.clearance_m for i, e in zip(idx, exact) if i in near)
 
 
+@pytest.mark.slow
 def test_points_near_the_table_answer_as_the_exact_check() -> None:
     """600 points on the lowest 8 cm of the benchmark box's sides, half of them pushed up to
     12 mm into the part: the tool meets the table at every depth, so the least-bad search runs

@@ -43,6 +43,7 @@ def demo() -> Iterator[Cell]:
         yield c
 
 
+@pytest.mark.slow
 def test_demo_heat_map_statuses_equal_the_full_check(demo: Cell) -> None:
     """300 stator samples at the heat map's settings (most collide in every pose: the case the
     shortcut is for) and 60 at a click's."""
@@ -56,6 +57,7 @@ def test_demo_heat_map_statuses_equal_the_full_check(demo: Cell) -> None:
     _compare(demo, pts[:60], nrm[:60])
 
 
+@pytest.mark.slow
 def test_box_near_the_table_statuses_equal_the_full_check() -> None:
     """A dense box on a table with a post, points pushed up to 12 mm into the part: collisions
     with table, post and part at every depth, marginal poses and joint limits."""

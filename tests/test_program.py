@@ -73,6 +73,7 @@ def test_the_adaptive_order_comes_from_the_procedure_itself() -> None:
     )
 
 
+@pytest.mark.slow
 def test_every_writer_names_its_own_program() -> None:
     from planner.export_plan.job import export_program
     from planner.plan_cell import open_cell
@@ -140,6 +141,7 @@ def test_a_nominal_program_searches_from_the_exported_safe_starts(path: Path, se
     assert np.abs(run.T_base_wobj - ref.T_base_wobj).max() < 1e-12
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", range(4))
 @pytest.mark.parametrize("retake", [True, False])
 def test_the_adaptive_rapid_program_measures_what_the_executed_program_measures(

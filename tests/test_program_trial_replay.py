@@ -92,6 +92,7 @@ def _search_callback(probe: Any) -> Any:
     return search
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("name", "seed"),
     [("plate_holes_best_fit.json", 1), ("plate_holes_321.json", 2), ("stator_section_ah.json", 3)],

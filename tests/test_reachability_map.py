@@ -41,6 +41,7 @@ def test_same_seed_same_samples() -> None:
         np.testing.assert_array_equal(x, y)
 
 
+@pytest.mark.slow
 def test_map_of_a_box_agrees_with_probe_checks(rng) -> None:
     with Cell(use_acl_cache=False) as cell:
         with pytest.raises(ShapeError, match="work object"):

@@ -102,11 +102,13 @@ def _in_repo(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.chdir(ROOT)  # the recorded outputs name the plan by its repository path
 
 
+@pytest.mark.slow
 def test_check_json_unchanged(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["check", PLAN, "--json"]) == 0
     _record_or_compare(GOLDEN / "check.json", capsys.readouterr().out)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("fmt", "files"),
     [
@@ -126,6 +128,7 @@ def test_export_unchanged(fmt: str, files: list[str], tmp_path: Path) -> None:
         _record_or_compare(GOLDEN / name, (tmp_path / name).read_text())
 
 
+@pytest.mark.slow
 def test_validate_json_unchanged(tmp_path: Path) -> None:
     out = tmp_path / "validate.json"
     argv = ["validate", PLAN, "--trials", "50", "--seed", "1", "--json", str(out)]

@@ -64,6 +64,7 @@ def _job(plan: Plan, T_nom: np.ndarray):  # type: ignore[no-untyped-def]
 
 
 # ------------------------------------------------------------------ RAPID
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("name", "seed"), [("plate_holes_best_fit.json", 1), ("stator_section_ah.json", 3)]
 )
@@ -94,6 +95,7 @@ def test_the_rapid_json_gives_the_frame_the_controller_computed(
 
 
 # ------------------------------------------------------------------ KRL
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("name", "seed"), [("plate_holes_321.json", 2), ("stator_section_ah.json", 3)]
 )
@@ -180,6 +182,7 @@ def test_a_measured_slot_without_its_point_is_named(tmp_path: Path) -> None:
 
 
 # ------------------------------------------------------------------ URScript
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("name", "seed"), [("plate_holes_best_fit.json", 1), ("stator_section_ah.json", 3)]
 )

@@ -99,6 +99,7 @@ def test_edge_search_up_the_front_face_is_feasible(cell: Cell) -> None:
     assert res.min_clearance_m > 0.005
 
 
+@pytest.mark.slow
 def test_a_search_leaving_the_workspace_fails_midway(cell: Cell) -> None:
     cmd = SearchCommand.from_point(TOP_APPROACH, cell.T_base_wobj)
     away = replace(cmd, kind="edge", direction=np.array([1.0, 0.0, 0.0]), length_m=1.0)
@@ -132,6 +133,7 @@ def test_bad_commands(cell: Cell) -> None:
         cell.check_search(replace(cmd, start_m=np.array([np.nan, 0.0, 0.0])))
 
 
+@pytest.mark.slow
 def test_numeric_ik_robot_runs_a_search(reference_dir) -> None:
     """UR5 (offset wrist, numeric IK): one approach search, continuous joints on the path."""
     with Cell(reference_dir / "robots" / "ur5" / "ur5.urdf", use_acl_cache=False) as ur5:

@@ -11,6 +11,7 @@ millimetres of Bullet's slack, and most links deep in the table or the post one 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from planner.cell import bound_kernels
 from planner.cell.broad_phase import broad_phase_of
@@ -20,6 +21,7 @@ from planner.cell.slack_bounds import SlackBounds
 from tests.test_broad_phase import MARGIN, cell, configurations  # noqa: F401  (fixture)
 
 
+@pytest.mark.slow
 def test_bounds_are_never_below_bullets_slack(cell: Cell) -> None:  # noqa: F811
     rng = np.random.default_rng(11)
     q, T_bf = configurations(cell, rng)

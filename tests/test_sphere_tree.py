@@ -87,6 +87,7 @@ def _shape(kind: int, R: np.ndarray, t: np.ndarray, dims, verts=None):  # type: 
     return kind, T34, np.asarray(dims, dtype=float), v, 0, 0 if verts is None else len(v)
 
 
+@pytest.mark.slow
 def test_gjk_bounds_hold_against_exact_distances(rng) -> None:
     """Spheres against boxes, cylinders, capsules and hulls: the exact distance is the
     distance from the sphere's centre to the other shape (computed independently) minus its

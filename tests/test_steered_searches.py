@@ -114,6 +114,7 @@ def _worst_gaps(plan: Plan, trials: int, seed: int) -> tuple[float, float]:
     return least, most
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("proximity", [False, True], ids=["touch", "proximity"])
 def test_steered_searches_start_outside_and_end_past_every_misplaced_face(proximity: bool) -> None:
     """The adaptive program of a plan sized to its steered bounds (no floors), run on ideal
@@ -248,6 +249,7 @@ def test_export_writes_the_steered_starts_and_refuses_fanuc() -> None:
     assert "search_sizing steered" in job.safety.describe()
 
 
+@pytest.mark.slow
 def test_validate_runs_the_tight_steered_program_without_a_failed_search() -> None:
     """The same tight program simulated on the plate's mesh with the touch probe and the robot's
     noise (``wobjcal validate``): no search starts touching or runs short in any trial (X1 and

@@ -74,6 +74,7 @@ def test_plan_units_must_agree_with_the_file(cad_dir: Path) -> None:
         load_work_object(path, units="mm")
 
 
+@pytest.mark.slow
 def test_a_second_load_comes_from_the_cache_and_a_broken_cache_only_slows(
     cad_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -254,6 +255,7 @@ def box_plans(cad_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Iterat
     yield {"folder": folder, "step": step, "stl": stl}
 
 
+@pytest.mark.slow
 def test_a_plan_on_the_step_box_checks_as_on_its_stl_export(box_plans: dict) -> None:
     from planner.check.job import check_plan
 
@@ -278,6 +280,7 @@ def test_validate_runs_on_the_step_box(box_plans: dict) -> None:
     assert np.abs(report.delta_procedure[:, :3]).max() < 1e-3
 
 
+@pytest.mark.slow
 def test_cli_check_on_a_step_plan_reports_the_files_unit(
     box_plans: dict, capsys: pytest.CaptureFixture[str], caplog: pytest.LogCaptureFixture
 ) -> None:
@@ -294,6 +297,7 @@ def test_cli_check_on_a_step_plan_reports_the_files_unit(
 
 
 # ---- bodies ----------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_a_file_of_several_bodies_needs_a_choice_naming_them(cad_dir: Path) -> None:
     path = cad_dir / "box_sides.STEP"
     with pytest.raises(MeshError, match=r"holds 10 bodies \(0 'box_base', 1 'side_long', 2 "):
@@ -440,6 +444,7 @@ def test_a_body_on_a_mesh_file_is_an_error(tmp_path: Path) -> None:
         load_work_object(path, body="all")
 
 
+@pytest.mark.slow
 def test_cli_says_a_bad_step_in_one_line(
     box_plans: dict, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -456,6 +461,7 @@ def test_cli_says_a_bad_step_in_one_line(
 
 
 # ---- the web UI's part upload ----------------------------------------------------------------
+@pytest.mark.slow
 def test_a_step_upload_in_the_ui_takes_the_files_unit(
     cad_dir: Path, tmp_path_factory: pytest.TempPathFactory
 ) -> None:

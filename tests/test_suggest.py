@@ -25,6 +25,7 @@ def suggested(ah: Plan) -> SuggestResult:
     return suggest_plan(ah, ASSETS, target_m=0.3e-3, max_points=10)
 
 
+@pytest.mark.slow
 def test_suggested_plan_meets_its_target_checked_and_simulated(suggested: SuggestResult) -> None:
     from planner.check.job import check_plan
     from planner.validate.job import validate_plan
@@ -42,6 +43,7 @@ def test_suggested_plan_meets_its_target_checked_and_simulated(suggested: Sugges
         assert row.procedure == pytest.approx(row.procedure_predicted, rel=0.25)
 
 
+@pytest.mark.slow
 def test_add_one_point_lowers_the_error(suggested: SuggestResult) -> None:
     more = suggest_plan(suggested.plan, ASSETS, add=1)
     assert len(more.plan.points) == len(suggested.plan.points) + 1
@@ -49,12 +51,14 @@ def test_add_one_point_lowers_the_error(suggested: SuggestResult) -> None:
     assert more.worst_m < suggested.worst_m
 
 
+@pytest.mark.slow
 def test_three_two_one_roles(ah: Plan) -> None:
     res = suggest_plan(ah, ASSETS, procedure="three_two_one")
     assert [p.role for p in res.plan.points] == ["primary"] * 3 + ["secondary"] * 2 + ["tertiary"]
     assert res.plan.method == "three_two_one" and res.quality is not None
 
 
+@pytest.mark.slow
 def test_unreachable_target_says_the_best_reached(ah: Plan) -> None:
     res = suggest_plan(ah, ASSETS, target_m=1e-6, max_points=7)
     assert not res.met
@@ -62,6 +66,7 @@ def test_unreachable_target_says_the_best_reached(ah: Plan) -> None:
     assert len(res.plan.points) == 7
 
 
+@pytest.mark.slow
 def test_part_without_planar_faces_is_refused(ah: Plan, reference_dir: Path) -> None:
     from calib.plan.file import file_sha256
 
@@ -72,6 +77,7 @@ def test_part_without_planar_faces_is_refused(ah: Plan, reference_dir: Path) -> 
         suggest_plan(plan, ASSETS)
 
 
+@pytest.mark.slow
 def test_cli_writes_the_plan(ah: Plan, tmp_path: Path) -> None:
     from planner.cli.main import main
 
@@ -86,6 +92,7 @@ def test_cli_writes_the_plan(ah: Plan, tmp_path: Path) -> None:
     assert len(load_plan(tmp_path / "t.json").points) == 7
 
 
+@pytest.mark.slow
 def test_plate_suggestion_lands_on_its_faces(reference_dir: Path) -> None:
     """The machined plate (touch probe, misplacement 3 mm / 1 deg): the side faces' flat band
     (6.35 mm) holds a search only once the top's points have fixed the height and the tilts,
@@ -139,6 +146,7 @@ def test_first_points_keep_the_whole_misplacement() -> None:
     assert height < 1e-9 and along == pytest.approx(a, rel=1e-6)
 
 
+@pytest.mark.slow
 def test_more_points_never_predict_a_larger_error(ah: Plan) -> None:
     """Without a target every size up to ``--max-points`` is designed, each from the one
     before it as well as from scratch: the predicted error never grows with the points (each

@@ -77,6 +77,7 @@ def test_edge_candidates_lie_on_the_top_edges_and_point_out(tmp_path: Path) -> N
     )
 
 
+@pytest.mark.slow
 def test_thin_box_is_fixed_by_edge_searches(box_plan: Plan) -> None:
     """The suggestion fixes all six DOF with edge searches, checks, and its Monte Carlo
     agrees with the prediction within 25 % on every row."""

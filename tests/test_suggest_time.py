@@ -121,6 +121,7 @@ def fastest_stator(tmp_path_factory: pytest.TempPathFactory) -> tuple[int, Path]
     return main(argv), out
 
 
+@pytest.mark.slow
 def test_the_fastest_plan_is_the_program_check_and_export_time(
     fastest_stator: tuple[int, Path],
 ) -> None:
@@ -186,6 +187,7 @@ def test_front_file_type_is_checked(tmp_path: Path, capsys: pytest.CaptureFixtur
     assert "a plot file ending in .png, .svg, .pdf" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_rows_are_finite_numbers_or_empty(fastest_stator: tuple[int, Path]) -> None:
     _, out = fastest_stator
     with (out / "front.csv").open() as f:

@@ -26,6 +26,7 @@ from planner.suggest import SuggestError, suggest_plan
 PLANS = Path(__file__).resolve().parents[1] / "assets" / "plans"
 
 
+@pytest.mark.slow
 def test_a_point_check_refuses_is_set_aside_and_the_layout_redone(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
@@ -56,6 +57,7 @@ def test_a_point_check_refuses_is_set_aside_and_the_layout_redone(
     assert real(res.plan, PLANS).feasible
 
 
+@pytest.mark.slow
 def test_a_refusal_says_at_which_bound_a_layout_exists() -> None:
     """The plate's 12.7 mm side faces under a 25 mm / 4 deg bound: no 3-2-1 fits them for
     the nominal TP program; the message says the adaptive program or the bound that would."""

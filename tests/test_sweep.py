@@ -69,6 +69,7 @@ def test_parse_range(text: str, expected: tuple[float, float]) -> None:
     assert parse_range(text, "base_dx_mm") == expected
 
 
+@pytest.mark.slow
 def test_serial_and_distributed_rows_are_the_same(serial_dir: Path, tmp_path: Path) -> None:
     result = run_sweep(PLATE, tmp_path, samples=N, seed=3, workers=2)
     assert result.ran == N
@@ -83,6 +84,7 @@ def test_serial_and_distributed_rows_are_the_same(serial_dir: Path, tmp_path: Pa
     assert all(float(r[COLUMNS.index("cycle_s")]) > 0 for r in rows.values())
 
 
+@pytest.mark.slow
 def test_resume_runs_only_the_missing_placements(
     serial_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -108,6 +110,7 @@ def test_resume_runs_only_the_missing_placements(
     assert ran == []
 
 
+@pytest.mark.slow
 def test_other_arguments_are_refused_naming_them(serial_dir: Path, tmp_path: Path) -> None:
     out = tmp_path / "other"
     shutil.copytree(serial_dir, out)
@@ -136,6 +139,7 @@ def test_cli_refuses_another_sweep_with_exit_2(
     assert "--format rapid (now krl)" in err and "Traceback" not in err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("extra", "message"),
     [
@@ -170,6 +174,7 @@ def test_bad_flags_exit_2_with_one_clear_error(
     assert not (tmp_path / "x").exists()  # nothing written
 
 
+@pytest.mark.slow
 def test_part_out_of_reach_is_a_row_with_its_reason(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -196,6 +201,7 @@ def test_a_check_that_raises_becomes_an_error_row(monkeypatch: pytest.MonkeyPatc
     assert row.points_total == len(load_plan(PLATE).points) and math.isnan(row.accuracy_mm)
 
 
+@pytest.mark.slow
 def test_a_running_scheduler_runs_the_same_rows(
     serial_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -68,6 +68,7 @@ def test_a_tilted_flange_is_refused_naming_the_plan_field(tmp_path: Path) -> Non
         check_plan(plan, STATOR.parent)
 
 
+@pytest.mark.slow
 def test_x_out_vendor_urdf_checks_like_the_z_out_one(tmp_path: Path) -> None:
     """Before: the tool stuck sideways through the wrist, every point 'feasible' with confdata
     of an impossible pose. Now the check, poses and confdata equal those of the same robot with
@@ -83,6 +84,7 @@ def test_x_out_vendor_urdf_checks_like_the_z_out_one(tmp_path: Path) -> None:
         assert g.clearance_pair == w.clearance_pair
 
 
+@pytest.mark.slow
 def test_the_plan_mount_is_used_and_exported(tmp_path: Path) -> None:
     """A tilted vendor flange with the mount given in the plan: the cell and the exported
     tool data use it (the controller's flange is the mount's rotation of the tip frame)."""

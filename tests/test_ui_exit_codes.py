@@ -16,6 +16,7 @@ import pytest
 REPO = Path(__file__).resolve().parent.parent
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("sig", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
 def test_ui_exit_code_after_a_signal(sig: signal.Signals, code: int, tmp_path: Path) -> None:
     from webui.testing import box_plan

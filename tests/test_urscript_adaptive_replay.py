@@ -75,6 +75,7 @@ def _job(plan: Any, T_nom: np.ndarray) -> ExportJob:
     return build_job(plan, T_nom, ToolData(T_flange_tcp=np.eye(4)))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("name", "seed"), CASES)
 def test_the_urscript_program_replays_a_validate_trial(name: str, seed: int) -> None:
     plan, setup, probe, _T_true = _trial(PLANS / name, "urscript", seed)

@@ -547,6 +547,7 @@ def test_nominal_part_gives_the_plan_points(path: Path) -> None:
         assert np.abs(np.array(got[1:]) - transform_points(T_nom, p.position_m)).max() < TOL_M
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", range(2))
 @pytest.mark.parametrize("shape", sorted(SHAPES))
 @pytest.mark.parametrize("path", PLANS, ids=[p.stem for p in PLANS])
@@ -582,6 +583,7 @@ def test_generated_variants_run_and_measure_exactly(path: Path, shape: str, seed
     assert np.allclose(vias, want, atol=1e-6) or (vias == [] and want == [])
 
 
+@pytest.mark.slow
 def test_the_plane_probe_agrees_with_the_box_probe() -> None:
     """Both ideal sensors answer the stator programs' searches alike (the plane probe is the
     reference for the plans that are not the box): the adaptive A-H one and a nominal one."""
@@ -598,6 +600,7 @@ def test_the_plane_probe_agrees_with_the_box_probe() -> None:
             assert np.abs(slot_points(a, job)[0] - slot_points(b, job)[0]).max() < TOL_M
 
 
+@pytest.mark.slow
 def test_polling_every_control_cycle_gives_the_same_points() -> None:
     """The event clock is an ideal controller: polling at 125 Hz (CB3) sees the same events."""
     plan = load(STATOR)

@@ -242,6 +242,7 @@ def test_fk_agrees_with_pybullet_and_ik_round_trips(
     assert np.abs(err).max() <= 1e-9
 
 
+@pytest.mark.slow
 def test_the_acl_allows_the_permanent_wrist_overlap(cell: Cell) -> None:
     acl = cell.checker.acl
     for a, b in (("link_4", "link_6"), ("link_4", "link_5"), ("link_5", "link_6")):

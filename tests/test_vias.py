@@ -64,6 +64,7 @@ def via_plan(demo: Plan, poses: dict[str, np.ndarray]) -> Plan:
 
 
 # ---- the plan field ------------------------------------------------------------------------
+@pytest.mark.slow
 def test_old_plans_save_unchanged_and_vias_round_trip(demo: Plan, via_plan: Plan) -> None:
     for path in sorted(PLANS.glob("*.json")):
         text = path.read_text()
@@ -104,6 +105,7 @@ def test_vias_of_one_plan_have_one_joint_count(demo: Plan) -> None:
 
 
 # ---- check ---------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_clear_vias_keep_the_point_feasible(via_plan: Plan, demo_cell: object) -> None:
     check = check_plan(via_plan, cell=demo_cell)  # type: ignore[arg-type]
     b = check.points[1]
@@ -114,6 +116,7 @@ def test_clear_vias_keep_the_point_feasible(via_plan: Plan, demo_cell: object) -
     assert "vias" not in check.to_json()["points"][0]
 
 
+@pytest.mark.slow
 def test_via_outside_the_joint_limits_is_named(
     demo: Plan, demo_cell: object, poses: dict[str, np.ndarray]
 ) -> None:
@@ -126,6 +129,7 @@ def test_via_outside_the_joint_limits_is_named(
     assert "vias: via 2" in c.reason
 
 
+@pytest.mark.slow
 def test_colliding_via_move_names_the_via_and_the_pair(
     demo: Plan, demo_cell: object, poses: dict[str, np.ndarray]
 ) -> None:
@@ -139,6 +143,7 @@ def test_colliding_via_move_names_the_via_and_the_pair(
     assert m.group(2) == "stator_section"
 
 
+@pytest.mark.slow
 def test_wrong_joint_count_is_named(demo: Plan, demo_cell: object) -> None:
     plan = with_vias(demo, 1, [[0.0] * 7])
     c = check_plan(plan, cell=demo_cell).points[1]  # type: ignore[arg-type]
@@ -179,6 +184,7 @@ def _vias_in(fmt: str, files: dict[str, str]) -> list[list[float]]:
     raise AssertionError(f"no parser for {fmt}")
 
 
+@pytest.mark.slow
 def test_every_format_moves_through_the_vias_first(via_plan: Plan, demo_cell: object) -> None:
     assert set(FORMATS) == {"rapid", "krl", "urscript", "fanuc"}  # a new format needs a parser
     want = np.array([v.q_rad for v in via_plan.points[1].via_points])
@@ -220,6 +226,7 @@ def test_probe_orders_follow_the_adaptive_rapid_program(demo: Plan) -> None:
     assert called == [ids[i] for i in adaptive]
 
 
+@pytest.mark.slow
 def test_vias_are_checked_from_every_point_a_program_comes_from(
     demo: Plan, demo_cell: object, poses: dict[str, np.ndarray], monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -57,6 +57,7 @@ def _env(tmp_path: Path, **extra: str) -> dict[str, str]:
     return env
 
 
+@pytest.mark.slow
 def test_a_check_after_the_warm_up_compiles_nothing(tmp_path: Path) -> None:
     """The warm-up's signatures are the ones a check calls with: after it, a check (a fresh
     distance field, parts and pairs, slack bounds of points pushed into the part) finds every
@@ -68,6 +69,7 @@ def test_a_check_after_the_warm_up_compiles_nothing(tmp_path: Path) -> None:
     assert out.stdout.strip().splitlines()[-1] == "compiled: []"
 
 
+@pytest.mark.slow
 def test_the_warm_up_command_and_the_background_helper_write_the_marker(tmp_path: Path) -> None:
     env = _env(tmp_path, WOBJCAL_BACKGROUND_COMPILE="0")
     cache = _cache(tmp_path)

@@ -32,6 +32,7 @@ def _ray_to(p_wobj: list[float]) -> tuple[np.ndarray, np.ndarray]:
     return origin, target - origin
 
 
+@pytest.mark.slow
 def test_click_places_point_checks_it_and_autosaves(app: WobjcalApp) -> None:
     check = app.place_at_ray(*_ray_to([0.1, 0.05, 0.0]), point_id="A")
     assert check is not None and check.point_id == "A"
@@ -102,6 +103,7 @@ def test_bad_uploads_change_nothing(app: WobjcalApp) -> None:
         assert app.state.doc is before, f"{name} changed the plan"
 
 
+@pytest.mark.slow
 def test_good_plan_upload_replaces_plan_and_undo_restores(app: WobjcalApp) -> None:
     before_ids = app.state.doc.ids
     # relative mesh references resolve against the session's plan folder
@@ -142,6 +144,7 @@ def test_feasible_point_has_pose_and_search_path(app: WobjcalApp) -> None:
     np.testing.assert_allclose(app.robot.q, check.q)
 
 
+@pytest.mark.slow
 def test_exports_are_robot_programs(app: WobjcalApp) -> None:
     original = app.plan_dir / "box_plan.json"
     app.files_panel.upload_plan(original.name, original.read_bytes())  # drop the extra points
@@ -154,6 +157,7 @@ def test_exports_are_robot_programs(app: WobjcalApp) -> None:
     assert ur.files[0][0].endswith(".script")
 
 
+@pytest.mark.slow
 def test_downloads_are_named_after_the_loaded_plan(app: WobjcalApp) -> None:
     """Issue item 4: the downloads of an uploaded plan are named after that plan's name (as
     ``wobjcal export -o DIR`` names them), whatever the file it came in was called."""
@@ -167,6 +171,7 @@ def test_downloads_are_named_after_the_loaded_plan(app: WobjcalApp) -> None:
         app.state.undo()
 
 
+@pytest.mark.slow
 def test_mesh_and_urdf_uploads_replace_the_cell(app: WobjcalApp) -> None:
     from webui.testing import box_mesh
 
@@ -215,6 +220,7 @@ def test_play_search_path_ends_at_its_last_pose(app: WobjcalApp) -> None:
     np.testing.assert_allclose(app.robot.q, check.q_path[-1])
 
 
+@pytest.mark.slow
 def test_plays_started_together_leave_one_animation_that_stops(app: WobjcalApp) -> None:
     """Eight plays of a long path started at once from eight threads (as button clicks of a
     thread pool), five rounds: one animation is left registered, and ``stop`` ends every one
@@ -292,6 +298,7 @@ def test_gizmo_sits_outside_the_part_and_a_drag_back_to_the_start_records_nothin
     panel.drag.value = False
 
 
+@pytest.mark.slow
 def test_the_points_table_says_when_the_layout_would_be_refused(app: WobjcalApp) -> None:
     """Issue 10, item 3: the UI shows what `wobjcal check` (and `calibrate`) would refuse, the
     same words as the check's ``layout``."""

@@ -58,6 +58,7 @@ def _edit_then_kill(plan: Path, port: int, home: Path) -> None:
         proc.kill()
 
 
+@pytest.mark.slow
 def test_the_edits_of_a_killed_session_are_restored_and_said(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

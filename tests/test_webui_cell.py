@@ -27,6 +27,7 @@ def test_fields_round_trip_in_mm_and_deg() -> None:
         cell_edits.pose_from_fields([0, np.nan, 0], [0, 0, 0])
 
 
+@pytest.mark.slow
 def test_moving_the_work_object_rebuilds_rechecks_and_undoes(demo_app: WobjcalApp) -> None:
     panel = demo_app.cell_panel
     source = demo_app.state.doc.source
@@ -49,6 +50,7 @@ def test_moving_the_work_object_rebuilds_rechecks_and_undoes(demo_app: WobjcalAp
     assert panel.position.value == pytest.approx(p)
 
 
+@pytest.mark.slow
 def test_robot_base_and_fixture_moves(demo_app: WobjcalApp) -> None:
     panel = demo_app.cell_panel
     assert "fixture: table" in panel.target.options
@@ -68,6 +70,7 @@ def test_robot_base_and_fixture_moves(demo_app: WobjcalApp) -> None:
         panel.move("fixture: nope", T)
 
 
+@pytest.mark.slow
 def test_snap_puts_the_part_on_the_table(demo_app: WobjcalApp) -> None:
     demo_app.cell_panel.snap_part("table")
     try:
@@ -84,6 +87,7 @@ def test_snap_puts_the_part_on_the_table(demo_app: WobjcalApp) -> None:
         demo_app.cell_panel.snap_part("nope")
 
 
+@pytest.mark.slow
 def test_cell_gizmo_drag_moves_the_target_and_a_still_drag_records_nothing(
     demo_app: WobjcalApp,
 ) -> None:

@@ -23,6 +23,7 @@ def _axis_ray(app: Any, point_id: str) -> tuple[np.ndarray, np.ndarray]:
     return target + 1.5 * n, -n
 
 
+@pytest.mark.slow
 def test_a_click_through_the_robot_places_nothing_and_names_the_link(demo_app: Any) -> None:
     app = demo_app
     app.select("A")

@@ -8,6 +8,7 @@ from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
+import pytest
 import trimesh
 
 from calib.frames import make_transform, matrix_from_rotvec
@@ -29,6 +30,7 @@ def _in_frustum(points: np.ndarray, position: np.ndarray, look_at: np.ndarray, f
     )
 
 
+@pytest.mark.slow
 def test_first_view_holds_part_and_robot_whatever_the_part(demo_app: Any) -> None:
     base = demo_app.view
     rng = np.random.default_rng(14)

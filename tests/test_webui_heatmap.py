@@ -4,6 +4,7 @@ surface; issue 22, item 7: one colour per face, never blended across a face."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import trimesh
 
 from webui.heatmap import (
@@ -55,6 +56,7 @@ def test_colours_are_voted_never_mixed_and_match_the_samples_near_them() -> None
     assert np.all(col[top][left, 0] == 255) and np.all(col[top][right, 2] == 255)
 
 
+@pytest.mark.slow
 def test_each_face_has_one_colour_so_the_renderer_blends_nothing() -> None:
     """Vertex colours are interpolated across a face: a face whose corners voted apart drew a
     stripe of a colour that means nothing (seen between "reach" and "footprint")."""

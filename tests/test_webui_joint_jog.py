@@ -32,6 +32,7 @@ def test_a_step_stops_at_the_limit_and_a_step_beyond_it_is_refused() -> None:
     assert stepped_value_deg("J2", 70.0, -1.0, -70.0, 70.0) == (pytest.approx(69.0), "")
 
 
+@pytest.mark.slow
 def test_fine_jog_fields_and_steps_move_the_robot(demo_app: WobjcalApp) -> None:
     panel = demo_app.teach_panel
     fine = panel.fine

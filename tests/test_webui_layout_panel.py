@@ -26,6 +26,7 @@ def app(tmp_path_factory: pytest.TempPathFactory) -> Iterator[WobjcalApp]:
     a.stop()
 
 
+@pytest.mark.slow
 def test_quality_is_live_and_follows_an_edit(app: WobjcalApp) -> None:
     panel = app.layout_panel
     q = panel.refresh().result(60)
@@ -60,6 +61,7 @@ def test_error_map_paints_every_vertex(app: WobjcalApp, monkeypatch: pytest.Monk
     assert painted[-1] is None
 
 
+@pytest.mark.slow
 def test_suggest_keeps_the_procedure_and_applies_only_on_accept(app: WobjcalApp) -> None:
     from webui.layout_panel import KEEP
 

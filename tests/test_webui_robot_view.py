@@ -34,6 +34,7 @@ def _plan_with_dae_visual(folder: Path) -> Path:
     return folder / "plan.json"
 
 
+@pytest.mark.slow
 def test_dae_visuals_are_drawn_with_pycollada(tmp_path: Path) -> None:
     pytest.importorskip("collada")  # declared in pyproject.toml for this
     app = run(_plan_with_dae_visual(tmp_path), port=free_port(), block=False, autosave_path=None)

@@ -88,6 +88,7 @@ def _ur5_zip(reference_dir: Path, drop: str | None = None) -> bytes:
     return buf.getvalue()
 
 
+@pytest.mark.slow
 def test_a_robot_zip_brings_its_meshes(app: WobjcalApp, reference_dir: Path) -> None:
     files = app.files_panel
     files.upload_urdf("ur5_package.zip", _ur5_zip(reference_dir))
@@ -123,6 +124,7 @@ def _with_frame(app: WobjcalApp, T_wobj_mesh: np.ndarray) -> None:
     app.replace_source(msgspec.structs.replace(source, work_object=wo), "3-point frame")
 
 
+@pytest.mark.slow
 def test_a_new_part_starts_with_its_own_frame_unless_the_frame_is_kept(
     app: WobjcalApp, reference_dir: Path
 ) -> None:

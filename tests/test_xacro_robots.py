@@ -96,6 +96,7 @@ def _xacro(folder: Path, body: str, name: str = "robot.xacro") -> Path:
 
 
 # ---- the xacro robot checks exactly like the package's own URDF --------------------------------
+@pytest.mark.slow
 def test_xacro_robot_checks_exactly_like_the_packages_own_urdf(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -342,6 +343,7 @@ def test_a_zip_without_a_needed_package_names_it(tmp_path: Path) -> None:
         unpack_robot_zip("irb2400.zip", _zip(SUPPORT), tmp_path / "a")
 
 
+@pytest.mark.slow
 def test_the_ui_takes_a_zip_of_ros_packages_as_the_robot(tmp_path: Path) -> None:
     from webui.server import run
     from webui.testing import box_plan, free_port

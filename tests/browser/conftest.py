@@ -16,6 +16,16 @@ from ui_helpers import CHROMIUM, CHROMIUM_ARGS, UiSession, open_page, start_ui
 
 from webui.testing import box_plan
 
+HERE = Path(__file__).resolve().parent
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Every test in this folder is a browser test (the marker is set by the directory:
+    ``-m "not browser"`` leaves them out without a marker in each file)."""
+    for item in items:
+        if HERE in Path(str(item.path)).resolve().parents:
+            item.add_marker(pytest.mark.browser)
+
 
 @pytest.fixture(scope="session")
 def browser() -> Iterator[Any]:

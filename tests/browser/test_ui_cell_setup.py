@@ -24,8 +24,6 @@ from ui_helpers import (
     wait_for,
 )
 
-pytestmark = pytest.mark.browser
-
 
 def _inputs(page: Any, handle: Any) -> Any:
     """The inputs of a viser widget (a number or text: one; a vector: one per component),

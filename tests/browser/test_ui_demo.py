@@ -7,7 +7,6 @@ import shutil
 from pathlib import Path
 
 import numpy as np
-import pytest
 from ui_helpers import (
     REPO,
     UiSession,
@@ -21,8 +20,6 @@ from ui_helpers import (
 from calib.atomic_io import write_bytes_atomic
 from calib.frames import transform_points
 from webui.plan_doc import PAPER_IDS
-
-pytestmark = pytest.mark.browser
 
 #: The README's screenshot: rewritten only when WOBJCAL_UPDATE_SCREENSHOTS=1 (tests leave the
 #: tracked tree alone otherwise).

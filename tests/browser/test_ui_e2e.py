@@ -18,8 +18,6 @@ from ui_helpers import UiSession, click_world, open_tab, save_screenshot, set_ca
 from calib.frames import transform_points
 from webui.testing import T_WORLD_WOBJ_BOX
 
-pytestmark = pytest.mark.browser
-
 
 def click_world_point(ui: UiSession, p_world: Any) -> None:
     """Click the canvas where ``p_world`` appears in the page's camera."""

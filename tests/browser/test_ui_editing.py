@@ -30,8 +30,6 @@ from webui.frame_panel import MODE, TRIAD_NODE
 from webui.joint_jog import PLUS
 from webui.testing import T_WORLD_WOBJ_BOX
 
-pytestmark = pytest.mark.browser
-
 
 def _field(page: Any, handle: Any) -> Any:
     """The input of a viser number widget."""

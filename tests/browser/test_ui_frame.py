@@ -16,8 +16,6 @@ from calib.plan.file import Plan
 from webui.frame_panel import MODE
 from webui.testing import T_WORLD_WOBJ_BOX
 
-pytestmark = pytest.mark.browser
-
 
 def _world_points(ui: UiSession) -> dict[str, np.ndarray]:
     doc = ui.app.state.doc

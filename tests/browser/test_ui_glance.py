@@ -26,8 +26,6 @@ from webui import clients
 from webui.plan_doc import NO_ROLE, PAPER_IDS
 from webui.scene import STATUS_RGB
 
-pytestmark = pytest.mark.browser
-
 
 def _camera_direction(ui: UiSession) -> np.ndarray:
     cam = ui.client().camera

@@ -13,8 +13,6 @@ from ui_helpers import UiSession, choose, open_tab, save_screenshot, wait_for
 
 from planner.sim.quality import LayoutQuality
 
-pytestmark = pytest.mark.browser
-
 LEVEL = 95.5
 
 

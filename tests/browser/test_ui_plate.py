@@ -13,8 +13,6 @@ from ui_helpers import REPO, UiSession, open_page, open_tab, start_ui, wait_for
 
 from webui.validation import error_colours
 
-pytestmark = pytest.mark.browser
-
 PLANS = REPO / "assets" / "plans"
 
 

@@ -17,8 +17,6 @@ from ui_helpers import UiSession, open_page, open_tab, start_ui, wait_for
 
 from webui.server import WobjcalApp
 
-pytestmark = pytest.mark.browser
-
 REPO = Path(__file__).resolve().parents[2]
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
 

@@ -14,8 +14,6 @@ from calib.frames import transform_points
 from webui.cell_edits import WORK_OBJECT, pose_of
 from webui.plan_doc import PAPER_IDS
 
-pytestmark = pytest.mark.browser
-
 
 def _input_of(page: Any, handle: Any) -> Any:
     """The (first) number input of a viser vector or slider widget."""

@@ -18,8 +18,6 @@ from calib.frames import transform_points
 from webui.app import WobjcalApp
 from webui.tab_selection import HIGHLIGHT
 
-pytestmark = pytest.mark.browser
-
 
 class Tab:
     """One page (its own browser context) and its connection on the server."""
