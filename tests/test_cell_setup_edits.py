@@ -4,7 +4,9 @@ cylinder fixture (validation, round trip, older plans' bytes kept), the mesh too
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import re
 from pathlib import Path
 
 import msgspec
@@ -244,3 +246,58 @@ def test_mesh_fixture_spec(plan_path: Path) -> None:
     spec = edits.mesh_fixture(plan, "clamp", "/tmp/clamp.stl", "mm", "a" * 64, (10, 20, 30))
     assert spec.shape == "mesh" and spec.units == "mm" and spec.sha256 == "a" * 64
     assert spec.T_world_fixture == Pose(position_m=(0.01, 0.02, 0.03))
+
+
+def test_an_older_description_with_sensor_keys_still_loads(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Before ``wobjcal.tool/1`` the docs asked for ``sensing_distance_m`` and
+    ``sensor_diameter_m`` in a tool JSON and the loader ignored extra keys: such a file (no
+    ``schema``) still loads, the keys ignored and said so in the log."""
+    builtin = Path(load_tool("builtin:cable_feeder").urdf_path or "")
+    desc = {
+        "name": "old_feeder",
+        "urdf": str(builtin),
+        "tcps": ["sensor"],
+        "sensor_tcp": "sensor",
+        "sensor_links": ["sensor_body"],
+        "sensing_distance_m": 0.008,
+        "sensor_diameter_m": 0.018,
+        "description": "written for wobjcal 0.1",
+    }
+    path = tmp_path / "old.tool.json"
+    path.write_text(json.dumps(desc))
+    with caplog.at_level("WARNING", logger="planner.cell.tool"):
+        tool = load_tool(path)
+    assert tool.name == "old_feeder" and tool.sensor_tcp == "sensor"
+    assert "sensing_distance_m" in caplog.text and "ignored" in caplog.text
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "says"),
+    [
+        ("speed_mm_s", 1e9, "search speed (mm/s): at most 250 mm/s"),
+        ("range_mm", 1000.0, "detection range (mm): at most 50 mm"),
+        ("diameter_mm", 1e6, "diameter (mm): at most 100 mm"),
+        ("noise_mm", 1000.0, "noise 1 sigma (mm): at most 5 mm"),
+    ],
+)
+def test_implausible_sensor_numbers_are_refused_naming_the_field(
+    plan_path: Path, field: str, value: float, says: str
+) -> None:
+    ui = ui_plan_from_plan(load_plan(plan_path))
+    fields = dataclasses.replace(edits.sensor_fields(ui), **{field: value})
+    with pytest.raises(InputError, match=re.escape(says)):
+        edits.with_sensor(ui, fields)
+
+
+def test_a_detection_range_the_tool_does_not_have_is_named() -> None:
+    """The built-in cable feeder's sensor TCP lies 8 mm in front of its sensor's face (a ray
+    back from the TCP into the tool): a 5 mm sensor is 3 mm off, and said so."""
+    from planner.cell.tool_face import gap_mismatch, sensor_face_gap_m
+
+    tool = load_tool("builtin:cable_feeder")
+    assert sensor_face_gap_m(tool) == pytest.approx(0.008, abs=1e-9)
+    assert gap_mismatch(tool, 0.008) == ""
+    why = gap_mismatch(tool, 0.005)
+    assert "8.0 mm in front of its sensor face" in why and "3.0 mm off" in why

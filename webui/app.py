@@ -284,6 +284,7 @@ class WobjcalApp:
         )
         if sensor_changed:  # the checks read it (footprint, standoff): all checked again
             changed = list(change.doc.ids)
+            self.heatmap.stop()  # coloured with the old sensor's footprint: gone, not stale
         with self._lock:
             for pid in [*changed, *(set(before) - set(change.doc.ids))]:
                 self._checks.pop(pid, None)

@@ -17,7 +17,9 @@ import numpy as np
 
 from calib.errors import InputError
 from calib.frames import make_transform, matrix_from_quat_wxyz, quat_wxyz_from_matrix
+from calib.models import ProximitySensor
 from calib.plan.file import Plan
+from planner.cell.tool_face import gap_mismatch
 from webui import cell_edits
 from webui.cell_edits import ROBOT_BASE, WORK_OBJECT
 from webui.cell_fixtures import FixturesSection
@@ -85,6 +87,21 @@ class CellPanel:
         self.refresh()
         self.target.value = target
 
+    def _tcp_mismatch(self, plan: Plan) -> str:
+        """Why the plan's proximity sensor does not fit its tool's sensor TCP (its sensing
+        distance is not the TCP's distance from the sensor face, :func:`planner.cell.tool_face.
+        gap_mismatch`), or ``""``."""
+        sensor = plan.validation.sensor
+        if not isinstance(sensor, ProximitySensor):
+            return ""
+        try:
+            tool = self.tool.tool_of(plan.cell.tool.name)
+        except (InputError, OSError):  # the tool section says why it has no tool
+            return ""
+        if tool.sensor_tcp is None or tool.sensor_tcp != plan.cell.tool.tcp:
+            return ""
+        return gap_mismatch(tool, sensor.standoff_m)
+
     def refresh(self) -> None:
         """Show the current plan's things and the chosen one's pose."""
         doc = self._app.state.doc
@@ -93,6 +110,7 @@ class CellPanel:
             return
         self.tool.refresh(source)
         self.sensor.refresh(doc)
+        self.sensor.warn(self._tcp_mismatch(source))
         self.fixtures.refresh(source)
         options = cell_edits.movable(source)
         if tuple(self.target.options) != options:

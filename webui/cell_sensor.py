@@ -6,6 +6,10 @@ sensing distance; a touch probe has none), **Noise 1σ (mm)** (the switching or 
 scatter) and **Search speed (mm/s)**, which sets the speed of *every* point's search, are
 applied together with **Apply sensor**: one undoable, autosaved step, after which every point
 is checked again (the footprint on the face and the search's standoff follow the sensor).
+Numbers beyond plausible (:data:`webui.cell_setup_edits.SENSOR_LIMITS`) are refused. The tool's
+sensor TCP must be where the sensor switches: when the detection range is not the TCP's
+distance from the tool's sensor face (:func:`planner.cell.tool_face.gap_mismatch`), the folder
+says so in red, since every measured point would be off by the difference.
 Picking another kind shows that kind's defaults (or the plan's, when it has that kind).
 """
 
@@ -69,6 +73,7 @@ class SensorSection:
                 hint="applies to every point's search",
             )  # fmt: skip
             self.note = gui.add_markdown("")
+            self.tcp_note = gui.add_markdown("")
             self.apply = gui.add_button("Apply sensor")
         self.kind.on_update(lambda ev: guard(ev, self._kind_chosen, ev))
         self.apply.on_click(lambda ev: guard(ev, self.apply_sensor))
@@ -83,6 +88,13 @@ class SensorSection:
         self.noise.value = round(fields.noise_mm, 6)
         if fields.speed_mm_s is not None:
             self.speed.value = round(fields.speed_mm_s, 6)
+
+    def warn(self, why: str) -> None:
+        """Say on the page why the sensor does not fit the tool's sensor TCP (``""``: it
+        does): the measured points would be off by the difference."""
+        text = f"**⚠ Sensor and tool disagree:** {why}." if why else ""
+        if self.tcp_note.content != text:
+            self.tcp_note.content = text
 
     def refresh(self, ui: UiPlan) -> None:
         """Show the plan's sensor and the points' search speed (only when they changed: numbers

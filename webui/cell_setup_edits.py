@@ -220,9 +220,26 @@ def sensor_fields(ui: UiPlan) -> SensorFields:
     )  # fmt: skip
 
 
+#: The largest sensor number the Sensor fields take (a typo of x100 is refused, not exported):
+#: face or ball diameter 100 mm, detection range 50 mm, noise 5 mm, search speed 250 mm/s.
+SENSOR_LIMITS = {
+    "diameter": 100.0,
+    "ball diameter": 100.0,
+    "detection range": 50.0,
+    "noise 1 sigma": 5.0,
+    "search speed": 250.0,
+}
+
+
 def _number(value: float, what: str, allow_zero: bool) -> float:
+    """``value`` checked: finite, positive (or zero) and at most its :data:`SENSOR_LIMITS`
+    entry (``what`` is ``"<name> (<unit>)"``)."""
     if not math.isfinite(value) or value < 0.0 or (value == 0.0 and not allow_zero):
         raise InputError(f"{what}: must be {'>= 0' if allow_zero else '> 0'}, got {value}")
+    most = SENSOR_LIMITS.get(what.split(" (")[0])
+    if most is not None and value > most:
+        unit = what.split(" (")[-1].rstrip(")") if " (" in what else ""
+        raise InputError(f"{what}: at most {most:g} {unit}, got {value:g} (a typo?)")
     return float(value)
 
 

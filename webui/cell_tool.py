@@ -27,6 +27,7 @@ from planner.cell.tool import Tool, load_tool, mesh_tool_description
 from webui.cell_edits import pose_from_fields
 from webui.cell_setup_edits import tcp_choice, with_tool
 from webui.cell_uploads import CellUploads
+from webui.files_panel import check_upload
 from webui.tab_selection import set_options
 from webui.urdf_zip import unpack_robot_zip
 
@@ -83,6 +84,10 @@ class ToolSection:
         )
 
     # ---- showing ---------------------------------------------------------------------------
+    def tool_of(self, ref: str) -> Tool:
+        """The tool ``ref`` of a plan (cached; see :meth:`_load`)."""
+        return self._load(ref)
+
     def _load(self, ref: str) -> Tool:
         """The tool ``ref`` (cached), its files resolved against the plan's folder."""
         if ref not in self._tools:
@@ -171,11 +176,12 @@ class ToolSection:
         ref: Path
         try:
             if lower.endswith(".zip"):
+                check_upload(name, content, TOOL_SUFFIXES, "tool")
                 kept = self._uploads.folder(content)
                 try:
                     ref = unpack_robot_zip(name, content, kept / "tool")
-                except InputError as exc:  # its messages speak of a robot
-                    raise InputError(str(exc).replace("robot", "tool")) from None
+                except InputError as exc:  # its messages speak of a robot, and of the zip
+                    raise InputError(f"{name} (a tool zip): {exc}") from None
             elif lower.endswith(".urdf"):
                 kept, _ = self._uploads.keep(name, content, TOOL_SUFFIXES, "tool")
                 ref = kept

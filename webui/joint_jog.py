@@ -51,9 +51,9 @@ def limits_deg(chain: KinematicChain) -> tuple[NDArray[np.float64], NDArray[np.f
     continuous joint)."""
     lo = np.where(np.isfinite(chain.lower), np.degrees(chain.lower), -CONTINUOUS_DEG)
     hi = np.where(np.isfinite(chain.upper), np.degrees(chain.upper), CONTINUOUS_DEG)
-    return (
-        np.asarray(np.round(lo, 3), dtype=np.float64),
-        np.asarray(np.round(hi, 3), dtype=np.float64),
+    return (  # to 0.001 deg, rounded inwards: a value at a shown limit is within the URDF's
+        np.asarray(np.ceil(lo * 1000.0 - 1e-9) / 1000.0, dtype=np.float64),
+        np.asarray(np.floor(hi * 1000.0 + 1e-9) / 1000.0, dtype=np.float64),
     )
 
 

@@ -22,6 +22,7 @@ plan field that sets the mount, ``cell.tool.T_flange_tool``.
 from __future__ import annotations
 
 import json
+import logging
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -47,6 +48,7 @@ from planner.robot.kinematics.chain import KinematicChain
 from planner.robot.urdf import load_urdf
 
 FloatArray = NDArray[np.float64]
+logger = logging.getLogger(__name__)
 
 #: Name of the flange frame; always a valid TCP (identity).
 FLANGE = "flange"
@@ -309,6 +311,15 @@ def _read_description(path: Path) -> dict[str, Any]:
     if not isinstance(desc, dict):
         raise URDFError(f"tool description {path} must hold a JSON object, got {type(desc)}")
     unknown = sorted(set(desc) - set(DESCRIPTION_KEYS))
+    if unknown and "schema" not in desc:  # a description from before wobjcal.tool/1: as read then
+        logger.warning(
+            "tool description %s: %s ignored (the sensor's numbers are the plan's "
+            "validation.sensor; give schema %r to have unknown keys refused)",
+            path,
+            ", ".join(unknown),
+            TOOL_SCHEMA,
+        )
+        unknown = []
     sensor_keys = [k for k in unknown if k.startswith("sens")]
     if sensor_keys:
         raise URDFError(

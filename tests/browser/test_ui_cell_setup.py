@@ -147,7 +147,12 @@ def test_the_sensor_and_search_speed_apply_in_one_step(ui: UiSession) -> None:
     assert s["validation"]["sensor"]["sensing_distance_m"] == pytest.approx(0.005)
     assert [p["search"]["speed_m_s"] for p in s["points"]] == pytest.approx([0.02] * 6)
     wait_for(lambda: _all_checked(ui), what="every point checked again")
+    # the built-in tool's sensor TCP lies 8 mm in front of its face: a 5 mm sensor is named
+    disagree = page.get_by_text("Sensor and tool disagree")
+    disagree.wait_for(state="visible", timeout=30_000)
+    assert "3.0 mm off along its normal" in page.inner_text("body")
     _undo(ui, lambda: app.state.doc is before, "one undo step")
+    disagree.wait_for(state="detached", timeout=30_000)
     open_tab(page, "Cell")
     diameter = _inputs(page, sensor.diameter)
     wait_for(lambda: float(diameter.input_value()) == 18.0, what="the page shows 18 mm again")
