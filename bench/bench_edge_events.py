@@ -35,7 +35,7 @@ from calib.models.robot_error import RobotErrorModel
 from calib.plan.base import file_sha256
 from calib.plan.file import load_plan
 from calib.probing import ProbePoint, SearchCommand, SearchSpec
-from planner.sim.probe import SimulatedProbe
+from planner.sim.proximity import SimulatedProbe
 from planner.sim.raycast import MeshRayCaster
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -39,7 +39,7 @@ from calib.plan.file import load_plan
 from planner.parts.stator import StatorGeometry
 from planner.parts.stator_demo import nominal_T_base_wobj, stator_ah_points
 from planner.parts.stator_mesh import build_stator_mesh
-from planner.sim.montecarlo import validate
+from planner.sim.montecarlo import simulate_stator_ah
 from planner.sim.raycast import MeshRayCaster
 from planner.validate.job import validate_plan
 
@@ -82,7 +82,7 @@ def _timed(fn: Any) -> tuple[Any, float, float]:
 
 def _stator(n: int, workers: int, seed: int) -> Any:
     g = StatorGeometry.full_section()
-    return validate(
+    return simulate_stator_ah(
         stator_ah_points(g),
         g,
         nominal_T_base_wobj(),

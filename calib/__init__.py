@@ -5,7 +5,7 @@ imports PyBullet, viser, trimesh or ``planner``.
 
 Owns:
     - foundations: :mod:`calib.frames` (transforms, Tait-Bryan z-y'-x'' angles of eq. 7-9,
-      quaternions), :mod:`calib.errors`, :mod:`calib.validation` and :mod:`calib.structs`
+      quaternions), :mod:`calib.errors`, :mod:`calib.arguments` and :mod:`calib.structs`
       (argument and field checks), :mod:`calib.probing` (probe points, search commands, the
       :data:`Probe` callback contract), :mod:`calib.units`, :mod:`calib.atomic_io`;
     - :mod:`calib.paper`: the paper's equations and its A-H procedure;

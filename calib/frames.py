@@ -40,8 +40,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
+from calib.arguments import as_float_array, check_finite
 from calib.errors import DegenerateGeometryError, ShapeError
-from calib.validation import as_float_array, check_finite
 
 FloatArray = NDArray[np.float64]
 

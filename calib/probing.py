@@ -18,9 +18,9 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import check_positive, check_unit_vector3, check_vector3
 from calib.errors import DegenerateGeometryError, ShapeError
 from calib.frames import transform_directions, transform_points
-from calib.validation import check_positive, check_unit_vector3, check_vector3
 
 FloatArray = NDArray[np.float64]
 SearchKind = Literal["approach", "edge"]

@@ -20,9 +20,9 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import as_float_array, check_finite, check_vector3
 from calib.errors import ShapeError
 from calib.frames import check_transform, invert_transform, motion_between, transform_points
-from calib.validation import as_float_array, check_finite, check_vector3
 
 FloatArray = NDArray[np.float64]
 Unit = Literal["m", "rad"]

@@ -20,7 +20,7 @@ import importlib
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from planner.errors import UnknownFrameError
+from planner.errors import UnknownBuiltinError
 
 if TYPE_CHECKING:
     import trimesh
@@ -56,16 +56,16 @@ def _strip(name: str) -> str:
     return name[len(PREFIX) :] if name.startswith(PREFIX) else name
 
 
-def _unknown(kind: str, name: str, names: list[str]) -> UnknownFrameError:
+def _unknown(kind: str, name: str, names: list[str]) -> UnknownBuiltinError:
     valid = ", ".join(PREFIX + k for k in sorted(names)) or "(none)"
-    return UnknownFrameError(f"unknown built-in {kind} {name!r}; valid names: {valid}")
+    return UnknownBuiltinError(f"unknown built-in {kind} {name!r}; valid names: {valid}")
 
 
 def robot_urdf(name: str) -> Path:
     """Path of the URDF of the built-in robot ``name`` (e.g. ``"builtin:irb4400"``).
 
     Raises:
-        UnknownFrameError: no such built-in robot (the message lists the valid names).
+        UnknownBuiltinError: no such built-in robot (the message lists the valid names).
     """
     key = _strip(name)
     if key not in BUILTIN_ROBOTS:
@@ -77,7 +77,7 @@ def tool_description(name: str) -> Path:
     """Path of the tool description JSON of the built-in tool ``name``.
 
     Raises:
-        UnknownFrameError: no such built-in tool (the message lists the valid names).
+        UnknownBuiltinError: no such built-in tool (the message lists the valid names).
     """
     key = _strip(name)
     if key not in BUILTIN_TOOLS:
@@ -94,7 +94,7 @@ def builtin_mesh(name: str) -> trimesh.Trimesh:
     """A fresh mesh (metres, wobj frame) of the built-in part ``name``.
 
     Raises:
-        UnknownFrameError: no such built-in part (the message lists the valid names).
+        UnknownBuiltinError: no such built-in part (the message lists the valid names).
     """
     key = _strip(name)
     if key not in BUILTIN_PARTS:

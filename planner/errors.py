@@ -17,6 +17,10 @@ class UnknownFrameError(InputError):
     """A frame, link, joint or TCP name is not known; the message lists the valid names."""
 
 
+class UnknownBuiltinError(InputError):
+    """A ``builtin:`` robot, tool or part name is not known; the message lists the valid ones."""
+
+
 class ToolMountError(InputError):
     """The tool cannot be mounted on the robot's flange as given; the message names the plan
     field that sets the mount (``cell.tool.T_flange_tool``)."""

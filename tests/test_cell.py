@@ -14,7 +14,7 @@ from calib.errors import NonFiniteError, ShapeError
 from calib.frames import invert_transform, make_transform, matrix_from_rotvec
 from planner.cell.cell import Cell
 from planner.cell.tool import Tool
-from planner.errors import MeshError, UnknownFrameError, URDFError
+from planner.errors import MeshError, UnknownBuiltinError, UnknownFrameError, URDFError
 
 T_WORLD_BASE = make_transform(matrix_from_rotvec([0, 0, 0.3]), [0.5, -0.2, 0.1])
 
@@ -153,7 +153,7 @@ def test_bad_robot_urdf_names_the_file(tmp_path) -> None:
     bad.write_text('<robot name="x"><link name="a"></robot>')
     with pytest.raises(URDFError, match=r"broken\.urdf"):
         Cell(robot=bad)
-    with pytest.raises(UnknownFrameError, match=r"builtin:irb4400"):
+    with pytest.raises(UnknownBuiltinError, match=r"builtin:irb4400"):
         Cell(robot="builtin:irb9999")
 
 

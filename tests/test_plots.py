@@ -9,14 +9,14 @@ from PIL import Image
 from planner.parts.stator import EPSILON_M, StatorGeometry
 from planner.parts.stator_demo import nominal_T_base_wobj, stator_ah_points
 from planner.sim.error_map import error_quantiles
-from planner.sim.montecarlo import validate
+from planner.sim.montecarlo import simulate_stator_ah
 from planner.sim.plots import histogram_figure, save_validation_plots, scatter_figure
 
 
 @pytest.fixture(scope="module")
 def report():
     g = StatorGeometry.full_section()
-    return validate(
+    return simulate_stator_ah(
         stator_ah_points(g), g, nominal_T_base_wobj(), 30, np.random.default_rng(2), workers=1
     )
 

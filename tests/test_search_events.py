@@ -14,7 +14,7 @@ from calib.procedures import RolePoint
 from planner.parts.stator import StatorGeometry
 from planner.parts.stator_mesh import build_stator_mesh
 from planner.program.model import search_keys
-from planner.sim.probe import SimulatedProbe
+from planner.sim.proximity import SimulatedProbe
 from planner.sim.raycast import MeshRayCaster
 from planner.sim.search_events import (
     LANDED_OFF_FACE,

@@ -12,7 +12,7 @@ from calib.frames import make_transform, matrix_from_rotvec
 from calib.models.proximity import ProximitySensor
 from calib.models.robot_error import RobotErrorModel
 from calib.probing import ProbePoint, SearchCommand, SearchSpec
-from planner.sim.probe import SimulatedProbe
+from planner.sim.proximity import SimulatedProbe
 from planner.sim.raycast import MeshRayCaster
 
 # a 0.4 x 0.4 x 0.2 m block whose top face is z = 0 and whose +y edge face is y = 0

@@ -16,7 +16,7 @@ from calib.probing import ProbePoint, SearchCommand
 from planner.demo import stator_plan
 from planner.parts.stator import StatorGeometry
 from planner.parts.stator_mesh import build_stator_mesh
-from planner.sim.probe import SimulatedProbe
+from planner.sim.proximity import SimulatedProbe
 from planner.sim.raycast import MeshRayCaster
 
 

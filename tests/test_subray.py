@@ -18,7 +18,7 @@ from calib.frames import make_transform, matrix_from_rotvec
 from calib.models.proximity import ProximitySensor
 from calib.models.robot_error import RobotErrorModel
 from calib.probing import ProbePoint, SearchCommand, SearchSpec
-from planner.sim.probe import SimulatedProbe
+from planner.sim.proximity import SimulatedProbe
 from planner.sim.raycast import MeshRayCaster
 from planner.sim.subray import cell_width_m, changing_rays
 

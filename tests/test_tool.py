@@ -11,7 +11,7 @@ from calib.errors import ShapeError
 from calib.frames import make_transform
 from calib.models import ProximitySensor
 from planner.cell.tool import Tool, load_tool
-from planner.errors import MeshError, UnknownFrameError, URDFError
+from planner.errors import MeshError, UnknownBuiltinError, UnknownFrameError, URDFError
 
 #: The plan's default sensor: the built-in tool's geometry must match it.
 SENSOR = ProximitySensor()
@@ -58,7 +58,7 @@ def test_unknown_tcp_lists_valid_names(feeder: Tool) -> None:
 
 
 def test_unknown_builtin_tool() -> None:
-    with pytest.raises(UnknownFrameError, match=r"builtin:cable_feeder"):
+    with pytest.raises(UnknownBuiltinError, match=r"builtin:cable_feeder"):
         load_tool("builtin:welding_gun")
 
 

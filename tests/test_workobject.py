@@ -13,7 +13,7 @@ import trimesh
 from calib.frames import make_transform
 from planner import builtins
 from planner.cell.workobject import load_work_object
-from planner.errors import MeshError, UnknownFrameError
+from planner.errors import MeshError, UnknownBuiltinError
 
 
 def test_plate_in_mm_is_detected_with_a_warning(reference_dir, caplog) -> None:
@@ -148,7 +148,7 @@ def test_builtin_part_registry(monkeypatch: pytest.MonkeyPatch) -> None:
     wobj = load_work_object("builtin:test_cube")
     assert wobj.name == "test_cube"
     assert wobj.mesh.volume == pytest.approx(1e-3)
-    with pytest.raises(UnknownFrameError, match=r"builtin:stator_section.*builtin:test_cube"):
+    with pytest.raises(UnknownBuiltinError, match=r"builtin:stator_section.*builtin:test_cube"):
         load_work_object("builtin:no_such_part")
 
 

@@ -15,6 +15,7 @@ import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import check_vector3
 from calib.errors import DegenerateGeometryError
 from calib.frames import (
     check_transform,
@@ -22,7 +23,6 @@ from calib.frames import (
     transform_directions,
     transform_points,
 )
-from calib.validation import check_vector3
 
 FloatArray = NDArray[np.float64]
 

@@ -20,6 +20,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import (
+    as_float_array,
+    check_finite,
+    check_points,
+    check_positive,
+    check_vector3,
+)
 from calib.errors import ShapeError
 from calib.estimators.layout import (
     ConstraintSet,
@@ -32,13 +39,6 @@ from calib.estimators.layout import (
 from calib.estimators.observability import analyze_layout, require_observable, unobservable_error
 from calib.frames import check_transform, small_motion
 from calib.probing import ProbePoint
-from calib.validation import (
-    as_float_array,
-    check_finite,
-    check_points,
-    check_positive,
-    check_vector3,
-)
 
 FloatArray = NDArray[np.float64]
 

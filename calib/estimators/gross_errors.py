@@ -33,12 +33,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import check_points, check_positive
 from calib.errors import DegenerateGeometryError
 from calib.estimators.best_fit import BestFitResult, best_fit
 from calib.estimators.layout import ConstraintSet, constraint_set
 from calib.estimators.observability import analyze_layout, scaled_jacobian
 from calib.probing import ProbePoint
-from calib.validation import check_points, check_positive
 
 FloatArray = NDArray[np.float64]
 

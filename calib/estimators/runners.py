@@ -22,6 +22,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import check_vector3
 from calib.errors import ProbeFailedError, ShapeError
 from calib.estimators.best_fit import BestFitResult, best_fit
 from calib.estimators.layout import (
@@ -36,7 +37,6 @@ from calib.estimators.observability import require_observable
 from calib.estimators.three_two_one import ThreeTwoOneLayout, ThreeTwoOneResult, three_two_one
 from calib.frames import check_transform
 from calib.probing import Probe, ProbePoint, SearchCommand
-from calib.validation import check_vector3
 
 FloatArray = NDArray[np.float64]
 #: A motion counts as fixed by a layout when its scaled singular value is above this part of the

@@ -31,12 +31,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import check_points
 from calib.errors import DegenerateGeometryError, ShapeError
 from calib.estimators.layout import axis_name, check_coincident
 from calib.frames import check_transform, invert_transform, make_transform, transform_points
 from calib.probing import ProbePoint
 from calib.tolerances import FACE_MAX_DEVIATION_M, ROLE_NORMAL_TOL_RAD, same_direction
-from calib.validation import check_points
 
 FloatArray = NDArray[np.float64]
 

@@ -12,9 +12,9 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import check_vector3
 from calib.frames import make_transform, matrix_from_rotvec
 from calib.structs import Strict, check_positive
-from calib.validation import check_vector3
 
 FloatArray = NDArray[np.float64]
 

@@ -1,7 +1,7 @@
 """The inductive proximity sensor: when does an M18 shielded sensor switch over a real part?
 
 This struct is the one definition of the sensor: the plan file holds it
-(``validation.sensor``), the simulation casts its ray bundle (:mod:`planner.sim.probe`), the
+(``validation.sensor``), the simulation casts its ray bundle (:mod:`planner.sim.proximity`), the
 planar-face check sizes its footprint with it, and the exporters take its sensing distance for
 the safe starts.
 

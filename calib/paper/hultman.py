@@ -25,9 +25,9 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import as_float_array, check_finite, check_positive, check_vector3
 from calib.errors import DegenerateGeometryError, ShapeError
 from calib.frames import check_transform, make_transform, tait_bryan_zyx_from_matrix
-from calib.validation import as_float_array, check_finite, check_positive, check_vector3
 
 FloatArray = NDArray[np.float64]
 

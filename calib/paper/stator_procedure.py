@@ -37,6 +37,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import check_vector3
 from calib.errors import DegenerateGeometryError, ProbeFailedError, ShapeError
 from calib.frames import check_transform
 from calib.paper.hultman import (  # the unchecked kernels: inputs are checked here, once
@@ -55,7 +56,6 @@ from calib.paper.stator_layout import (
     relabel_point,
 )
 from calib.probing import Probe, ProbePoint, ProbeResult, SearchCommand
-from calib.validation import check_vector3
 
 __all__ = [
     "STATOR_POINT_IDS",

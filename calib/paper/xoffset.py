@@ -21,11 +21,11 @@ import msgspec
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import check_shape
 from calib.errors import DegenerateGeometryError, ShapeError
 from calib.frames import check_transform, make_transform
 from calib.limits import MAX_XOFFSET_LAYERS, MAX_XOFFSET_SLOTS
 from calib.probing import ProbePoint, SearchSpec
-from calib.validation import check_shape
 
 FloatArray = NDArray[np.float64]
 

@@ -17,9 +17,9 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from calib.arguments import check_positive
 from calib.frames import motion_between
 from calib.procedures.base import ProcedureKind, RolePoint
-from calib.validation import check_positive
 
 FloatArray = NDArray[np.float64]
 

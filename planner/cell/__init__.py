@@ -21,7 +21,7 @@ Owns:
       :mod:`~planner.cell.disk_cache`);
     - queries: :mod:`~planner.cell.feasibility` (probe poses, ``check_probes``) with
       :mod:`~planner.cell.probe_candidates`, :mod:`~planner.cell.probe_rule`,
-      :mod:`~planner.cell.probe_search`, :mod:`~planner.cell.probe_flags`,
+      :mod:`~planner.cell.probe_choice`, :mod:`~planner.cell.probe_flags`,
       :mod:`~planner.cell.probe_parts`,
       :mod:`~planner.cell.slack_bounds` (bounds that spare Bullet queries) and
       :mod:`~planner.cell.probe_clearance` (Bullet for the parts the broad phase leaves open),

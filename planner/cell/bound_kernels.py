@@ -1,7 +1,7 @@
 """Upper bounds of distances with GJK, compiled with numba: how near two shapes surely are.
 
 The broad phase (:mod:`planner.cell.broad_kernels`) shows parts far (clear) or below the
-margin; the search among a point's candidates (:mod:`planner.cell.probe_search`) also needs
+margin; the search among a point's candidates (:mod:`planner.cell.probe_choice`) also needs
 to know that a candidate *cannot* beat another one without asking Bullet. An upper bound does
 that: GJK's simplex closest point ``v`` is a point of the Minkowski difference ``A - B``
 (a convex combination of support points), so ``dist(A, B) <= |v|`` whatever the iteration

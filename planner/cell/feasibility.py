@@ -6,7 +6,7 @@ A probe pose puts the TCP (``sensor`` by default) on the surface point with its 
 (:mod:`planner.cell.probe_candidates`); candidates (pose, branch) within limits and away from
 wrist singularity are then collision-checked in order of least joint motion from ``q_ref``
 (candidates near a joint limit last): the first that passes with margin is chosen, else the
-least-bad one (:mod:`planner.cell.probe_search`). A feasible pose whose clearance slack or
+least-bad one (:mod:`planner.cell.probe_choice`). A feasible pose whose clearance slack or
 joint-limit margin is small is ``"marginal"``. Infeasible poses say why: out of reach, a joint
 at its limit, singular wrist, or the limiting collision pair and its clearance.
 
@@ -25,8 +25,8 @@ from typing import TYPE_CHECKING, Literal, cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import check_positive, check_shape
 from calib.errors import DegenerateGeometryError, ShapeError
-from calib.validation import check_positive, check_shape
 from planner.cell.clearance import Clearance
 from planner.cell.collision import DEFAULT_MARGIN_M
 from planner.cell.probe_candidates import (
@@ -39,8 +39,8 @@ from planner.cell.probe_candidates import (
     singular,
     tcp_frames,
 )
+from planner.cell.probe_choice import ProbeSearch
 from planner.cell.probe_rule import CLEARANCE_TIE_M, Decision, select
-from planner.cell.probe_search import ProbeSearch
 
 if TYPE_CHECKING:
     from planner.cell.scene import CellScene
@@ -132,7 +132,7 @@ def check_probes(
         margin_m: clearance to work object and fixtures, m (default the cell's 5 mm).
         q_ref: ``(n,)`` reference configuration for "least joint motion" (default home).
         max_checks: largest number of candidates collision-checked per point (>= 1).
-        staged: decide candidates with :class:`planner.cell.probe_search.ProbeSearch` (a
+        staged: decide candidates with :class:`planner.cell.probe_choice.ProbeSearch` (a
             broad phase for the whole batch, Bullet only for the parts it leaves open);
             ``False``: one whole clearance query per candidate, the exact check. Both give
             the same answers.

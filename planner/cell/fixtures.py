@@ -15,10 +15,10 @@ import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import check_positive
 from calib.errors import ShapeError
 from calib.frames import check_transform, make_transform
 from calib.limits import MAX_MESH_TRIANGLES
-from calib.validation import check_positive
 from planner.cell.bodies import BodyLinks, mesh_collision_shape, static_body
 from planner.cell.pybullet_client import pb
 from planner.cell.workobject import load_work_object

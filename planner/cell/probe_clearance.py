@@ -1,6 +1,6 @@
 """Exact clearance of probe candidates, part by part, for the parts the broad phase left open.
 
-:mod:`planner.cell.probe_search` decides probe points from the parts of the clearance query
+:mod:`planner.cell.probe_choice` decides probe points from the parts of the clearance query
 (:meth:`planner.cell.collision.CollisionChecker.plan`). The broad phase
 (:mod:`planner.cell.broad_phase`) shows most parts report nothing; :class:`ProbeClearance`
 evaluates the others with Bullet, one part at a time, in the state the part needs:

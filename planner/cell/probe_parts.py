@@ -1,6 +1,6 @@
 """A probe candidate's open clearance parts with Bullet, cheapest first.
 
-:class:`OpenParts` is the exact step of :mod:`planner.cell.probe_search`: for one candidate,
+:class:`OpenParts` is the exact step of :mod:`planner.cell.probe_choice`: for one candidate,
 the parts the broad phase left open go to Bullet (:class:`planner.cell.probe_clearance.
 ProbeClearance`) one at a time, cached ones first (they cost nothing), then the self part,
 then against boxes and cylinders, then against meshes by link size, stopping as soon as the

@@ -2,7 +2,7 @@
 
 The rule, shared by the exact check (:func:`planner.cell.feasibility.check_probes` with
 ``staged=False``: one whole clearance query per candidate, :func:`select`) and the fast path
-(:mod:`planner.cell.probe_search`):
+(:mod:`planner.cell.probe_choice`):
 
 1. the candidates are taken in order (:class:`planner.cell.probe_candidates.ProbeCandidates`),
    at most ``max_checks``; the first whose clearance passes (no collision, slack at least
@@ -49,7 +49,7 @@ class Decision:
 @dataclass(frozen=True)
 class Verdict:
     """The status of a point that the rule leaves to its least-bad candidate, found without
-    finding that candidate (:class:`planner.cell.probe_search.ProbeSearch` with
+    finding that candidate (:class:`planner.cell.probe_choice.ProbeSearch` with
     ``statuses_only``: the heat map's question is "can this point be probed, and if not,
     why", not "which pose and how near").
 

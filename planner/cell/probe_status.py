@@ -12,7 +12,7 @@ stops early where the rule's exact answer is not needed:
   pose deep in a mesh takes several full Bullet queries), the candidates are tried highest
   upper bound first until one shows a slack at least the tie above 0 (``marginal``), or all
   are shown to collide (``infeasible``), each stopping at its first part shown below 0
-  (:meth:`planner.cell.probe_search.ProbeSearch._status`).
+  (:meth:`planner.cell.probe_choice.ProbeSearch._status`).
 
 Pruning applies here and not in :func:`check_probes`: the rule there picks the least joint
 motion over every rotation and the least-bad pose by its exact slack, and a click, ``wobjcal
@@ -28,8 +28,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from planner.cell.feasibility import Status, feasibility_of, prepare_candidates
+from planner.cell.probe_choice import ProbeSearch
 from planner.cell.probe_rule import Verdict
-from planner.cell.probe_search import ProbeSearch
 
 if TYPE_CHECKING:
     from planner.cell.scene import CellScene

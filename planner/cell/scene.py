@@ -25,9 +25,9 @@ import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import check_shape
 from calib.errors import ShapeError
 from calib.frames import check_transform, invert_transform
-from calib.validation import check_shape
 from planner.builtins import is_builtin, robot_urdf
 from planner.cell.acl import acl_key, compute_acl, sample_configurations
 from planner.cell.bodies import BodyLinks, set_link_pose, world_link_pose
@@ -71,7 +71,8 @@ class CellScene:
 
     Raises:
         URDFError: missing or malformed robot/tool URDF (the message names the file).
-        UnknownFrameError: unknown built-in name, base or tip link.
+        UnknownBuiltinError: unknown built-in name.
+        UnknownFrameError: unknown base or tip link.
         ToolMountError: the tool cannot be mounted without ``T_flange_tool`` (named).
     """
 

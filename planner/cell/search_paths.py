@@ -22,9 +22,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import check_positive, check_shape, check_vector3
 from calib.errors import DegenerateGeometryError
 from calib.frames import invert_transform
-from calib.validation import check_positive, check_shape, check_vector3
 from planner.cell.collision import DEFAULT_MARGIN_M
 from planner.cell.feasibility import (
     MARGINAL_LIMIT_RAD,

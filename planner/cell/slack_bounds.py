@@ -1,6 +1,6 @@
 """Upper bounds of probe candidates' slacks without Bullet: GJK on the exact shapes.
 
-The search among a point's candidates (:mod:`planner.cell.probe_search`) needs Bullet's exact
+The search among a point's candidates (:mod:`planner.cell.probe_choice`) needs Bullet's exact
 slack only for candidates that can still win: the first that passes, or the least-bad one. A
 candidate whose slack is surely below the margin cannot pass, and one whose slack is surely
 more than the tie below the best exact slack found cannot be the least-bad one. The broad

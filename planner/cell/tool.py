@@ -274,7 +274,8 @@ def load_tool(spec: str | Path | Tool) -> Tool:
     :class:`calib.models.ProximitySensor`, not part of the tool.
 
     Raises:
-        UnknownFrameError: unknown built-in name, or a ``sensor_tcp`` that is not a TCP.
+        UnknownBuiltinError: unknown built-in name.
+        UnknownFrameError: a ``sensor_tcp`` that is not a TCP.
         URDFError: the file is missing or malformed (the message names the key).
         MeshError: a mesh tool's mesh is missing, unreadable or empty.
     """

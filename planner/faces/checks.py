@@ -18,9 +18,9 @@ import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import check_points
 from calib.errors import ShapeError
 from calib.probing import ProbePoint
-from calib.validation import check_points
 from planner.faces.detection import NoPlanarFaceError, PlanarFaces, find_planar_faces
 from planner.faces.footprint import (
     DEFAULT_FOOTPRINT_RADIUS_M,

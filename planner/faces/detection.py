@@ -43,8 +43,8 @@ import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import check_points
 from calib.tolerances import FACE_ANGLE_TOL_RAD, FACE_FLATNESS_RMS_M, FACE_MAX_DEVIATION_M
-from calib.validation import check_points
 from planner.errors import MeshError
 from planner.faces.brep import brep_plane_labels, brep_regions
 from planner.faces.footprint import DEFAULT_FOOTPRINT_RADIUS_M, holds_footprint

@@ -25,8 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import check_positive
 from calib.errors import ShapeError
-from calib.validation import check_positive
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]

@@ -3,7 +3,7 @@ Carlo, the prediction beside it, and the report.
 
 Owns:
     - :mod:`planner.sim.sensors`: the sensor registry (:data:`SENSORS`: model -> simulator);
-    - :mod:`planner.sim.probe`: :class:`SimulatedProbe`, the proximity sensor's searches
+    - :mod:`planner.sim.proximity`: :class:`SimulatedProbe`, the proximity sensor's searches
       against the misplaced part (closed-form approach, scanned and refined edge search);
     - :mod:`planner.sim.touch`: the touch probe's searches (the sweeping ball's exact contact);
     - :mod:`planner.sim.raycast`: batched first-hit ray casting (Embree), with triangle ids;
@@ -12,8 +12,8 @@ Owns:
     - :mod:`planner.sim.setup`: :class:`SimulationSetup`, what every trial of a plan shares;
     - :mod:`planner.sim.trial`: one trial (:class:`TrialRunner`) of any procedure;
     - :mod:`planner.sim.xoffset`: the paper's x-offset run and its slot-target errors;
-    - :mod:`planner.sim.montecarlo`: :func:`simulate` (any plan) and :func:`validate` (A-H on
-      a stator), many seeded trials on up to 2 processes;
+    - :mod:`planner.sim.montecarlo`: :func:`simulate` (any plan) and
+      :func:`simulate_stator_ah` (A-H on a stator), many seeded trials on up to 2 processes;
     - :mod:`planner.sim.predict`: the intervals predicted from the procedure's linearisation;
     - :mod:`planner.sim.rows`, :mod:`planner.sim.report_points`, :mod:`planner.sim.summary`,
       :mod:`planner.sim.report`: what each row measures, the rows of a plan, the report built

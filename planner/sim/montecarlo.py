@@ -48,7 +48,7 @@ from planner.program.safety import SafetySpec
 from planner.program.settings import DEFAULT_EDGE_INSET_M, resolved_settings
 from planner.sim.error_map import error_map
 from planner.sim.predict import predict
-from planner.sim.probe import ReachabilityHook, cell_search_hook
+from planner.sim.proximity import ReachabilityHook, cell_search_hook
 from planner.sim.report import PAPER_TABLE1, ValidationReport
 from planner.sim.report_points import report_rows
 from planner.sim.rows import RowSpec
@@ -62,7 +62,7 @@ __all__ = [
     "default_pivot",
     "default_settings",
     "simulate",
-    "validate",
+    "simulate_stator_ah",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -99,7 +99,7 @@ def simulate(
         reachability: optional hook vetting each commanded search (runs in one process).
         cell: optional :class:`planner.cell.cell.Cell` with the part as its work object; each
             trial moves the work object to the true pose and vets every search with
-            ``cell.check_search`` (:func:`planner.sim.probe.cell_search_hook`). Runs in one
+            ``cell.check_search`` (:func:`planner.sim.proximity.cell_search_hook`). Runs in one
             process; the work object is put back at the end.
         reach_trials: with ``reachability`` or ``cell``, vet only the first ``reach_trials``
             trials that way and run the rest without it, in parallel; ``None`` vets every
@@ -233,7 +233,7 @@ def stator_setup(
     return setup, part
 
 
-def validate(
+def simulate_stator_ah(
     points: Mapping[str, ProbePoint],
     geometry: StatorGeometry,
     T_base_wobj_nominal: ArrayLike,

@@ -1,6 +1,6 @@
 """Bookkeeping of simulated searches: events, where a footprint landed, reachability hooks.
 
-Used by the simulated sensors (:mod:`planner.sim.probe`, :mod:`planner.sim.touch`) to report,
+Used by the simulated sensors (:mod:`planner.sim.proximity`, :mod:`planner.sim.touch`) to report,
 besides the measured point, what happened in each search (the report counts these per point,
 with the reason), and to vet the path a search really ran against a
 :class:`planner.cell.cell.Cell`. Landings are judged over the whole footprint against the

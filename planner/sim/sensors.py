@@ -76,7 +76,7 @@ SENSORS: dict[str, SensorKind] = {
     "proximity": SensorKind(
         "proximity",
         ProximitySensor,
-        "planner.sim.probe:SimulatedProbe",
+        "planner.sim.proximity:SimulatedProbe",
         "inductive proximity sensor: ray bundle over the face, exponential damping, hysteresis",
         {"sensor repeatability": {"repeatability_sigma_m": 0.0}},
     ),

@@ -94,7 +94,7 @@ def run_xoffset(
 
 def in_turn(probe: Probe, commands: list[SearchCommand]) -> list[ProbeResult]:
     """``probe`` on each of ``commands`` in turn, up to and including the first failure: at once
-    where the probe can (``run_in_turn`` of :class:`planner.sim.probe.SimulatedProbe`: one ray
+    where the probe can (``run_in_turn`` of :class:`planner.sim.proximity.SimulatedProbe`: one ray
     cast for all its approaches), else one by one."""
     batch = getattr(probe, "run_in_turn", None)
     if batch is not None:

@@ -33,7 +33,7 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from calib.validation import check_shape
+from calib.arguments import check_shape
 from planner.builtins import robot_urdf
 from planner.robot.kinematics.opw_robot import OPWRobot
 

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from calib.validation import check_shape
+from calib.arguments import check_shape
 from planner.errors import UnknownFrameError, URDFError
 from planner.robot.urdf import Joint, URDFModel, load_urdf
 

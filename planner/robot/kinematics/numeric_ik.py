@@ -16,8 +16,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
+from calib.arguments import check_shape
 from calib.frames import check_transform
-from calib.validation import check_shape
 from planner.robot.kinematics.chain import KinematicChain
 
 FloatArray = NDArray[np.float64]

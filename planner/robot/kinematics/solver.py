@@ -14,8 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from calib.arguments import as_float_array, check_finite
 from calib.errors import DegenerateGeometryError, ShapeError
-from calib.validation import as_float_array, check_finite
 from planner.robot.kinematics.branches import BranchFlags, classify
 from planner.robot.kinematics.chain import KinematicChain
 from planner.robot.kinematics.numeric_ik import NumericIK

@@ -1,4 +1,4 @@
-"""Tests of planner.cell.probe_search: the rule, and the fast path against the exact check.
+"""Tests of planner.cell.probe_choice: the rule, and the fast path against the exact check.
 
 The exact check is ``check_probes(staged=False)``: one whole Bullet clearance query per
 candidate, in order. The default path (broad phase, Bullet only for the open parts, best-first
