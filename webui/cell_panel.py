@@ -25,6 +25,7 @@ from webui.cell_edits import ROBOT_BASE, WORK_OBJECT
 from webui.cell_fixtures import FixturesSection
 from webui.cell_sensor import SensorSection
 from webui.cell_tool import ToolSection
+from webui.guard import guarded
 
 if TYPE_CHECKING:
     from webui.context import AppContext
@@ -68,13 +69,8 @@ class CellPanel:
         self.refresh()
 
     def _guard(self, event: Any, fn: Any, *args: Any) -> None:
-        try:
-            fn(*args)
-        except InputError as exc:
-            self._app.notify("Cell not changed", str(exc), client=getattr(event, "client", None))
-        except Exception as exc:  # never a traceback in the browser
-            logger.exception("cell edit failed")
-            self._app.notify("Cell not changed", f"{type(exc).__name__}: {exc}")
+        client = getattr(event, "client", None)
+        guarded(self._app, client, fn, *args, title="Cell not changed", action="cell edit")
 
     def _plan(self) -> Plan:
         source = self._app.state.doc.source

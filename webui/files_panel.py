@@ -21,6 +21,7 @@ from calib.units import MESH_UNITS
 from planner.export import export_file_stem
 from webui import autosave, uploads
 from webui.exports import FORMATS, ExportResult, export_program
+from webui.guard import guarded
 from webui.markdown_text import plain
 from webui.part_upload import PendingPart, drop_points, frame_note, off_surface, project_points
 from webui.plan_adapter import plan_from_ui, ui_plan_from_bytes, with_source
@@ -149,17 +150,10 @@ class FilesPanel:
         """Run ``fn(*args)``; a refusal shows as an error notification titled ``failure`` that
         stays until closed."""
         client = getattr(event, "client", None)
-        try:
-            with self._app.busy(f"{fn.__name__.replace('_', ' ')}"):
-                title = fn(*args)
-        except InputError as exc:
-            self._app.notify(failure, str(exc), client=client)
-        except Exception as exc:  # never a traceback in the browser
-            logger.exception("file action failed")
-            self._app.notify(failure, f"{type(exc).__name__}: {exc}", client=client)
-        else:
-            if title:
-                self._app.notify(title, "", client=client, error=False)
+        with self._app.busy(f"{fn.__name__.replace('_', ' ')}"):
+            title = guarded(self._app, client, fn, *args, title=failure, action="file action")
+        if title:
+            self._app.notify(title, "", client=client, error=False)
 
     # ---- uploads ---------------------------------------------------------------------------
     def upload_plan(self, name: str, content: bytes) -> str:

@@ -28,6 +28,7 @@ from calib.frames import transform_points
 from calib.plan.file import Plan
 from calib.user_frame import MIN_SEPARATION_M, three_point_frame
 from webui import cell_edits
+from webui.guard import guarded
 from webui.scene import pose_kwargs
 
 if TYPE_CHECKING:
@@ -98,13 +99,8 @@ class FramePanel:
         app.click_handlers[MODE] = self._on_click
 
     def _guard(self, event: Any, fn: Any, *args: Any) -> None:
-        try:
-            fn(*args)
-        except InputError as exc:
-            self._app.notify("Frame not changed", str(exc), client=getattr(event, "client", None))
-        except Exception as exc:  # never a traceback in the browser
-            logger.exception("3-point frame failed")
-            self._app.notify("Frame not changed", f"{type(exc).__name__}: {exc}")
+        client = getattr(event, "client", None)
+        guarded(self._app, client, fn, *args, title="Frame not changed", action="3-point frame")
 
     def begin(self) -> None:
         """Start picking: the next clicks on the part are the origin, +x, the xy-plane."""

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.errors import InputError
+from webui.guard import guarded
 from webui.markdown_text import plain
 
 if TYPE_CHECKING:
@@ -143,16 +144,10 @@ class FineJog:
             self._sync.on = False
 
     def _guard(self, event: Any, fn: Callable[..., Any], *args: Any) -> Any:
-        try:
-            return fn(*args)
-        except InputError as exc:
-            self._note(str(exc))  # beside the fields; the notification closes by itself
-            client = getattr(event, "client", None)
-            self._app.notify("Not moved", str(exc), client=client, error=False)
-        except Exception as exc:  # never a traceback in the browser
-            logger.exception("fine jog failed")
-            self._app.notify("Error", f"{type(exc).__name__}: {exc}")
-        return None
+        # a refusal also beside the fields; its notification closes by itself
+        client = getattr(event, "client", None)
+        return guarded(self._app, client, fn, *args, title="Not moved", action="fine jog",
+                       refusal_is_error=False, on_refusal=self._note)  # fmt: skip
 
     def _note(self, text: str) -> None:
         content = "" if not text else f"<span style='color:orange'>{plain(text)}</span>"

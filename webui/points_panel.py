@@ -12,9 +12,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from calib.errors import InputError
 from calib.procedures import PROCEDURES
 from webui import heatmap, plan_doc
+from webui.guard import guarded
 from webui.plan_adapter import with_procedure
 from webui.plan_doc import PAPER_IDS
 from webui.scene import legend_html
@@ -108,15 +108,8 @@ class PointsPanel:
         return bool(getattr(self._syncing, "on", False))
 
     def _guard(self, event: Any, fn: Any, *args: Any) -> Any:
-        """Run ``fn``; turn input errors into a notification for the event's client."""
-        try:
-            return fn(*args)
-        except InputError as exc:
-            self._app.notify("Not done", str(exc), client=getattr(event, "client", None))
-        except Exception as exc:
-            logger.exception("panel action failed")
-            self._app.notify("Error", f"{type(exc).__name__}: {exc}", client=event.client)
-        return None
+        """Run ``fn`` (:func:`webui.guard.guarded`: a refusal told to the event's tab)."""
+        return guarded(self._app, getattr(event, "client", None), fn, *args, action="points")
 
     def target_id(self) -> str:
         """The id a click places: the chosen one, or the next free id."""

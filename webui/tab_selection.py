@@ -23,6 +23,7 @@ import viser
 from calib.errors import InputError
 from calib.frames import transform_points
 from webui import plan_doc
+from webui.guard import guarded
 from webui.plan_doc import NO_ROLE, UiPlan
 from webui.scene import MARKER_RADIUS_M, SELECTED_RGB
 from webui.status_table import details_markdown
@@ -102,13 +103,7 @@ class TabSelection:
         self._show_fields(False)
 
     def _guard(self, fn: Any, *args: Any) -> None:
-        try:
-            fn(*args)
-        except InputError as exc:
-            self._app.notify("Not done", str(exc), client=self.client)
-        except Exception as exc:  # never a traceback in the browser
-            logger.exception("selection action failed")
-            self._app.notify("Error", f"{type(exc).__name__}: {exc}", client=self.client)
+        guarded(self._app, self.client, fn, *args, action="selection action")
 
     def _show_fields(self, visible: bool) -> None:
         for widget in self.settings:

@@ -37,6 +37,7 @@ from calib.plan.cell import Pose
 from calib.plan.vias import ViaPoint
 from webui import plan_doc
 from webui.backend import JogStatus
+from webui.guard import guarded
 from webui.joint_jog import FineJog
 from webui.moves_view import ViaView, draw_moves
 from webui.search_room import new_point_overtravel_cap_m
@@ -106,14 +107,8 @@ class TeachPanel:
             self._sync.on = False
 
     def _guard(self, event: Any, fn: Any, *args: Any) -> Any:
-        try:
-            return fn(*args)
-        except InputError as exc:
-            self._app.notify("Not done", str(exc), client=getattr(event, "client", None))
-        except Exception as exc:  # never a traceback in the browser
-            logger.exception("teach action failed")
-            self._app.notify("Error", f"{type(exc).__name__}: {exc}")
-        return None
+        client = getattr(event, "client", None)
+        return guarded(self._app, client, fn, *args, action="teach action")
 
     def _tcp(self) -> str:
         source = self._app.state.doc.source
