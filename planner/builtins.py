@@ -20,6 +20,7 @@ import importlib
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from calib.registry import unknown_name
 from planner.errors import UnknownBuiltinError
 
 if TYPE_CHECKING:
@@ -57,8 +58,7 @@ def _strip(name: str) -> str:
 
 
 def _unknown(kind: str, name: str, names: list[str]) -> UnknownBuiltinError:
-    valid = ", ".join(PREFIX + k for k in sorted(names)) or "(none)"
-    return UnknownBuiltinError(f"unknown built-in {kind} {name!r}; valid names: {valid}")
+    return unknown_name(f"built-in {kind}", name, [PREFIX + k for k in names], UnknownBuiltinError)
 
 
 def robot_urdf(name: str) -> Path:

@@ -76,7 +76,9 @@ def test_hultman_needs_a_to_h_roles() -> None:
 def test_unknown_method_and_missing_point() -> None:
     plan = _ideal_stator()
     m = _measure(plan, nominal_T_base_wobj(plan))
-    with pytest.raises(InputError, match="method must be one of"):
+    with pytest.raises(
+        InputError, match=r"unknown procedure \(--method\) '.*'; known: best_fit, hultman2013"
+    ):
         calibrate_plan(plan, m, "guess")
     partial = Measurements(
         points={k: v for k, v in m.points.items() if k != "E"}, failed={"E": "no detection"}

@@ -50,7 +50,10 @@ def test_a_plan_and_a_controller_give_one_named_program() -> None:
     )
     prog = measuring_program(with_edge, "rapid")
     assert prog.name == "RAPID, nominal best fit" and "approach searches only" in prog.note
-    with pytest.raises(InputError, match="format must be one of"):
+    with pytest.raises(
+        InputError,
+        match=r"unknown controller \(--format\) '.*'; known: fanuc, krl, rapid, urscript",
+    ):
         measuring_program(stator, "kawasaki")
 
 

@@ -152,6 +152,8 @@ def test_sensor_registry_gives_the_simulator_of_the_plans_sensor() -> None:
         standoff_m = 0.002
 
     with pytest.raises(
-        PlanError, match=r"no simulator for Unknown; known sensors: \['proximity', 'touch'\]"
+        PlanError,
+        match=r"unknown sensor simulator \(validation.sensor.kind\) 'capacitive'; known: "
+        r"proximity, touch$",
     ):
         sensor_kind(Unknown())

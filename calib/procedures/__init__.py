@@ -36,6 +36,7 @@ from calib.procedures.best_fit import BEST_FIT, BestFit
 from calib.procedures.hultman2013 import HULTMAN2013
 from calib.procedures.iterative import ITERATIVE, Iterative
 from calib.procedures.three_two_one import THREE_TWO_ONE, ThreeTwoOne
+from calib.registry import lookup
 
 #: The procedures by method name, in the order the UI offers them.
 PROCEDURES: dict[str, ProcedureKind] = {
@@ -74,6 +75,4 @@ def procedure_kind(method: str | ProcedureSettings) -> ProcedureKind:
         PlanError: no such procedure (the message lists the known ones).
     """
     name = method if isinstance(method, str) else method_of(method)
-    if name not in PROCEDURES:
-        raise PlanError(f"procedure.method: must be one of {list(PROCEDURES)}, got {name!r}")
-    return PROCEDURES[name]
+    return lookup(PROCEDURES, name, "procedure (procedure.method)", PlanError)

@@ -49,6 +49,7 @@ from calib.plan.measurements import Measurements
 from calib.procedures import PROCEDURES, procedure_kind
 from calib.procedures.base import edge_offset_of
 from calib.procedures.uncertainty import propagated_covariance
+from calib.registry import lookup
 from calib.tolerances import FACE_FLATNESS_RMS_M
 from planner.plan_cell import T_base_world, nominal_T_base_wobj
 from planner.program.build import plan_settings
@@ -152,8 +153,7 @@ def calibrate_plan(
         ProbeFailedError: the A-H replay needs a point that was not measured.
     """
     method = method or plan.method
-    if method not in PROCEDURES:
-        raise InputError(f"method must be one of {list(PROCEDURES)}, got {method!r}")
+    lookup(PROCEDURES, method, "procedure (--method)")
     known = {p.id for p in plan.points}
     unknown = sorted(set(measurements.points) - known)
     if unknown:

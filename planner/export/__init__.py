@@ -34,7 +34,7 @@ import importlib
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from calib.errors import InputError
+from calib.registry import lookup
 from planner.export.job import ExportJob, TargetPair, ToolData, build_job
 from planner.export.text import file_stem, module_name
 from planner.program.controllers import CONTROLLERS
@@ -146,9 +146,7 @@ def export_files(job: ExportJob, fmt: str) -> dict[str, str]:
     Raises:
         InputError: unknown format (the message lists the known ones).
     """
-    if fmt not in FORMATS:
-        raise InputError(f"format must be one of {sorted(FORMATS)}, got {fmt!r}")
-    files = FORMATS[fmt].load()(job)
+    files = lookup(FORMATS, fmt, "export format (--format)").load()(job)
     if tuple(files) != FORMATS[fmt].suffixes:
         raise RuntimeError(f"writer of {fmt!r} returned {list(files)}, not {FORMATS[fmt].suffixes}")
     return files

@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from calib.errors import InputError
+from calib.registry import lookup
 
 
 @dataclass(frozen=True)
@@ -137,6 +137,4 @@ def controller(name: str | None) -> Controller:
         InputError: no such controller (the message lists the known ones).
     """
     key = DEFAULT_CONTROLLER if name is None else name
-    if key not in CONTROLLERS:
-        raise InputError(f"format must be one of {list(CONTROLLERS)}, got {key!r}")
-    return CONTROLLERS[key]
+    return lookup(CONTROLLERS, key, "controller (--format)")

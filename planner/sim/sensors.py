@@ -28,6 +28,7 @@ from calib.models.proximity import ProximitySensor
 from calib.models.sensor import SensorModel
 from calib.models.touch import TouchProbe
 from calib.probing import ProbeResult, SearchCommand
+from calib.registry import lookup, unknown_name
 from planner.sim.search_events import ProbeEvent
 
 
@@ -103,10 +104,10 @@ def sensor_kind(model: SensorModel) -> SensorKind:
     Raises:
         PlanError: no simulator for this kind of sensor (the message lists the known ones).
     """
-    kind = SENSORS.get(getattr(type(model), "KIND", ""))
-    if kind is None or not isinstance(model, kind.model):
-        raise PlanError(
-            f"validation.sensor: no simulator for {type(model).__name__}; known sensors: "
-            f"{sorted(SENSORS)}"
+    name = str(getattr(type(model), "KIND", type(model).__name__))
+    kind = lookup(SENSORS, name, "sensor simulator (validation.sensor.kind)", PlanError)
+    if not isinstance(model, kind.model):
+        raise unknown_name(
+            "sensor simulator (validation.sensor.kind)", type(model).__name__, SENSORS, PlanError
         )
     return kind
