@@ -24,6 +24,7 @@ from planner.export.job import ToolData, build_job
 from planner.plan_cell import nominal_T_base_wobj
 from planner.program.build import measuring_program, safety_spec
 from planner.program.execute import execute
+from planner.program.steered_searches import search_variance_m2, steered_bounds
 from planner.suggest.search_sizing import MIN_OVERTRAVEL_M, MIN_START_M, steered_plan
 
 REPO = Path(__file__).resolve().parents[1]
@@ -169,10 +170,19 @@ def test_bounds_are_the_whole_misplacement_before_the_first_update_and_never_mor
     safety = safety_spec(plan)
     order = [p.id for p in plan.points]  # a best fit measures in plan order
     steered = dict(safety.steered_bounds_m)
-    assert order[0] not in steered and set(order[1:]) == set(steered)
-    for p in plan.points:
+    raw = steered_bounds(
+        [p.to_probe_point() for p in plan.points], "best_fit", HARD_T_M, HARD_W_RAD,
+        safety.pivot_wobj_m,
+        search_variance_m2(plan),
+    )  # fmt: skip
+    assert order[0] not in raw and set(order[1:]) == set(raw)  # the first: whole misplacement
+    for p in plan.points:  # kept exactly where the bound is shorter than the whole one
         whole = safety.surface_shift_bound_m(p.position_m)
-        assert safety.surface_shift_bound_m(p.position_m, p.id) <= whole
+        if p.id in raw and raw[p.id] < whole:
+            assert steered[p.id] == raw[p.id]
+        else:
+            assert p.id not in steered
+    assert len(steered) >= 5
     assert safety_spec(msgspec.structs.replace(plan, search_sizing="whole")).steered_bounds_m == ()
 
 
@@ -286,3 +296,15 @@ def test_steering_shortens_nothing_when_the_floors_hold_every_search() -> None:
     hard = _hard_plate(tight=False)
     pairs = zip(floored(hard, True), floored(hard, False), strict=True)
     assert sum(a[0] < b[0] - 1e-3 for a, b in pairs) >= 5
+
+
+@pytest.mark.slow
+def test_suggest_writes_whole_searches_from_a_steered_plan() -> None:
+    """``--objective accuracy`` writes searches for the whole misplacement, and says so: a plan
+    it starts from with ``search_sizing: "steered"`` does not pass that on."""
+    from planner.suggest import suggest_plan
+
+    start = msgspec.structs.replace(load_plan(PLATE), search_sizing="steered")
+    res = suggest_plan(start, PLATE.parent, max_points=6)
+    assert not res.plan.steered_searches
+    assert "search_sizing" not in plan_to_json(res.plan)

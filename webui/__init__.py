@@ -7,6 +7,7 @@ size (:mod:`webui.upload_guard`), the interface its panels see
 scene and robot drawing, click-to-place (:mod:`webui.surface`), the edited plan with undo/redo
 and autosave (:mod:`webui.plan_doc`, :mod:`webui.state`, :mod:`webui.plan_adapter`), and the
 one worker thread that owns the cell (:mod:`webui.worker`, :mod:`webui.backend`). Checks,
-validation, exports and calibration are the planner's own jobs (:mod:`planner.check.job`, ...).
+validation, exports and calibration are the planner's own jobs (:mod:`planner.check`,
+:mod:`planner.validate`, ...).
 ``docs/webui.md`` has the details.
 """

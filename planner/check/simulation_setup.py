@@ -2,9 +2,9 @@
 models and nominal pose (:func:`prediction_setup`), and with the part's faces and the x-offset
 run's targets, what every trial shares (:func:`simulation_setup`).
 
-Below both jobs that use it: ``wobjcal check`` predicts the layout's quality and landing risk
-from :func:`prediction_setup`, ``wobjcal validate`` simulates from :func:`simulation_setup`
-(and checks the plan first, so it imports :mod:`planner.check.job`; this module imports neither).
+In :mod:`planner.check`, below the validation that also uses it: ``wobjcal check`` predicts the
+layout's quality and landing risk from :func:`prediction_setup`, ``wobjcal validate`` simulates
+from :func:`simulation_setup` (after checking the plan); this module imports neither job.
 """
 
 from __future__ import annotations

@@ -122,16 +122,22 @@ def steered_safety(plan: Plan, whole: SafetySpec) -> SafetySpec:
         return steered
     try:
         ordered = [rp.point for rp in kind.assign(plan.role_points())]
-    except InputError:  # the layout lacks a role: no adaptive program
-        return steered
-    bounds = steered_bounds(
-        ordered,
-        kind.method,
-        whole.max_translation_m,
-        whole.max_angle_rad,
-        whole.pivot_wobj_m,
-        search_variance_m2(plan),
-    )
+        bounds = steered_bounds(
+            ordered,
+            kind.method,
+            whole.max_translation_m,
+            whole.max_angle_rad,
+            whole.pivot_wobj_m,
+            search_variance_m2(plan),
+        )
+    except InputError:  # no adaptive program (a role missing, a degenerate layout): the
+        return steered  # programs refuse the plan, naming search_sizing
+    by_id = {p.id: p for p in plan.points}
+    nearer = {  # only the searches the bound really shortens start nearer
+        pid: b
+        for pid, b in bounds.items()
+        if b < whole.surface_shift_bound_m(by_id[pid].position_m)
+    }
     return dataclasses.replace(
-        steered, steered_bounds_m=tuple((pid, bounds[pid]) for pid in sorted(bounds))
+        steered, steered_bounds_m=tuple((pid, nearer[pid]) for pid in sorted(nearer))
     )

@@ -416,7 +416,13 @@ def suggested_plan(
         ]
         report = msgspec.structs.replace(report, points_of_interest=pts)
     validation = msgspec.structs.replace(plan.validation, report=report)
-    return msgspec.structs.replace(plan, points=points, procedure=proc, validation=validation)
+    return msgspec.structs.replace(  # searches sized whole: steered_plan sizes them after
+        plan,
+        points=points,
+        procedure=proc,
+        validation=validation,
+        search_sizing=msgspec.UNSET,
+    )
 
 
 def _vec3(p: FloatArray | None) -> tuple[float, float, float]:
