@@ -45,6 +45,8 @@ class CellPanel:
     """
 
     def __init__(self, app: AppContext) -> None:
+        self._mismatch_key: tuple[str, str, float] | None = None
+        self._mismatch = ""
         self._app = app
         self._gizmo: Any = None
         self._gizmo_T: np.ndarray | None = None
@@ -90,6 +92,12 @@ class CellPanel:
         sensor = plan.validation.sensor
         if not isinstance(sensor, ProximitySensor):
             return ""
+        key = (plan.cell.tool.name, plan.cell.tool.tcp, sensor.standoff_m)
+        if key != self._mismatch_key:  # asked on every edit: the tool's files read on a change
+            self._mismatch_key, self._mismatch = key, self._tool_mismatch(plan, sensor)
+        return self._mismatch
+
+    def _tool_mismatch(self, plan: Plan, sensor: ProximitySensor) -> str:
         try:
             tool = self.tool.tool_of(plan.cell.tool.name)
         except (InputError, OSError):  # the tool section says why it has no tool
