@@ -67,6 +67,37 @@ def test_undo_redo_restore_points_and_checks(app: WobjcalApp) -> None:
     assert "B" in app.state.doc.ids
 
 
+def test_undo_and_redo_bring_back_the_checks_shown_without_checking_again(
+    app: WobjcalApp, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An undo or redo makes a plan current again: each point's check as it was shown in that
+    very plan comes back with it (``webui.doc_memo``); an edit to a new place is checked."""
+    from webui import plan_doc
+    from webui.backend import CellSession
+
+    app.place_at_ray(*_ray_to([0.05, -0.1, 0.0]), point_id="U")
+    placed = app.check_of("U")
+    app.move_point_to("U", [0.0, -0.05, 0.0])
+    moved = app.check_of("U")
+    assert placed is not None and moved is not None and moved is not placed
+    checked: list[list[str]] = []
+    check_points = CellSession.check_points
+
+    def counted(self: CellSession, points: list, plan: object = None) -> list:
+        checked.append([p.id for p in points])
+        return check_points(self, points, plan)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(CellSession, "check_points", counted)
+    app.state.undo()
+    assert app.check_of("U") is placed and checked == []
+    app.state.redo()
+    assert app.check_of("U") is moved and checked == []
+    assert "| U |" in app.points_panel.status_md.content
+    app.move_point_to("U", [0.02, -0.05, 0.0])
+    assert checked == [["U"]] and app.check_of("U") is not None
+    app.state.update(lambda d: plan_doc.delete_point(d, "U"), "delete U")
+
+
 def test_plan_download_is_the_strict_plan(app: WobjcalApp) -> None:
     from webui import plan_doc
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -96,3 +97,42 @@ def test_autosave_error_is_reported_not_raised(tmp_path: Path) -> None:
     s: SessionState[int] = SessionState(0, serialize=lambda d: b"1", autosave_path=blocker / "a")
     s.apply(1, "edit")
     assert s.doc == 1 and s.last_autosave_error
+
+
+def test_autosave_is_written_while_the_listeners_run(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The UI's listener checks and draws the edit; a slow disk does not hold it up, and the
+    file holds the edit once the change returns."""
+    import webui.state
+
+    events: list[str] = []
+    write = webui.state.atomic_write_bytes
+
+    def slow_write(path: Path, data: bytes) -> None:
+        time.sleep(0.3)  # an fsync on a busy disk
+        write(path, data)
+        events.append("written")
+
+    monkeypatch.setattr(webui.state, "atomic_write_bytes", slow_write)
+    s = _state(tmp_path)
+    s.subscribe(lambda _change: events.append("listener"))
+    s.apply((3,), "three")
+    assert events == ["listener", "written"], "the listener waited for the disk"
+    assert json.loads((tmp_path / "sub" / "autosave.json").read_text()) == [3]
+
+
+def test_overlapping_changes_leave_the_latest_document_in_the_file(tmp_path: Path) -> None:
+    s = _state(tmp_path)
+
+    def add(k: int) -> None:
+        for i in range(25):
+            s.update(lambda d, v=k * 100 + i: (*d, v), "add")
+
+    threads = [threading.Thread(target=add, args=(k,)) for k in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len(s.doc) == 100 and not s.last_autosave_error
+    assert json.loads((tmp_path / "sub" / "autosave.json").read_text()) == list(s.doc)

@@ -27,6 +27,8 @@ from webui import click_place, clients, plan_doc
 from webui.autosave import AutosaveLock
 from webui.backend import CellSession, CellView
 from webui.busy import BusyIndicator
+from webui.doc_memo import DocMemo
+from webui.gui_first import flush_gui_first
 from webui.heatmap import N_SAMPLES as HEAT_MAP_SAMPLES
 from webui.heatmap import HeatMap
 from webui.plan_adapter import autosave_bytes, plan_as_edited, plan_point, with_source
@@ -92,6 +94,15 @@ class WobjcalApp:
         self.picker: SurfacePicker | None = None
         self.robot: TabRobots | None = None  # one drawing per tab, each at its own pose
         self._checks: dict[str, tuple[ProbePoint, PointCheck]] = {}
+        #: the cell's generation: what was worked out in an earlier cell is not reused
+        self._cell_gen = 0
+        #: what undo and redo bring back with a plan object seen before (:mod:`webui.doc_memo`):
+        #: each point's check as it was shown in that plan, its role flags, its cycle time
+        self._check_memo: DocMemo[tuple[ProbePoint, PointCheck]] = DocMemo()
+        self._flags_memo: DocMemo[RoleFlags] = DocMemo()
+        self._cycle_memo: DocMemo[tuple[tuple[tuple[str, PointCheck], ...], CycleTime | None]] = (
+            DocMemo()
+        )
         #: the estimated cycle time of the plan as edited, from the latest checks
         self.cycle: CycleTime | None = None
         #: the latest cycle-time estimate (:meth:`update_cycle_time`)
@@ -152,6 +163,9 @@ class WobjcalApp:
             self.view, self.picker = view, picker
             self._cell_key = _cell_key(plan)
             self._checks.clear()
+            self._cell_gen += 1
+            self._check_memo.clear()
+            self._cycle_memo.clear()
         self.scene.draw_work_object(view.wobj_mesh, view.T_world_wobj)
         self.scene.draw_fixtures(view.fixtures)
         if self.robot is not None:
@@ -223,17 +237,43 @@ class WobjcalApp:
     def _redraw(self, point_ids: list[str] | None = None) -> None:
         """Redraw the given points (all when ``None``), drop removed ones, refresh the panel."""
         doc = self.state.doc
-        before, self.flags = self.flags, role_flags(doc)
+        flags = self._flags_memo.get(doc)
+        if flags is None:
+            flags = role_flags(doc)
+            self._flags_memo.put(doc, flags)
+        before, self.flags = self.flags, flags
         if point_ids is not None:  # a point whose flag came or went is redrawn too
             moved = set(before.by_point) ^ set(self.flags.by_point)
             point_ids = [*point_ids, *(i for i in moved if i not in point_ids and i in doc.ids)]
-        # the table first, on its own: the page applies a batch of GUI messages at once, but a
-        # batch with scene messages only in its next frame (0.2-1 s with software WebGL)
+        known = self._known_cycle(doc)
+        if known is not None:  # undo or redo to a plan whose estimate is known: in this row
+            self.cycle = known[0]
+        # the table first, in a websocket message of its own: the page applies a message of
+        # GUI updates at once, one with scene updates only in its next frame (0.2-1 s with
+        # software WebGL), and viser sends what is queued together (:mod:`webui.gui_first`)
         self.points_panel.refresh()
-        self.server.flush()
+        flush_gui_first(self.server)
         self.scene.draw_points(doc, self.checks(), None, only=point_ids, flags=self.flags.by_point)
         self.server.flush()
         self.update_cycle_time()  # after the rows: a click or undo does not wait for it
+
+    def _sorted_checks(self) -> tuple[tuple[str, PointCheck], ...]:
+        """The latest checks, by point id (what a cycle-time estimate is made from)."""
+        with self._lock:
+            return tuple(sorted(((pid, c) for pid, (_, c) in self._checks.items())))
+
+    def _known_cycle(self, doc: UiPlan) -> tuple[CycleTime | None] | None:
+        """The cycle time estimated before for this very plan object from these very checks,
+        in this cell, as a 1-tuple (``(None,)``: a plan that has none, e.g. a point without a
+        role); ``None`` when it is not known."""
+        if plan_as_edited(doc) is None:  # no plan loaded, or an edit that breaks a plan rule
+            return (None,)
+        checks = self._sorted_checks()
+        hit = self._cycle_memo.get(doc, self._cell_gen)
+        if hit is None or len(hit[0]) != len(checks):
+            return None
+        same = all(a == b and x is y for (a, x), (b, y) in zip(hit[0], checks, strict=True))
+        return (hit[1],) if same else None
 
     def update_cycle_time(self) -> Future[CycleTime | None]:
         """Estimate the cycle time of the plan as edited, from the latest checks, on the cell
@@ -247,17 +287,31 @@ class WobjcalApp:
             done.set_result(None)
             self.cycle_future = done
             return done
-        checks = list(self.checks().values())
+        known = self._known_cycle(doc)
+        if known is not None:  # undo or redo: estimated before, from the same checks
+            self.cycle = known[0]
+            self.points_panel.refresh()  # nothing is sent when the table already says it
+            done = Future()
+            done.set_result(known[0])
+            self.cycle_future = done
+            return done
+        sorted_checks = self._sorted_checks()
+        gen = self._cell_gen
+        checks = [c for _, c in sorted_checks]
         fut = self.worker.submit(lambda s: None if s is None else s.cycle_time(plan, checks))
 
         def show(f: Future[CycleTime | None]) -> None:
-            if self.state.doc is not doc:  # a later edit's estimate follows
-                return
             try:
-                self.cycle = f.result()
+                cycle = f.result()
             except Exception:  # the status table goes without it; checks are not affected
                 logger.exception("the cycle time estimate failed")
-                self.cycle = None
+                cycle = None
+            else:
+                if gen == self._cell_gen:
+                    self._cycle_memo.put(doc, (sorted_checks, cycle), gen)
+            if self.state.doc is not doc:  # a later edit's estimate follows
+                return
+            self.cycle = cycle
             self.points_panel.refresh()
 
         fut.add_done_callback(show)
@@ -265,6 +319,14 @@ class WobjcalApp:
         return fut
 
     def _on_change(self, change: Change[UiPlan]) -> None:
+        """Every change of the plan: its rows first (checked, drawn, sent), then the layout's
+        quality, on the layout panel's own thread (after the rows: it does not slow them)."""
+        try:
+            self._show_change(change)
+        finally:
+            self.layout_panel.refresh()
+
+    def _show_change(self, change: Change[UiPlan]) -> None:
         source = change.doc.source
         if isinstance(source, Plan) and _cell_key(source) != self._cell_key:
             try:  # e.g. undo of an upload: go back to the earlier cell
@@ -285,12 +347,22 @@ class WobjcalApp:
         if sensor_changed:  # the checks read it (footprint, standoff): all checked again
             changed = list(change.doc.ids)
             self.heatmap.stop()  # coloured with the old sensor's footprint: gone, not stale
+        known = []  # points whose check in this very plan is known: undo or redo to it
         with self._lock:
             for pid in [*changed, *(set(before) - set(change.doc.ids))]:
-                self._checks.pop(pid, None)
+                entry = self._checks.pop(pid, None)
+                if entry is not None:  # for an undo back to the plan it was shown in
+                    self._check_memo.put(change.previous, entry, (pid, self._cell_gen))
+            for pid in changed:
+                entry = self._check_memo.get(change.doc, (pid, self._cell_gen))
+                if entry is not None and entry[0] == change.doc.get(pid).probe:
+                    self._checks[pid] = entry
+                    known.append(pid)
         if len(changed) > 2 or not changed:  # grey "pending" markers for bulk changes
             self._redraw(changed)
-        self.recheck(changed)  # draws the changed points (one round trip per click)
+        elif known:
+            self._redraw(known)
+        self.recheck([pid for pid in changed if pid not in known])  # draws them
         self.teach_panel.after_checks()  # vias and shown moves of the plan as it now is
         for cid in self.selection.follow(change.doc, set(changed)):  # tabs whose point changed
             if self.points_panel.follow.value:

@@ -31,6 +31,7 @@ import numpy as np
 from calib.errors import InputError, PlanError
 from planner.check.job import plan_detectability, plan_quality
 from planner.sim.quality import DOF_NAMES, LayoutQuality, error_radius
+from webui.doc_memo import DocMemo
 from webui.markdown_text import plain
 from webui.plan_adapter import plan_from_ui, ui_plan_from_plan
 from webui.scene import heat_rgb
@@ -158,6 +159,10 @@ class LayoutPanel:
         self.last: LayoutQuality | None = None
         self.last_note = ""
         self.last_seconds = 0.0
+        #: the quality, its note and the panel's text of plans rated before on this part: an
+        #: undo or redo back to one shows it again without rating it again
+        self._memo: DocMemo[tuple[LayoutQuality | None, str, str]] = DocMemo()
+        self._memo_view: object = None
         self._painted = False
         gui = app.server.gui
         with app.tab("Layout"):
@@ -189,9 +194,11 @@ class LayoutPanel:
 
     # ---- live quality ----------------------------------------------------------------------
     def _on_change(self, change: object) -> None:
+        """A suggestion made for the plan as it was goes; the app calls :meth:`refresh` once
+        it has sent the edit's rows (``WobjcalApp._on_change``: the rating, on this panel's
+        thread, does not slow them)."""
         if self.pending is not None and getattr(change, "label", "") != "suggest layout":
             self.discard()  # made for the plan as it was
-        self.refresh()
 
     def refresh(self) -> Future[LayoutQuality | None]:
         """Predict the quality of the current points on the panel's thread (the latest edit
@@ -206,12 +213,23 @@ class LayoutPanel:
             return self.last
         t0 = time.perf_counter()
         doc = self._app.state.doc
-        q, note = self.compute(doc)
+        view = self._app.view
+        if view is not self._memo_view:  # another part or cell: nothing rated before holds
+            self._memo.clear()
+            self._memo_view = view
+        known = self._memo.get(doc)
+        if known is None:
+            q, note = self.compute(doc)
+            text = "\n\n".join(
+                t for t in (quality_markdown(q, note), redundancy_markdown(doc)) if t
+            )
+            known = (q, note, text)
+            self._memo.put(doc, known)
+        q, note, text = known
         self.last, self.last_note = q, note
         self.last_seconds = time.perf_counter() - t0
-        self.quality_md.content = "\n\n".join(
-            t for t in (quality_markdown(q, note), redundancy_markdown(doc)) if t
-        )
+        if self.quality_md.content != text:
+            self.quality_md.content = text
         self._paint()
         return q
 

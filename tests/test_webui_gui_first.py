@@ -1,0 +1,89 @@
+"""The status table's GUI updates go out before the scene's, in a websocket message of their own."""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Any
+
+from webui.gui_first import _broadcast_buffer, flush_gui_first
+from webui.testing import free_port
+
+
+class _Buffer:
+    """A viser broadcast buffer as far as :func:`flush_gui_first` reads it."""
+
+    def __init__(self, counter: int, cursors: dict[int, int]) -> None:
+        self.message_counter = counter
+        self.generator_cursors = cursors
+
+
+class _Websock:
+    def __init__(self, buffer: Any) -> None:
+        self.buffer = buffer
+
+    def get_message_buffer(self) -> Any:
+        return self.buffer
+
+
+class _Server:
+    def __init__(self, buffer: Any) -> None:
+        self._websock_server = _Websock(buffer)
+        self.flushes = 0
+
+    def flush(self) -> None:
+        self.flushes += 1
+
+
+def test_waits_until_every_tab_took_what_is_queued() -> None:
+    buffer = _Buffer(counter=10, cursors={1: 9, 2: 4})  # tab 2 has not taken messages 5-9 yet
+    server = _Server(buffer)
+
+    def take() -> None:
+        time.sleep(0.02)
+        buffer.generator_cursors[2] = 9
+
+    threading.Thread(target=take).start()
+    t0 = time.monotonic()
+    assert flush_gui_first(server, wait_s=5.0)  # type: ignore[arg-type]
+    assert 0.015 < time.monotonic() - t0 < 4.0 and server.flushes == 1
+
+
+def test_gives_up_after_the_wait_and_without_tabs_does_not_wait() -> None:
+    stuck = _Server(_Buffer(counter=10, cursors={1: 3}))
+    t0 = time.monotonic()
+    assert not flush_gui_first(stuck, wait_s=0.05)  # type: ignore[arg-type]
+    assert 0.04 < time.monotonic() - t0 < 2.0
+    assert flush_gui_first(_Server(_Buffer(counter=10, cursors={})))  # type: ignore[arg-type]
+
+
+def test_a_viser_without_that_buffer_gets_a_plain_flush() -> None:
+    server = _Server(buffer=None)
+    assert not flush_gui_first(server)  # type: ignore[arg-type]
+    assert server.flushes == 1
+
+
+def test_the_installed_viser_has_the_buffer_it_reads() -> None:
+    """A viser that renamed its buffer's counter or cursors would lose the ordering silently."""
+    import viser
+
+    server = viser.ViserServer(host="127.0.0.1", port=free_port(), verbose=False)
+    try:
+        assert _broadcast_buffer(server) is not None
+        assert flush_gui_first(server)  # no tab connected: nothing to wait for
+    finally:
+        server.stop()
+
+
+def test_on_an_event_loop_it_does_not_wait() -> None:
+    """viser's sender runs on its event loop: waiting there would stop it."""
+    import asyncio
+
+    stuck = _Server(_Buffer(counter=10, cursors={1: 3}))
+
+    async def on_loop() -> bool:
+        return flush_gui_first(stuck, wait_s=5.0)  # type: ignore[arg-type]
+
+    t0 = time.monotonic()
+    assert not asyncio.run(on_loop())
+    assert time.monotonic() - t0 < 1.0 and stuck.flushes == 1
