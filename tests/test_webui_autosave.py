@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 
 from calib.errors import InputError
+from planner.cell.disk_cache import cache_root
 from planner.cli.main import main
 from webui import autosave
 from webui.server import run
@@ -42,7 +43,14 @@ def _edit_then_kill(plan: Path, port: int, home: Path) -> None:
         time.sleep(120)
         """
     )
-    env = {**os.environ, "HOME": str(home), "PYTHONPATH": str(REPO)}
+    # another home for the autosave, but this machine's caches: with a cold kernel cache the
+    # child compiles every kernel first, which on a loaded machine outlasts the cell's 120 s
+    env = {
+        **os.environ,
+        "HOME": str(home),
+        "PYTHONPATH": str(REPO),
+        "WOBJCAL_CACHE_DIR": str(cache_root()),
+    }
     proc = subprocess.Popen([sys.executable, "-c", child], stdout=subprocess.PIPE, env=env)
     try:
         assert proc.stdout is not None
