@@ -7,7 +7,9 @@ Owns:
     - foundations: :mod:`calib.frames` (transforms, Tait-Bryan z-y'-x'' angles of eq. 7-9,
       quaternions), :mod:`calib.errors`, :mod:`calib.arguments` and :mod:`calib.structs`
       (argument and field checks), :mod:`calib.probing` (probe points, search commands, the
-      :data:`Probe` callback contract), :mod:`calib.units`, :mod:`calib.atomic_io`;
+      :data:`Probe` callback contract), :mod:`calib.plane_probe` (the one ideal probe: searches
+      answered on the nominal faces' planes), :mod:`calib.procedure_run` (``ProcedureRun``:
+      what every procedure run returns), :mod:`calib.units`, :mod:`calib.atomic_io`;
     - :mod:`calib.paper`: the paper's equations and its A-H procedure;
     - :mod:`calib.estimators`: 3-2-1, best fit with covariance, observability, step runners;
     - :mod:`calib.procedures`: the registry of procedures a plan can name;

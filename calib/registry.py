@@ -1,15 +1,22 @@
-"""Looking a name up in a registry, with the one error every registry gives.
+"""Registries: looking a name up, with the one error every registry gives, and loading a
+plug-in an entry names.
 
 The registries (procedures, export formats, controllers, sensor simulators, built-in robots,
 tools and parts) are plain mappings from a name to an entry; :func:`lookup` is how every caller
 reads one, so an unknown name always reads ``unknown <what> '<name>'; known: a, b``, from the
 plan field or command-line option that named it.
+
+An entry holds what is cheap to import (the procedures are objects of :mod:`calib`) and names
+the rest by reference, ``"module:attribute"`` (a writer, a simulator class, a mesh factory),
+imported when first used by :func:`load`: the one way every registry loads a plug-in, so
+listing a registry imports none of them.
 """
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Iterable, Mapping
-from typing import TypeVar
+from typing import Any, TypeVar
 
 from calib.errors import InputError
 
@@ -39,3 +46,20 @@ def lookup(
         return registry[name]
     except (KeyError, TypeError):
         raise unknown_name(what, name, registry.keys(), error) from None
+
+
+def load(ref: str) -> Any:
+    """The object a registry entry names by ``"module:attribute"`` (``attribute`` may be dotted,
+    e.g. ``"planner.parts.stator:StatorGeometry.prototype"``), importing its module.
+
+    Raises:
+        ValueError: ``ref`` is not ``"module:attribute"``; ImportError, AttributeError: the
+            module or attribute does not exist (a defect of the registry, not of user input).
+    """
+    module, sep, attribute = ref.partition(":")
+    if not (module and sep and attribute):
+        raise ValueError(f"a registry reference is 'module:attribute', got {ref!r}")
+    obj: Any = importlib.import_module(module)
+    for name in attribute.split("."):
+        obj = getattr(obj, name)
+    return obj

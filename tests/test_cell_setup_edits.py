@@ -237,7 +237,8 @@ def test_sensor_edit_in_mm_and_the_search_speed(plan_path: Path) -> None:
         edits.with_sensor(ui, edits.SensorFields("proximity", 18.0, 0.0, 0.04, None))
     with pytest.raises(InputError, match=r"^search speed \(mm/s\): must be > 0, got -1"):
         edits.with_sensor(ui, edits.SensorFields("proximity", 18.0, 8.0, 0.04, -1.0))
-    with pytest.raises(InputError, match="sensor kind: must be one of proximity, touch"):
+    unknown = r"^unknown sensor kind \(validation\.sensor\.kind\) 'laser'; known: proximity, touch$"
+    with pytest.raises(InputError, match=unknown):
         edits.with_sensor(ui, edits.SensorFields("laser", 18.0, 8.0, 0.04, None))
 
 

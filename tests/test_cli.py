@@ -171,7 +171,13 @@ def test_calibrate_text_has_paste_lines(
     assert code == 0
     assert 'PERS wobjdata wobjCalibrated:=[FALSE,TRUE,"",[[' in out
     assert "BASE_DATA[10]={X " in out
+    assert "wobj_calibrated = p[" in out and "UFRAME[9]=PR[1] ;" in out  # every format's
     assert f"x {T_true[0, 3] * 1e3:.3f}" in out
+    code, out, _ = run(
+        capsys, "calibrate", str(_ideal_stator(tmp_path)), str(meas), "--format", "krl"
+    )
+    assert code == 0 and "BASE_DATA[10]={X " in out
+    assert "PERS wobjdata" not in out and "UFRAME" not in out and "p[" not in out
 
 
 def test_calibrate_gross_error_exits_1_without_paste_lines(

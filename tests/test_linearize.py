@@ -13,9 +13,10 @@ from calib.estimators.three_two_one import ThreeTwoOneLayout, three_two_one
 from calib.frames import make_transform, matrix_from_rotvec, motion_between
 from calib.models import SearchNoise
 from calib.paper.stator_layout import example_stator_points
+from calib.plane_probe import PlaneProbe
 from calib.probing import SearchCommand
 from calib.procedures import BEST_FIT, HULTMAN2013, THREE_TWO_ONE, RolePoint
-from calib.procedures.linearize import PlaneProbe, event_covariance, linearize
+from calib.procedures.linearize import event_covariance, linearize
 
 T_NOM = make_transform(matrix_from_rotvec([0.1, -0.2, 0.3]), [1.0, 0.2, 0.5])
 T_TRUE = T_NOM @ make_transform(matrix_from_rotvec([0.02, -0.01, 0.015]), [0.01, -0.006, 0.004])

@@ -20,9 +20,10 @@ import pytest
 
 from calib.frames import invert_transform, transform_directions, transform_points
 from calib.plan.file import Plan, load_plan
+from calib.plane_probe import PlaneProbe
 from calib.probing import Probe, ProbePoint, ProbeResult, SearchCommand, SearchSpec
 from calib.procedures import procedure_kind
-from calib.procedures.linearize import PlaneProbe, RunFunction, linearize
+from calib.procedures.linearize import RunFunction, linearize
 from planner.check.job import plan_quality
 from planner.check.simulatable import check_simulatable, work_object_mesh
 from planner.sim.setup import SimulationSetup

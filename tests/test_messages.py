@@ -285,10 +285,11 @@ def test_the_ui_layout_panel_says_it() -> None:
 def test_suggest_add_grows_a_three_two_one_plan_into_a_best_fit() -> None:
     """Was: `suggest --add N` refused a 3-2-1 plan ('added points need the best fit'), so the
     command the redundancy line names could not run."""
-    from planner.suggest import as_best_fit
+    from calib.procedures import PROCEDURES
+    from planner.suggest import as_procedure
 
     plan = load_plan(PLATE_321, check_files=False)
-    grown = as_best_fit(plan)
+    grown = as_procedure(plan, PROCEDURES["best_fit"])
     assert grown.method == "best_fit" and {p.role for p in grown.points} == {"fit"}
     assert [p.position_m for p in grown.points] == [p.position_m for p in plan.points]
 

@@ -110,7 +110,7 @@ def test_three_two_one_converges_from_misplacement(seed: int) -> None:
     assert not np.allclose(log[3].T_base_wobj_estimate, T_nominal)
     np.testing.assert_allclose(log[6].T_base_wobj_estimate, res.estimates[2], atol=0)
     # second-round commands aim at the true surface points
-    for cmd, step in zip(log[6:], res.steps[6:]):
+    for cmd, step in zip(log[6:], res.probes[6:]):
         assert np.linalg.norm(cmd.nominal_m - step.measured_m) < 1e-9
 
 
@@ -135,7 +135,7 @@ def test_progressive_updates_aim_later_points_better(rng: np.random.Generator) -
         res = run_best_fit(
             faces.points, plane_probe(faces, T_true), T_nominal, progressive=progressive
         )
-        first = res.steps[: len(faces.points)]
+        first = res.probes[: len(faces.points)]
         # distance between where a point was expected and where it was really measured
         aim_error[progressive] = np.mean(
             [np.linalg.norm(s.command.nominal_m - s.measured_m) for s in first[5:]]

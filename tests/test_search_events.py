@@ -108,7 +108,8 @@ def test_search_ids_of_roles_and_retakes() -> None:
 def test_cell_hook_reports_the_cells_reason() -> None:
     seen = []
 
-    def check_search(command, step_m):  # the Cell method's signature
+    def check_search(command, step_m, exact_clearance):  # the Cell method's arguments
+        assert exact_clearance is False  # the verdict only
         seen.append((command.point_id, step_m))
         bad = command.point_id == "far"
         return SimpleNamespace(feasible=not bad, reason="joint 3 at limit" if bad else "")

@@ -79,7 +79,7 @@ def test_converges_from_worst_misplacement_commanded_in_wrong_frame() -> None:
         assert miss > 0.010
     start_dt, start_dr = pose_error(T_prelim, T_true)
     assert start_dt >= 0.019 and start_dr >= math.radians(2.99)
-    errors = [pose_error(step.T_base_wobj, T_true) for step in res.steps]
+    errors = [pose_error(u.T_base_wobj, T_true) for u in res.updates]
     assert errors[-1][0] < 1e-9 and errors[-1][1] < 1e-9
     # later searches are commanded in the improved estimate: D2 lands on its nominal
     d2_miss = np.linalg.norm(res.measured_m["D2"] - res.commands["D2"].nominal_m)
@@ -90,21 +90,21 @@ def test_steps_follow_the_paper(rng: np.random.Generator) -> None:
     T_prelim = nominal_pose(0.05, (1.0, 0.2, 0.7))
     T_true = T_prelim @ random_transform(rng, 0.015, math.radians(2.0))
     res = run_stator_procedure(LAYOUT, T_prelim, BoxProbe(T_true))
-    assert [s.point_ids for s in res.steps] == [
-        (), ("A", "B"), ("B",), ("C",), ("A", "B", "D", "E"), ("E",), ("H", "F", "D"),
+    assert [u.point_ids for u in res.updates] == [
+        ("A", "B"), ("B",), ("C",), ("A", "B", "D", "E"), ("E",), ("H", "F", "D"),
         ("H",), ("C2",), ("D2",),
     ]  # fmt: skip
     assert list(res.measured_m) == ["A", "B", "C", "D", "E", "F", "G", "H", "C2", "D2"]
     R_true = T_true[:3, :3]
     # after A, B, D, E the x axis is the side-face normal exactly (all four lie on the face)
-    np.testing.assert_allclose(res.steps[4].T_base_wobj[:3, 0], R_true[:, 0], atol=1e-12)
+    np.testing.assert_allclose(res.updates[3].T_base_wobj[:3, 0], R_true[:, 0], atol=1e-12)
     # but y still follows A -> B, which was commanded in the wrong frame (rotation about x)
-    assert np.linalg.norm(res.steps[4].T_base_wobj[:3, 1] - R_true[:, 1]) > 1e-6
+    assert np.linalg.norm(res.updates[3].T_base_wobj[:3, 1] - R_true[:, 1]) > 1e-6
     # the final rotation (H, F, D) is exact before any origin update
-    np.testing.assert_allclose(res.steps[6].T_base_wobj[:3, :3], R_true, atol=1e-12)
+    np.testing.assert_allclose(res.updates[5].T_base_wobj[:3, :3], R_true, atol=1e-12)
     # each origin step moves the origin along one WOCS axis only
-    for i, axis in ((2, 0), (3, 1), (5, 0), (7, 2), (8, 1), (9, 0)):
-        before, after = res.steps[i - 1].T_base_wobj, res.steps[i].T_base_wobj
+    for i, axis in ((1, 0), (2, 1), (4, 0), (6, 2), (7, 1), (8, 0)):
+        before, after = res.updates[i - 1].T_base_wobj, res.updates[i].T_base_wobj
         shift_w = before[:3, :3].T @ (after[:3, 3] - before[:3, 3])
         assert np.all(np.abs(np.delete(shift_w, axis)) < 1e-12)
         np.testing.assert_array_equal(after[:3, :3], before[:3, :3])
@@ -113,7 +113,7 @@ def test_steps_follow_the_paper(rng: np.random.Generator) -> None:
         p_true = transform_points(invert_transform(T_true), res.measured_m[pid])
         assert abs(p_true[0]) < 1e-12 and abs(p_true[2]) < 1e-12
     # eq. 12's P3 lies 50 mm above B
-    assert res.p3_m[2] - res.measured_m["B"][2] == pytest.approx(0.050)
+    assert res.constructed_m["P3"][2] - res.measured_m["B"][2] == pytest.approx(0.050)
 
 
 def test_faces_off_the_origin_are_handled() -> None:

@@ -18,8 +18,8 @@ from calib.estimators.steering import normal_shift_bound, normal_shift_maps
 from calib.frames import matrix_from_rotvec
 from calib.models import ProximitySensor
 from calib.plan.file import Plan, load_plan, plan_digest, plan_from_json, plan_to_json
+from calib.plane_probe import PlaneProbe
 from calib.probing import ProbeResult, SearchCommand
-from calib.procedures.linearize import PlaneProbe
 from planner.export.job import ToolData, build_job
 from planner.plan_cell import nominal_T_base_wobj
 from planner.program.build import measuring_program, safety_spec

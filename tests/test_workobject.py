@@ -143,7 +143,9 @@ def cube_mesh() -> trimesh.Trimesh:
 
 def test_builtin_part_registry(monkeypatch: pytest.MonkeyPatch) -> None:
     """A part is one factory plus one table entry; unknown names list the valid ones."""
-    monkeypatch.setitem(builtins.BUILTIN_PARTS, "test_cube", f"{__name__}:cube_mesh")
+    monkeypatch.setitem(
+        builtins.BUILTIN_PARTS, "test_cube", builtins.BuiltinPart(f"{__name__}:cube_mesh")
+    )
     assert "builtin:test_cube" in builtins.builtin_part_names()
     wobj = load_work_object("builtin:test_cube")
     assert wobj.name == "test_cube"

@@ -28,6 +28,7 @@ from webui.autosave import AutosaveLock
 from webui.backend import CellSession, CellView
 from webui.busy import BusyIndicator
 from webui.doc_memo import DocMemo
+from webui.guard import guarded
 from webui.gui_first import flush_gui_first
 from webui.heatmap import N_SAMPLES as HEAT_MAP_SAMPLES
 from webui.heatmap import HeatMap
@@ -118,7 +119,9 @@ class WobjcalApp:
         self.heatmap = HeatMap(self)
         self.points_panel = points_panel.PointsPanel(self)
         #: each tab's selected point, its settings widgets and highlight (issue 14, item 9)
-        self.selection = Selections(self, self.points_panel.selection_folder)
+        self.selection = Selections(
+            self, self.points_panel.selection_folder, self.points_panel.guard
+        )
         self.cell_panel = cell_panel.CellPanel(self)
         self.frame_panel = frame_panel.FramePanel(self)  # 3-point work-object frame
         self.teach_panel = teach_panel.TeachPanel(self)
@@ -485,13 +488,7 @@ class WobjcalApp:
     def _on_scene_click(self, event: Any) -> None:
         """Every click on the 3D view: handled by the current mode, or told why it did nothing."""
         handler = self.click_handlers.get(self.click_mode, self.click_handlers["place"])
-        try:
-            handler(event)
-        except InputError as exc:
-            self.notify("Click not used", str(exc), client=event.client, error=True)
-        except Exception as exc:  # never a traceback in the browser
-            logger.exception("a click failed")
-            self.notify("Click not used", f"{type(exc).__name__}: {exc}", client=event.client)
+        guarded(self, event.client, handler, event, title="Click not used", action="a click")
 
     # ---- clients ---------------------------------------------------------------------------
     def _upload_refused(self, client_id: int, name: str, message: str) -> None:

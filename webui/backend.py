@@ -172,8 +172,8 @@ class CellSession:
             return None
         try:
             return plan_cycle_time(plan, checks, self.cell)
-        except InputError:
-            return None
+        except InputError:  # not a refusal to tell anyone: no program yet means no cycle time
+            return None  # (the status table shows why the points or the plan fall short)
 
     # ---- jogging ---------------------------------------------------------------------------
     def T_world_tcp(self, q: ArrayLike, tcp: str) -> NDArray[np.float64]:

@@ -9,8 +9,7 @@ lists the problems and names the point to re-measure, as ``wobjcal calibrate`` d
 
 from __future__ import annotations
 
-import logging
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,41 +18,36 @@ from calib.frames import motion_between
 from calib.plan.measurements import measurements_from_json
 from planner.calibrate.job import CalibrationOutput, calibrate_plan
 from webui.files_panel import check_upload
+from webui.panel import Panel
 from webui.plan_adapter import plan_from_ui
 
 if TYPE_CHECKING:
     from webui.context import AppContext
 
-logger = logging.getLogger(__name__)
 
-
-class CalibratePanel:
-    """GUI widgets of the calibration from measured points.
+class CalibratePanel(Panel):
+    """GUI widgets of the calibration from measured points (a folder of the Files tab).
 
     Args:
         app: the app whose plan the measurements belong to.
     """
 
+    TAB = "Files"
+    REFUSED = "Not calibrated"
+    ACTION = "calibration"
+
     def __init__(self, app: AppContext) -> None:
-        self._app = app
+        super().__init__(app)
         self.last_output: CalibrationOutput | None = None
         gui = app.server.gui
-        with app.tab("Files"), gui.add_folder("Calibrate", expand_by_default=False):
+        with app.tab(self.TAB), gui.add_folder("Calibrate", expand_by_default=False):
             self.upload = gui.add_upload_button("Upload measurements (.json)", mime_type=".json")
             self.result_md = gui.add_markdown(
                 "Upload a `wobjcal.measurements/1` file to compute the calibrated frame."
             )
-        self.upload.on_upload(self._on_upload)
-
-    def _on_upload(self, event: Any) -> None:
-        f = event.target.value
-        try:
-            self.calibrate(f.name, f.content)
-        except InputError as exc:
-            self._app.notify("Not calibrated", str(exc), client=event.client)
-        except Exception as exc:  # never a traceback in the browser
-            logger.exception("calibration failed")
-            self._app.notify("Not calibrated", f"{type(exc).__name__}: {exc}", client=event.client)
+        self.upload.on_upload(
+            lambda ev: self.guard(ev, self.calibrate, ev.target.value.name, ev.target.value.content)
+        )
 
     def calibrate(self, name: str, content: bytes) -> CalibrationOutput:
         """Calibrate the session plan with uploaded measurements; draw and describe the result."""
@@ -89,6 +83,7 @@ class CalibratePanel:
         for pid, r in out.residuals_m.items():
             rows.append(f"| {pid} | {r * 1000.0:+.3f} |")
         self.result_md.content = "\n".join(rows)
+        # the outcome is every tab's (the frame is drawn, or removed, in the shared scene)
         if not out.trusted:
             self._app.scene.draw_calibrated_frame(None)
             self._app.notify("Calibration not trusted", " ".join(out.problems), error=True)

@@ -39,6 +39,7 @@ from webui.tab_selection import set_options
 if TYPE_CHECKING:
     from calib.plan.cell import FixtureSpec
     from webui.context import AppContext
+    from webui.panel import Guard
 
 NO_FIXTURE = "(no fixture)"
 #: A fixture mesh: any mesh the work object takes except CAD files (they carry bodies).
@@ -52,11 +53,12 @@ class FixturesSection:
 
     Args:
         app: the app whose plan's fixtures are edited.
-        guard: runs an edit, showing an input error as a notification (the panel's ``_guard``).
+        guard: the Cell panel's :meth:`webui.panel.Panel.guard`: runs an edit, a refusal told
+            to the tab that acted.
         on_added: called with the ``Move`` target of a fixture just added (the panel shows it).
     """
 
-    def __init__(self, app: AppContext, guard: Any, on_added: Any) -> None:
+    def __init__(self, app: AppContext, guard: Guard, on_added: Any) -> None:
         self._app = app
         self._uploads = CellUploads(app)
         self._on_added = on_added

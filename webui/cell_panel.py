@@ -25,7 +25,7 @@ from webui.cell_edits import ROBOT_BASE, WORK_OBJECT
 from webui.cell_fixtures import FixturesSection
 from webui.cell_sensor import SensorSection
 from webui.cell_tool import ToolSection
-from webui.guard import guarded
+from webui.panel import Panel
 
 if TYPE_CHECKING:
     from webui.context import AppContext
@@ -37,21 +37,26 @@ NO_FIXTURE = "(no fixture)"
 GIZMO_TOL = 1e-6
 
 
-class CellPanel:
-    """GUI widgets of the cell setup (shared by all tabs).
+class CellPanel(Panel):
+    """GUI widgets of the cell setup (shared by all tabs); its tool, sensor and fixture
+    sections run their edits through its :meth:`guard`.
 
     Args:
         app: the app whose plan's cell is edited.
     """
 
+    TAB = "Cell"
+    REFUSED = "Cell not changed"
+    ACTION = "cell edit"
+
     def __init__(self, app: AppContext) -> None:
+        super().__init__(app)
         self._mismatch_key: tuple[str, str, float] | None = None
         self._mismatch = ""
-        self._app = app
         self._gizmo: Any = None
         self._gizmo_T: np.ndarray | None = None
         gui = app.server.gui
-        with app.tab("Cell"):
+        with app.tab(self.TAB):
             gui.add_markdown("Move the work object, the robot base or a fixture (world frame).")
             self.target = gui.add_dropdown("Move", (WORK_OBJECT, ROBOT_BASE))
             self.position = gui.add_vector3("Position (mm)", (0.0, 0.0, 0.0), step=1.0)
@@ -60,19 +65,15 @@ class CellPanel:
             self.use_gizmo = gui.add_checkbox("Move with gizmo", False)
             self.snap_to = gui.add_dropdown("Snap onto", (NO_FIXTURE,))
             self.snap = gui.add_button("Snap part onto fixture")
-            self.tool = ToolSection(app, self._guard)
-            self.sensor = SensorSection(app, self._guard)
-            self.fixtures = FixturesSection(app, self._guard, self._show_target)
+            self.tool = ToolSection(app, self.guard)
+            self.sensor = SensorSection(app, self.guard)
+            self.fixtures = FixturesSection(app, self.guard, self._show_target)
         self.target.on_update(lambda _ev: self.refresh())
-        self.apply.on_click(lambda ev: self._guard(ev, self.apply_fields))
-        self.use_gizmo.on_update(lambda ev: self._guard(ev, self._update_gizmo))
-        self.snap.on_click(lambda ev: self._guard(ev, self.snap_part, str(self.snap_to.value)))
+        self.apply.on_click(lambda ev: self.guard(ev, self.apply_fields))
+        self.use_gizmo.on_update(lambda ev: self.guard(ev, self._update_gizmo))
+        self.snap.on_click(lambda ev: self.guard(ev, self.snap_part, str(self.snap_to.value)))
         app.state.subscribe(lambda _change: self.refresh())
         self.refresh()
-
-    def _guard(self, event: Any, fn: Any, *args: Any) -> None:
-        client = getattr(event, "client", None)
-        guarded(self._app, client, fn, *args, title="Cell not changed", action="cell edit")
 
     def _plan(self) -> Plan:
         source = self._app.state.doc.source
@@ -185,4 +186,4 @@ class CellPanel:
             return
         g = event.target
         T = make_transform(matrix_from_quat_wxyz(g.wxyz), g.position)
-        self._guard(event, self.move, str(self.target.value), T)
+        self.guard(event, self.move, str(self.target.value), T)

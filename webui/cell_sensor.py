@@ -25,6 +25,7 @@ from webui.plan_doc import UiPlan
 
 if TYPE_CHECKING:
     from webui.context import AppContext
+    from webui.panel import Guard
 
 
 def default_fields(kind: str, speed_mm_s: float | None) -> SensorFields:
@@ -47,10 +48,11 @@ class SensorSection:
 
     Args:
         app: the app whose plan's sensor is edited.
-        guard: runs an edit, showing an input error as a notification (the panel's ``_guard``).
+        guard: the Cell panel's :meth:`webui.panel.Panel.guard`: runs an edit, a refusal told
+            to the tab that acted.
     """
 
-    def __init__(self, app: AppContext, guard: Any) -> None:
+    def __init__(self, app: AppContext, guard: Guard) -> None:
         self._app = app
         self._shown: SensorFields | None = None  # what the fields were last set to
         gui = app.server.gui

@@ -24,6 +24,7 @@ from calib.limits import MAX_FIXTURES
 from calib.models import SENSOR_KINDS, ProximitySensor, TouchProbe
 from calib.plan.cell import FixtureSpec, Pose
 from calib.plan.file import Plan
+from calib.registry import unknown_name
 from calib.units import MESH_UNITS
 from planner.cell.tool import FLANGE, Tool
 from webui.cell_edits import pose_from_fields
@@ -255,8 +256,8 @@ def with_sensor(ui: UiPlan, fields: SensorFields) -> UiPlan:
     if not isinstance(ui.source, Plan):
         raise InputError("load a plan first: there is no sensor to set up")
     if fields.kind not in SENSOR_KINDS:
-        raise InputError(
-            f"sensor kind: must be one of {', '.join(SENSOR_KINDS)}, got {fields.kind!r}"
+        raise unknown_name(
+            "sensor kind (validation.sensor.kind)", fields.kind, SENSOR_KINDS, InputError
         )
     noise = _number(fields.noise_mm, "noise 1 sigma (mm)", allow_zero=True) / 1000.0
     old = ui.source.validation.sensor

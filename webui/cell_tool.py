@@ -15,7 +15,7 @@ from __future__ import annotations
 import hashlib
 import re
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from calib.atomic_io import write_text_atomic
 from calib.errors import InputError
@@ -33,6 +33,7 @@ from webui.urdf_zip import unpack_robot_zip
 
 if TYPE_CHECKING:
     from webui.context import AppContext
+    from webui.panel import Guard
 
 #: What the tool upload takes: a URDF, a zip of a URDF with its meshes, or a mesh.
 TOOL_SUFFIXES = (".urdf", ".zip", ".stl", ".obj", ".ply", ".off", ".glb", ".gltf")
@@ -50,10 +51,11 @@ class ToolSection:
 
     Args:
         app: the app whose plan's tool is edited.
-        guard: runs an edit, showing an input error as a notification (the panel's ``_guard``).
+        guard: the Cell panel's :meth:`webui.panel.Panel.guard`: runs an edit, a refusal told
+            to the tab that acted.
     """
 
-    def __init__(self, app: AppContext, guard: Any) -> None:
+    def __init__(self, app: AppContext, guard: Guard) -> None:
         self._app = app
         self._uploads = CellUploads(app)
         self._refs: dict[str, str] = {}  # dropdown label -> tool reference
@@ -124,7 +126,7 @@ class ToolSection:
                 f"**Tool:** {tool.name} ({mesh}), probing with TCP **{spec.tcp}**; "
                 f"TCPs: {', '.join(tcps)}"
             )
-        except InputError as exc:
+        except InputError as exc:  # not an action of a tab: the summary says why, for every tab
             tcps = (spec.tcp,)
             self.summary.content = f"**Tool:** {tool_label(spec.name)}: {exc}"
         set_options(self.tcp, tcps)

@@ -13,8 +13,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from calib.errors import InputError
 from calib.plan.file import Plan
+from calib.registry import lookup
 from planner.export import FORMATS as EXPORT_FORMATS
 
 if TYPE_CHECKING:
@@ -56,10 +56,9 @@ def export_program(plan: Plan, fmt: str, plan_dir: Path, cell: Cell | None = Non
     """
     from planner.export_plan.job import export_program as make
 
-    if fmt not in FORMATS:
-        raise InputError(f"unknown export format {fmt!r}; known: {', '.join(FORMATS)}")
-    result = make(plan, plan_dir, FORMATS[fmt], cell=cell)
-    stem = EXPORT_FORMATS[FORMATS[fmt]].file_stem(plan.name)
+    name = lookup(FORMATS, fmt, "export format (download)")
+    result = make(plan, plan_dir, name, cell=cell)
+    stem = EXPORT_FORMATS[name].file_stem(plan.name)
     out = tuple((f"{stem}{suffix}", text.encode("utf-8")) for suffix, text in result.files.items())
     if result.check is not None:
         refusals = result.check.refusals()

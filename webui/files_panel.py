@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import logging
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -21,8 +22,8 @@ from calib.units import MESH_UNITS
 from planner.export import export_file_stem
 from webui import autosave, uploads
 from webui.exports import FORMATS, ExportResult, export_program
-from webui.guard import guarded
 from webui.markdown_text import plain
+from webui.panel import Panel, client_of
 from webui.part_upload import PendingPart, drop_points, frame_note, off_surface, project_points
 from webui.plan_adapter import plan_from_ui, ui_plan_from_bytes, with_source
 from webui.state import atomic_write_bytes
@@ -70,7 +71,7 @@ def check_upload(name: str, content: bytes, suffixes: tuple[str, ...], what: str
         raise UploadError(f"{name}: a {what} must end in {', '.join(suffixes)}")
 
 
-class FilesPanel:
+class FilesPanel(Panel):
     """GUI widgets for uploads and downloads.
 
     Args:
@@ -78,13 +79,17 @@ class FilesPanel:
         upload_dir: where uploaded meshes and URDFs are kept (they must outlive the request).
     """
 
+    TAB = "Files"
+    REFUSED = "File not used"
+    ACTION = "file action"
+
     def __init__(self, app: AppContext, upload_dir: Path = UPLOAD_DIR) -> None:
-        self._app = app
+        super().__init__(app)
         self.upload_dir = upload_dir
         #: the upload folders this session wrote (removed at the end unless its plan uses them)
         self.created: set[Path] = set()
         gui = app.server.gui
-        with app.tab("Files"):
+        with app.tab(self.TAB):
             self.plan_upload = gui.add_upload_button("Upload plan (.json)", mime_type=".json")
             self.mesh_upload = gui.add_upload_button("Upload work-object mesh")
             self.units = gui.add_dropdown("Mesh units", MESH_UNITS, initial_value="mm")
@@ -112,22 +117,22 @@ class FilesPanel:
             self.export_buttons = {fmt: gui.add_button(f"Download {fmt}") for fmt in FORMATS}
             self.export_md = gui.add_markdown("")
             self.export_anyway = gui.add_button("Export anyway", color="red", visible=False)
-        self.plan_upload.on_upload(lambda ev: self._guard(ev, self.upload_plan, *_file(ev)))
-        self.mesh_upload.on_upload(lambda ev: self._guard(ev, self.stage_mesh, *_file(ev)))
-        self.units.on_update(lambda ev: self._guard(ev, self._show_pending, failure="Units"))
-        self.accept.on_click(lambda ev: self._guard(ev, self.accept_mesh))
-        self.cancel.on_click(lambda ev: self._guard(ev, self.cancel_mesh, failure="Not done"))
-        self.project_off.on_click(lambda ev: self._guard(ev, self.fix_off_surface, "project"))
-        self.drop_off.on_click(lambda ev: self._guard(ev, self.fix_off_surface, "drop"))
+        self.plan_upload.on_upload(lambda ev: self.guard(ev, self.upload_plan, *_file(ev)))
+        self.mesh_upload.on_upload(lambda ev: self.guard(ev, self.stage_mesh, *_file(ev)))
+        self.units.on_update(lambda ev: self.guard(ev, self._show_pending, title="Units"))
+        self.accept.on_click(lambda ev: self.guard(ev, self.accept_mesh))
+        self.cancel.on_click(lambda ev: self.guard(ev, self.cancel_mesh, title="Not done"))
+        self.project_off.on_click(lambda ev: self.guard(ev, self.fix_off_surface, "project"))
+        self.drop_off.on_click(lambda ev: self.guard(ev, self.fix_off_surface, "drop"))
         self.pending: PendingPart | None = None
         #: ``{point id: distance, m}`` of the points off the surface after the last new part.
         self.off: dict[str, float] = {}
-        self.urdf_upload.on_upload(lambda ev: self._guard(ev, self.upload_urdf, *_file(ev)))
+        self.urdf_upload.on_upload(lambda ev: self.guard(ev, self.upload_urdf, *_file(ev)))
         self.download.on_click(
-            lambda ev: self._guard(ev, self.download_plan, ev.client, failure="Not downloaded")
+            lambda ev: self.guard(ev, self.download_plan, ev.client, title="Not downloaded")
         )
         self.download_bundle.on_click(
-            lambda ev: self._guard(ev, self.download_zip, ev.client, failure="Not downloaded")
+            lambda ev: self.guard(ev, self.download_zip, ev.client, title="Not downloaded")
         )
         for fmt, button in self.export_buttons.items():
             button.on_click(self._export_callback(fmt))
@@ -136,24 +141,25 @@ class FilesPanel:
         self.refused_format: str | None = None
         self._refused_doc: UiPlan | None = None
         self.export_anyway.on_click(
-            lambda ev: self._guard(ev, self.download_anyway, ev.client, failure="Not exported")
+            lambda ev: self.guard(ev, self.download_anyway, ev.client, title="Not exported")
         )
         app.state.subscribe(lambda change: self._clear_refusal())
 
     def _export_callback(self, fmt: str) -> Any:
         def callback(event: Any) -> None:
-            self._guard(event, self.download_export, event.client, fmt, failure="Not exported")
+            self.guard(event, self.download_export, event.client, fmt, title="Not exported")
 
         return callback
 
-    def _guard(self, event: Any, fn: Any, *args: Any, failure: str = "File not used") -> None:
-        """Run ``fn(*args)``; a refusal shows as an error notification titled ``failure`` that
-        stays until closed."""
-        client = getattr(event, "client", None)
+    def guard(self, event: Any, fn: Callable[..., Any], *args: Any, **options: Any) -> Any:
+        """:meth:`Panel.guard`, and more: the busy line names the file action while it runs
+        (an upload or a bundle takes seconds), and the title ``fn`` returns, when not empty,
+        is told to the tab as a note (what was done, e.g. a plan exported despite its check)."""
         with self._app.busy(f"{fn.__name__.replace('_', ' ')}"):
-            title = guarded(self._app, client, fn, *args, title=failure, action="file action")
+            title = super().guard(event, fn, *args, **options)
         if title:
-            self._app.notify(title, "", client=client, error=False)
+            self._app.notify(title, "", client=client_of(event), error=False)
+        return title
 
     # ---- uploads ---------------------------------------------------------------------------
     def upload_plan(self, name: str, content: bytes) -> str:

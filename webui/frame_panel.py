@@ -28,7 +28,7 @@ from calib.frames import transform_points
 from calib.plan.file import Plan
 from calib.user_frame import MIN_SEPARATION_M, three_point_frame
 from webui import cell_edits
-from webui.guard import guarded
+from webui.panel import Panel
 from webui.scene import pose_kwargs
 
 if TYPE_CHECKING:
@@ -74,15 +74,19 @@ def preview_frame(
     return T
 
 
-class FramePanel:
+class FramePanel(Panel):
     """The "Define frame by 3 points" widgets (in the Cell tab) and their click mode.
 
     Args:
         app: the app whose work-object frame is defined.
     """
 
+    TAB = "Cell"
+    REFUSED = "Frame not changed"
+    ACTION = "3-point frame"
+
     def __init__(self, app: AppContext) -> None:
-        self._app = app
+        super().__init__(app)
         #: The points picked so far, wobj frame (the frame before the new one), m.
         self.picked: list[NDArray[np.float64]] = []
         #: The face normal at the picked origin, wobj frame (``None``: not picked yet).
@@ -90,17 +94,13 @@ class FramePanel:
         #: The preview triad drawn (wobj frame), or ``None``.
         self.triad: NDArray[np.float64] | None = None
         gui = app.server.gui
-        with app.tab("Cell"):
+        with app.tab(self.TAB):
             self.start = gui.add_button("Define frame by 3 points")
             self.cancel = gui.add_button("Cancel 3-point frame", visible=False)
             self.status = gui.add_markdown("")
-        self.start.on_click(lambda ev: self._guard(ev, self.begin))
-        self.cancel.on_click(lambda ev: self._guard(ev, self.stop))
+        self.start.on_click(lambda ev: self.guard(ev, self.begin))
+        self.cancel.on_click(lambda ev: self.guard(ev, self.stop))
         app.click_handlers[MODE] = self._on_click
-
-    def _guard(self, event: Any, fn: Any, *args: Any) -> None:
-        client = getattr(event, "client", None)
-        guarded(self._app, client, fn, *args, title="Frame not changed", action="3-point frame")
 
     def begin(self) -> None:
         """Start picking: the next clicks on the part are the origin, +x, the xy-plane."""

@@ -24,12 +24,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.errors import InputError
-from webui.guard import guarded
 from webui.markdown_text import plain
 
 if TYPE_CHECKING:
     from planner.robot.kinematics.chain import KinematicChain
     from webui.context import AppContext
+    from webui.panel import Guard
 
 logger = logging.getLogger(__name__)
 
@@ -103,7 +103,9 @@ class FineJog:
     """The "Fine jog" folder of the Teach tab (shared by all tabs).
 
     Args:
-        app: the app (its GUI and notifications).
+        app: the app (its GUI).
+        guard: the Teach panel's :meth:`webui.panel.Panel.guard` (a refusal told to the tab
+            that acted).
         jog: the teach panel's jog: put the robot at ``q`` (rad), check and show it.
         current: the jogged joint values now, rad.
     """
@@ -111,10 +113,12 @@ class FineJog:
     def __init__(
         self,
         app: AppContext,
+        guard: Guard,
         jog: Callable[[NDArray[np.float64]], Any],
         current: Callable[[], NDArray[np.float64]],
     ) -> None:
         self._app = app
+        self._panel_guard = guard
         self._jog = jog
         self._current = current
         self._sync = threading.local()
@@ -143,11 +147,11 @@ class FineJog:
         finally:
             self._sync.on = False
 
-    def _guard(self, event: Any, fn: Callable[..., Any], *args: Any) -> Any:
-        # a refusal also beside the fields; its notification closes by itself
-        client = getattr(event, "client", None)
-        return guarded(self._app, client, fn, *args, title="Not moved", action="fine jog",
-                       refusal_is_error=False, on_refusal=self._note)  # fmt: skip
+    def _try(self, event: Any, fn: Callable[..., Any], *args: Any) -> Any:
+        """The Teach panel's rule, and more: a refusal is also shown beside the fields (a typed
+        value out of range stays explained there), and its notification closes by itself."""
+        return self._panel_guard(event, fn, *args, title="Not moved", refusal_is_error=False,
+                                 on_refusal=self._note)  # fmt: skip
 
     def _note(self, text: str) -> None:
         content = "" if not text else f"<span style='color:orange'>{plain(text)}</span>"
@@ -201,13 +205,13 @@ class FineJog:
         if getattr(self._sync, "on", False):
             return
         value = float(self.fields[i].value)
-        if self._guard(event, self.set_joint, i, value) is None:
+        if self._try(event, self.set_joint, i, value) is None:
             self.show(self._current())  # refused: the field shows where the joint is
 
     def _on_button(self, event: Any) -> None:
         i = list(self.joint.options).index(str(self.joint.value))
         sign = -1.0 if str(event.target.value) == MINUS else 1.0
-        self._guard(event, self.step_joint, i, sign * self.step_deg)
+        self._try(event, self.step_joint, i, sign * self.step_deg)
 
     def set_joint(self, index: int, value_deg: float) -> Any:
         """Jog joint ``index`` (0-based) to ``value_deg`` (deg), the others unchanged.

@@ -24,15 +24,17 @@ import math
 import threading
 import time
 from concurrent.futures import Future
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from calib.errors import InputError, PlanError
+from calib.procedures import DESIGNED, PROCEDURES
 from planner.check.job import plan_detectability, plan_quality
 from planner.sim.quality import DOF_NAMES, LayoutQuality, error_radius
 from webui.doc_memo import DocMemo
 from webui.markdown_text import plain
+from webui.panel import Panel
 from webui.plan_adapter import plan_from_ui, ui_plan_from_plan
 from webui.scene import heat_rgb
 from webui.worker import CellWorker
@@ -76,9 +78,10 @@ def quality_markdown(q: LayoutQuality | None, note: str = "") -> str:
     return "\n".join(lines)
 
 
-#: The "Procedure" choices: the plan's own, or another the suggestion switches to.
+#: The "Procedure" choices: the plan's own, or another the suggestion switches to (every
+#: procedure whose registry entry has a layout design, by its label).
 KEEP = "keep the plan's"
-PROCEDURE_CHOICES = {KEEP: "", "best fit": "best_fit", "3-2-1": "three_two_one"}
+PROCEDURE_CHOICES = {KEEP: "", **{PROCEDURES[m].label: m for m in DESIGNED}}
 OBJECTIVE_CHOICES = {"accuracy": "accuracy", "least cycle time": "time"}
 
 
@@ -143,15 +146,19 @@ def redundancy_markdown(doc: UiPlan) -> str:
     return "**Redundancy:** " + d.message(how=how).replace("|", "/")
 
 
-class LayoutPanel:
+class LayoutPanel(Panel):
     """Live layout quality and the Suggest buttons, shared by all tabs.
 
     Args:
         app: the app whose plan is rated.
     """
 
+    TAB = "Layout"
+    REFUSED = "Not suggested"
+    ACTION = "suggest"
+
     def __init__(self, app: AppContext) -> None:
-        self._app = app
+        super().__init__(app)
         self._worker: CellWorker[None] = CellWorker(None, name="wobjcal-layout")
         self._generation = 0
         self._lock = threading.Lock()
@@ -165,7 +172,7 @@ class LayoutPanel:
         self._memo_view: object = None
         self._painted = False
         gui = app.server.gui
-        with app.tab("Layout"):
+        with app.tab(self.TAB):
             self.quality_md = gui.add_markdown("")
             self.show_map = gui.add_checkbox("Show predicted error on part", False)
             self.target = gui.add_number("Target (mm)", 0.3, min=0.001, max=100.0, step=0.01)
@@ -185,9 +192,9 @@ class LayoutPanel:
         #: the suggestion shown and not yet accepted, and its label for the undo step
         self.pending: SuggestResult | None = None
         self._pending_for: UiPlan | None = None
-        self.suggest_button.on_click(lambda e: self._on_suggest(e, add=0))
-        self.add_button.on_click(lambda e: self._on_suggest(e, add=1))
-        self.accept_button.on_click(lambda e: self._on_accept(e))
+        self.suggest_button.on_click(lambda e: self.guard(e, self.suggest, 0))
+        self.add_button.on_click(lambda e: self.guard(e, self.suggest, 1))
+        self.accept_button.on_click(lambda e: self.guard(e, self.accept, title="Not applied"))
         self.discard_button.on_click(lambda _e: self.discard())
         self.show_map.on_update(lambda _e: self._paint())
         app.state.subscribe(self._on_change)
@@ -270,13 +277,6 @@ class LayoutPanel:
             )
 
     # ---- suggest ---------------------------------------------------------------------------
-    def _on_suggest(self, event: Any, add: int) -> None:
-        client = getattr(event, "client", None)
-        try:
-            self.suggest(add=add)
-        except InputError as exc:
-            self._app.notify("Not suggested", str(exc), client=client)
-
     def suggest(self, add: int = 0) -> Future[SuggestResult]:
         """Suggest a layout (``add``: keep the points, add this many) in the cell's worker,
         for the procedure and objective picked in the panel; the returned future completes once
@@ -287,7 +287,7 @@ class LayoutPanel:
                 procedure (the default) is one Suggest cannot design (A-H): pick another.
         """
         from planner.check.job import check_plan
-        from planner.suggest import PROCEDURES, suggest_plan
+        from planner.suggest import DEFAULT_PROCEDURE, grown_procedures, suggest_plan
 
         made_for = self._app.state.doc  # a suggestion is for this plan only
         plan = plan_from_ui(made_for)
@@ -295,9 +295,9 @@ class LayoutPanel:
             raise InputError("a suggestion is already running")
         procedure = PROCEDURE_CHOICES.get(str(self.procedure.value), "") or plan.method
         objective = OBJECTIVE_CHOICES.get(str(self.objective.value), "accuracy")
-        if add:
-            procedure = "best_fit"  # added points: a best fit of all (the message says so)
-        elif procedure not in PROCEDURES:
+        if add:  # added points: a best fit of all (the message says so), as wobjcal suggest
+            procedure = DEFAULT_PROCEDURE
+        elif procedure not in DESIGNED:
             raise InputError(
                 f"the plan's procedure is {plan.method}, whose points Suggest cannot design: "
                 "pick best fit or 3-2-1 under Suggested procedure to suggest one instead (the "
@@ -305,7 +305,7 @@ class LayoutPanel:
             )
         if add:
             objective = "accuracy"
-        if objective == "time" and procedure != "best_fit":
+        if objective == "time" and procedure not in grown_procedures():
             raise InputError(
                 "the least cycle time is designed for a best fit: pick best fit under "
                 "Suggested procedure, or accuracy under Objective"
@@ -360,6 +360,7 @@ class LayoutPanel:
         self.progress.visible = False
         self.suggest_button.disabled = self.add_button.disabled = False
         self._suggesting.clear()  # before the future completes: its caller may suggest again
+        # the run's outcome, failure included, is every tab's: the suggestion is shown to all
         try:
             before, res = fut.result()
         except Exception as exc:  # the message names the faces tried and why
@@ -382,12 +383,6 @@ class LayoutPanel:
         title = "Layout suggested: accept or discard it" if res.met else "Best layout found"
         self._app.notify(title, res.message, error=not res.met)
         done.set_result(res)
-
-    def _on_accept(self, event: Any) -> None:
-        try:
-            self.accept()
-        except InputError as exc:
-            self._app.notify("Not applied", str(exc), client=getattr(event, "client", None))
 
     def accept(self) -> None:
         """Replace the plan's points with the suggestion shown (one undo step).

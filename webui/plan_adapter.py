@@ -18,7 +18,7 @@ import msgspec
 from calib.errors import WobjcalError
 from calib.plan.file import Plan, PlanError, PlanPoint, load_plan, plan_from_json, plan_to_json
 from calib.plan.json_io import canonical_json
-from calib.procedures import PROCEDURES, RolePoint, method_of, procedure_kind
+from calib.procedures import RolePoint, method_of, procedure_kind
 from webui.plan_doc import (
     NO_ROLE,
     UiPlan,
@@ -143,11 +143,9 @@ def with_procedure(ui: UiPlan, method: str) -> UiPlan:
     """
     if not isinstance(ui.source, Plan):
         raise PlanError("no plan is loaded: load a plan or the demo first")
-    if method not in PROCEDURES:
-        raise PlanError(f"procedure: must be one of {list(PROCEDURES)}, got {method!r}")
+    kind = procedure_kind(method)
     if method == ui.method:
         return ui
-    kind = PROCEDURES[method]
     source = msgspec.structs.replace(ui.source, points=[], procedure=kind.settings_type())
     empty = with_source(dataclasses.replace(ui, points=()), source)
     kept = dataclasses.replace(empty, points=ui.points)

@@ -12,9 +12,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from calib.errors import InputError
 from calib.procedures import PROCEDURES
 from webui import heatmap, plan_doc
-from webui.guard import guarded
+from webui.panel import Panel
 from webui.plan_adapter import with_procedure
 from webui.plan_doc import PAPER_IDS
 from webui.scene import legend_html
@@ -29,21 +30,25 @@ logger = logging.getLogger(__name__)
 NEXT = "next"
 
 
-class PointsPanel:
+class PointsPanel(Panel):
     """GUI widgets for placing and inspecting points and editing the plan (shared by all tabs;
-    each tab's selection and its settings are :mod:`webui.tab_selection`'s).
+    each tab's selection and its settings are :mod:`webui.tab_selection`'s, guarded by this
+    panel's :meth:`guard`).
 
     Args:
         app: the app whose plan the panel edits.
     """
 
+    TAB = "Points"
+    ACTION = "points"
+
     def __init__(self, app: AppContext) -> None:
-        self._app = app
+        super().__init__(app)
         self._syncing = threading.local()
         gui = app.server.gui
         self._gizmo: Any = None
         self._gizmo_for: tuple[str, tuple[float, ...]] | None = None
-        with app.tab("Points"):
+        with app.tab(self.TAB):
             self.procedure = gui.add_dropdown(
                 "Procedure",
                 tuple(PROCEDURES),
@@ -78,8 +83,8 @@ class PointsPanel:
                 legend_html(heatmap.CATEGORY_MEANING, heatmap.CATEGORY_RGB), visible=False
             )
         self.procedure.on_update(self._on_procedure)
-        self.undo.on_click(lambda ev: self._guard(ev, self._app.state.undo))
-        self.redo.on_click(lambda ev: self._guard(ev, self._app.state.redo))
+        self.undo.on_click(lambda ev: self.guard(ev, self._app.state.undo))
+        self.redo.on_click(lambda ev: self.guard(ev, self._app.state.redo))
         # the keys, through viser's command palette (its hotkeys are ignored while a text or
         # number field has the focus: there Ctrl+Z undoes the typing)
         self.undo_key = gui.add_command(
@@ -88,11 +93,13 @@ class PointsPanel:
         self.redo_key = gui.add_command(
             "Redo", description="redo the edit undone last", hotkey="Z", modifier="cmd/ctrl+shift"
         )
-        self.undo_key.on_trigger(lambda ev: self._guard(ev, self._app.state.undo))
-        self.redo_key.on_trigger(lambda ev: self._guard(ev, self._app.state.redo))
-        self.drag.on_update(lambda ev: self._guard(ev, self._update_gizmo))
-        self.play.on_click(self._on_play)
-        self.robot_to.on_click(lambda ev: self._guard(ev, self._app.robot_to_selected, ev.client))
+        self.undo_key.on_trigger(lambda ev: self.guard(ev, self._app.state.undo))
+        self.redo_key.on_trigger(lambda ev: self.guard(ev, self._app.state.redo))
+        self.drag.on_update(lambda ev: self.guard(ev, self._update_gizmo))
+        self.play.on_click(
+            lambda ev: self.guard(ev, self.play_search, ev.client, title="Nothing to play")
+        )
+        self.robot_to.on_click(lambda ev: self.guard(ev, self._app.robot_to_selected, ev.client))
         self.heat.on_update(self._on_heat)
 
     # ---- helpers ---------------------------------------------------------------------------
@@ -106,10 +113,6 @@ class PointsPanel:
 
     def _is_programmatic(self) -> bool:
         return bool(getattr(self._syncing, "on", False))
-
-    def _guard(self, event: Any, fn: Any, *args: Any) -> Any:
-        """Run ``fn`` (:func:`webui.guard.guarded`: a refusal told to the event's tab)."""
-        return guarded(self._app, getattr(event, "client", None), fn, *args, action="points")
 
     def target_id(self) -> str:
         """The id a click places: the chosen one, or the next free id."""
@@ -195,7 +198,7 @@ class PointsPanel:
         method = str(self.procedure.value)
         if method == self._app.state.doc.method:
             return
-        self._guard(
+        self.guard(
             event,
             self._app.state.update,
             lambda d: with_procedure(d, method),
@@ -231,11 +234,14 @@ class PointsPanel:
         scene.remove_by_name("/wobj/drag_preview")
         if np.linalg.norm(handle - start) < 1e-6:  # dropped where it was picked up
             return
-        self._guard(event, self._app.move_point_to, sel, pos)
+        self.guard(event, self._app.move_point_to, sel, pos)
 
-    def _on_play(self, event: Any) -> None:
-        """Play the search of the point this tab has selected, on this tab's robot."""
-        client = getattr(event, "client", None)
+    def play_search(self, client: Any = None) -> None:
+        """Play the search of the point the tab of ``client`` has selected, on its robot.
+
+        Raises:
+            InputError: no robot, or no search path computed for the selected point (why).
+        """
         cid = None if client is None else client.client_id
         sel = self._app.selection.of(cid)
         check = None if sel is None else self._app.check_of(sel)
@@ -244,8 +250,7 @@ class PointsPanel:
             why = "select a point whose search path was computed" if robot else "no robot loaded"
             if robot and check is not None and check.path_reason:
                 why = f"no sample of its search path passed: {check.path_reason}"
-            self._app.notify("Nothing to play", why, client=client)
-            return
+            raise InputError(why)
         robot.play(check.q_path, client_id=cid)
 
     def _on_heat(self, event: Any) -> None:
@@ -261,4 +266,4 @@ class PointsPanel:
             client=getattr(event, "client", None),
             error=False,
         )
-        self._guard(event, self._app.show_reachability)
+        self.guard(event, self._app.show_reachability)

@@ -23,13 +23,13 @@ import viser
 from calib.errors import InputError
 from calib.frames import transform_points
 from webui import plan_doc
-from webui.guard import guarded
 from webui.plan_doc import NO_ROLE, UiPlan
 from webui.scene import MARKER_RADIUS_M, SELECTED_RGB
 from webui.status_table import details_markdown
 
 if TYPE_CHECKING:
     from webui.context import AppContext
+    from webui.panel import Guard
 
 logger = logging.getLogger(__name__)
 
@@ -55,11 +55,16 @@ class TabSelection:
         app: the app whose plan the tab edits.
         client: the tab.
         folder: the shared GUI container the tab's widgets go in.
+        guard: the Points panel's :meth:`webui.panel.Panel.guard` (a refusal told to the tab
+            that acted: this one, whose widgets these are).
     """
 
-    def __init__(self, app: AppContext, client: viser.ClientHandle, folder: Any) -> None:
+    def __init__(
+        self, app: AppContext, client: viser.ClientHandle, folder: Any, guard: Guard
+    ) -> None:
         self._app = app
         self.client = client
+        self._guard = guard
         #: The tab's selected point, or ``None``.
         self.point_id: str | None = None
         self._syncing = False
@@ -93,17 +98,14 @@ class TabSelection:
             self.apply = gui.add_button("Apply settings")
             self.delete = gui.add_button("Delete point", color="red")
         self.selected.on_update(self._on_selected)
-        self.apply.on_click(lambda ev: self._guard(self.apply_settings))
-        self.delete.on_click(lambda ev: self._guard(self.delete_selected))
+        self.apply.on_click(lambda ev: guard(ev, self.apply_settings))
+        self.delete.on_click(lambda ev: guard(ev, self.delete_selected))
         #: the widgets that describe the selected point (hidden while none is selected)
         self.settings = (
             self.details, self.position_mm, self.normal, self.role, self.kind, self.start_mm,
             self.over_mm, self.edge_dir, self.apply, self.delete,
         )  # fmt: skip
         self._show_fields(False)
-
-    def _guard(self, fn: Any, *args: Any) -> None:
-        guarded(self._app, self.client, fn, *args, action="selection action")
 
     def _show_fields(self, visible: bool) -> None:
         for widget in self.settings:
@@ -114,7 +116,7 @@ class TabSelection:
         if self._syncing:
             return
         value = str(self.selected.value)
-        self._guard(self._app.select, None if value == NONE else value, self.client)
+        self._guard(event, self._app.select, None if value == NONE else value, self.client)
 
     # ---- from the plan ---------------------------------------------------------------------
     def show(self, doc: UiPlan, settings: bool) -> None:
@@ -259,11 +261,13 @@ class Selections:
     Args:
         app: the app.
         folder: the shared GUI container the tabs' selection widgets go in.
+        guard: the Points panel's :meth:`webui.panel.Panel.guard`, which runs the tabs' actions.
     """
 
-    def __init__(self, app: AppContext, folder: Any) -> None:
+    def __init__(self, app: AppContext, folder: Any, guard: Guard) -> None:
         self._app = app
         self._folder = folder
+        self._guard = guard
         self._lock = threading.RLock()
         self._build_lock = threading.Lock()
         self._tabs: dict[int, TabSelection] = {}
@@ -275,7 +279,7 @@ class Selections:
         # viser runs connect handlers on a thread pool, and a GUI container may be entered by
         # one thread at a time: tabs that connect together take turns
         with self._build_lock:
-            tab = TabSelection(self._app, client, self._folder)
+            tab = TabSelection(self._app, client, self._folder, self._guard)
         with self._lock:
             self._tabs[client.client_id] = tab
         return tab

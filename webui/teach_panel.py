@@ -37,9 +37,9 @@ from calib.plan.cell import Pose
 from calib.plan.vias import ViaPoint
 from webui import plan_doc
 from webui.backend import JogStatus
-from webui.guard import guarded
 from webui.joint_jog import FineJog
 from webui.moves_view import ViaView, draw_moves
+from webui.panel import Panel
 from webui.search_room import new_point_overtravel_cap_m
 
 if TYPE_CHECKING:
@@ -54,25 +54,28 @@ BEHIND_M = 0.2
 MIN_START_M = 0.001
 
 
-class TeachPanel:
+class TeachPanel(Panel):
     """Jog sliders, TCP gizmo and teaching (shared by all tabs).
 
     Args:
         app: the app whose robot is jogged.
     """
 
+    TAB = "Teach"
+    ACTION = "teach action"
+
     def __init__(self, app: AppContext) -> None:
-        self._app = app
+        super().__init__(app)
         self._sync = threading.local()
         self.sliders: list[Any] = []
         self._gizmo: Any = None
         self.q: NDArray[np.float64] = np.zeros(0)
         self.last_status: JogStatus | None = None
         gui = app.server.gui
-        with app.tab("Teach"):
+        with app.tab(self.TAB):
             gui.add_markdown("Jog the robot; teach the pose as a point's approach.")
             self.joints = gui.add_folder("Joints (deg)")
-            self.fine = FineJog(app, self.jog, lambda: self.q)
+            self.fine = FineJog(app, self.guard, self.jog, lambda: self.q)
             self.status_md = gui.add_markdown("")
             self.from_point = gui.add_button("Jog to selected point")
             self.drag_tcp = gui.add_checkbox("Drag TCP (IK)", False)
@@ -86,12 +89,12 @@ class TeachPanel:
             )
             self.show_moves = gui.add_checkbox("Show moves between points", False)
             self.moves_md = gui.add_markdown("")
-        self.from_point.on_click(lambda ev: self._guard(ev, self.jog_to_selected, ev.client))
-        self.drag_tcp.on_update(lambda ev: self._guard(ev, self._update_gizmo))
-        self.teach_button.on_click(lambda ev: self._guard(ev, self.teach, str(self.target.value)))
-        self.via_button.on_click(lambda ev: self._guard(ev, self.teach_via, ev.client))
-        self.unvia_button.on_click(lambda ev: self._guard(ev, self.remove_via, ev.client))
-        self.show_moves.on_update(lambda ev: self._guard(ev, self.draw_moves))
+        self.from_point.on_click(lambda ev: self.guard(ev, self.jog_to_selected, ev.client))
+        self.drag_tcp.on_update(lambda ev: self.guard(ev, self._update_gizmo))
+        self.teach_button.on_click(lambda ev: self.guard(ev, self.teach, str(self.target.value)))
+        self.via_button.on_click(lambda ev: self.guard(ev, self.teach_via, ev.client))
+        self.unvia_button.on_click(lambda ev: self.guard(ev, self.remove_via, ev.client))
+        self.show_moves.on_update(lambda ev: self.guard(ev, self.draw_moves))
         self.via_view = ViaView(app)
         app.state.subscribe(lambda _c: self._on_change())
         #: ``{"A->B": problem}`` of the last drawn moves (``""``: clear).
@@ -105,10 +108,6 @@ class TeachPanel:
             yield
         finally:
             self._sync.on = False
-
-    def _guard(self, event: Any, fn: Any, *args: Any) -> Any:
-        client = getattr(event, "client", None)
-        return guarded(self._app, client, fn, *args, action="teach action")
 
     def _tcp(self) -> str:
         source = self._app.state.doc.source
@@ -169,7 +168,7 @@ class TeachPanel:
         if getattr(self._sync, "on", False):
             return
         q = np.radians([float(s.value) for s in self.sliders])
-        self._guard(event, self.jog, q)
+        self.guard(event, self.jog, q)
 
     def jog(self, q: ArrayLike) -> JogStatus:
         """Put the robot at ``q`` (rad): draw it, check limits and clearance, show the status."""
@@ -231,7 +230,7 @@ class TeachPanel:
         if getattr(self._sync, "on", False):
             return
         g = event.target
-        self._guard(event, self.move_tcp, make_transform(matrix_from_quat_wxyz(g.wxyz), g.position))
+        self.guard(event, self.move_tcp, make_transform(matrix_from_quat_wxyz(g.wxyz), g.position))
 
     def move_tcp(self, T_world_tcp: ArrayLike) -> JogStatus | None:
         """Jog so that the TCP is at ``T_world_tcp`` (IK nearest the current joints: the

@@ -30,6 +30,7 @@ from planner.sim.budget import check_run_size, run_size
 from planner.sim.report import ValidationReport
 from planner.validate.job import check_simulatable
 from webui import validation
+from webui.panel import Panel
 from webui.plan_adapter import plan_from_ui
 from webui.worker import CellWorker
 
@@ -44,15 +45,19 @@ REPORT_WIDTH_PX = 640
 REPORT_HEIGHT_PX = 560
 
 
-class ValidatePanel:
+class ValidatePanel(Panel):
     """GUI widgets of the validation, shared by all tabs.
 
     Args:
         app: the app whose plan is validated.
     """
 
+    TAB = "Validate"
+    REFUSED = "Validation not started"
+    ACTION = "validation"
+
     def __init__(self, app: AppContext) -> None:
-        self._app = app
+        super().__init__(app)
         self._worker: CellWorker[None] = CellWorker(None, name="wobjcal-validate")
         self._running = threading.Event()
         self._start_lock = threading.Lock()
@@ -61,7 +66,7 @@ class ValidatePanel:
         #: Why the shown report no longer fits the plan (``""``: it does).
         self.stale = ""
         gui = app.server.gui
-        with app.tab("Validate"):
+        with app.tab(self.TAB):
             self.trials = gui.add_number("Trials", 200, min=10, max=100000, step=10)
             self.button = gui.add_button("Validate plan", color="blue")
             self.progress = gui.add_progress_bar(0.0, visible=False, animated=True)
@@ -78,17 +83,10 @@ class ValidatePanel:
         # the control panel docked on the right, also in a 1100 px window
         self.report_window.float(x=12, y=12, width=REPORT_WIDTH_PX, height=REPORT_HEIGHT_PX)
         self.plots: list[Any] = []
-        self.button.on_click(self._on_click)
+        self.button.on_click(lambda ev: self.guard(ev, self.start, int(self.trials.value)))
         self.show_error.on_update(self._on_show_error)
         self.show_report.on_update(lambda _ev: self._show_window(bool(self.show_report.value)))
         app.state.subscribe(self._on_plan_change)
-
-    def _on_click(self, event: Any) -> None:
-        client = getattr(event, "client", None)
-        try:
-            self.start(int(self.trials.value))
-        except InputError as exc:
-            self._app.notify("Validation not started", str(exc), client=client)
 
     def start(self, trials: int) -> Future[validation.ValidationSummary]:
         """Start a validation of the session plan; return a future of the report.
@@ -137,6 +135,7 @@ class ValidatePanel:
             self._running.clear()
 
     def _show(self, fut: Future[validation.ValidationSummary]) -> None:
+        # the run's outcome, failure included, is every tab's: its report is shown to all
         try:
             summary = fut.result()
         except PlanError as exc:  # refused before any trial ran: the point and why

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -37,6 +36,7 @@ from calib.estimators.observability import require_observable
 from calib.estimators.three_two_one import ThreeTwoOneLayout, ThreeTwoOneResult, three_two_one
 from calib.frames import check_transform
 from calib.probing import Probe, ProbePoint, SearchCommand
+from calib.procedure_run import EstimateUpdate, ProbeStep, ProcedureRun, measured_by_key
 
 FloatArray = NDArray[np.float64]
 #: A motion counts as fixed by a layout when its scaled singular value is above this part of the
@@ -45,54 +45,8 @@ FloatArray = NDArray[np.float64]
 #: apart turning a 100 mm layout, sits at about 0.05).
 FIXED_RCOND = 1e-4
 logger = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class ProbeStep:
-    """One measurement of a procedure.
-
-    Attributes:
-        point_id: id of the probe point.
-        round: pass over the layout the measurement belongs to (0-based).
-        command: the search as commanded, built from the estimate at that moment (base frame).
-        measured_m: ``(3,)`` the measured point, robot base frame, metres.
-    """
-
-    point_id: str
-    round: int
-    command: SearchCommand
-    measured_m: FloatArray
-
-
-@dataclass(frozen=True)
-class ProcedureResult:
-    """Outcome of a calibration procedure.
-
-    Attributes:
-        T_base_wobj: ``(4, 4)`` the final estimate of the work-object frame, base frame.
-        steps: every measurement in the order taken.
-        estimates: ``(K, 4, 4)`` the estimate after each update, in order (the last one is
-            ``T_base_wobj``).
-        fit: the final fit (its residuals and, for a best fit, covariance).
-        point_ids: ids of the layout's points, in layout order.
-    """
-
-    T_base_wobj: FloatArray
-    steps: tuple[ProbeStep, ...]
-    estimates: FloatArray
-    fit: ThreeTwoOneResult | BestFitResult
-    point_ids: tuple[str, ...]
-
-    @property
-    def n_probes(self) -> int:
-        """Number of searches run."""
-        return len(self.steps)
-
-    @property
-    def measured_base(self) -> FloatArray:
-        """``(N, 3)`` the last measurement of each point, in layout order, base frame, metres."""
-        last = {s.point_id: s.measured_m for s in self.steps}
-        return np.array([last[i] for i in self.point_ids])
+#: The name of an update by the smallest motion that puts the points so far on their faces.
+SMALLEST_MOTION = "smallest motion onto the faces measured so far"
 
 
 def probe_point(
@@ -211,7 +165,7 @@ def run_three_two_one(
     *,
     rounds: int = 1,
     edge_offset_m: float = 0.0,
-) -> ProcedureResult:
+) -> ProcedureRun:
     """Run a 3-2-1 alignment step by step.
 
     Round by round: probe the three primary points in the current estimate and fix the primary
@@ -236,7 +190,7 @@ def run_three_two_one(
     all_cs = constraint_set(layout.points, "3-2-1 layout")
     groups = (layout.primary, layout.primary + layout.secondary)
     steps: list[ProbeStep] = []
-    estimates: list[FloatArray] = []
+    updates: list[EstimateUpdate] = []
     fit: ThreeTwoOneResult | None = None
     for rnd in range(rounds):
         done: list[ProbeStep] = []
@@ -245,16 +199,16 @@ def run_three_two_one(
             cs = constraint_set(group)
             q = np.array([corrected_point(s, edge_offset_m) for s in done])
             T = min_norm_update(cs, q, T, all_cs.centroid_m, all_cs.scale_m)
-            estimates.append(T)
+            updates.append(EstimateUpdate(T, SMALLEST_MOTION, _ids(done)))
         done.append(probe_point(probe, layout.tertiary[0], T, rnd))
         q = np.array([corrected_point(s, edge_offset_m) for s in done])
         fit = three_two_one(layout, q, T_base_wobj_guess=T)
         T = fit.T_base_wobj
-        estimates.append(T)
+        updates.append(EstimateUpdate(T, "3-2-1", _ids(done)))
         steps += done
         logger.info("3-2-1 round %d done", rnd)
     assert fit is not None  # rounds >= 1 is checked above
-    return ProcedureResult(T, tuple(steps), np.array(estimates), fit, all_cs.point_ids)
+    return _run(T, all_cs.point_ids, steps, updates, fit)
 
 
 def run_best_fit(
@@ -267,7 +221,7 @@ def run_best_fit(
     sigma_m: float | None = None,
     edge_offset_m: float = 0.0,
     edge_rows: Literal["both", "edge"] = "both",
-) -> ProcedureResult:
+) -> ProcedureRun:
     """Probe all points, fit, and re-probe in the new estimate, for ``rounds`` passes.
 
     Args:
@@ -294,7 +248,7 @@ def run_best_fit(
     require_observable(cs)
     pts = tuple(points)
     steps: list[ProbeStep] = []
-    estimates: list[FloatArray] = []
+    updates: list[EstimateUpdate] = []
     fit: BestFitResult | None = None
     for rnd in range(rounds):
         done: list[ProbeStep] = []
@@ -304,15 +258,32 @@ def run_best_fit(
                 sub = leading_points(cs, k + 1)
                 q = np.array([corrected_point(s, edge_offset_m) for s in done])
                 T = min_norm_update(sub, q, T, cs.centroid_m, cs.scale_m)
-                estimates.append(T)
+                updates.append(EstimateUpdate(T, SMALLEST_MOTION, _ids(done)))
         q = np.array([corrected_point(s, edge_offset_m) for s in done])
         fit = best_fit(cs, q, T, sigma_m=sigma_m)
         T = fit.T_base_wobj
-        estimates.append(T)
+        updates.append(EstimateUpdate(T, "best fit", _ids(done)))
         steps += done
         logger.info("best-fit round %d: rms %.3g mm", rnd, fit.rms_m * 1e3)
     assert fit is not None  # rounds >= 1 is checked above
-    return ProcedureResult(T, tuple(steps), np.array(estimates), fit, cs.point_ids)
+    return _run(T, cs.point_ids, steps, updates, fit)
+
+
+def _ids(steps: Sequence[ProbeStep]) -> tuple[str, ...]:
+    return tuple(s.point_id for s in steps)
+
+
+def _run(
+    T: FloatArray,
+    used_ids: Sequence[str],
+    steps: Sequence[ProbeStep],
+    updates: Sequence[EstimateUpdate],
+    fit: ThreeTwoOneResult | BestFitResult,
+) -> ProcedureRun:
+    """The run of a step runner: every measurement keyed ``"<id>"``, ``"<id>#<k>"``."""
+    return ProcedureRun(
+        T, tuple(used_ids), measured_by_key(steps), tuple(steps), tuple(updates), fit
+    )
 
 
 def _check_rounds(rounds: int) -> None:

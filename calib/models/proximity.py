@@ -189,10 +189,14 @@ class ProximitySensor(Strict, frozen=True, kw_only=True, tag="proximity", tag_fi
         and the switching travel is ``lambda ln(on_level / S(0))`` exactly; ``inf`` when no ray
         meets metal.
         """
-        s0 = float(self.signal(distances_m))
-        if s0 <= 0.0:
+        return self.travel_to_switch_m(float(self.signal(distances_m)), jitter_m)
+
+    def travel_to_switch_m(self, signal: float, jitter_m: float = 0.0) -> float:
+        """:meth:`switch_travel_m` from the signal at the start, ``signal`` (m; ``inf`` for a
+        signal of 0: no metal), for callers that have the signals of many searches at once."""
+        if signal <= 0.0:
             return math.inf
-        return self.decay_length_m * math.log(self.on_level(jitter_m) / s0)
+        return self.decay_length_m * math.log(self.on_level(jitter_m) / signal)
 
     def coverage_shift_m(self, covered_fraction: float) -> float:
         """How much closer the switch happens over a flat face covering ``covered_fraction``, m.

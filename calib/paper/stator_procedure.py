@@ -32,7 +32,7 @@ the face by ``d`` would tilt the final WOCS by about ``d / |F - D|``.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -44,7 +44,6 @@ from calib.paper.hultman import (  # the unchecked kernels: inputs are checked h
     _rotation_from_points,
     _rotation_from_vectors,
     _shift_origin,
-    alpha1_from_points,
     p3_estimate,
 )
 from calib.paper.settings import Hultman2013
@@ -56,11 +55,10 @@ from calib.paper.stator_layout import (
     relabel_point,
 )
 from calib.probing import Probe, ProbePoint, ProbeResult, SearchCommand
+from calib.procedure_run import EstimateUpdate, ProbeStep, ProcedureRun
 
 __all__ = [
     "STATOR_POINT_IDS",
-    "ProcedureResult",
-    "ProcedureStep",
     "StatorLayout",
     "check_stator_points",
     "example_stator_points",
@@ -69,47 +67,6 @@ __all__ = [
 ]
 
 FloatArray = NDArray[np.float64]
-
-
-@dataclass(frozen=True)
-class ProcedureStep:
-    """One update of the WOCS estimate.
-
-    Attributes:
-        name: what the step does, e.g. ``"x origin from B (P4)"``.
-        point_ids: measurement keys the step uses, e.g. ``("A", "B")``.
-        equations: the paper's equations applied, e.g. ``"eq. 10"``.
-        T_base_wobj: ``(4, 4)`` the estimate after the step, base frame, metres.
-    """
-
-    name: str
-    point_ids: tuple[str, ...]
-    equations: str
-    T_base_wobj: FloatArray
-
-
-@dataclass(frozen=True)
-class ProcedureResult:
-    """The outcome of a complete A-H procedure.
-
-    Attributes:
-        T_base_wobj: ``(4, 4)`` the calibrated work-object frame.
-        steps: the estimate after each step, in order (the first is the preliminary frame).
-        measured_m: measured point per key (``"A"`` ... ``"H"``, retakes ``"C2"``, ``"D2"``),
-            each ``(3,)``, base frame, metres.
-        commands: the search command sent for each key, base frame.
-        n_probes: number of probe calls.
-        alpha1_rad: alpha1 of eq. 11, radians.
-        p3_m: ``(3,)`` the constructed P3 of eq. 12, base frame, metres.
-    """
-
-    T_base_wobj: FloatArray
-    steps: tuple[ProcedureStep, ...]
-    measured_m: Mapping[str, FloatArray]
-    commands: Mapping[str, SearchCommand]
-    n_probes: int
-    alpha1_rad: float
-    p3_m: FloatArray = field(repr=False)
 
 
 def probe_from_measurements(measured_m: Mapping[str, ArrayLike]) -> Probe:
@@ -138,7 +95,8 @@ class _Run:
         self.probe = probe
         self.measured: dict[str, FloatArray] = {}
         self.commands: dict[str, SearchCommand] = {}
-        self.steps: list[ProcedureStep] = [ProcedureStep("preliminary WOCS", (), "", T)]
+        self.probes: list[ProbeStep] = []
+        self.updates: list[EstimateUpdate] = []
 
     def measure(
         self, point_id: str, key: str | None = None, start_m: FloatArray | None = None
@@ -163,11 +121,13 @@ class _Run:
             raise ProbeFailedError(key, result.reason or "the probe gave no reason")
         p = check_vector3(result.point_m, f"probe result for point {key}")
         self.measured[key] = p
+        own_id = self.layout.points[point_id].id  # the point's own (plan) id
+        self.probes.append(ProbeStep(own_id, int(key != point_id), command, p))
         return p
 
     def step(self, T: FloatArray, name: str, ids: tuple[str, ...], equations: str) -> None:
         self.T = T
-        self.steps.append(ProcedureStep(name, ids, equations, T))
+        self.updates.append(EstimateUpdate(T, name, ids, equations))
 
     def origin(self, axis: int, key: str, name: str, point: FloatArray | None = None) -> None:
         face = self.layout.face_coords_wobj[axis]
@@ -186,7 +146,7 @@ def run_stator_procedure(
     T_base_wobj_prelim: ArrayLike,
     probe: Probe | Callable[[SearchCommand], ProbeResult],
     settings: Hultman2013 | None = None,
-) -> ProcedureResult:
+) -> ProcedureRun:
     """Run the paper's A-H procedure (section 3.2) with ``probe`` and return the calibrated WOCS.
 
     Args:
@@ -199,7 +159,9 @@ def run_stator_procedure(
             paper's values by default.
 
     Returns:
-        The final frame, the estimate after every step, all measured points and commands.
+        The final frame, the points' own ids in A-H order (``used_ids``), every measurement
+        by measurement key (``"A"`` ... ``"H"``, the retakes ``"C2"``, ``"D2"``: ``measured_m``
+        and the commands), the estimate after every step and the constructed ``"P3"`` (eq. 12).
 
     Raises:
         ProbeFailedError: a probe returned no point (``point_id`` is the measurement key).
@@ -214,7 +176,6 @@ def run_stator_procedure(
     run = _Run(layout, T0, probe)
 
     a, b = run.measure("A"), run.measure("B")
-    alpha1 = alpha1_from_points(a, b)
     p3 = p3_estimate(a, b, cfg.beta1_rad, cfg.p3_height_m)
     R1 = _rotation_from_points(a, b, p3, False, ("A", "B", "P3"))
     run.rotate(R1, "preliminary rotation from A, B, P3", ("A", "B"), "eq. 1-9, 11-12")
@@ -253,12 +214,11 @@ def run_stator_procedure(
 
     if not np.all(np.isfinite(run.T)):  # cannot happen after the checks above; never silent
         raise DegenerateGeometryError("the A-H procedure produced a non-finite frame")
-    return ProcedureResult(
+    return ProcedureRun(
         T_base_wobj=run.T,
-        steps=tuple(run.steps),
+        used_ids=tuple(layout.points[r].id for r in STATOR_POINT_IDS),
         measured_m=run.measured,
-        commands=run.commands,
-        n_probes=len(run.commands),
-        alpha1_rad=alpha1,
-        p3_m=p3,
+        probes=tuple(run.probes),
+        updates=tuple(run.updates),
+        constructed_m={"P3": p3},
     )

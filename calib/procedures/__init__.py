@@ -3,7 +3,8 @@
 Owns:
     - :mod:`calib.procedures.base`: the :class:`~calib.procedures.base.ProcedureKind` protocol
       (roles, role checks, :meth:`run` with a probe, :meth:`estimate` from measurements, the
-      layout an adaptive robot program needs), :class:`RolePoint`, :class:`ProcedureRun`;
+      layout an adaptive robot program needs), :class:`RolePoint`; what a run returns,
+      :class:`~calib.procedure_run.ProcedureRun`, lives below, in :mod:`calib.procedure_run`;
     - one module per procedure, with its settings struct (the plan's ``procedure`` object) and
       its implementation: ``hultman2013`` (the paper's A-H), ``three_two_one``, ``best_fit``,
       ``iterative`` (the iterative best fit: measure all, fit, re-command all, until it
@@ -15,8 +16,14 @@ Also: :mod:`calib.procedures.comparison` (the best fit of a procedure's own meas
 as the procedure is fed) and :mod:`calib.procedures.linearize` (the predicted covariance of any
 procedure, from its own run against the ideal part).
 
-Every caller (the plan file, ``wobjcal calibrate``, the validation, the exporters, the UI)
-looks a procedure up here; none tests the method's name. Adding a procedure is one module
+Every caller (the plan file, ``wobjcal calibrate``, the validation, the exporters, suggest,
+the UI) looks a procedure up here; none tests the method's name. What differs between
+procedures outside their own module is a field of the entry: ``design``
+(:class:`~calib.procedures.base.LayoutDesign`: how ``wobjcal suggest`` designs its layouts;
+:data:`DESIGNED` lists those that have one), ``steering``
+(:class:`~calib.procedures.base.Steering`: after which points an adaptive program updates its
+frame) and ``published`` (the half-widths the validation shows beside a built-in part: the
+paper's Table 1 for A-H). Adding a procedure is one module
 (a settings struct tagged ``method="<name>"`` and a class following the protocol) plus its entry
 in :data:`PROCEDURES` and in the :data:`ProcedureSettings` union, as the iterative best fit went
 in::
@@ -31,7 +38,7 @@ from __future__ import annotations
 
 from calib.errors import PlanError
 from calib.paper.settings import Hultman2013
-from calib.procedures.base import ProcedureKind, ProcedureRun, RolePoint
+from calib.procedures.base import LayoutDesign, ProcedureKind, ProcedureRun, RolePoint, Steering
 from calib.procedures.best_fit import BEST_FIT, BestFit
 from calib.procedures.hultman2013 import HULTMAN2013
 from calib.procedures.iterative import ITERATIVE, Iterative
@@ -46,17 +53,27 @@ PROCEDURES: dict[str, ProcedureKind] = {
 ProcedureSettings = Hultman2013 | ThreeTwoOne | BestFit | Iterative
 #: The method names.
 METHODS = tuple(PROCEDURES)
+#: The procedures whose layouts ``wobjcal suggest`` designs (a
+#: :class:`~calib.procedures.base.LayoutDesign` in their entry), in the registry's order.
+DESIGNED = tuple(m for m, kind in PROCEDURES.items() if kind.design is not None)
+#: Of those, the ones whose layout grows point by point (``--add``, ``--objective time``); the
+#: first (the best fit) is what suggest designs for unless told.
+GROWN = tuple(m for m in DESIGNED if (d := PROCEDURES[m].design) is not None and d.grows)
 
 __all__ = [
+    "DESIGNED",
+    "GROWN",
     "METHODS",
     "PROCEDURES",
     "BestFit",
     "Hultman2013",
     "Iterative",
+    "LayoutDesign",
     "ProcedureKind",
     "ProcedureRun",
     "ProcedureSettings",
     "RolePoint",
+    "Steering",
     "ThreeTwoOne",
     "method_of",
     "procedure_kind",

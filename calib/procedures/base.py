@@ -9,10 +9,11 @@ measures as the procedure commands) or from measurements already taken
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
@@ -20,6 +21,7 @@ from numpy.typing import NDArray
 
 from calib.errors import PlanError
 from calib.probing import Probe, ProbePoint
+from calib.procedure_run import ProcedureRun
 
 if TYPE_CHECKING:
     from calib.paper.stator_layout import StatorLayout
@@ -42,20 +44,71 @@ class RolePoint:
 
 
 @dataclass(frozen=True)
-class ProcedureRun:
-    """The frame a procedure computed, and from which points.
+class LayoutDesign:
+    """How ``wobjcal suggest`` designs a layout for a procedure (:mod:`planner.suggest`): what
+    differs between procedures there, so suggest reads it from the registry and tests no name.
 
     Attributes:
-        T_base_wobj: ``(4, 4)`` the calibrated work object in the robot base frame, metres.
-        used_ids: the plan point ids the frame was computed from, in procedure order.
-        measured_m: ``{key: (3,)}`` every measurement the procedure took or used, base frame,
-            metres; the key is the point id, or ``"<id>#2"`` for a second measurement of a
-            point (the A-H procedure's retakes of C and D).
+        role: the role of every point of a *grown* design (``face_roles`` empty): any number
+            of points from 6 up, added until the target holds (best fit: ``"fit"``); such a
+            procedure also takes ``--add`` (more points to a plan) and ``--objective time``.
+        face_roles: ``((role, n), ...)``: a *face* design instead, exactly ``n`` points of
+            each role, the points of one role on one planar face, the faces pairwise far from
+            parallel, the roles in measuring order (3-2-1: primary 3, secondary 2, tertiary 1).
+            The counts differ from each other, so a face's count names its role.
     """
 
-    T_base_wobj: FloatArray
-    used_ids: tuple[str, ...]
-    measured_m: Mapping[str, FloatArray] = field(default_factory=dict)
+    role: str = ""
+    face_roles: tuple[tuple[str, int], ...] = ()
+
+    def __post_init__(self) -> None:
+        counts = [n for _, n in self.face_roles]
+        if self.face_roles and (len(set(counts)) != len(counts) or min(counts) < 1):
+            raise ValueError(f"face_roles: distinct counts >= 1, got {self.face_roles}")
+        if not self.face_roles and not self.role:
+            raise ValueError("a grown design needs the role of its points")
+
+    @property
+    def grows(self) -> bool:
+        """True: any number of points, grown until the target holds (``role`` each)."""
+        return not self.face_roles
+
+    @property
+    def n_points(self) -> int | None:
+        """The points of a face design, ``None`` for a grown one."""
+        return sum(n for _, n in self.face_roles) if self.face_roles else None
+
+    def roles_of(self, face_counts: Sequence[int]) -> list[str]:
+        """The role of each point of a design, from how many of the design's points lie on
+        that point's face (a face design), or ``role`` (a grown one)."""
+        if self.grows:
+            return [self.role] * len(face_counts)
+        by_count = {n: r for r, n in self.face_roles}
+        return [by_count[n] for n in face_counts]
+
+
+@dataclass(frozen=True)
+class Steering:
+    """How a program that steers a procedure search by search updates its frame
+    (:mod:`planner.program.steering`: the smallest motion that puts the points measured so far
+    on their nominal faces, the later searches commanded in that estimate).
+
+    Attributes:
+        group_sizes: how many points each update adds, in measuring order (3-2-1: ``(3, 2,
+            1)``, after the primary, secondary and tertiary points); ``()``: an update after
+            every point (the progressive best fit).
+    """
+
+    group_sizes: tuple[int, ...] = ()
+
+    def update_counts(self, n_points: int) -> tuple[int, ...]:
+        """How many of the first points each update fits, for ``n_points`` in measuring order
+        (``()``: a layout of another size, which this steering does not update)."""
+        if not self.group_sizes:
+            return tuple(range(1, n_points + 1))
+        if n_points != sum(self.group_sizes):
+            return ()
+        return tuple(itertools.accumulate(self.group_sizes))
 
 
 #: ``{point id: (k, 3)}`` the measurements of each point in order (retakes after the first),
@@ -77,6 +130,16 @@ class ProcedureKind(Protocol):
         label: the procedure's short name for humans, e.g. ``"best fit"``, ``"A-H"`` (a
             measuring program is named after it: "RAPID, adaptive A-H").
         summary: one line for humans.
+        design: how ``wobjcal suggest`` designs its layouts; ``None``: suggest does not
+            (the A-H layout follows the stator's geometry, section 3.2 of the paper).
+        steering: how a program that steers it search by search updates its frame (a
+            controller that runs it adaptively, :attr:`planner.program.controllers.Controller.
+            adaptive_methods`); ``None``: no such program (it runs in the nominal frame, or
+            adapts by its own layout, :meth:`adaptive_layout`).
+        published: the published half-widths of this procedure on the part it was published
+            for, display units, by ``(report row key, confidence percent)`` (the paper's Table
+            1 for A-H), shown beside a validation of a built-in part with exact geometry;
+            ``None``: none.
     """
 
     method: str
@@ -85,6 +148,9 @@ class ProcedureKind(Protocol):
     role_limits: Mapping[str, int | None]
     label: str
     summary: str
+    design: LayoutDesign | None
+    steering: Steering | None
+    published: Mapping[tuple[str, float], float] | None
 
     def role_problem(self, roles: Sequence[str], complete: bool) -> str:
         """What is wrong with the points' roles (``""`` when fine); ``complete``: also require

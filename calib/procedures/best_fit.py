@@ -20,9 +20,11 @@ from calib.paper.stator_layout import StatorLayout
 from calib.probing import Probe
 from calib.procedures.base import (
     FloatArray,
+    LayoutDesign,
     Measured,
     ProcedureRun,
     RolePoint,
+    Steering,
     check_edge_offset,
     edge_corrected,
     edge_offset_of,
@@ -76,6 +78,11 @@ class BestFitProcedure:
     role_limits: Mapping[str, int | None] = MappingProxyType({ROLE: None})
     label = "best fit"
     summary = "least-squares fit of every point to its face"
+    #: suggest grows the layout point by point until the target holds
+    design: LayoutDesign | None = LayoutDesign(role=ROLE)
+    #: an adaptive program updates after every point (the progressive best fit)
+    steering: Steering | None = Steering()
+    published: Mapping[tuple[str, float], float] | None = None
     #: Its linearised covariance is the least-squares one of its searches, ``(A^T W A)^-1``,
     #: for approach searches without a shared TCP error (a test checks it against the
     #: linearisation): the UI's live layout quality takes that fast path.
@@ -109,15 +116,13 @@ class BestFitProcedure:
         face is the command's), with the sensor's edge-event offset removed.
         """
         pts = [rp.point for rp in self.assign(points)]
-        res = run_best_fit(
+        return run_best_fit(
             pts,
             probe,
             T_base_wobj_nominal,
             edge_offset_m=edge_offset_of(settings),
             edge_rows="edge",
         )
-        last = {s.point_id: s.measured_m for s in res.steps}
-        return ProcedureRun(res.T_base_wobj, tuple(p.id for p in pts), last)
 
     def estimate(
         self,

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from functools import lru_cache
 from types import MappingProxyType
 
@@ -17,12 +18,15 @@ from calib.errors import PlanError
 from calib.paper.settings import Hultman2013
 from calib.paper.stator_layout import STATOR_POINT_IDS, StatorLayout, check_stator_points
 from calib.paper.stator_procedure import probe_from_measurements, run_stator_procedure
+from calib.paper.table1 import PAPER_TABLE1
 from calib.probing import Probe, ProbePoint
 from calib.procedures.base import (
     FloatArray,
+    LayoutDesign,
     Measured,
     ProcedureRun,
     RolePoint,
+    Steering,
     unknown_role_problem,
 )
 
@@ -50,6 +54,12 @@ class Hultman2013Procedure:
     role_limits: Mapping[str, int | None] = MappingProxyType(dict.fromkeys(ROLES, 1))
     label = "A-H"
     summary = "the paper's A-H procedure: 3 points fix the plane, searches fix the origin"
+    #: no suggested layout: A-H's points follow the stator's geometry (paper, section 3.2)
+    design: LayoutDesign | None = None
+    #: adaptive by its own steps (:meth:`adaptive_layout`), not the progressive update
+    steering: Steering | None = None
+    #: the paper's Table 1, beside a validation of a built-in stator
+    published: Mapping[tuple[str, float], float] | None = PAPER_TABLE1
 
     def role_problem(self, roles: Sequence[str], complete: bool) -> str:
         """See :meth:`ProcedureKind.role_problem`."""
@@ -93,9 +103,9 @@ class Hultman2013Procedure:
     ) -> ProcedureRun:
         """Run A-H step by step (:func:`calib.paper.stator_procedure.run_stator_procedure`)."""
         layout, ids = self._keyed(points)
-        res = run_stator_procedure(layout, T_base_wobj_nominal, probe, _settings(settings))
-        measured = {_key(k, ids): v for k, v in res.measured_m.items()}
-        return ProcedureRun(res.T_base_wobj, tuple(ids[r] for r in ROLES), measured)
+        return _plan_keyed(
+            run_stator_procedure(layout, T_base_wobj_nominal, probe, _settings(settings)), ids
+        )
 
     def estimate(
         self,
@@ -123,11 +133,7 @@ class Hultman2013Procedure:
         res = run_stator_procedure(
             layout, T_base_wobj_nominal, probe_from_measurements(table), _settings(settings)
         )
-        return ProcedureRun(
-            res.T_base_wobj,
-            tuple(ids[r] for r in ROLES),
-            {_key(k, ids): v for k, v in res.measured_m.items()},
-        )
+        return _plan_keyed(res, ids)
 
     def adaptive_layout(self, points: Sequence[RolePoint]) -> StatorLayout | None:
         """The A-H layout (programs run A-H adaptively); ``None`` when a role is missing."""
@@ -151,6 +157,12 @@ def _settings(settings: object) -> Hultman2013:
     if not isinstance(settings, Hultman2013):
         raise PlanError(f"hultman2013 needs Hultman2013 settings, got {type(settings).__name__}")
     return settings
+
+
+def _plan_keyed(run: ProcedureRun, ids: dict[str, str]) -> ProcedureRun:
+    """``run`` of :func:`run_stator_procedure` with its measurements keyed as a plan's
+    (``"C2"`` -> ``"<id>#2"``); the commands keep the keys they were sent under."""
+    return replace(run, measured_m={_key(k, ids): v for k, v in run.measured_m.items()})
 
 
 def _key(key: str, ids: dict[str, str]) -> str:

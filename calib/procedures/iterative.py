@@ -21,15 +21,17 @@ from calib.errors import PlanError, ShapeError
 from calib.estimators.best_fit import BestFitResult, best_fit
 from calib.estimators.layout import constraint_set, search_constraint_set
 from calib.estimators.observability import require_observable
-from calib.estimators.runners import ProbeStep, ProcedureResult, corrected_point, probe_point
+from calib.estimators.runners import corrected_point, probe_point
 from calib.frames import check_transform, motion_between
 from calib.limits import MAX_ROUNDS
 from calib.probing import Probe, ProbePoint
+from calib.procedure_run import EstimateUpdate, ProbeStep, measured_by_key
 from calib.procedures.base import (
     FloatArray,
     Measured,
     ProcedureRun,
     RolePoint,
+    Steering,
     check_edge_offset,
     edge_corrected,
     edge_offset_of,
@@ -83,6 +85,9 @@ class IterativeProcedure(BestFitProcedure):
     settings_type: type = Iterative
     label = "iterative best fit"
     summary = "measure all, fit, re-command every search in the new frame, until it settles"
+    #: the best fit's design (inherited); no search-by-search steering: its rounds re-command
+    #: every search in the last round's fit
+    steering: Steering | None = None
 
     def run(
         self,
@@ -94,7 +99,7 @@ class IterativeProcedure(BestFitProcedure):
         """Round after round until the fit settles; the frame is the last round's fit."""
         cfg = _settings(settings)
         pts = [rp.point for rp in self.assign(points)]
-        res = run_iterative_fit(
+        return run_iterative_fit(
             pts,
             probe,
             T_base_wobj_nominal,
@@ -102,11 +107,6 @@ class IterativeProcedure(BestFitProcedure):
             max_rounds=cfg.max_rounds,
             edge_offset_m=edge_offset_of(cfg),
         )
-        measured: dict[str, FloatArray] = {}
-        for step in res.steps:  # every round's measurement: "<id>", "<id>#2", ...
-            k = sum(1 for key in measured if key.split("#")[0] == step.point_id)
-            measured[step.point_id if k == 0 else f"{step.point_id}#{k + 1}"] = step.measured_m
-        return ProcedureRun(res.T_base_wobj, tuple(p.id for p in pts), measured)
 
     def estimate(
         self,
@@ -135,7 +135,7 @@ def run_iterative_fit(
     max_rounds: int = 5,
     edge_offset_m: float = 0.0,
     sigma_m: float | None = None,
-) -> ProcedureResult:
+) -> ProcedureRun:
     """The iterative best fit: measure every point, fit, re-command every search in the new
     estimate, and repeat until a round's fit moves the frame less than ``tolerance_m``.
 
@@ -173,7 +173,7 @@ def run_iterative_fit(
     require_observable(cs)
     pts = tuple(points)
     steps: list[ProbeStep] = []
-    estimates: list[FloatArray] = []
+    updates: list[EstimateUpdate] = []
     fit: BestFitResult | None = None
     for rnd in range(max_rounds):
         done = [probe_point(probe, p, T, rnd) for p in pts]
@@ -181,14 +181,14 @@ def run_iterative_fit(
         fit = best_fit(cs, q, T, sigma_m=sigma_m)
         moved = motion_between(T, fit.T_base_wobj)
         T = fit.T_base_wobj
-        estimates.append(T)
+        updates.append(EstimateUpdate(T, f"best fit (round {rnd + 1})", cs.point_ids))
         steps += done
         size = max(float(np.linalg.norm(moved[:3])), float(np.linalg.norm(moved[3:])) * cs.scale_m)
         logger.info("iterative fit round %d: moved %.3g mm", rnd, size * 1e3)
         if size < tolerance_m:
             break
     assert fit is not None  # max_rounds >= 1 is checked above
-    return ProcedureResult(T, tuple(steps), np.array(estimates), fit, cs.point_ids)
+    return ProcedureRun(T, cs.point_ids, measured_by_key(steps), tuple(steps), tuple(updates), fit)
 
 
 def _settings(settings: object) -> Iterative:

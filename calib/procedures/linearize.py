@@ -1,16 +1,16 @@
 """Predicted accuracy of any procedure: linearise its run around the ideal measurements.
 
-A procedure turns a sequence of searches into a frame, each search commanded in the estimate
-so far (the A-H procedure's F is commanded in the plane measured through D and E, so F's
-recorded x *is* a function of D's and E's noise). To first order every noise source moves one
-search's event along its direction by a small travel ``eps_j``, and the frame error is
-``delta = G eps`` with ``G = d delta / d eps`` (6 x S). :func:`linearize` finds ``G`` by running
-the procedure itself against :class:`PlaneProbe` (the nominal faces of the part at the true
-pose, every event moved by its ``eps_j``) with central differences, so the step-by-step
-dependencies are in ``G`` exactly as they are in the procedure, and nothing is derived by hand
-per procedure. With the covariance ``C`` of ``eps`` (:func:`event_covariance`: the sensor's own
-noise, the robot's repeatability, a TCP calibration error common to all searches) the predicted
-covariance of the frame is ``G C G^T`` (:meth:`Linearization.covariance`).
+A procedure turns a sequence of searches into a frame, each search commanded in the estimate so far
+(the A-H procedure's F is commanded in the plane measured through D and E, so F's recorded x *is* a
+function of D's and E's noise). To first order every noise source moves one search's event along its
+direction by a small travel ``eps_j``, and the frame error is ``delta = G eps`` with ``G = d delta /
+d eps`` (6 x S). :func:`linearize` finds ``G`` by running the procedure itself against the ideal
+probe (:class:`calib.plane_probe.PlaneProbe`: the nominal faces of the part at the true pose, every
+event moved by its ``eps_j``) with central differences, so the step-by-step dependencies are in
+``G`` exactly as they are in the procedure, and nothing is derived by hand per procedure. With the
+covariance ``C`` of ``eps`` (:func:`event_covariance`: the sensor's own noise, the robot's
+repeatability, a TCP calibration error common to all searches) the predicted covariance of the frame
+is ``G C G^T`` (:meth:`Linearization.covariance`).
 
 For the best fit this reproduces the estimator's own covariance
 (:meth:`calib.estimators.best_fit.BestFitResult.predicted_error` with the same noise); for the
@@ -22,7 +22,7 @@ bulge), the sensor's response to tilted faces, the robot's smooth absolute-accur
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -30,64 +30,13 @@ from numpy.typing import NDArray
 from calib.errors import InputError
 from calib.frames import check_transform
 from calib.models.sensor import SearchNoise, tool_rotation
-from calib.probing import Probe, ProbeResult, SearchCommand
+from calib.plane_probe import PlaneProbe
+from calib.probing import Probe, SearchCommand
 
 FloatArray = NDArray[np.float64]
 
 #: A run of a procedure against a probe: named output vectors (e.g. the frame errors).
 RunFunction = Callable[[Probe], Mapping[str, FloatArray]]
-
-
-@dataclass
-class PlaneProbe:
-    """An ideal probe on the nominal faces of the part posed at ``T_base_wobj_true``.
-
-    Each search ends where its commanded line meets the plane of the face that stops it (the
-    command's ``nominal_m`` and ``stop_normal``, carried from the estimate it was commanded in
-    onto the true part), an edge search ``edge_offset_m`` further (where the sensor reports the
-    edge), and the ``j``-th search's event moves by ``eps[j]`` along its direction.
-
-    An edge search's event also moves with its track's standoff where it crosses the edge
-    (``edge_axis_gain`` metres per metre the track runs closer to the face it slides over than
-    commanded): a track commanded in an estimate whose face plane is off, or tilted, runs
-    closer or farther there.
-
-    Args:
-        T_base_wobj_true: ``(4, 4)`` where the part is, base frame.
-        edge_offset_m: how far past a face's end an edge search reports it, metres.
-        edge_axis_gain: the sensor's axis gain of an edge search
-            (:attr:`calib.models.sensor.SearchNoise.axis_gain`).
-        eps: event travel added to the ``j``-th search, metres.
-    """
-
-    T_base_wobj_true: FloatArray
-    edge_offset_m: float = 0.0
-    edge_axis_gain: float = 0.0
-    eps: Mapping[int, float] = field(default_factory=dict)
-    commands: list[SearchCommand] = field(default_factory=list)
-
-    def __call__(self, cmd: SearchCommand) -> ProbeResult:
-        """The recorded point of one search (base frame)."""
-        j = len(self.commands)
-        self.commands.append(cmd)
-        d = np.asarray(cmd.direction, dtype=np.float64)
-        stop = -d if cmd.stop_normal is None else np.asarray(cmd.stop_normal, dtype=np.float64)
-        T_est = cmd.T_base_wobj_estimate  # the estimate onto the true part: R_move, t_move
-        R_move = self.T_base_wobj_true[:3, :3] @ T_est[:3, :3].T
-        t_move = self.T_base_wobj_true[:3, 3] - R_move @ T_est[:3, 3]
-        p = R_move @ np.asarray(cmd.nominal_m, dtype=np.float64) + t_move
-        m = R_move @ stop
-        denom = float(d @ m)
-        if abs(denom) < 1e-9:
-            return ProbeResult(None, "search runs parallel to the face that should stop it")
-        start = np.asarray(cmd.start_m, dtype=np.float64)
-        t = float((p - start) @ m) / denom
-        if cmd.kind == "edge":  # the track's standoff where it crosses the edge
-            face_n = -(R_move @ np.asarray(cmd.sensor_axis, dtype=np.float64))
-            closer = -float((start + t * d - p) @ face_n)
-            t += self.edge_offset_m + self.edge_axis_gain * closer
-        t += float(self.eps.get(j, 0.0))
-        return ProbeResult(start + t * d, travel_m=t)
 
 
 @dataclass(frozen=True)
@@ -125,7 +74,8 @@ def linearize(
         T_base_wobj_true: ``(4, 4)`` the part's pose the ideal measurements are taken on.
         edge_offset_m: the sensor's edge-event offset (the procedure removes it again).
         step_m: central-difference step of the event travels, metres.
-        edge_axis_gain: the sensor's axis gain of edge searches (see :class:`PlaneProbe`).
+        edge_axis_gain: the sensor's axis gain of edge searches (see
+            :class:`calib.plane_probe.PlaneProbe`).
 
     Raises:
         InputError: the ideal run fails, or a perturbed run takes a different number of

@@ -22,9 +22,11 @@ from calib.paper.stator_layout import StatorLayout
 from calib.probing import Probe, ProbePoint
 from calib.procedures.base import (
     FloatArray,
+    LayoutDesign,
     Measured,
     ProcedureRun,
     RolePoint,
+    Steering,
     check_edge_offset,
     count_problem,
     edge_corrected,
@@ -154,6 +156,11 @@ class ThreeTwoOneProcedure:
     role_limits: Mapping[str, int | None] = MappingProxyType(dict(ROLE_COUNTS))
     label = "3-2-1"
     summary = "3 points on a primary face, 2 on a secondary, 1 on a tertiary"
+    #: suggest puts 3, 2 and 1 points on three faces far from parallel
+    design: LayoutDesign | None = LayoutDesign(face_roles=tuple(ROLE_COUNTS.items()))
+    #: an adaptive program updates after the primary, the secondary and the tertiary points
+    steering: Steering | None = Steering(tuple(ROLE_COUNTS.values()))
+    published: Mapping[tuple[str, float], float] | None = None
     #: Six face constraints, solved exactly: its linearised covariance is the least-squares
     #: one of its searches (a test checks it against the linearisation to 1e-9).
     least_squares = True
@@ -191,11 +198,9 @@ class ThreeTwoOneProcedure:
     ) -> ProcedureRun:
         """Primary, then secondary, then tertiary, each commanded in the estimate so far."""
         layout = self.layout(points)
-        res = run_three_two_one(
+        return run_three_two_one(
             layout, probe, T_base_wobj_nominal, edge_offset_m=edge_offset_of(settings)
         )
-        measured = {s.point_id: s.measured_m for s in res.steps}
-        return ProcedureRun(res.T_base_wobj, tuple(measured), measured)
 
     def estimate(
         self,

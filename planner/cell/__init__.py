@@ -25,6 +25,7 @@ Owns:
       :mod:`~planner.cell.probe_parts`,
       :mod:`~planner.cell.slack_bounds` (bounds that spare Bullet queries) and
       :mod:`~planner.cell.probe_clearance` (Bullet for the parts the broad phase leaves open),
+      :mod:`~planner.cell.path_clearance` (the verdict of a sampled path, broad phase first),
       :mod:`~planner.cell.search_paths` (``check_search``),
       :mod:`~planner.cell.reachability_map`.
 

@@ -32,6 +32,7 @@ from planner.cell.feasibility import (
     singular,
     tcp_frames,
 )
+from planner.cell.path_clearance import first_failure
 from planner.robot.reach import no_ik_reason
 
 if TYPE_CHECKING:
@@ -81,6 +82,7 @@ def check_search(
     max_starts: int = 6,
     sensor_x: ArrayLike | None = None,
     branch: int | None = None,
+    exact_clearance: bool = True,
 ) -> PathFeasibility:
     """Check the search ``command`` in ``cell`` (see the module docstring).
 
@@ -101,6 +103,10 @@ def check_search(
             ``None``: every ``rotation_step_deg``, least motion away from the limits first.
         branch: only start solutions of this IK branch (the probe pose's: the program's
             configuration); ``None`` or ``-1``: any branch.
+        exact_clearance: compute the clearance of every sample (``min_clearance_m``);
+            ``False``: only the verdict, the same ``feasible`` and ``reason`` (the broad
+            phase clears most of each sample's query: :mod:`planner.cell.path_clearance`),
+            ``min_clearance_m`` NaN.
 
     Returns:
         The first start candidate whose whole path passes, else the one that got farthest.
@@ -176,6 +182,7 @@ def check_search(
                 margin,
                 skip_from,
                 float(angles[r]),
+                exact_clearance,
             )
             if res.feasible:
                 return res
@@ -196,6 +203,7 @@ def _walk(
     margin: float,
     skip_from: float,
     rotation: float,
+    exact_clearance: bool = True,
 ) -> PathFeasibility:
     """Follow one start solution along the sampled path (see the module docstring)."""
     sol = cell.solver.solve(T_flange, seeds=q_start[None])
@@ -227,7 +235,13 @@ def _walk(
         if sing.any():
             fail_j, reason = int(np.argmax(sing)), why
     min_cl = math.inf
-    for j in range(fail_j):
+    if not exact_clearance:  # the verdict only: the first sample that fails, broad phase first
+        skip = s[:fail_j] > skip_from
+        j, cl = first_failure(cell, q_path[:fail_j], T_flange[:fail_j], skip, margin)
+        if cl is not None:
+            fail_j, reason = j, cl.describe()
+        min_cl = math.nan
+    for j in range(fail_j if exact_clearance else 0):
         cell.set_joint_positions(q_path[j])
         cl = cell.clearance(margin, sensor_wobj_allowed=True, skip_wobj=s[j] > skip_from)
         min_cl = min(min_cl, cl.clearance_m)

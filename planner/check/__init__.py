@@ -7,9 +7,9 @@ each placement) call it, so it sits below them.
 Owns: the job (:mod:`.job`: :func:`check_plan`, :func:`check_points`, the layout and quality
 verdicts), what it returns (:mod:`.results`), the program's search paths walked in the cell
 (:mod:`.paths`), the cycle time of the checked program (:mod:`.cycle`), via points for colliding
-moves (:mod:`.vias`), the procedure's dry run on the nominal part (:mod:`.dry_run`), and what the
-prediction shares with the validation: whether a plan can be simulated (:mod:`.simulatable`)
-and its simulation setups (:mod:`.simulation_setup`).
+moves (:mod:`.vias`), and what the prediction shares with the validation: whether a plan can be
+simulated (:mod:`.simulatable`) and its simulation setups (:mod:`.simulation_setup`). The
+procedure's dry run on the nominal part uses the one ideal probe, :mod:`calib.plane_probe`.
 """
 
 from typing import TYPE_CHECKING, Any

@@ -51,11 +51,11 @@ from numpy.typing import NDArray
 from calib.errors import InputError, ProbeFailedError
 from calib.frames import invert_transform, transform_points
 from calib.plan.file import Plan, PlanPoint
+from calib.plane_probe import PlaneProbe
 from calib.procedures import procedure_kind
 from calib.procedures.base import edge_offset_of
 from calib.tolerances import FACE_MAX_DEVIATION_M
 from planner.check.cycle import plan_cycle_time
-from planner.check.dry_run import nominal_part_probe
 from planner.check.paths import ProgramPath, check_program_path, measured_starts_wobj
 from planner.check.results import ConfData, PlanCheck, PointCheck, Status
 from planner.plan_cell import nominal_T_base_wobj, open_cell
@@ -360,10 +360,11 @@ def layout_problem(plan: Plan, fmt: str | None = None) -> str:
     """Why the plan's procedure would refuse its points, ``""`` when it would not.
 
     A dry run of the measuring program of the controller ``fmt`` (``None``: the default) on the
-    nominal part with an exact sensor (:func:`planner.check.dry_run.nominal_part_probe`): every
-    search commanded as the program does (nominal or in the frame estimated so far), and
-    answered where it meets the nominal face or edge (an edge search started off the face by
-    ``edge_start_offset_m`` switches that far off it; the sensor's edge-event offset is added).
+    nominal part with an exact sensor (:class:`calib.plane_probe.PlaneProbe`, a search that
+    finds nothing within its length failing as on the robot): every search commanded as the
+    program does (nominal or in the frame estimated so far), and answered where it meets the
+    nominal face or edge (an edge search started off the face by ``edge_start_offset_m``
+    switches that far off it; the sensor's edge-event offset is added).
     It must accept them (roles, faces, observability) and give back the nominal frame: a
     layout that breaks the procedure's assumptions (e.g. A and B of the A-H procedure not at
     one height) shows as the distance, at the worst point, between the two frames; more than
@@ -378,7 +379,7 @@ def layout_problem(plan: Plan, fmt: str | None = None) -> str:
     T = nominal_T_base_wobj(plan)
     try:
         program = measuring_program(plan, fmt)
-        probe = nominal_part_probe(T, edge_offset_of(program.settings))
+        probe = PlaneProbe(T, edge_offset_of(program.settings), within_length=True)
         T_est = execute(program, T, probe).T_base_wobj
     except (InputError, ProbeFailedError) as exc:
         return f"{plan.method}: {exc}"

@@ -24,6 +24,7 @@ from calib.estimators.observability import analyze_layout
 from calib.models import Misplacement, RobotErrorModel
 from calib.plan.file import Plan, PlanError
 from calib.procedures import RolePoint, procedure_kind
+from planner.builtins import builtin_geometry
 from planner.parts.stator import StatorGeometry
 from planner.program.build import safety_spec
 from planner.program.reach import search_problems
@@ -31,7 +32,6 @@ from planner.program.settings import DEFAULT_EDGE_INSET_M, resolved_settings
 from planner.sim.sensors import sensor_kind
 
 __all__ = [
-    "SIMULATED_PARTS",
     "ProgressCallback",
     "ValidationModels",
     "check_simulatable",
@@ -39,12 +39,6 @@ __all__ = [
     "validation_models",
     "work_object_mesh",
 ]
-
-#: Built-in stators -> the ``StatorGeometry`` constructor (their slot holes, bulge, epsilon).
-SIMULATED_PARTS: dict[str, str] = {
-    "builtin:stator_section": "full_section",
-    "builtin:stator_prototype": "prototype",
-}
 
 #: progress(done_trials, total_trials)
 ProgressCallback = Callable[[int, int], None]
@@ -124,8 +118,9 @@ def check_simulatable(plan: Plan) -> ValidationModels:
             f"by its edge coordinate only): {free}"
         )
     geometry = None
-    if plan.work_object.mesh in SIMULATED_PARTS and plan.work_object.mesh_pose is None:
-        geometry = getattr(StatorGeometry, SIMULATED_PARTS[plan.work_object.mesh])()
+    if plan.work_object.mesh_pose is None:  # a built-in's exact geometry, in its own frame
+        exact = builtin_geometry(plan.work_object.mesh)
+        geometry = exact if isinstance(exact, StatorGeometry) else None
     if getattr(plan.procedure, "xoffset", None) is not None and geometry is None:
         raise PlanError(
             "procedure.xoffset: the x-offset run is simulated only on a built-in stator "

@@ -16,8 +16,7 @@ from calib.frames import motion_between, quat_wxyz_from_matrix, tait_bryan_zyx_f
 from calib.procedures import METHODS
 from planner.calibrate.job import CalibrationOutput, calibrate_plan
 from planner.cli.common import print_json, read_plan, stdout
-from planner.export.krl import BASE_NO, frame_text
-from planner.export.rapid import pose_text
+from planner.export import FORMATS
 from planner.results import KINDS, read_results
 
 
@@ -45,8 +44,9 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "hultman2013 replays the paper's A-H procedure with the recorded points; three_two_one\n"
         "uses the plan's 3-2-1 roles (or picks them from the faces); best_fit fits all points.\n"
         "Text output: origin (mm), Tait-Bryan z-y'-x'' angles (deg, paper eq. 7-9 = KUKA A, B,\n"
-        "C), quaternion (w, x, y, z), 1 sigma per degree of freedom, residuals (mm) and the ABB\n"
-        "wobjdata and KUKA BASE_DATA lines to paste. --json prints T_base_wobj (4x4),\n"
+        "C), quaternion (w, x, y, z), 1 sigma per degree of freedom, residuals (mm) and the lines\n"
+        "to paste into each controller (--format: one): ABB RAPID wobjdata, KUKA KRL BASE_DATA,\n"
+        "a URScript pose, the FANUC TP user frame. --json prints T_base_wobj (4x4),\n"
         "origin_m, tait_bryan_zyx_deg, quat_wxyz, residuals_m, covariance (6x6) and sigma.\n\n"
         "Every result is screened first: all points are fitted by least squares and a point off\n"
         "its face by more than K sigma of the noise the plan expects (its sensor and robot\n"
@@ -75,6 +75,11 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         help="the controller that wrote RESULTS (default: detected from the contents)",
     )
     p.add_argument("--method", choices=METHODS, help="method (default: the plan's procedure)")
+    p.add_argument(
+        "--format",
+        choices=list(FORMATS),
+        help="print the lines to paste for this controller only (default: every one)",
+    )
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument(
         "--k-sigma",
@@ -160,7 +165,7 @@ def result_json(out: CalibrationOutput, with_frame: bool = True) -> dict[str, An
     return data
 
 
-def _print_text(out: CalibrationOutput, paste: bool) -> None:
+def _print_text(out: CalibrationOutput, paste: bool, fmt: str | None = None) -> None:
     con = stdout()
     T = out.T_base_wobj
     o = T[:3, 3] * 1e3
@@ -197,13 +202,11 @@ def _print_text(out: CalibrationOutput, paste: bool) -> None:
         return
     if not out.trusted:
         con.print("[red]NOT TRUSTED (printed because of --force):[/]")
-    con.print("ABB RAPID (world frame = robot base):")
-    con.print(
-        f'  PERS wobjdata wobjCalibrated:=[FALSE,TRUE,"",{pose_text(T)},[[0,0,0],[1,0,0,0]]];',
-        markup=False,
-    )
-    con.print("KUKA KRL ($WORLD = $ROBROOT):")
-    con.print(f"  BASE_DATA[{BASE_NO}]={frame_text(T)}", markup=False)
+    for f in FORMATS.values() if fmt is None else (FORMATS[fmt],):
+        lines = f.paste_lines(T)
+        con.print(f"{f.vendor} {f.label} ({lines.where}):", markup=False)
+        for line in lines.lines:
+            con.print(f"  {line}", markup=False)
 
 
 def cmd_calibrate(args: argparse.Namespace) -> int:
@@ -222,5 +225,5 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     if args.json:
         print_json(result_json(out, with_frame=paste))
     else:
-        _print_text(out, paste)
+        _print_text(out, paste, args.format)
     return 0 if paste else 1

@@ -16,8 +16,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from calib.limits import MAX_REPORT_ROWS
+from calib.procedures import DESIGNED, GROWN
 from planner.cli.common import count_arg, read_plan, stdout
 from planner.program.controllers import CONTROLLERS, DEFAULT_CONTROLLER
+from planner.suggest import DEFAULT_PROCEDURE
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -88,13 +90,16 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         "the predicted error at the points of interest (greedy plus exchange on the\n"
         "information matrix), adding points until the target holds at the confidence or\n"
         "--max-points is reached. Writes the plan (atomically) and prints its predicted\n"
-        "quality. With --add N the plan's points are kept and N are added (best fit; a 3-2-1\n"
-        "or A-H plan becomes a best fit of all its points, since those take exactly their own).\n"
-        "With --objective time (best fit, needs --target) every size from 6 to --max-points is\n"
-        "designed, written in its landing order and in the order of least joint-move time,\n"
-        "and, when the --format controller runs a best fit adaptively, once more with its later\n"
-        "searches started nearer (search_sizing steered: only an adaptive program runs it),\n"
-        "checked and timed as 'wobjcal check' does, and the plan of least cycle time that meets\n"
+        "quality. --procedure is any procedure whose registry entry has a layout design: the\n"
+        "best fit and the iterative best fit grow point by point, the 3-2-1 puts 3, 2 and 1\n"
+        "points on three faces. With --add N the plan's points are kept and N are added (a\n"
+        "procedure that grows; a 3-2-1 or A-H plan becomes one of all its points, since those\n"
+        "take exactly their own). With --objective time (a procedure that grows, needs\n"
+        "--target) every size from 6 to --max-points is designed, written in its landing order\n"
+        "and in the order of least joint-move time, and, when the --format controller steers\n"
+        "the procedure adaptively, once more with its later searches started nearer\n"
+        "(search_sizing steered: only an adaptive program runs it), checked and timed as\n"
+        "'wobjcal check' does, and the plan of least cycle time that meets\n"
         "the target is written; the accuracy-versus-time front is printed as a table, and with\n"
         "--front FILE plotted (PNG, SVG or PDF; the table beside it as FILE.csv).\n\n"
         "exit codes: 0 target met (or none given) and the plan passes 'wobjcal check' for\n"
@@ -134,16 +139,18 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
     )
     p.add_argument(
         "--procedure",
-        choices=("best_fit", "three_two_one"),
-        default="best_fit",
-        help="the procedure of the suggested plan (default best_fit)",
+        choices=DESIGNED,
+        default=DEFAULT_PROCEDURE,
+        help=f"the procedure of the suggested plan (default {DEFAULT_PROCEDURE})",
     )
     p.add_argument(
         "--add",
         type=count_arg(1, 40),
         default=0,
         metavar="N",
-        help="keep the plan's points and add the N best (best fit)",
+        help="keep the plan's points and add the N best (a procedure whose layout grows: "
+        + ", ".join(GROWN)
+        + ")",
     )
     p.add_argument(
         "--format",
@@ -165,7 +172,7 @@ def register(sub: Any, add: Callable[..., argparse.ArgumentParser]) -> None:
         type=_plot_path,
         metavar="FILE",
         help="plot the accuracy-versus-time front to FILE (.png, .svg or .pdf) and write its "
-        "table to FILE.csv (best fit)",
+        "table to FILE.csv (a procedure that grows)",
     )
     p.add_argument("-o", "--output", metavar="OUT", required=True, help="plan file to write")
     p.set_defaults(handler=cmd_suggest)

@@ -13,34 +13,46 @@ Owns:
       ``urscript_layout``, ``urscript_probe``, ``urscript_adaptive``, ``urscript_steer``,
       ``urscript_xoffset``), ``fanuc`` (FANUC TP ``.ls``, nominal); the adaptive ones write the
       frame updates of :mod:`planner.program`;
+    - :mod:`planner.export.paste`: :class:`~planner.export.paste.PasteLines`, a calibrated
+      frame in a controller's syntax (what ``wobjcal calibrate`` prints to paste);
     - the registry :data:`FORMATS` and :func:`export_files`.
 
 A writer is a function ``(ExportJob) -> {file suffix: text}`` (KRL writes a ``.src`` and a
-``.dat``). Adding a robot language is one module with a writer plus one entry in
-:data:`FORMATS`; the command line (``wobjcal export --format NAME``), the web UI's download
-buttons and the tests all look formats up here::
+``.dat``); beside it, a function ``(T_base_wobj) -> PasteLines`` writes a calibrated frame in
+the same language. Adding a robot language is one module with both plus one entry in
+:data:`FORMATS`; the command line (``wobjcal export --format NAME``, the lines ``wobjcal
+calibrate`` prints), the web UI's download buttons and the tests all look formats up here::
 
     CONTROLLERS["mylang"] = Controller("mylang", "MyLang", "Maker")  # planner.program
-    FORMATS["mylang"] = ExportFormat("mylang", "planner.export.mylang:export_mylang", (".prg",))
+    FORMATS["mylang"] = ExportFormat(
+        "mylang", "planner.export.mylang:export_mylang", (".prg",),
+        "planner.export.mylang:paste_lines",
+    )
 
-Writers are imported when first used, so listing the formats imports no writer. Files are
+Writers are imported when first used (:func:`calib.registry.load`), so listing the formats
+imports no writer. Files are
 named after the plan (:func:`export_file_stem`; the command line's ``-o DIR`` and the UI's
 downloads), or after the program where the controller wants that (``program_name``).
 """
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from calib.registry import lookup
+import numpy as np
+from numpy.typing import NDArray
+
+from calib.registry import load, lookup
 from planner.export.job import ExportJob, TargetPair, ToolData, build_job
+from planner.export.paste import PasteLines
 from planner.export.text import file_stem, module_name
 from planner.program.controllers import CONTROLLERS
 
 #: A writer: the program files of a job, ``{suffix: text}``.
 Writer = Callable[[ExportJob], dict[str, str]]
+#: The lines to paste for a calibrated ``(4, 4)`` ``T_base_wobj`` (robot base, metres).
+PasteWriter = Callable[[NDArray[np.float64]], PasteLines]
 
 
 @dataclass(frozen=True)
@@ -54,6 +66,8 @@ class ExportFormat:
         writer: ``"module:function"`` of the writer ``(ExportJob) -> {suffix: text}``.
         suffixes: the suffixes of the files the writer returns, first one first (the first
             file is written to the output path, the others beside it with their suffix).
+        paste: ``"module:function"`` of ``(T_base_wobj) -> PasteLines``: a calibrated work
+            object in this language (:meth:`paste_lines`).
         program_name: ``"module:function"`` naming the program from the job's name, for a
             controller whose file must be named as the program in it (KRL's ``DEF``, FANUC's
             ``/PROG``); ``""``: the files are named after the plan (:meth:`file_stem`).
@@ -62,6 +76,7 @@ class ExportFormat:
     name: str
     writer: str
     suffixes: tuple[str, ...]
+    paste: str
     program_name: str = ""
 
     @property
@@ -76,9 +91,14 @@ class ExportFormat:
 
     def load(self) -> Writer:
         """The writer function (imports its module)."""
-        module, _, function = self.writer.partition(":")
-        writer: Writer = getattr(importlib.import_module(module), function)
+        writer: Writer = load(self.writer)
         return writer
+
+    def paste_lines(self, T_base_wobj: NDArray[np.float64]) -> PasteLines:
+        """The lines that give this controller the calibrated work object ``T_base_wobj``
+        (``(4, 4)``, robot base, metres), in its language (imports the writer's module)."""
+        paste: PasteWriter = load(self.paste)
+        return paste(np.asarray(T_base_wobj, dtype=np.float64))
 
     def file_stem(self, plan_name: str) -> str:
         """The name (without suffix) of the files of the plan named ``plan_name``, as the
@@ -87,8 +107,7 @@ class ExportFormat:
         systems (:func:`planner.export.text.file_stem`)."""
         if not self.program_name:
             return file_stem(plan_name)
-        module, _, function = self.program_name.partition(":")
-        name: Callable[[str], str] = getattr(importlib.import_module(module), function)
+        name: Callable[[str], str] = load(self.program_name)
         return file_stem(name(module_name(plan_name or "plan")))
 
 
@@ -96,18 +115,30 @@ class ExportFormat:
 FORMATS: dict[str, ExportFormat] = {
     f.name: f
     for f in (
-        ExportFormat("rapid", "planner.export.rapid:rapid_files", (".mod",)),
+        ExportFormat(
+            "rapid",
+            "planner.export.rapid:rapid_files",
+            (".mod",),
+            "planner.export.rapid:paste_lines",
+        ),
         ExportFormat(
             "krl",
             "planner.export.krl:export_krl",
             (".src", ".dat"),
+            "planner.export.krl:paste_lines",
             "planner.export.krl:program_name",
         ),
-        ExportFormat("urscript", "planner.export.urscript:urscript_files", (".script",)),
+        ExportFormat(
+            "urscript",
+            "planner.export.urscript:urscript_files",
+            (".script",),
+            "planner.export.urscript:paste_lines",
+        ),
         ExportFormat(
             "fanuc",
             "planner.export.fanuc:export_fanuc",
             (".ls",),
+            "planner.export.fanuc:paste_lines",
             "planner.export.fanuc_text:program_name",
         ),
     )
@@ -120,6 +151,8 @@ __all__ = [
     "FORMAT_CHOICES",
     "ExportFormat",
     "ExportJob",
+    "PasteLines",
+    "PasteWriter",
     "TargetPair",
     "ToolData",
     "Writer",

@@ -71,6 +71,7 @@ from planner.export.job import (
     digest_text,
     safety_header,
 )
+from planner.export.paste import PasteLines
 from planner.export.text import fmt
 
 __all__ = [
@@ -81,6 +82,7 @@ __all__ = [
     "comment_lines",
     "config_text",
     "export_fanuc",
+    "paste_lines",
     "program_name",
     "turn_number",
     "wpr_deg",
@@ -202,6 +204,20 @@ class _Program:
             pad = "" if line[:2] in ("J ", "L ") else "  "
             out.append(f"{i:4d}:{pad}{line} ;")
         return "\n".join(out)
+
+
+def paste_lines(T_base_wobj: np.ndarray) -> PasteLines:
+    """The calibrated work object as the TP instructions the programs set their user frame
+    with (the export registry's paste lines): ``PR[PR_UFRAME]`` component by component (X, Y,
+    Z mm; W, P, R deg), then ``UFRAME[UFRAME_NO]=PR[PR_UFRAME]``, relative to WORLD taken to be
+    the robot base."""
+    prog = _Program()
+    prog.set_register(PR_UFRAME, T_base_wobj)
+    prog.add(f"UFRAME[{UFRAME_NO}]=PR[{PR_UFRAME}]")
+    return PasteLines(
+        f"TP instructions, WORLD = robot base; user frame {UFRAME_NO}",
+        tuple(f"{line} ;" for line in prog.lines),
+    )
 
 
 def export_fanuc(job: ExportJob) -> dict[str, str]:

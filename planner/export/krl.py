@@ -73,6 +73,7 @@ from planner.export.krl_text import (
     stop_lines,
 )
 from planner.export.krl_xoffset import has_xoffset, xoffset_data, xoffset_routines
+from planner.export.paste import PasteLines
 from planner.export.text import comment_text, fmt, identifier
 from planner.program.model import MeasuringProgram
 
@@ -85,6 +86,7 @@ __all__ = [
     "e6pos_text",
     "export_krl",
     "frame_text",
+    "paste_lines",
     "program_name",
     "status_turn",
 ]
@@ -102,6 +104,13 @@ def frame_text(T: np.ndarray) -> str:
     abc = np.degrees(tait_bryan_zyx_from_matrix(T[:3, :3]))
     vals = [*p, *abc]
     return "{" + ",".join(f"{k} {fmt(v, 6)}" for k, v in zip("XYZABC", vals, strict=True)) + "}"
+
+
+def paste_lines(T_base_wobj: np.ndarray) -> PasteLines:
+    """The calibrated work object as KRL's base the programs use (the export registry's paste
+    lines): ``BASE_DATA[BASE_NO]={X ..,Y ..,Z ..,A ..,B ..,C ..}``, mm and degrees, relative to
+    ``$WORLD`` taken to be ``$ROBROOT``."""
+    return PasteLines("$WORLD = $ROBROOT", (f"BASE_DATA[{BASE_NO}]={frame_text(T_base_wobj)}",))
 
 
 def status_turn(arm: ArmPose) -> tuple[int, int]:

@@ -36,6 +36,7 @@ import numpy as np
 from calib._version import __version__
 from calib.frames import quat_wxyz_from_matrix
 from planner.export.job import ExportJob, check_header, cycle_header, digest_text
+from planner.export.paste import PasteLines
 from planner.export.rapid_probe import WOBJ, probe_proc
 from planner.export.rapid_steer import steer_main, steer_procs
 from planner.export.rapid_write import MEASURED_FILE, write_proc
@@ -59,6 +60,21 @@ def pose_text(T: np.ndarray) -> str:
     return f"[[{trans}],[{rot}]]"
 
 
+def wobjdata_text(T_base_wobj: np.ndarray) -> str:
+    """A ``wobjdata`` literal whose user frame is ``T_base_wobj`` (in the world frame, taken to
+    be the robot base), not held by the robot, object frame identity."""
+    return f'[FALSE,TRUE,"",{pose_text(T_base_wobj)},[[0,0,0],[1,0,0,0]]]'
+
+
+def paste_lines(T_base_wobj: np.ndarray) -> PasteLines:
+    """The calibrated work object as a RAPID ``wobjdata`` declaration (the export registry's
+    paste lines): ``PERS wobjdata wobjCalibrated``, mm and a (w, x, y, z) quaternion."""
+    return PasteLines(
+        "world frame = robot base",
+        (f"PERS wobjdata wobjCalibrated:={wobjdata_text(T_base_wobj)};",),
+    )
+
+
 def robtarget_text(T: np.ndarray, conf: tuple[int, int, int, int] | None) -> str:
     """A ``robtarget`` literal."""
     cf = ",".join(str(int(c)) for c in (conf or (0, 0, 0, 0)))
@@ -80,7 +96,7 @@ def _declarations(job: ExportJob, names: list[str]) -> list[str]:
     ids = ",".join(_string(pid) for pid, _ in slots)
     retake = ",".join("TRUE" if r else "FALSE" for _, r in slots)
     empty = ",".join(['""'] * n)
-    nominal = f'[FALSE,TRUE,"",{pose_text(job.T_base_wobj)},[[0,0,0],[1,0,0,0]]]'
+    nominal = wobjdata_text(job.T_base_wobj)
     lines = [
         f"    PERS tooldata tSensor:=[TRUE,{pose_text(tool.T_flange_tcp)},"
         f"[{fmt(tool.mass_kg, 3)},[{cog}],[1,0,0,0],0,0,0]];",

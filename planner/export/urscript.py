@@ -30,7 +30,10 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import numpy as np
+
 from planner.export.job import ExportJob, safety_header
+from planner.export.paste import PasteLines
 from planner.export.text import identifier, literal_text
 from planner.export.urscript_layout import preamble
 from planner.export.urscript_probe import (
@@ -43,7 +46,7 @@ from planner.export.urscript_probe import (
     via_lines,
 )
 
-__all__ = ["SENSOR_IN", "export_urscript", "pose_text", "urscript_files"]
+__all__ = ["SENSOR_IN", "export_urscript", "paste_lines", "pose_text", "urscript_files"]
 
 
 def export_urscript(job: ExportJob) -> str:
@@ -84,3 +87,10 @@ def _export_nominal(job: ExportJob) -> str:
 def urscript_files(job: ExportJob) -> dict[str, str]:
     """The URScript program of ``job`` as ``{".script": text}`` (the export registry's writer)."""
     return {".script": export_urscript(job)}
+
+
+def paste_lines(T_base_wobj: np.ndarray) -> PasteLines:
+    """The calibrated work object as a URScript pose in the robot base frame (the export
+    registry's paste lines), as the programs hold their ``wobj``: metres and a rotation vector
+    in radians; a target ``p`` in the work object is ``pose_trans(wobj_calibrated, p)``."""
+    return PasteLines("robot base frame", (f"wobj_calibrated = {pose_text(T_base_wobj)}",))

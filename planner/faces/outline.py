@@ -54,7 +54,7 @@ class FaceOutlines:
             tri = np.asarray(self._faces.mesh.triangles, dtype=np.float64)
             mine = tri[self._faces.face_id == face_id]  # (T, 3, 3)
             uv = mine @ self.basis(face_id)  # (T, 3, 2)
-            self._face[face_id] = shapely.union_all(shapely.polygons(uv)).buffer(_WELD_M)
+            self._face[face_id] = _union(uv).buffer(_WELD_M)
         return self._face[face_id]
 
     def normal(self, face_id: int) -> FloatArray:
@@ -116,3 +116,24 @@ class FaceOutlines:
             d = float(free.boundary.distance(c))
             self._clearance[key] = d if free.contains(c) else -d
         return self._clearance[key]
+
+
+def _union(uv: FloatArray) -> shapely.Geometry:
+    """The union of triangles ``(T, 3, 2)`` that tile a face (in-plane coordinates, metres).
+
+    The triangles of a planar face of a mesh share their edges exactly (each vertex projects
+    to one point), so their union is a coverage union, which only dissolves the shared edges
+    (the same geometry as ``union_all``, which overlays every pair: 0.13 against 2.4 s for the
+    stator's side face of 26,000 triangles). It is taken only when it is surely right: every
+    triangle turns the same way (none folded over) and the result is a valid polygon whose
+    area is the triangles' (no overlap); anything else goes through ``union_all``.
+    """
+    polys = shapely.polygons(uv)
+    e1, e2 = uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]
+    twice = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]  # signed areas (x2)
+    if len(uv) and (np.all(twice > 0.0) or np.all(twice < 0.0)):
+        merged = shapely.coverage_union_all(polys)
+        total = 0.5 * float(np.abs(twice).sum())
+        if shapely.is_valid(merged) and abs(merged.area - total) <= 1e-9 * total:
+            return merged
+    return shapely.union_all(polys)

@@ -25,10 +25,10 @@ from calib.errors import InputError, ProbeFailedError
 from calib.frames import small_motion
 from calib.paper.settings import Hultman2013
 from calib.plan.file import Plan
+from calib.plane_probe import PlaneProbe
 from calib.probing import ProbeResult, SearchCommand
 from calib.procedures import RolePoint, procedure_kind
 from calib.procedures.base import edge_offset_of
-from calib.procedures.linearize import PlaneProbe
 from planner.program.controllers import CONTROLLERS, Controller, controller
 from planner.program.model import (
     FACE_APPROACH,

@@ -27,6 +27,7 @@ from numpy.typing import NDArray
 from calib.estimators.layout import ConstraintSet, constraint_set
 from calib.estimators.runners import fixed_motions, min_norm_update
 from calib.probing import ProbePoint
+from calib.procedures import PROCEDURES, procedure_kind
 from planner.program.model import MeasuringProgram
 
 FloatArray = NDArray[np.float64]
@@ -39,23 +40,25 @@ STEP_TOL_M = 1e-9
 
 def update_groups(method: str, ordered_ids: Sequence[str]) -> list[tuple[str, ...]]:
     """The points each update of an adaptive ``method`` program fits, for points measured in
-    ``ordered_ids`` order (``[]``: the program does not steer itself).
+    ``ordered_ids`` order (``[]``: the program does not steer itself), as the procedure's
+    registry entry says (:attr:`calib.procedures.base.ProcedureKind.steering`): the best fit
+    after every point, the points so far (the progressive best fit; the last update is the fit
+    of them all); the 3-2-1 after the three primary points, after the two secondary ones, after
+    the tertiary one (the order of its roles).
 
-    - ``best_fit``: after every point, the points so far (the progressive best fit; the last
-      update is the fit of them all);
-    - ``three_two_one``: after the three primary points, after the two secondary ones, after
-      the tertiary one (the order of its roles).
+    Raises:
+        PlanError: ``method`` is no procedure (the message lists the known ones).
     """
     ids = tuple(ordered_ids)
-    if method == "best_fit":
-        return [ids[: k + 1] for k in range(len(ids))]
-    if method == "three_two_one" and len(ids) == 6:
-        return [ids[:3], ids[:5], ids]
-    return []
+    steering = procedure_kind(method).steering
+    if steering is None:
+        return []
+    return [ids[:k] for k in steering.update_counts(len(ids))]
 
 
-#: The procedures whose adaptive programs steer by :func:`steer` (approach searches only).
-STEERED_METHODS = ("best_fit", "three_two_one")
+#: The procedures whose adaptive programs steer by :func:`steer` (approach searches only): those
+#: whose registry entry has a :class:`~calib.procedures.base.Steering`.
+STEERED_METHODS = tuple(m for m, kind in PROCEDURES.items() if kind.steering is not None)
 
 
 def layout_pivot_scale(points: Sequence[ProbePoint]) -> tuple[FloatArray, float]:

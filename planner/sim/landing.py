@@ -2,7 +2,7 @@
 face, under the plan's misplacement.
 
 The program (:mod:`planner.program`) is executed against the ideal part (its faces' planes,
-:class:`calib.procedures.linearize.PlaneProbe`) misplaced as the validation misplaces it,
+:class:`calib.plane_probe.PlaneProbe`) misplaced as the validation misplaces it,
 :data:`TRIALS` seeded times; no noise (micrometres against millimetres of misplacement). For every
 search it records the travel to its event against the search's length, and for every approach
 where it lands on the true part: the centre of the sensor's footprint must lie on the planar
@@ -29,9 +29,9 @@ from numpy.typing import NDArray
 from calib.errors import InputError, ProbeFailedError
 from calib.frames import invert_transform, transform_points
 from calib.models import Misplacement
+from calib.plane_probe import PlaneProbe
 from calib.probing import ProbeResult, SearchCommand
 from calib.procedures.base import edge_offset_of
-from calib.procedures.linearize import PlaneProbe
 from planner.faces.outline import FaceOutlines
 from planner.program.execute import execute
 from planner.program.model import FACE_APPROACH, MeasuringProgram, search_keys

@@ -12,16 +12,14 @@ beside the interval predicted from the program's linearisation (:mod:`planner.si
 would call it.
 
 Trials are seeded one by one from ``rng`` (``SeedSequence.spawn``), so a run is repeatable and
-does not depend on how trials are split over worker processes. The ray-casting scene is built
+does not depend on how trials are split over worker processes. A run starts and finishes in two
+halves (:mod:`planner.sim.simulation_run`): the workers start first, so that the caller may
+check the plan in its cell meanwhile. The ray-casting scene is built
 once per worker; rays are moved into the part frame instead of moving the mesh.
 """
 
 from __future__ import annotations
 
-import dataclasses
-import logging
-import os
-import time
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -31,7 +29,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import InputError, ShapeError
 from calib.frames import check_transform
-from calib.limits import MAX_PROTOCOL_TRIALS
 from calib.models import Misplacement, RobotErrorModel
 from calib.models.proximity import ProximitySensor
 from calib.paper.settings import Hultman2013
@@ -46,15 +43,12 @@ from planner.program.build import build_program
 from planner.program.controllers import controller
 from planner.program.safety import SafetySpec
 from planner.program.settings import DEFAULT_EDGE_INSET_M, resolved_settings
-from planner.sim.error_map import error_map
-from planner.sim.predict import predict
 from planner.sim.proximity import ReachabilityHook, cell_search_hook
 from planner.sim.report import PAPER_TABLE1, ValidationReport
 from planner.sim.report_points import report_rows
 from planner.sim.rows import RowSpec
 from planner.sim.setup import SimulationSetup, default_pivot, default_settings, face_lookup
-from planner.sim.summary import build_report
-from planner.sim.trial import TrialResult, TrialSeed, run_all
+from planner.sim.simulation_run import start_simulation
 
 __all__ = [
     "DEFAULT_EDGE_INSET_M",
@@ -66,7 +60,6 @@ __all__ = [
 ]
 
 FloatArray = NDArray[np.float64]
-log = logging.getLogger(__name__)
 
 #: progress(done_trials, total_trials)
 ProgressCallback = Callable[[int, int], None]
@@ -112,74 +105,19 @@ def simulate(
 
     Raises:
         InputError: bad arguments (named in the message), or a plan that cannot calibrate even
-            on the ideal part (from the prediction, before any trial runs).
+            on the ideal part (from the prediction; the workers already started are stopped).
     """
-    if not isinstance(n_trials, int) or not 2 <= n_trials <= MAX_TRIALS:
-        raise ShapeError(f"n_trials must be an integer 2 to {MAX_TRIALS:,}, got {n_trials!r}")
-    if protocol is not None and (min(protocol) < 2 or len(protocol) != 2):
-        raise ShapeError(f"protocol must be (positions, repeats), each >= 2, got {protocol!r}")
-    if protocol is not None and protocol[0] * protocol[1] > MAX_PROTOCOL_TRIALS:
-        raise ShapeError(
-            f"protocol: {protocol[0]:,} x {protocol[1]:,} trials, at most "
-            f"{MAX_PROTOCOL_TRIALS:,} (every trial's result stays in memory until the report)"
-        )
-    prediction = predict(setup)  # before the run: a plan that cannot work fails here
-    setup = dataclasses.replace(setup, accuracy_field=setup.robot_error.sample_field(rng))
-    seeds: list[TrialSeed] = list(np.random.SeedSequence(int(rng.integers(2**63))).spawn(n_trials))
-    extra: list[TrialSeed] = []
-    if protocol is not None:
-        base = np.random.SeedSequence(int(rng.integers(2**63)))
-        for pos in base.spawn(protocol[0]):
-            extra += [(noise, pos) for noise in pos.spawn(protocol[1])]
-    n_workers = min(2, os.cpu_count() or 1) if workers is None else max(1, int(workers))
     if cell is not None and reachability is None:
         reachability = cell_search_hook(cell)
     n_reach = 0 if reachability is None else n_trials
     if reach_trials is not None and reachability is not None:
         if int(reach_trials) < 0:
             raise ShapeError(f"reach_trials must be >= 0, got {reach_trials!r}")
-        n_reach = min(int(reach_trials), n_trials)
-    total = n_trials + len(extra)
-    if total - n_reach < 50:
-        n_workers = 1
-    t0 = time.perf_counter()
-    T_cell = None if cell is None else cell.T_world_wobj
-
-    def vetted(done: int, _total: int) -> None:  # progress over all trials, vetted ones first
-        if progress is not None:
-            progress(done, total)
-
-    def later(done: int, _total: int) -> None:
-        if progress is not None:
-            progress(n_reach + done, total)
-
-    try:
-        results: list[TrialResult] = []
-        if n_reach:
-            # vetted trials run here: they move the cell's part to where it really lies
-            results = run_all(setup, mesh, seeds[:n_reach], 1, reachability, vetted, cell)
-        if n_reach < total:
-            results += run_all(setup, mesh, seeds[n_reach:] + extra, n_workers, None, later)
-    finally:
-        if cell is not None:
-            cell.move_work_object(T_cell)
-    elapsed = time.perf_counter() - t0
-    log.info("validated %d trials in %.2f s on %d workers", total, elapsed, n_workers)
-    main, proto = results[:n_trials], results[n_trials:]
-    report = build_report(
-        setup, main, proto, protocol, rows, prediction, paper, elapsed, n_workers, n_reach
+        n_reach = min(int(reach_trials), n_trials) if isinstance(n_trials, int) else 0
+    run = start_simulation(
+        setup, mesh, n_trials, rng, vetted=n_reach, protocol=protocol, workers=workers
     )
-    pois = {
-        r.key: r.points_wobj[0].copy()
-        for r in rows
-        if r.points_wobj is not None and len(r.points_wobj) == 1
-    }
-    return dataclasses.replace(
-        report,
-        points_of_interest=pois,
-        probe_points_wobj=np.array([rp.point.position_m for rp in setup.points], dtype=float),
-        error_map=error_map(report.delta_procedure, mesh),
-    )
+    return run.finish(rows, reachability=reachability, cell=cell, paper=paper, progress=progress)
 
 
 def stator_setup(

@@ -17,9 +17,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.frames import motion_between, small_motion
+from calib.plane_probe import PlaneProbe
 from calib.probing import Probe
 from calib.procedures.comparison import FedFit
-from calib.procedures.linearize import PlaneProbe, event_covariance, linearize
+from calib.procedures.linearize import event_covariance, linearize
 from planner.program.execute import execute
 from planner.sim.setup import SimulationSetup
 from planner.sim.xoffset import run_xoffset

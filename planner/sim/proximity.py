@@ -26,23 +26,20 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
-from calib.frames import check_transform, invert_transform
 from calib.models.proximity import ProximitySensor
-from calib.models.robot_error import AccuracyField, RobotErrorModel
 from calib.probing import ProbeResult, SearchCommand
-from planner.sim.raycast import MeshRayCaster
 from planner.sim.search_events import (
-    FaceLookup,
     ProbeEvent,
     ReachabilityHook,
     cell_search_hook,
     robot_offset,
 )
+from planner.sim.sensor_base import SimulatedSensor
 from planner.sim.subray import CellSignal, cell_width_m, first_switch
 
 __all__ = ["ProbeEvent", "ReachabilityHook", "SimulatedProbe", "cell_search_hook", "robot_offset"]
@@ -51,55 +48,28 @@ FloatArray = NDArray[np.float64]
 
 
 @dataclass
-class SimulatedProbe:
-    """A probe callback against the true part at ``T_base_wobj_true``.
+class SimulatedProbe(SimulatedSensor):
+    """A proximity-sensor probe callback against the true part at ``T_base_wobj_true``.
 
-    Args:
-        caster: ray caster of the part mesh in its own (wobj) frame.
-        T_base_wobj_true: ``(4, 4)`` where the part really is, base frame.
-        rng: random generator for robot and sensor noise.
-        sensor: the sensor model.
-        robot_error: robot repeatability (per search) and accuracy model.
-        accuracy_field: this robot's accuracy field (``robot_error.sample_field``), or None.
-        faces: the true part's planar faces and the face each search should land on, to
-            classify landings over the whole footprint; ``None``: not classified.
-        tcp_error_m: ``(3,)`` this calibration's TCP error, sensor tool frame, m, or None.
-        reachability: optional hook that vets the path each successful search really ran (the
-            command cut at the switching event); its reason fails the probe.
+    Args (besides :class:`~planner.sim.sensor_base.SimulatedSensor`'s):
+        sensor: the proximity-sensor model.
         edge_inset_m: an edge search runs its track this far inside the commanded path along
             the sensor axis (so the sensor detects the face it slides over); the reported point
             stays on the commanded path, i.e. on the face (the contract of the A-H procedure).
-        scan_step_m: step of the coarse edge scan, m.
         edge_tolerance_m: bisection tolerance of the edge event, m.
+        scan_step_m: step of the coarse edge scan, m.
         between_rays: resolve a scanning search's switch between the rays of the bundle
             (:mod:`planner.sim.subray`); False: plain rays, each switching at once (for
             comparison: ``bench/bench_edge_events.py``).
     """
 
-    caster: MeshRayCaster
-    T_base_wobj_true: ArrayLike
-    rng: np.random.Generator
     sensor: ProximitySensor = field(default_factory=ProximitySensor)
-    robot_error: RobotErrorModel = field(default_factory=RobotErrorModel)
-    accuracy_field: AccuracyField | None = None
-    faces: FaceLookup | None = None
-    tcp_error_m: FloatArray | None = None
-    reachability: ReachabilityHook | None = None
     edge_inset_m: float = 0.003
-    scan_step_m: float = 0.0025
     edge_tolerance_m: float = 2e-5
+    scan_step_m: float = 0.0025
     between_rays: bool = True
-    events: list[ProbeEvent] = field(default_factory=list)
-
-    def __post_init__(self) -> None:
-        self.T_base_wobj_true = check_transform(self.T_base_wobj_true, "T_base_wobj_true")
-        self._T_wobj_base = invert_transform(self.T_base_wobj_true)
 
     # -- helpers ---------------------------------------------------------------------------
-    def _to_part(self, p_base: FloatArray) -> FloatArray:
-        T = self._T_wobj_base
-        return p_base @ T[:3, :3].T + T[:3, 3]
-
     def _distances(self, tcp_base: FloatArray, axis: FloatArray, offsets: FloatArray) -> FloatArray:
         """Face-to-metal distances ``(K, n)`` for TCP positions ``(K, 3)`` (base frame)."""
         centres = tcp_base - self.sensor.sensing_distance_m * axis
@@ -111,38 +81,25 @@ class SimulatedProbe:
         """Signal ``(K,)`` from distances ``(K, n)``; ``-1`` where the face is inside the part."""
         return np.where(np.any(dist <= 0.0, axis=1), -1.0, self.sensor.signal(dist))
 
-    def _fail(self, cmd: SearchCommand, reason: str) -> ProbeResult:
-        self.events.append(ProbeEvent(cmd.point_id, cmd.kind, reason=reason))
-        return ProbeResult(point_m=None, reason=reason)
-
     def _succeed(
         self,
         cmd: SearchCommand,
         travel: float,
         triangles: NDArray[np.int64] | None = None,
     ) -> ProbeResult:
-        if self.reachability is not None:  # the path the robot really ran: start to the event
-            why = self.reachability(replace(cmd, length_m=max(travel, 1e-6)))
-            if why:
-                return self._fail(cmd, why)
-        landing, frac = "", 0.0
-        if self.faces is not None and triangles is not None:
-            landing, frac = self.faces.landing(cmd.point_id, triangles)
-        self.events.append(
-            ProbeEvent(cmd.point_id, cmd.kind, landing=landing, off_fraction=frac, travel_m=travel)
-        )
+        refused = self._vet(cmd, travel)  # the path the robot really ran: start to the event
+        if refused is not None:
+            return refused
         point = np.asarray(cmd.start_m, float) + travel * np.asarray(cmd.direction, float)
-        return ProbeResult(point_m=point, travel_m=travel)
+        return self._record(cmd, travel, point, self._landing(cmd, triangles))
 
     # -- the probe -------------------------------------------------------------------------
-    def __call__(self, cmd: SearchCommand) -> ProbeResult:
-        """Run one commanded search against the true part."""
-        start = np.asarray(cmd.start_m, float)
-        axis = np.asarray(cmd.sensor_axis, float)
-        offset = robot_offset(
-            start, axis, self.rng, self.robot_error, self.accuracy_field, self.tcp_error_m
-        )
-        tcp0 = start + offset + (self.edge_inset_m * axis if cmd.kind == "edge" else 0.0)
+    def _search(
+        self, cmd: SearchCommand, start: FloatArray, axis: FloatArray, tcp0: FloatArray
+    ) -> ProbeResult:
+        """Run one commanded search against the true part (an approach along the sensor axis
+        in closed form, any other by scanning)."""
+        tcp0 = tcp0 + (self.edge_inset_m * axis if cmd.kind == "edge" else 0.0)
         direction = np.asarray(cmd.direction, float)
         length = float(cmd.length_m)
         if cmd.kind == "approach" and float(direction @ axis) > 1.0 - 1e-12:
@@ -174,9 +131,7 @@ class SimulatedProbe:
                     return out
                 continue
             start = np.asarray(cmd.start_m, float)
-            tcp0 = start + robot_offset(
-                start, axis, self.rng, self.robot_error, self.accuracy_field, self.tcp_error_m
-            )
+            tcp0 = start + self._offset(start, axis)
             pending.append((cmd, tcp0, axis, self.sensor.sample_jitter_m(self.rng)))
         return out + self._cast_in_turn(pending)
 
@@ -184,20 +139,35 @@ class SimulatedProbe:
         self, searches: Sequence[tuple[SearchCommand, FloatArray, FloatArray, float]]
     ) -> list[ProbeResult]:
         """Approaches along their axes ``(command, tcp0, axis, jitter)``: one ray cast, then
-        each judged in turn as :meth:`_approach_along_axis` does, up to the first failure."""
+        each judged in turn as :meth:`_judge_approach` does, up to the first failure (their
+        signals and nearest metal computed for all at once, row by row as one search's)."""
         if not searches:
             return []
         R = self._T_wobj_base[:3, :3]
-        origins = np.concatenate(
-            [self._to_part(self.sensor.ray_origins(tcp0, axis)) for _, tcp0, axis, _ in searches]
-        )
+        offsets: dict[bytes, FloatArray] = {}  # the face's ray offsets, once per sensor axis
+        centres, rows = [], []
+        for _, tcp0, axis, _ in searches:
+            key = axis.tobytes()
+            if key not in offsets:
+                offsets[key] = self.sensor.face_offsets_m(axis)
+            centres.append(tcp0 - self.sensor.sensing_distance_m * axis)
+            rows.append(offsets[key])
+        origins = self._to_part((np.array(centres)[:, None, :] + np.array(rows)).reshape(-1, 3))
         n_rays = len(origins) // len(searches)
         axes = np.repeat(np.array([R @ axis for _, _, axis, _ in searches]), n_rays, axis=0)
         dist_all, tri_all = self.caster.first_hits_ids(origins, axes)
+        dist = dist_all.reshape(len(searches), n_rays)
+        inside = np.any(dist <= 0.0, axis=1)
+        signal = self.sensor.signal(dist)
+        nearest = dist.min(axis=1)
         out: list[ProbeResult] = []
         for k, (cmd, _, _, jitter) in enumerate(searches):
-            rays = slice(k * n_rays, (k + 1) * n_rays)
-            res = self._judge_approach(cmd, dist_all[rays], tri_all[rays], jitter)
+            tri = tri_all[k * n_rays : (k + 1) * n_rays]
+            if inside[k]:
+                res = self._fail(cmd, "sensor face inside the part at start")
+            else:
+                travel = self.sensor.travel_to_switch_m(float(signal[k]), jitter)
+                res = self._judged(cmd, travel, float(nearest[k]), tri)
             out.append(res)
             if not res.ok:
                 break
@@ -218,15 +188,22 @@ class SimulatedProbe:
     ) -> ProbeResult:
         """Where an approach along the sensor axis switches, from its rays' distances ``dist``
         and triangles ``tri`` at the start and the switching jitter (m)."""
-        length = float(cmd.length_m)
         if np.any(dist <= 0.0):
             return self._fail(cmd, "sensor face inside the part at start")
         travel = self.sensor.switch_travel_m(dist, jitter)
+        return self._judged(cmd, travel, float(dist.min()), tri)
+
+    def _judged(
+        self, cmd: SearchCommand, travel: float, nearest: float, tri: NDArray[np.int64]
+    ) -> ProbeResult:
+        """An approach along the sensor axis that switches after ``travel`` (m), its nearest
+        ray meeting metal ``nearest`` away (m), its rays' triangles ``tri``."""
+        length = float(cmd.length_m)
         if travel <= 0.0:
             return self._fail(cmd, "sensor already detecting at start")
         if not math.isfinite(travel) or travel > length:
             return self._fail(cmd, f"no detection within {length * 1e3:.0f} mm")
-        if travel >= float(dist.min()):
+        if travel >= nearest:
             return self._fail(cmd, "sensor face touched the part before switching")
         return self._succeed(cmd, travel, tri)  # along the axis the rays are the footprint's
 

@@ -22,6 +22,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from planner.errors import MeshError
+from planner.sim.hit_kernel import finish_hits
 
 FloatArray = NDArray[np.float64]
 
@@ -71,6 +72,19 @@ class MeshRayCaster:
         self._edge_normals = inward
         self._edge_offsets = np.einsum("fkj,fkj->fk", inward, tri[:, [1, 2, 0]])
         self._scale = float(max(np.ptp(mesh.vertices, axis=0).max(), 1e-9))
+        #: what the compiled float64 step of a cast reads (:mod:`planner.sim.hit_kernel`)
+        self._kernel_arrays = tuple(
+            np.ascontiguousarray(x)
+            for x in (
+                self._normals,
+                self._offsets,
+                self._has_sharp,
+                self._sharp,
+                self._edge_normals,
+                self._edge_offsets,
+                self._neighbour,
+            )
+        )
 
     @staticmethod
     def _sharp_local_edges(mesh: trimesh.Trimesh) -> NDArray[np.bool_]:
@@ -129,30 +143,17 @@ class MeshRayCaster:
             ids = self._scene.run(o.astype(np.float32), d.astype(np.float32))
         else:  # pragma: no cover
             ids = self._intersector.intersects_first(o, d)
-        tri = np.asarray(ids, dtype=np.int64)
-        idx = np.flatnonzero(tri >= 0)
-        if len(idx) == 0:
-            return out, tri_out
-        denom, t = self._plane_hits(o[idx], d[idx], tri[idx], parallel=0.0)
-        t = np.maximum(t, 0.0)
-        beyond = self._beyond_real_edge(o[idx] + t[:, None] * d[idx], tri[idx])
-        if np.any(beyond):  # across a seam of one face: the ray hits the triangle next door
-            b = np.flatnonzero(beyond)
-            nb_tri, nb_t = self._neighbour_hits(o[idx[b]], d[idx[b]], t[b], tri[idx[b]])
-            on = nb_tri >= 0
-            tri[idx[b[on]]], t[b[on]] = nb_tri[on], nb_t[on]
-            denom[b[on]] = np.einsum("ij,ij->i", self._normals[nb_tri[on]], d[idx[b[on]]])
-            beyond[b[on]] = False
-        keep = ~beyond
-        out[idx[keep]] = np.where(denom[keep] > 0, 0.0, t[keep])  # back face: origin inside
-        tri_out[idx[keep]] = tri[idx[keep]]
-        if np.any(beyond) and depth < 4:  # continue just past the face that was not hit
-            r = idx[beyond]
+        tri = np.ascontiguousarray(ids, dtype=np.int64)
+        out, tri_out, cont, t_cont = finish_hits(
+            o, d, tri, self._kernel_arrays, -1e-12 * self._scale, 1e-7 * self._scale
+        )
+        if depth < 4 and cont.any():  # continue just past the face that was not hit
+            r = np.flatnonzero(cont)
             step = 1e-9 * self._scale
             more, more_tri = self.first_hits_ids(
-                o[r] + (t[beyond] + step)[:, None] * d[r], d[r], depth + 1
+                o[r] + (t_cont[r] + step)[:, None] * d[r], d[r], depth + 1
             )
-            out[r] = t[beyond] + step + more
+            out[r] = t_cont[r] + step + more
             tri_out[r] = more_tri
         return out, tri_out
 
@@ -167,57 +168,3 @@ class MeshRayCaster:
     def triangle_offset(self, triangle: int | NDArray[np.int64]) -> FloatArray:
         """Plane offset ``d`` of a triangle (or triangles): its plane is ``normal . x = d``, m."""
         return np.asarray(self._offsets[triangle], dtype=np.float64)
-
-    def _neighbour_hits(
-        self, o: FloatArray, d: FloatArray, t: FloatArray, tri: NDArray[np.int64]
-    ) -> tuple[NDArray[np.int64], FloatArray]:
-        """For rays ``(K,)`` that met ``tri`` at ``t`` just outside it: the triangle across the
-        edge they passed and the distance to it, where the ray meets that triangle inside it
-        (float64) within Embree's widening of ``t``; ``-1`` where it does not (a real edge).
-
-        Two triangles of one machined face stored in float32 (an STL) meet at 1e-8 to 1e-4
-        rad; a ray through their seam may be reported on the one it grazes."""
-        dist = self._edge_distances(o + t[:, None] * d, tri)
-        nb = self._neighbour[tri, np.argmin(dist, axis=1)]
-        out_tri = np.full(len(tri), -1, dtype=np.int64)
-        out_t = np.array(t, dtype=np.float64)
-        has = np.flatnonzero(nb >= 0)
-        if len(has) == 0:
-            return out_tri, out_t
-        _, t_nb = self._plane_hits(o[has], d[has], nb[has], parallel=np.inf)
-        q = o[has] + np.where(np.isfinite(t_nb), t_nb, 0.0)[:, None] * d[has]
-        inside = self._edge_distances(q, nb[has]).min(axis=1) >= -1e-12 * self._scale
-        ok = inside & (np.abs(t_nb - t[has]) <= 1e-7 * self._scale)
-        out_tri[has[ok]] = nb[has[ok]]
-        out_t[has[ok]] = np.maximum(t_nb[ok], 0.0)
-        return out_tri, out_t
-
-    def _plane_hits(
-        self, o: FloatArray, d: FloatArray, tri: NDArray[np.int64], parallel: float
-    ) -> tuple[FloatArray, FloatArray]:
-        """``(denom, t)`` of rays ``(K,)`` against the planes of triangles ``tri``, float64:
-        ``denom = n . d`` (positive: the face seen from behind), ``t`` the distance along the
-        ray to the plane (``parallel`` where the ray runs parallel to it)."""
-        n = self._normals[tri]
-        denom = np.einsum("ij,ij->i", n, d)
-        num = self._offsets[tri] - np.einsum("ij,ij->i", n, o)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return denom, np.where(np.abs(denom) > 1e-15, num / denom, parallel)
-
-    def _edge_distances(self, p: FloatArray, tri: NDArray[np.int64]) -> FloatArray:
-        """``(K, 3)`` in-plane distances of points ``p`` inside the edges of triangles ``tri``
-        (edge opposite vertex k; negative: outside it), metres."""
-        return np.einsum("kej,kj->ke", self._edge_normals[tri], p) - self._edge_offsets[tri]
-
-    def _beyond_real_edge(self, p: FloatArray, tri: NDArray[np.int64]) -> NDArray[np.bool_]:
-        """True where hit points ``(K, 3)`` lie outside their triangle across a real edge."""
-        flags = np.zeros(len(tri), bool)
-        check = np.flatnonzero(self._has_sharp[tri])  # only triangles with a real edge matter
-        if len(check) == 0:
-            return flags
-        t = tri[check]
-        dist = self._edge_distances(p[check], t)
-        worst = np.argmin(dist, axis=1)
-        outside = dist[np.arange(len(t)), worst] < -1e-12 * self._scale
-        flags[check] = outside & self._sharp[t, worst]
-        return flags

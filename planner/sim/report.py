@@ -23,32 +23,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from calib.paper.table1 import PAPER_TABLE1 as PAPER_TABLE1  # the paper's Table 1
 from planner.sim.error_map import ErrorMap
 
 FloatArray = NDArray[np.float64]
-
-#: The paper's Table 1 half-widths, display units, keyed by (row key, level in percent).
-PAPER_TABLE1: dict[tuple[str, float], float] = {
-    ("origin_x", 95.5): 0.10,
-    ("origin_y", 95.5): 0.08,
-    ("origin_z", 95.5): 0.16,
-    ("rot_x", 95.5): 0.0002,
-    ("rot_y", 95.5): 0.0018,
-    ("rot_z", 95.5): 0.0003,
-    ("rot_x", 99.99): 0.0004,
-    ("rot_y", 99.99): 0.0035,
-    ("rot_z", 99.99): 0.0006,
-    ("yz_origin", 95.5): 0.18,
-    ("yz_origin", 99.0): 0.23,
-    ("yz_origin", 99.9): 0.30,
-    ("yz_epsilon", 95.5): 0.40,
-    ("yz_epsilon", 99.0): 0.51,
-    ("yz_epsilon", 99.9): 0.66,
-    ("yz_slots", 95.5): 0.28,
-    ("yz_slots", 99.99): 0.55,
-    ("yz_slots", 99.999): 0.62,
-    ("yz_slots", 99.9999): 0.69,
-}
 
 
 @dataclass(frozen=True)

@@ -33,11 +33,13 @@ def cell_search_hook(cell: Any, step_m: float = 0.002) -> ReachabilityHook:
     :class:`planner.cell.cell.Cell`); place the cell's work object where the part really is, so a
     search that collides because the part moved is caught.
 
-    The reason returned is ``"unreachable or colliding: <the cell's reason>"``.
+    The reason returned is ``"unreachable or colliding: <the cell's reason>"``. Only the
+    verdict is computed (``exact_clearance=False``: the broad phase clears most of each
+    sample's collision query, :mod:`planner.cell.path_clearance`; the same verdict and reason).
     """
 
     def hook(command: SearchCommand) -> str:
-        res = cell.check_search(command, step_m=step_m)
+        res = cell.check_search(command, step_m=step_m, exact_clearance=False)
         return "" if res.feasible else f"unreachable or colliding: {res.reason}"
 
     return hook
@@ -79,7 +81,8 @@ def program_search_hook(
     pose for (a plan simulated though check refuses it) is reported as such, never vetted with
     a pose no program runs.
 
-    The reason returned is ``"unreachable or colliding: <the cell's reason>"``.
+    The reason returned is ``"unreachable or colliding: <the cell's reason>"``; as
+    :func:`cell_search_hook`, only the verdict is computed.
     """
     R_nom_T = np.asarray(T_base_wobj_nominal, dtype=float)[:3, :3].T
 
@@ -89,7 +92,7 @@ def program_search_hook(
             return f"unreachable or colliding: check found no pose for point {pid}"
         pose = poses.get(pid if pid is not None else (other_searches or ""))
         if pose is None:
-            res = cell.check_search(command, step_m=step_m, tcp=tcp)
+            res = cell.check_search(command, step_m=step_m, tcp=tcp, exact_clearance=False)
         else:
             R = np.asarray(command.T_base_wobj_estimate, dtype=float)[:3, :3] @ R_nom_T
             res = cell.check_search(
@@ -100,6 +103,7 @@ def program_search_hook(
                 sensor_x=R @ pose.sensor_x_base,
                 branch=pose.branch,
                 max_starts=1,
+                exact_clearance=False,
             )
         return "" if res.feasible else f"unreachable or colliding: {res.reason}"
 

@@ -21,82 +21,45 @@ first is counted as landed off its face.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
-from calib.frames import check_transform, invert_transform
-from calib.models.robot_error import AccuracyField, RobotErrorModel
 from calib.models.touch import TouchProbe
 from calib.probing import ProbeResult, SearchCommand
 from planner.sim.raycast import MeshRayCaster
-from planner.sim.search_events import (
-    LANDED_OFF_FACE,
-    FaceLookup,
-    ProbeEvent,
-    ReachabilityHook,
-    robot_offset,
-)
+from planner.sim.search_events import LANDED_OFF_FACE
+from planner.sim.sensor_base import SimulatedSensor
 
 FloatArray = NDArray[np.float64]
 
 
 @dataclass
-class SimulatedTouchProbe:
+class SimulatedTouchProbe(SimulatedSensor):
     """A touch-probe callback against the true part at ``T_base_wobj_true``.
 
-    Args:
-        caster: ray caster of the part mesh in its own (wobj) frame.
-        T_base_wobj_true: ``(4, 4)`` where the part really is, base frame.
-        rng: random generator for robot and trigger noise.
+    Args (besides :class:`~planner.sim.sensor_base.SimulatedSensor`'s):
         sensor: the touch probe.
-        robot_error: robot repeatability and accuracy model.
-        accuracy_field: this robot's accuracy field, or None.
-        faces: planar faces of the part and the face each search should land on, or None.
-        tcp_error_m: ``(3,)`` this calibration's TCP error, sensor tool frame, m, or None.
-        reachability: optional hook that vets the path each successful search really ran.
-        edge_inset_m: unused (the proximity sensor's edge searches); accepted so that every
-            simulator is built alike (:mod:`planner.sim.sensors`).
-        edge_tolerance_m: unused, as ``edge_inset_m``.
+        edge_inset_m, edge_tolerance_m: unused (the proximity sensor's edge searches);
+            accepted so that every simulator is built alike (:mod:`planner.sim.sensors`).
     """
 
-    caster: MeshRayCaster
-    T_base_wobj_true: ArrayLike
-    rng: np.random.Generator
     sensor: TouchProbe = field(default_factory=TouchProbe)
-    robot_error: RobotErrorModel = field(default_factory=RobotErrorModel)
-    accuracy_field: AccuracyField | None = None
-    faces: FaceLookup | None = None
-    tcp_error_m: FloatArray | None = None
-    reachability: ReachabilityHook | None = None
-    edge_inset_m: float = 0.0
-    edge_tolerance_m: float = 0.0
-    events: list[ProbeEvent] = field(default_factory=list)
 
-    def __post_init__(self) -> None:
-        self.T_base_wobj_true = check_transform(self.T_base_wobj_true, "T_base_wobj_true")
-        self._T_wobj_base = invert_transform(self.T_base_wobj_true)
+    def _refusal(self, cmd: SearchCommand) -> str:
+        return "" if cmd.kind == "approach" else "a touch probe cannot run an edge search"
 
-    def _fail(self, cmd: SearchCommand, reason: str) -> ProbeResult:
-        self.events.append(ProbeEvent(cmd.point_id, cmd.kind, reason=reason))
-        return ProbeResult(point_m=None, reason=reason)
-
-    def __call__(self, cmd: SearchCommand) -> ProbeResult:
+    def _search(
+        self, cmd: SearchCommand, start: FloatArray, axis: FloatArray, tcp0: FloatArray
+    ) -> ProbeResult:
         """Run one commanded approach against the true part."""
-        if cmd.kind != "approach":
-            return self._fail(cmd, "a touch probe cannot run an edge search")
-        start = np.asarray(cmd.start_m, float)
-        axis = np.asarray(cmd.sensor_axis, float)
         direction = np.asarray(cmd.direction, float)
-        offset = robot_offset(
-            start, axis, self.rng, self.robot_error, self.accuracy_field, self.tcp_error_m
-        )
         if float(direction @ axis) < 1.0 - 1e-9:
             return self._fail(cmd, "touch probe: only approaches along the stylus axis")
         r = self.sensor.radius_m
         R, t = self._T_wobj_base[:3, :3], self._T_wobj_base[:3, 3]
-        centre0 = R @ (start + offset - r * axis) + t  # part frame from here on
+        centre0 = R @ (tcp0 - r * axis) + t  # part frame from here on
         a = R @ axis
         origins = centre0 + self.sensor.front_points_m(a)
         dist, tri = self.caster.first_hits_ids(origins, np.broadcast_to(a, origins.shape))
@@ -117,23 +80,19 @@ class SimulatedTouchProbe:
         )
         if travel > length:
             return self._fail(cmd, f"no contact within {length * 1e3:.0f} mm")
-        if self.reachability is not None:
-            why = self.reachability(replace(cmd, length_m=max(travel, 1e-6)))
-            if why:
-                return self._fail(cmd, why)
-        landing, frac = ("", 0.0) if self.faces is None else self.faces.landing(cmd.point_id, tri)
+        refused = self._vet(cmd, travel)
+        if refused is not None:
+            return refused
+        landing, frac = self._landing(cmd, tri)
         if self.faces is not None and not landing:
             want = self.faces.intended.get(cmd.point_id, -1)
             face = self.faces.triangle_face[on_face_of] if on_face_of >= 0 else -1
             if want >= 0 and face != want:  # the ball met an edge or another face first
                 landing = LANDED_OFF_FACE
-        self.events.append(
-            ProbeEvent(cmd.point_id, cmd.kind, landing=landing, off_fraction=frac, travel_m=travel)
-        )
         pole = start + travel * direction  # what the controller records (the TCP)
         n_est = -axis if cmd.stop_normal is None else np.asarray(cmd.stop_normal, float)
         point = pole - r * axis - r * n_est  # ball centre, then one radius along the normal
-        return ProbeResult(point_m=point, travel_m=travel)
+        return self._record(cmd, travel, point, (landing, frac))
 
 
 def sweep_contact(

@@ -1,5 +1,5 @@
 """One Monte Carlo trial, and the per-process state the trials share (see
-:func:`planner.sim.montecarlo.simulate`).
+:func:`planner.sim.montecarlo.simulate`; the worker processes: :mod:`planner.sim.trial_pool`).
 
 A worker process holds one :class:`~planner.sim.setup.SimulationSetup` and one ray caster of
 the part (:func:`init_worker`); each trial draws its own misplacement and noise from its own
@@ -13,8 +13,6 @@ the best fit of the same measurements fed as the procedure is fed
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -26,7 +24,6 @@ from calib.errors import InputError, ProbeFailedError
 from calib.frames import motion_between
 from calib.procedures.comparison import FedFit
 from planner.program.execute import execute
-from planner.sim.pool import kill_pool, open_pool
 from planner.sim.raycast import MeshRayCaster
 from planner.sim.search_events import ProbeEvent, ReachabilityHook, search_group
 from planner.sim.sensors import sensor_kind
@@ -39,13 +36,10 @@ __all__ = [
     "TrialResult",
     "TrialRunner",
     "init_worker",
-    "run_all",
     "run_chunk_in_worker",
 ]
 
 FloatArray = NDArray[np.float64]
-#: progress(done_trials, total_trials)
-ProgressCallback = Callable[[int, int], None]
 #: A trial's seed, or ``(noise seed, position seed)`` for the paper's protocol.
 TrialSeed = np.random.SeedSequence | tuple[np.random.SeedSequence, np.random.SeedSequence]
 
@@ -174,39 +168,3 @@ def init_worker(setup: SimulationSetup, mesh: trimesh.Trimesh) -> None:
 def run_chunk_in_worker(seeds: list[TrialSeed]) -> list[TrialResult]:
     """Run ``seeds`` on this worker process's runner (see :func:`init_worker`)."""
     return _PROCESS_RUNNER[0].run_chunk(seeds)
-
-
-def run_all(
-    setup: SimulationSetup,
-    mesh: trimesh.Trimesh,
-    seeds: list[TrialSeed],
-    n_workers: int,
-    reach: ReachabilityHook | None,
-    progress: ProgressCallback | None,
-    cell: Any = None,
-) -> list[TrialResult]:
-    """Run ``seeds`` in this process (1 worker; the only place a ``reach`` hook or a ``cell``
-    is used) or on a process pool, each process with its own :class:`TrialRunner`, built
-    once per process (:func:`init_worker`); ``progress(done, total)`` after every chunk."""
-    total = len(seeds)
-    chunk = max(1, min(100, math.ceil(total / (8 * n_workers))))
-    chunks = [seeds[i : i + chunk] for i in range(0, total, chunk)]
-    out: list[TrialResult] = []
-    if n_workers == 1:
-        runner = TrialRunner(setup, mesh, cell)
-        for c in chunks:
-            out.extend(runner.run_chunk(c, reach))
-            if progress is not None:
-                progress(len(out), total)
-        return out
-    pool = open_pool(n_workers, init_worker, (setup, mesh))
-    try:
-        for res in pool.map(run_chunk_in_worker, chunks):
-            out.extend(res)
-            if progress is not None:
-                progress(len(out), total)
-    except BaseException:  # Ctrl-C, SIGTERM, an error: no worker left running, no waiting
-        kill_pool(pool)
-        raise
-    pool.shutdown(wait=True)
-    return out

@@ -1,4 +1,6 @@
-"""The accuracy-versus-time front of a best-fit layout, and the fastest plan under a target.
+"""The accuracy-versus-time front of a grown layout (a procedure whose
+:class:`~calib.procedures.base.LayoutDesign` grows: the best fit, the iterative best fit), and
+the fastest plan under a target.
 
 For every size the design grows through (6 points up to ``max_points``,
 :func:`planner.suggest.steps.best_fit_design`), two plans are written and judged as
@@ -14,10 +16,12 @@ exported as it stands:
   its face; edge searches stay last, nearest first.
 
 Both are written with every search sized for the whole misplacement. When the controller runs
-a best fit adaptively, a third plan of each size takes the faster of the two orders with its
-searches ``steered`` (:func:`planner.suggest.search_sizing.steered_plan`): the searches after
-the first start nearer and run shorter, sized for what the estimate before them leaves. Only
-an adaptive program runs such a plan (a FANUC TP export refuses it), so its row says so.
+the procedure adaptively, steering it search by search (its registry entry's
+:class:`~calib.procedures.base.Steering`), a third plan of each size takes the faster of the
+two orders with its searches ``steered`` (:func:`planner.suggest.search_sizing.steered_plan`):
+the searches after the first start nearer and run shorter, sized for what the estimate before
+them leaves. Only an adaptive program runs such a plan (a FANUC TP export refuses it), so its
+row says so.
 
 Each row carries the check's predicted error at the confidence (the controller's program
 linearised, :func:`planner.check.job.plan_quality`) and its estimated cycle time
@@ -38,6 +42,7 @@ from numpy.typing import NDArray
 
 from calib.estimators.design import Design
 from calib.plan.file import Plan
+from calib.procedures import ProcedureKind
 from planner.check.cycle import cell_motion_limits
 from planner.check.job import check_plan, plan_quality
 from planner.check.results import PlanCheck
@@ -122,6 +127,7 @@ class FrontRow:
 def design_front(
     ctx: Context,
     plan: Plan,
+    kind: ProcedureKind,
     *,
     max_points: int,
     fmt: str | None,
@@ -132,12 +138,13 @@ def design_front(
 ) -> list[FrontRow]:
     """The front's rows (module docstring), sizes ascending, ``landing`` before ``time`` (a
     ``time`` row only where its order differs), then the steered row (only when the controller
-    ``fmt`` runs a best fit adaptively).
+    ``fmt`` steers ``kind`` search by search).
 
     Args:
         ctx: the suggestion's context (pool, sequencer, cell; its search sizing is reset for
             each design).
         plan: the plan the points are written into (its cell, part and models).
+        kind: the procedure of the plans written (its layout design grows).
         max_points: the largest size designed.
         fmt: the controller whose program is checked, predicted and timed.
         at_m: points of interest given on the command line, or None.
@@ -148,22 +155,25 @@ def design_front(
     designs: list[tuple[int, Design]] = []
     best_fit_design(ctx, None, max_points, 0, None, say, collect=designs)
     limits = cell_motion_limits(ctx.cell, plan, fmt)
-    steers = "best_fit" in controller(fmt).adaptive_methods
+    steers = kind.steering is not None and kind.method in controller(fmt).adaptive_methods
     rows: list[FrontRow] = []
     for k, (n, d) in enumerate(designs):
         say("front", k, len(designs))
-        landing = _row(ctx, plan, d, n, "landing", fmt, at_m, level_percent, target_m)
+        landing = _row(ctx, plan, kind, d, n, "landing", fmt, at_m, level_percent, target_m)
         rows.append(landing)
         order = _time_order(ctx, d.chosen, landing.check, limits)
         fast = (landing, d)
         if order is not None and order != tuple(d.chosen):
             timed = dataclasses.replace(d, chosen=order)
-            fast = (_row(ctx, plan, timed, n, "time", fmt, at_m, level_percent, target_m), timed)
+            fast = (
+                _row(ctx, plan, kind, timed, n, "time", fmt, at_m, level_percent, target_m),
+                timed,
+            )
             rows.append(fast[0])
         if steers and not ctx.pool.is_edge[list(d.chosen)].any():
             row, design = fast
-            steered = _steered_row(ctx, plan, design, n, row.order, fmt, at_m, level_percent,
-                                   target_m)  # fmt: skip
+            steered = _steered_row(ctx, plan, kind, design, n, row.order, fmt, at_m,
+                                   level_percent, target_m)  # fmt: skip
             if steered is not None:
                 rows.append(steered)
     say("front", len(designs), len(designs))
@@ -225,6 +235,7 @@ def fastest(rows: Sequence[FrontRow]) -> FrontRow | None:
 def _row(
     ctx: Context,
     plan: Plan,
+    kind: ProcedureKind,
     d: Design,
     n: int,
     order: Order,
@@ -236,13 +247,14 @@ def _row(
     """Write ``d`` as a plan (every search for the whole misplacement), add its vias, check,
     predict and time it."""
     ctx.size_searches(tuple(d.chosen))  # the searches sized about this layout's centroid
-    written = suggested_plan(plan, ctx, d, "best_fit", 0, at_m)
+    written = suggested_plan(plan, ctx, d, kind, 0, at_m)
     return _judged(ctx, written, n, order, fmt, level, target_m)
 
 
 def _steered_row(
     ctx: Context,
     plan: Plan,
+    kind: ProcedureKind,
     d: Design,
     n: int,
     order: Order,
@@ -255,7 +267,7 @@ def _steered_row(
     steered_plan`); None when that shortens no search (the floors already hold every one: the
     same program, which only an adaptive controller would run)."""
     ctx.size_searches(tuple(d.chosen))
-    whole = suggested_plan(plan, ctx, d, "best_fit", 0, at_m)
+    whole = suggested_plan(plan, ctx, d, kind, 0, at_m)
     written = steered_plan(whole)
     if [p.search for p in written.points] == [p.search for p in whole.points]:
         return None

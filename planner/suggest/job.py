@@ -22,7 +22,10 @@ points of interest) and proposes the points:
    the points measured before it, the whole misplacement for the first ones, stays on its
    face; points that fit in no order are set aside and the design redone), growing the number of
    points until the predicted error at every point of interest holds ``target_m`` at the
-   confidence, or ``max_points`` is reached (3-2-1: six points, every ordered triple of faces);
+   confidence, or ``max_points`` is reached: the procedure's
+   :class:`~calib.procedures.base.LayoutDesign` (its registry entry) says how, a *grown* design
+   (best fit, iterative best fit: any number of points, one role) or a *face* design (3-2-1:
+   3, 2 and 1 points on every ordered triple of faces far from parallel);
 4. via points where a joint move between two of the points would collide
    (:func:`planner.check.vias.plan_with_vias`: retract, or turn the shoulder or elbow);
 5. the written plan's quality predicted exactly (:func:`planner.check.job.plan_quality`: the
@@ -31,13 +34,15 @@ points of interest) and proposes the points:
    reach, landing risk): anything it refuses is named in the message and the result does not
    count as met (``wobjcal suggest`` exits 1).
 
-``add=N`` keeps the plan's points and adds the ``N`` best, by best fit (a 3-2-1 or A-H plan
-becomes a best fit of all its points: those procedures take exactly their own).
+``add=N`` keeps the plan's points and adds the ``N`` best, for a procedure whose design grows
+(a 3-2-1 or A-H plan becomes a plan of that procedure with all its points: those procedures
+take exactly their own).
 
-``objective="time"`` (best fit, with a target) writes instead the plan of least estimated cycle
-time whose predicted error holds the target: every size from 6 to ``max_points`` designed, each
-in its landing order and in the order of least joint-move time, all written, checked and timed
-(:mod:`planner.suggest.front`); ``front=True`` returns that front with either objective.
+``objective="time"`` (a grown design, with a target) writes instead the plan of least
+estimated cycle time whose predicted error holds the target: every size from 6 to
+``max_points`` designed, each in its landing order and in the order of least joint-move time,
+all written, checked and timed (:mod:`planner.suggest.front`); ``front=True`` returns that
+front with either objective.
 """
 
 from __future__ import annotations
@@ -55,12 +60,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.errors import InputError
+from calib.estimators.design import Design
 from calib.estimators.layout import search_constraint_set
 from calib.plan.bundle import rebased_plan
 from calib.plan.file import Plan, PlanError, PlanPoint
 from calib.plan.report_spec import PointOfInterest
 from calib.probing import ProbePoint, SearchSpec
-from calib.procedures import BestFit
+from calib.procedures import DESIGNED, GROWN, ProcedureKind
+from calib.procedures import PROCEDURES as ALL_PROCEDURES
+from calib.registry import lookup
 from planner.check.job import check_plan
 from planner.check.results import PlanCheck
 from planner.check.vias import plan_with_vias
@@ -87,12 +95,12 @@ from planner.suggest.steps import (
     Context,
     SuggestProgress,
     best_fit_design,
+    face_design,
     faces_text,
     feasible_poses,
     fixed_rows,
     nothing_message,
     suggested_plan,
-    three_two_one_design,
 )
 
 if TYPE_CHECKING:
@@ -100,7 +108,9 @@ if TYPE_CHECKING:
     from planner.sim.quality import LayoutQuality
 
 FloatArray = NDArray[np.float64]
-PROCEDURES = ("best_fit", "three_two_one")
+#: The procedures suggest designs for: those whose registry entry has a
+#: :class:`~calib.procedures.base.LayoutDesign` (:data:`calib.procedures.DESIGNED`).
+PROCEDURES = DESIGNED
 #: Candidates per planar face (after thinning).
 PER_FACE = 40
 
@@ -201,7 +211,7 @@ def suggest_plan(
     confidence_percent: float | None = None,
     at_m: FloatArray | None = None,
     max_points: int = 8,
-    procedure: str = "best_fit",
+    procedure: str = GROWN[0],
     add: int = 0,
     progress: SuggestProgress | None = None,
     cell: Cell | None = None,
@@ -219,10 +229,13 @@ def suggest_plan(
         target_m: the largest predicted half-width at the points of interest, metres.
         confidence_percent: the level of the target (default: the first report level).
         at_m: ``(K, 3)`` points of interest, wobj frame, metres (default: the plan's).
-        max_points: most points to suggest (best fit; 3-2-1 takes six).
-        procedure: ``"best_fit"`` or ``"three_two_one"``.
-        add: keep the plan's points and add this many (a plan of another procedure becomes a
-            best fit of all, :func:`as_best_fit`).
+        max_points: most points to suggest (a grown design; a face design takes its own
+            number, 3-2-1 six).
+        procedure: one of :data:`PROCEDURES` (a procedure with a layout design; default the
+            first whose layout grows, the best fit).
+        add: keep the plan's points and add this many (a procedure whose design grows; a plan
+            of another procedure becomes one of ``procedure`` with all its points,
+            :func:`as_procedure`).
         progress: ``progress(stage, done, total)``.
         cell: the plan's open cell (the UI's); ``None`` opens one.
         per_face: candidates per planar face.
@@ -232,17 +245,22 @@ def suggest_plan(
             an adaptive one by what the earlier searches leave.
         objective: ``"accuracy"`` (the least error: points added until the target holds, in
             the order they land in) or ``"time"`` (the least cycle time under ``target_m``;
-            best fit only, not with ``add``).
-        front: also return the accuracy-versus-time front (best fit only, not with ``add``).
+            a grown design only, not with ``add``).
+        front: also return the accuracy-versus-time front (a grown design only, not with
+            ``add``).
 
     Raises:
         SuggestError: no layout can be had (the message names faces and reasons).
         InputError: bad arguments, or a plan file that cannot load.
     """
-    if procedure not in PROCEDURES:
-        raise InputError(f"procedure: one of {', '.join(PROCEDURES)}, got {procedure!r}")
-    if add and procedure != "best_fit":
-        raise InputError("--add works with the best fit (3-2-1 takes exactly six points)")
+    kind = designed_procedure(procedure)
+    design = kind.design
+    assert design is not None  # designed_procedure returns only procedures with a design
+    if add and not design.grows:
+        raise InputError(
+            f"--add works with a procedure whose layout grows ({', '.join(grown_procedures())}; "
+            f"{kind.label} takes exactly {design.n_points} points)"
+        )
     if target_m is not None and not (math.isfinite(target_m) and target_m > 0):
         raise InputError(f"target: a positive distance, got {target_m!r} m")
     if max_points < 6 and not add:
@@ -254,10 +272,10 @@ def suggest_plan(
             "--objective time: the least cycle time under an accuracy target needs the target "
             "(--target MM)"
         )
-    if (objective == "time" or front) and (add or procedure != "best_fit"):
+    if (objective == "time" or front) and (add or not design.grows):
         what = "--add" if add else f"--procedure {procedure}"
         raise InputError(
-            f"--objective time and --front design a best fit from 6 to --max-points points; "
+            f"--objective time and --front design a {kind.label} from 6 to --max-points points; "
             f"{what} fixes the points (leave it out, or use --objective accuracy)"
         )
     if cell is None:
@@ -280,12 +298,14 @@ def suggest_plan(
     converted = ""
     if add and (why := plan.fixed_points()):
         raise InputError(f"--add: {why}")
-    if add and plan.method != "best_fit":  # 3-2-1 and A-H take exactly their own points
+    if add and plan.method != kind.method:  # 3-2-1 and A-H take exactly their own points
         converted = (
             f"; the plan's procedure {plan.method} takes exactly its own points, so the plan "
-            f"written is a best fit of all {len(plan.points) + add}"
+            f"written is a {kind.label} of all {len(plan.points) + add}"
+            if plan.method not in GROWN
+            else f"; the plan written is a {kind.label} of all {len(plan.points) + add}"
         )
-        plan = as_best_fit(plan)
+        plan = as_procedure(plan, kind)
     target_controller = controller(fmt)
     steered = procedure in target_controller.adaptive_methods
     t0 = time.perf_counter()
@@ -364,11 +384,11 @@ def suggest_plan(
     ctx.edge_start_m, ctx.edge_overtravel_m = edge_start, 2.0 * worst_shift + 0.02
     if objective == "time":
         return _fastest_plan(
-            ctx, plan, target_m, max_points, at_m, level, fmt, t0, tried, len(cands), rejected,
-            say,
+            ctx, plan, kind, target_m, max_points, at_m, level, fmt, t0, tried, len(cands),
+            rejected, say,
         )  # fmt: skip
     new_plan, design_note, check, history = _design_until_checked(
-        ctx, plan, procedure, target_m, max_points, add, fixed, at_m, steered, fmt, tried, say
+        ctx, plan, kind, target_m, max_points, add, fixed, at_m, steered, fmt, tried, say
     )
     say("prediction", 0, 1)
     quality, note = checked_quality(new_plan, check, mesh, fmt)
@@ -385,7 +405,7 @@ def suggest_plan(
             f"target {(target_m or 0.0) * 1e3:.3f} mm at {level:g} % not reached: the best "
             "layout of "
             f"{n} points gives {worst * 1e3:.3f} mm ("
-            + ("more points: --max-points; or " if procedure != "three_two_one" else "")
+            + ("more points: --max-points; or " if design.grows else "")
             + "a smaller noise or misplacement)"
         )
     if note:
@@ -401,7 +421,7 @@ def suggest_plan(
     rows: tuple[FrontRow, ...] = ()
     if front:  # the plan written marked (or added, when a redesign made it differ)
         drawn = design_front(
-            ctx, plan, max_points=max_points, fmt=fmt, at_m=at_m, level_percent=level,
+            ctx, plan, kind, max_points=max_points, fmt=fmt, at_m=at_m, level_percent=level,
             target_m=target_m, say=say,
         )  # fmt: skip
         rows = tuple(with_written(drawn, row_of(new_plan, check, quality, level, target_m)))
@@ -430,6 +450,7 @@ def suggest_plan(
 def _fastest_plan(
     ctx: Context,
     plan: Plan,
+    kind: ProcedureKind,
     target_m: float | None,
     max_points: int,
     at_m: FloatArray | None,
@@ -444,7 +465,7 @@ def _fastest_plan(
     """``objective="time"``: the front, and its fastest row that meets the target (or, when
     none does, the usable row of least error, else the first, with ``met`` False and why)."""
     rows = design_front(
-        ctx, plan, max_points=max_points, fmt=fmt, at_m=at_m, level_percent=level,
+        ctx, plan, kind, max_points=max_points, fmt=fmt, at_m=at_m, level_percent=level,
         target_m=target_m, say=say,
     )  # fmt: skip
     if not rows:
@@ -508,14 +529,38 @@ def _fastest_plan(
     )
 
 
-def as_best_fit(plan: Plan) -> Plan:
-    """``plan`` with its points kept as they are, every role ``fit`` and the best fit as its
-    procedure (the same edge-event offset): what ``--add`` grows a 3-2-1 or A-H plan into."""
+def designed_procedure(method: str) -> ProcedureKind:
+    """The registry entry of a procedure suggest designs for (:data:`PROCEDURES`).
+
+    Raises:
+        InputError: no such procedure, or one without a layout design (the message lists the
+            ones suggest designs for).
+    """
+    designed = {m: ALL_PROCEDURES[m] for m in PROCEDURES}
+    return lookup(designed, method, "procedure to suggest (--procedure)")
+
+
+def grown_procedures() -> tuple[str, ...]:
+    """The procedures whose layout suggest grows point by point (``--add``, ``--objective
+    time``): :data:`calib.procedures.GROWN`."""
+    return GROWN
+
+
+def as_procedure(plan: Plan, kind: ProcedureKind) -> Plan:
+    """``plan`` with its points kept as they are, each with the role of ``kind``'s grown design
+    and ``kind`` as its procedure (its default settings, the same edge-event offset): what
+    ``--add`` grows a 3-2-1 or A-H plan into.
+
+    Raises:
+        InputError: ``kind``'s layout does not grow (it takes a fixed set of points).
+    """
+    if kind.design is None or not kind.design.grows:
+        raise InputError(f"{kind.label} takes a fixed set of points: no plan grows into it")
     offset = getattr(plan.procedure, "edge_event_offset_m", None)
     return msgspec.structs.replace(
         plan,
-        points=[msgspec.structs.replace(p, role="fit") for p in plan.points],
-        procedure=BestFit(edge_event_offset_m=offset),
+        points=[msgspec.structs.replace(p, role=kind.design.role) for p in plan.points],
+        procedure=kind.settings_type(edge_event_offset_m=offset),
     )
 
 
@@ -527,7 +572,7 @@ REDESIGNS = 3
 def _design_until_checked(
     ctx: Context,
     plan: Plan,
-    procedure: str,
+    kind: ProcedureKind,
     target_m: float | None,
     max_points: int,
     add: int,
@@ -552,15 +597,12 @@ def _design_until_checked(
     """
     set_aside: dict[str, str] = {}
     for attempt in range(REDESIGNS + 1):
-        if procedure == "three_two_one":
-            design, history = three_two_one_design(ctx, say)
-        else:
-            design, history = best_fit_design(ctx, target_m, max_points, add, fixed, say)
+        design, history = _design(ctx, kind, target_m, max_points, add, fixed, say)
         if design is None:
             why = _no_layout(ctx, plan, steered, fmt, tried, set_aside)
-            change = _smallest_change(ctx, plan, procedure, max_points, add, fixed, fmt)
+            change = _smallest_change(ctx, plan, kind, max_points, add, fixed, fmt)
             raise SuggestError(why + (f". {change}" if change else ""))
-        new_plan = suggested_plan(plan, ctx, design, procedure, add, at_m)
+        new_plan = suggested_plan(plan, ctx, design, kind, add, at_m)
         say("moves between points", 0, 1)
         new_plan, via_notes = plan_with_vias(new_plan, ctx.cell)
         say("check", 0, 1)
@@ -590,6 +632,23 @@ def _design_until_checked(
     return new_plan, note, check, history
 
 
+def _design(
+    ctx: Context,
+    kind: ProcedureKind,
+    target_m: float | None,
+    max_points: int,
+    add: int,
+    fixed: tuple[FloatArray, FloatArray] | None,
+    say: SuggestProgress,
+) -> tuple[Design | None, list[tuple[int, float]]]:
+    """The design of ``kind``'s layout design: grown to the target, or over faces."""
+    design = kind.design
+    assert design is not None
+    if design.grows:
+        return best_fit_design(ctx, target_m, max_points, add, fixed, say)
+    return face_design(ctx, design.face_roles, say)
+
+
 #: Fractions of the plan's misplacement bound tried, largest first, to say at which bound a
 #: layout exists when none does at the plan's.
 BOUND_FRACTIONS = (0.75, 0.5, 0.35, 0.25, 0.15, 0.1)
@@ -598,7 +657,7 @@ BOUND_FRACTIONS = (0.75, 0.5, 0.35, 0.25, 0.15, 0.1)
 def _smallest_change(
     ctx: Context,
     plan: Plan,
-    procedure: str,
+    kind: ProcedureKind,
     max_points: int,
     add: int,
     fixed: tuple[FloatArray, FloatArray] | None,
@@ -619,10 +678,7 @@ def _smallest_change(
             off_face=set(), check_paths=False,
         )  # fmt: skip
         quiet: SuggestProgress = lambda stage, done, total: None  # noqa: E731
-        if procedure == "three_two_one":
-            design, _ = three_two_one_design(trial, quiet)
-        else:
-            design, _ = best_fit_design(trial, None, max_points, add, fixed, quiet)
+        design, _ = _design(trial, kind, None, max_points, add, fixed, quiet)
         return design is not None
 
     base = ctx.sequencer
@@ -630,7 +686,7 @@ def _smallest_change(
     label = f"the {controller(fmt).label} program"
     out = []
     if not base.steered and not bool(ctx.pool.is_edge.any()):
-        adaptive = [c.name for c in CONTROLLERS.values() if procedure in c.adaptive_methods]
+        adaptive = [c.name for c in CONTROLLERS.values() if kind.method in c.adaptive_methods]
         if adaptive and exists(_scaled(base, 1.0, steered=True)):
             out.append(
                 f"An adaptive program has a layout at this bound: --format {adaptive[0]} "

@@ -1,6 +1,8 @@
 """The steps of :func:`planner.suggest.suggest_plan`: feasibility of the candidates in the
-cell, the designs (best fit growing to the target, 3-2-1 over every triple of faces), the
-suggested plan, and the refusals' words.
+cell, the designs (a grown one, e.g. the best fit, growing to the target; a face one, e.g. the
+3-2-1, over every ordered set of faces: the procedure's
+:class:`~calib.procedures.base.LayoutDesign` says which), the suggested plan, and the refusals'
+words.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ from calib.estimators.layout import (
 from calib.plan.file import Plan, PlanPoint
 from calib.plan.report_spec import PointOfInterest, ReportSpec
 from calib.probing import ProbePoint, SearchSpec
-from calib.procedures import BestFit, ThreeTwoOne
+from calib.procedures import ProcedureKind
 from planner.faces.candidates import Candidates, FaceTried
 from planner.plan_cell import nominal_T_base_wobj
 from planner.program.safety import SafetySpec
@@ -159,16 +161,15 @@ class Context:
         return self.paths_ok(chosen)
 
     def sequence(self, chosen: tuple[int, ...], quota: dict[int, int] | None) -> Ordered:
-        """The measuring order of ``chosen`` (3-2-1: by ``quota``, largest group first) and
-        the candidates whose footprint leaves their face in it."""
+        """The measuring order of ``chosen`` (a face design: by face, in ``quota``'s order,
+        the roles' measuring order) and the candidates whose footprint leaves their face in
+        it."""
         if self.sequencer is None:
             return Ordered(chosen, ())
         if quota is None:
             return self.sequencer.order_progressive(chosen)
         face = self.pool.face
-        groups = [
-            [i for i in chosen if int(face[i]) == f] for f in sorted(quota, key=lambda f: -quota[f])
-        ]
+        groups = [[i for i in chosen if int(face[i]) == f] for f in quota]
         return self.sequencer.order_groups(groups)
 
     def weak(self, chosen: tuple[int, ...]) -> bool:
@@ -260,7 +261,7 @@ def _select_feasible(ctx: Context, n: int, **kw: object) -> Design | None:
     stuck: set[int] = set()
     for _ in range(50):
         blocked = np.array([ctx.path_ok.get(i, True) is False or i in stuck for i in range(len(A))])
-        if kw.get("quota") is not None:  # 3-2-1 takes approach searches only
+        if kw.get("quota") is not None:  # a face design takes approach searches only
             blocked |= ctx.pool.is_edge
         d = select(
             A,
@@ -342,46 +343,55 @@ def best_fit_design(
     return best, history
 
 
-def three_two_one_design(
-    ctx: Context, say: SuggestProgress
+def face_design(
+    ctx: Context, face_roles: tuple[tuple[str, int], ...], say: SuggestProgress
 ) -> tuple[Design | None, list[tuple[int, float]]]:
+    """A face design (:attr:`calib.procedures.base.LayoutDesign.face_roles`; the 3-2-1's
+    3, 2, 1): the best over every ordered set of planar faces, pairwise far from parallel, that
+    hold enough candidates, each face given its role's number of points."""
     face = ctx.pool.face
     count = {f: int(np.sum(face == f)) for f in set(face.tolist())}
     normals = {f: ctx.pool.normals[np.flatnonzero(face == f)[0]] for f in count}
+    need = [n for _, n in face_roles]
     best: Design | None = None
     best_worst = math.inf
-    triples = [
+    sets = [
         t
-        for t in itertools.permutations(sorted(count), 3)
-        if count[t[0]] >= 3
-        and count[t[1]] >= 2
+        for t in itertools.permutations(sorted(count), len(need))
+        if all(count[f] >= n for f, n in zip(t, need, strict=True))
         and all(abs(float(normals[a] @ normals[b])) < 0.5 for a, b in itertools.combinations(t, 2))
     ]
-    for k, (p, s, t) in enumerate(triples):
-        say("design", k, len(triples))
-        d = _select_feasible(ctx, 6, groups=face, quota={p: 3, s: 2, t: 1})
+    for k, faces in enumerate(sets):
+        say("design", k, len(sets))
+        quota = dict(zip(faces, need, strict=True))
+        d = _select_feasible(ctx, sum(need), groups=face, quota=quota)
         if d is None:
             continue
         worst = ctx.worst(d.covariance)
         if worst < best_worst:
             best, best_worst = d, worst
-    return best, ([(6, best_worst)] if best is not None else [])
+    return best, ([(sum(need), best_worst)] if best is not None else [])
 
 
 def suggested_plan(
-    plan: Plan, ctx: Context, d: Design, procedure: str, add: int, at_m: FloatArray | None
+    plan: Plan,
+    ctx: Context,
+    d: Design,
+    procedure: ProcedureKind,
+    add: int,
+    at_m: FloatArray | None,
 ) -> Plan:
-    roles = ["fit"] * len(d.chosen)
-    if procedure == "three_two_one":  # the face with three points is primary, two secondary
-        face = ctx.pool.face
-        counts = {
-            int(f): sum(int(face[i]) == int(f) for i in d.chosen) for f in face[list(d.chosen)]
-        }
-        name = {3: "primary", 2: "secondary", 1: "tertiary"}
-        chosen = sorted(d.chosen, key=lambda i: -counts[int(face[i])])
-        roles = [name[counts[int(face[i])]] for i in chosen]
-    else:
-        chosen = list(d.chosen)
+    """The plan of design ``d`` for ``procedure`` (its points with the roles of its layout
+    design; with ``add``, the plan's points and procedure kept, the new points added)."""
+    design = procedure.design
+    assert design is not None  # suggest designs only procedures with a layout design
+    face = ctx.pool.face
+    on_face = {int(f): sum(int(face[i]) == int(f) for i in d.chosen) for f in face[list(d.chosen)]}
+    chosen = list(d.chosen)
+    if not design.grows:  # the roles in their measuring order, each face's points together
+        rank = {n: k for k, (_, n) in enumerate(design.face_roles)}
+        chosen.sort(key=lambda i: rank[on_face[int(face[i])]])
+    roles = design.roles_of([on_face[int(face[i])] for i in chosen])
     taken = {p.id for p in plan.points} if add else set()
     ids: list[str] = []
     k = 1
@@ -395,15 +405,7 @@ def suggested_plan(
     ]
     points = list(plan.points) + new if add else new
     offset = getattr(plan.procedure, "edge_event_offset_m", None)
-    proc = (
-        plan.procedure
-        if add
-        else (
-            ThreeTwoOne(edge_event_offset_m=offset)
-            if procedure == "three_two_one"
-            else BestFit(edge_event_offset_m=offset)
-        )
-    )
+    proc = plan.procedure if add else procedure.settings_type(edge_event_offset_m=offset)
     report: ReportSpec = plan.validation.report
     if at_m is not None:
         pts = [

@@ -27,6 +27,8 @@ Example::
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
@@ -35,8 +37,8 @@ import trimesh
 
 from calib.errors import InputError
 from calib.plan.file import Plan
+from calib.procedures import procedure_kind
 from planner.check.simulatable import (
-    SIMULATED_PARTS,
     ProgressCallback,
     ValidationModels,
     check_simulatable,
@@ -51,13 +53,14 @@ from planner.program.build import measuring_program
 from planner.program.model import search_keys
 from planner.sim.budget import check_run_size, run_size, sensitivity_runs
 from planner.sim.montecarlo import simulate
-from planner.sim.report import PAPER_TABLE1, ValidationReport
+from planner.sim.report import ValidationReport
 from planner.sim.report_points import report_rows
+from planner.sim.rows import RowSpec
 from planner.sim.search_events import ProgramPose, program_search_hook
 from planner.sim.sensitivity import SensitivityTable, sensitivity
+from planner.sim.simulation_run import SimulationRun, start_simulation
 
 __all__ = [
-    "SIMULATED_PARTS",
     "ValidationModels",
     "check_simulatable",
     "prediction_setup",
@@ -132,41 +135,85 @@ def validate_plan(
     if check not in ("refuse", "report", "off"):
         raise InputError(f"check must be 'refuse', 'report' or 'off', got {check!r}")
     if check != "off" or reach_trials:
-        if cell is not None:
-            return _validate_in_cell(
-                plan, models, part, cell, trials, seed, workers, progress, reach_trials,
-                protocol, fmt, check == "refuse",
-            )  # fmt: skip
-        with open_cell(plan, folder) as own:
-            return _validate_in_cell(
-                plan, models, part, own, trials, seed, workers, progress, reach_trials,
-                protocol, fmt, check == "refuse",
-            )  # fmt: skip
+        # the trials outside the cell start on the workers first: they run while the cell
+        # opens and check judges the plan (an error of the start waits for check's verdict)
+        try:
+            started: _Started | InputError = _start(
+                plan, models, part, trials, seed, workers, protocol, fmt, reach_trials
+            )
+        except InputError as exc:
+            started = exc
+        try:
+            if cell is not None:
+                return _validate_in_cell(
+                    plan, started, cell, fmt, progress, reach_trials, check == "refuse"
+                )
+            with open_cell(plan, folder) as own:
+                return _validate_in_cell(
+                    plan, started, own, fmt, progress, reach_trials, check == "refuse"
+                )
+        finally:
+            if isinstance(started, _Started):
+                started.run.cancel()  # (nothing left to cancel once finished)
     return _simulate(plan, models, part, trials, seed, workers, progress, protocol, fmt)
+
+
+@dataclass
+class _Started:
+    """A validation whose trials outside the cell are running (:func:`_start`)."""
+
+    run: SimulationRun
+    rows: list[RowSpec]
+    paper: Mapping[tuple[str, float], float] | None
+
+
+def _start(
+    plan: Plan,
+    models: ValidationModels,
+    part: trimesh.Trimesh,
+    trials: int | None,
+    seed: int | None,
+    workers: int | None,
+    protocol: tuple[int, int] | None,
+    fmt: str | None,
+    vetted: int,
+) -> _Started:
+    """The preflight, the setup and the start of the Monte Carlo run of ``plan`` on ``part``
+    (the first ``vetted`` trials wait to be vetted in the cell)."""
+    preflight(plan, models, part)
+    setup = simulation_setup(plan, models, part, fmt)
+    rows = report_rows(plan.validation.report, part, models.geometry, setup.xoffset)
+    n = plan.validation.trials if trials is None else int(trials)
+    rng = np.random.default_rng(plan.validation.seed if seed is None else seed)
+    run = start_simulation(setup, part, n, rng, vetted=vetted, protocol=protocol, workers=workers)
+    return _Started(run, rows, _published(models))
+
+
+def _published(models: ValidationModels) -> Mapping[tuple[str, float], float] | None:
+    """The procedure's published half-widths (the paper's Table 1 for A-H), on a built-in
+    part; else None."""
+    return procedure_kind(models.method).published if models.geometry is not None else None
 
 
 def _validate_in_cell(
     plan: Plan,
-    models: ValidationModels,
-    part: trimesh.Trimesh,
+    started: _Started | InputError,
     cell: Any,
-    trials: int | None,
-    seed: int | None,
-    workers: int | None,
+    fmt: str | None,
     progress: ProgressCallback | None,
     reach_trials: int,
-    protocol: tuple[int, int] | None,
-    fmt: str | None,
     refuse: bool,
 ) -> ValidationReport:
-    """Check the plan in its open ``cell`` (check's verdict, and the poses the vetting uses),
-    then simulate."""
+    """Check the plan in its open ``cell`` (check's verdict, and the poses the vetting uses)
+    while the run's workers go on, then finish the run (the vetted trials here)."""
     from planner.check.job import check_plan
 
     checked = check_plan(plan, cell=cell, fmt=fmt)
     problems = checked.problems()
     if problems and refuse:
         raise PlanRefused(measuring_program(plan, fmt).name, problems)
+    if isinstance(started, InputError):
+        raise started
     hook = None
     if reach_trials:
         T_nom = nominal_T_base_wobj(plan)
@@ -182,10 +229,13 @@ def _validate_in_cell(
         # the x-offset run's searches are commanded with D's orientation (A-H programs)
         d = next((rp.point.id for rp in program.points if rp.role == "D"), None)
         hook = program_search_hook(cell, poses, keys, T_nom, plan.cell.tool.tcp, other_searches=d)
-    report = _simulate(
-        plan, models, part, trials, seed, workers, progress, protocol, fmt,
-        cell=cell if reach_trials else None, reachability=hook, reach_trials=reach_trials,
-    )  # fmt: skip
+    report = started.run.finish(
+        started.rows,
+        reachability=hook,
+        cell=cell if reach_trials else None,
+        paper=started.paper,
+        progress=progress,
+    )
     return dataclasses.replace(report, check_problems=problems)
 
 
@@ -205,7 +255,7 @@ def _simulate(
     preflight(plan, models, part)
     setup = simulation_setup(plan, models, part, fmt)
     rows = report_rows(plan.validation.report, part, models.geometry, setup.xoffset)
-    paper = PAPER_TABLE1 if models.geometry is not None and models.method == "hultman2013" else None
+    paper = _published(models)
     n = plan.validation.trials if trials is None else int(trials)
     rng = np.random.default_rng(plan.validation.seed if seed is None else seed)
     return simulate(

@@ -80,14 +80,28 @@ class NumericIK:
         self._lo = np.where(np.isfinite(chain.lower), chain.lower, -np.pi)
         self._hi = np.where(np.isfinite(chain.upper), chain.upper, np.pi)
         self._wrap = ~np.isfinite(chain.lower) | ~np.isfinite(chain.upper)
-        if rng is None:
-            from scipy.stats import qmc  # here: scipy.stats costs ~0.2 s at import
+        self._n_seeds = int(n_seeds)
+        self._seeds: NDArray[np.float64] | None = None
+        if rng is not None:  # drawn now: the caller's generator is used in its order
+            self._seeds = self._spread(rng.uniform(size=(int(n_seeds), n)))
 
-            unit = qmc.Halton(d=n, scramble=False).random(int(n_seeds) + 1)[1:]
-        else:
-            unit = rng.uniform(size=(int(n_seeds), n))
+    @property
+    def seeds(self) -> NDArray[np.float64]:
+        """``(n_seeds, n)`` the solver's own start configurations, rad: the middle of the
+        limits, then the Halton set (or the caller's random draws) spread over them. The
+        Halton set is made on first use: ``scipy.stats`` takes ~0.2 s to import (seconds on a
+        loaded machine), and a cell whose arm is OPW never solves numerically."""
+        if self._seeds is None:
+            from scipy.stats import qmc
+
+            unit = qmc.Halton(d=self.chain.n_joints, scramble=False).random(self._n_seeds + 1)
+            self._seeds = self._spread(unit[1:])
+        return self._seeds
+
+    def _spread(self, unit: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The middle of the limits and ``unit (k, n)`` points of the unit cube over them."""
         mid = 0.5 * (self._lo + self._hi)
-        self.seeds = np.vstack([mid, self._lo + unit * (self._hi - self._lo)])[: max(n_seeds, 1)]
+        return np.vstack([mid, self._lo + unit * (self._hi - self._lo)])[: max(self._n_seeds, 1)]
 
     def solve(self, T_base_tip: ArrayLike, seeds: ArrayLike | None = None) -> NumericIKResult:
         """Solve for ``N`` tip poses ``(N, 4, 4)`` (base frame).
