@@ -19,7 +19,8 @@ other job runs it and it sits below them), then side by side, importing none of 
 :mod:`planner.validate`, :mod:`planner.suggest`, :mod:`planner.calibrate`,
 :mod:`planner.export_plan`, :mod:`planner.sweep` and :mod:`planner.demo` (the built-in demo);
 :mod:`planner.cli` is the ``wobjcal`` command over them all. :mod:`planner.builtins` lists the
-built-in robots, tools and parts; :mod:`planner.errors` the planner's errors.
+built-in robots, tools and parts; :mod:`planner.errors` the planner's errors;
+:mod:`planner.reasons` why a pose, a search or a move fails, with its kind.
 """
 
 from calib._version import __version__

@@ -8,6 +8,7 @@ is a module, else to ``package``. Used by ``tests/test_import_graph.py``.
 from __future__ import annotations
 
 import ast
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -126,3 +127,133 @@ def cycles(graph_edges: list[Edge]) -> list[list[str]]:
         if v not in index:
             visit(v)
     return found
+
+
+# ---- reasons sorted by their words ------------------------------------------------------------
+#: Names of a reason's words: a variable or attribute called so holds what a person reads.
+REASON_NAME = re.compile(
+    r"^(?:.*_)?(?:reasons?|why|causes?|problems?|refusals?|failures?|messages?|msg)(?:_.*)?$"
+)
+#: The words of a :class:`planner.reasons.Reason` (``cause.text``), under a reason's name.
+WORDS = {"text", "note"}
+#: ``str`` methods that look for words in a text.
+SEARCHES = {
+    "startswith", "endswith", "find", "rfind", "index", "rindex", "count",
+    "split", "rsplit", "partition", "rpartition",
+}  # fmt: skip
+#: ``str`` methods whose only use on a reason is to compare its words.
+CASES = {"lower", "upper", "casefold"}
+#: ``re`` functions (and compiled patterns' methods) that look for words in a text.
+REGEX = {"search", "match", "fullmatch", "findall", "finditer", "sub", "subn", "split"}
+#: Calls looked through to the reason they are made on (``str(reason)``,
+#: ``reason.lower().strip()``).
+_THROUGH = CASES | {"strip", "lstrip", "rstrip"}
+
+
+@dataclass(frozen=True)
+class TextSort:
+    """A place that sorts a reason by its words.
+
+    Attributes:
+        module: dotted module name.
+        line: line number.
+        code: the expression, as source.
+    """
+
+    module: str
+    line: int
+    code: str
+
+
+def _chain(node: ast.AST) -> list[str] | None:
+    """The names along ``node`` (``check.pose_cause.text`` -> ``["check", "pose_cause",
+    "text"]``), looking through subscripts, ``str(...)`` and case or strip calls; ``None``
+    for anything else (a literal, a computed value)."""
+    names: list[str] = []
+    while True:
+        if isinstance(node, ast.Call):
+            f = node.func
+            if isinstance(f, ast.Attribute) and f.attr in _THROUGH and not node.args:
+                node = f.value
+            elif isinstance(f, ast.Name) and f.id == "str" and len(node.args) == 1:
+                node = node.args[0]
+            else:
+                return None
+        elif isinstance(node, ast.Subscript):
+            node = node.value
+        elif isinstance(node, ast.Attribute):
+            names.append(node.attr)
+            node = node.value
+        elif isinstance(node, ast.Name):
+            names.append(node.id)
+            return names[::-1]
+        else:
+            return None
+
+
+def is_reason_text(node: ast.AST) -> bool:
+    """``node`` holds a reason's words: its last name is a reason's (:data:`REASON_NAME`),
+    or it is a reason's ``text`` or ``note`` (``cause.text``); a reason's ``kind`` or
+    ``pair`` is not words."""
+    names = _chain(node)
+    if not names:
+        return False
+    last = names[-1]
+    if REASON_NAME.match(last):
+        return True
+    return last in WORDS and any(REASON_NAME.match(n) for n in names[:-1])
+
+
+def _words(node: ast.AST) -> bool:
+    """A text literal with words in it (an f-string too); ``""`` is no words."""
+    if isinstance(node, ast.Constant):
+        return isinstance(node.value, str) and node.value != ""
+    return isinstance(node, ast.JoinedStr)
+
+
+def _texts(node: ast.AST) -> bool:
+    """A tuple, list or set of text literals (``reason in ("a", "b")``)."""
+    return isinstance(node, ast.Tuple | ast.List | ast.Set) and any(_words(e) for e in node.elts)
+
+
+def text_sorts_in(tree: ast.AST, module: str = "<snippet>") -> list[TextSort]:
+    """Where ``tree`` sorts a reason by its words: a literal searched for in it (``"reach" in
+    reason``), compared with it (``reason == "singular wrist"``), looked for with a ``str``
+    method (``why.startswith("joint")``, ``reason.split("; ")``), a regular expression run on
+    it (``re.search(p, reason)``, ``PATTERN.sub("", reason)``), it put in one case
+    (``reason.lower()``), or it looked up among literals (``reason in ("a", "b")``)."""
+    out = []
+    for node in ast.walk(tree):
+        hit = False
+        if isinstance(node, ast.Compare):
+            left = node.left
+            for op, right in zip(node.ops, node.comparators, strict=True):
+                if isinstance(op, ast.In | ast.NotIn):
+                    hit |= _words(left) and is_reason_text(right)
+                    hit |= is_reason_text(left) and _texts(right)
+                elif isinstance(op, ast.Eq | ast.NotEq):
+                    hit |= _words(left) and is_reason_text(right)
+                    hit |= _words(right) and is_reason_text(left)
+                left = right
+        elif isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute):
+            attr, owner, args = node.func.attr, node.func.value, node.args
+            if attr in SEARCHES and is_reason_text(owner):
+                hit = any(_words(a) for a in args)
+            elif attr in CASES and not args:
+                hit = is_reason_text(owner)
+            if attr in REGEX and not hit:
+                # re.search(pattern, text), re.sub(pattern, repl, text); compiled: one less
+                is_re = isinstance(owner, ast.Name) and owner.id == "re"
+                at = int(is_re) + int(attr in ("sub", "subn"))
+                hit = len(args) > at and is_reason_text(args[at])
+        if hit:
+            out.append(TextSort(module, getattr(node, "lineno", 0), ast.unparse(node)))
+    return out
+
+
+def text_sorts(root: Path = ROOT) -> list[TextSort]:
+    """:func:`text_sorts_in` over every module of :data:`PACKAGES`."""
+    out = []
+    for mod, path in modules(root).items():
+        out += text_sorts_in(ast.parse(path.read_text(), filename=str(path)), mod)
+    return out

@@ -178,7 +178,8 @@ def test_the_planar_face_check_refuses_15_mm_end_strips_for_an_18_mm_sensor() ->
         (why,) = plan_face_reasons(
             mesh, [point], name="bracket", footprint_radius_m=SENSOR.footprint_radius_m
         )
-        assert "too narrow for the 18 mm sensor" in why
+        assert why is not None and why.kind == "footprint"
+        assert "too narrow for the 18 mm sensor" in why.text
 
 
 def test_a_20_mm_end_strip_holds_the_18_mm_sensor_however_the_stl_is_meshed() -> None:
@@ -186,9 +187,11 @@ def test_a_20_mm_end_strip_holds_the_18_mm_sensor_however_the_stl_is_meshed() ->
 
     point = ProbePoint("T1", (0.0, 0.09, 0.1), (-1.0, 0.0, 0.0), SearchSpec("approach"))
     fine = bracket_mesh().subdivide_to_size(0.02)
-    assert plan_face_reasons(fine, [point], footprint_radius_m=SENSOR.footprint_radius_m) == [""]
+    assert plan_face_reasons(fine, [point], footprint_radius_m=SENSOR.footprint_radius_m) == [None]
     coarse = bracket_mesh()  # the fewest triangles: what a CAD export without a chord limit gives
-    assert plan_face_reasons(coarse, [point], footprint_radius_m=SENSOR.footprint_radius_m) == [""]
+    assert plan_face_reasons(coarse, [point], footprint_radius_m=SENSOR.footprint_radius_m) == [
+        None
+    ]
 
 
 # --------------------------------------------------------------------------- check

@@ -114,6 +114,14 @@ def test_a_part_in_the_wrong_units_is_named_with_its_size(reference_dir: Path) -
     about_part = [p.reason for p in result.points if "work object plate_holes" in p.reason]
     assert about_part, [p.reason for p in result.points]
     assert all("203 x 305 x 12.7 m (file units 'm', given)" in r for r in about_part)
+    # the note goes where the reason says it measures the part, or its pair names the part
+    # (issue 23, item 3), and --json's reasons say the same words with their kinds
+    noted = [c for p in result.points for c in p.causes if c.note]
+    assert noted and all(c.about_part or "plate_holes" in (c.pair or ()) for c in noted)
+    assert {c.kind for c in noted} <= {"reach", "collision", "footprint"}
+    for p in result.points:
+        out = p.to_json()
+        assert "; ".join(r["text"] for r in out["reasons"]) == out["reason"]
 
 
 @pytest.mark.parametrize(

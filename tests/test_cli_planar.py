@@ -41,7 +41,7 @@ def test_shipped_plan_points_all_lie_on_planar_faces(capsys: pytest.CaptureFixtu
     plan = load_plan(STATOR)
     wo = load_work_object(plan.work_object.mesh, units=plan.work_object.units)
     reasons = plan_face_reasons(wo.mesh, [p.to_probe_point() for p in plan.points])
-    assert reasons == [""] * 8
+    assert reasons == [None] * 8
     code, out, _ = run(capsys, "check", str(STATOR), "--json")
     assert code == 0
     rows = json.loads(out)["points"]

@@ -1,16 +1,20 @@
-"""The import graph: no circles anywhere, and every package imports only the layers below it.
+"""The import graph: no circles anywhere, and every package imports only the layers below it;
+and no module sorts a reason by its words (issue 23, item 3).
 
 Read from the source (``tests/import_graph.py``): imports at module level, inside functions and
-under ``TYPE_CHECKING`` all count. ``docs/ARCHITECTURE.md`` draws the same layers.
+under ``TYPE_CHECKING`` all count. ``docs/ARCHITECTURE.md`` draws the same layers. A reason's
+kind is given where the outcome is decided (:mod:`planner.reasons`); whoever sorts reasons
+reads that kind, never the English text.
 """
 
 from __future__ import annotations
 
+import ast
 from pathlib import Path
 
 import pytest
 
-from tests.import_graph import Edge, cycles, edges, modules
+from tests.import_graph import Edge, cycles, edges, modules, text_sorts, text_sorts_in
 
 #: The jobs: one package (or the demo module) each, called by the CLI, the UI and scripts.
 #: ``check`` is the verdict every other job must give the program the robot will run (one
@@ -22,6 +26,7 @@ JOBS = tuple(f"planner.{name}" for name in JOB_NAMES)
 BELOW_JOBS = {
     "calib",
     "planner.errors",
+    "planner.reasons",
     "planner.builtins",
     "planner.robot",
     "planner.parts",
@@ -34,28 +39,26 @@ BELOW_JOBS = {
     "planner.results",
     "planner.plan_cell",
 }
+#: What every package of ``planner`` may import: ``calib``, the errors and the reasons (why a
+#: pose, a search or a move fails, with its kind: ``planner.reasons``, which imports nothing).
+BASE = {"calib", "planner.errors", "planner.reasons"}
 ALLOWED: dict[str, set[str]] = {
     "calib": set(),
     "planner": {"calib"},  # the version
     "planner.errors": {"calib"},
-    "planner.builtins": {"calib", "planner.errors"},
-    "planner.robot": {"calib", "planner.errors", "planner.builtins"},
-    "planner.parts": {"calib", "planner.errors"},
-    "planner.faces": {"calib", "planner.errors"},
-    "planner.cad": {"calib", "planner.errors", "planner.faces"},
-    "planner.cell": {"calib", "planner.errors", "planner.builtins", "planner.robot", "planner.cad"},
-    "planner.program": {"calib", "planner.errors"},
-    "planner.sim": {"calib", "planner.errors", "planner.parts", "planner.faces", "planner.program"},
-    "planner.export": {"calib", "planner.errors", "planner.program"},
-    "planner.results": {"calib", "planner.errors", "planner.export", "planner.plan_cell"},
-    "planner.plan_cell": {
-        "calib",
-        "planner.errors",
-        "planner.builtins",
-        "planner.robot",
-        "planner.cell",
-        "planner.export",
-    },
+    "planner.reasons": set(),
+    "planner.builtins": BASE,
+    "planner.robot": BASE | {"planner.builtins"},
+    "planner.parts": BASE,
+    "planner.faces": BASE,
+    "planner.cad": BASE | {"planner.faces"},
+    "planner.cell": BASE | {"planner.builtins", "planner.robot", "planner.cad"},
+    "planner.program": BASE,
+    "planner.sim": BASE | {"planner.parts", "planner.faces", "planner.program"},
+    "planner.export": BASE | {"planner.program"},
+    "planner.results": BASE | {"planner.export", "planner.plan_cell"},
+    "planner.plan_cell": BASE
+    | {"planner.builtins", "planner.robot", "planner.cell", "planner.export"},
     CHECK: BELOW_JOBS,
     **{job: BELOW_JOBS | {CHECK} for job in JOBS},
     "planner.cli": BELOW_JOBS | {CHECK, *JOBS},
@@ -65,7 +68,7 @@ ALLOWED: dict[str, set[str]] = {
 SUBPACKAGES = (
     "robot", "cad", "cell", "faces", "program", "sim", "parts", "export", "results", "cli",
 )  # fmt: skip
-TOP_MODULES = ("errors", "builtins", "plan_cell", "__main__")
+TOP_MODULES = ("errors", "reasons", "builtins", "plan_cell", "__main__")
 #: The one allowed upward import: ``wobjcal ui`` starts the web app, lazily, in one function.
 LAZY_UI = ("planner.cli.misc", "webui", "cmd_ui")
 #: At most this many modules directly in ``planner/`` (``__init__`` and ``__main__`` included).
@@ -147,3 +150,66 @@ def test_jobs_are_packages_and_the_top_level_is_small() -> None:
             assert (planner / name / "__init__.py").is_file(), name
     known = {f"{m}.py" for m in (*TOP_MODULES, "__init__", "demo")}
     assert set(top) <= known, f"a module of no known layer: {sorted(set(top) - known)}"
+
+
+#: Modules that may still look for words in a message, and why: neither sorts a feasibility or
+#: search outcome. Each must still do so (a stale entry fails).
+READS_WORDS = {
+    # msgspec's own validation errors (a library's words) turned into plan-field paths
+    "calib.plan.json_io",
+    # the layout's messages (the procedures' role_problem, the dry run) name their points and
+    # roles in words; the layout problem is not one of the outcomes given a kind
+    "webui.role_check",
+}
+
+
+def test_no_module_sorts_a_reason_by_its_words() -> None:
+    """Reasons are sorted by kind (``planner.reasons``): no module outside
+    :data:`READS_WORDS` searches, compares, splits or case-folds a reason's text."""
+    found = text_sorts()
+    bad = [f"{t.module}:{t.line}: {t.code}" for t in found if t.module not in READS_WORDS]
+    assert bad == [], "sort reasons by Reason.kind, not by their words"
+    assert {t.module for t in found} >= READS_WORDS, "an entry of READS_WORDS no longer applies"
+
+
+#: Text-sorting code (most of it what the heat map, suggest, the check and the status table
+#: did before reasons had kinds): each snippet must be caught.
+SORTS_BY_WORDS = (
+    'r = reason.lower()\nif "reach" in r or "no ik" in r:\n    pass',
+    'def f(status, reason):\n    text = reason.lower()\n    return "hit" in text',
+    'about = "out of reach" in reason or "from the surface" in reason',
+    'parts = check.reason.split("; ")',
+    "note = PART_NOTE.search(reason)",
+    'short = PART_NOTE.sub("", reason)',
+    're.match(r"^joint \\d", why)',
+    'if x.pose_reason.startswith("joint"):\n    pass',
+    'if cause.text.endswith("mm)"):\n    pass',
+    'if reasons[0] == "singular wrist":\n    pass',
+    'if str(p.cause) != "singular wrist":\n    pass',
+    'stuck = [p for p, problem in notes.items() if "added" not in problem]',
+    'if why in ("singular wrist", "near a singularity"):\n    pass',
+    'hit = f"{pair[0]} hits" in message',
+    'k = path_reason.find("at ")',
+)
+#: Code that reads a reason's kind and pair, or builds its words: none may be caught.
+SORTS_BY_KIND = (
+    'if cause.kind == "reach":\n    pass',
+    'if "table" in reason.pair:\n    pass',
+    "counts = {r.kind for r in check.causes}",
+    'text = "; ".join(str(r) for r in reasons)',
+    'why = f"search path: {path_reason}"',
+    "if not reason:\n    pass",
+    'if key.endswith("2") or flags.upper(j) > 0 or name.lower() == "x":\n    pass',
+    "if p.id in why:\n    pass",
+    'label = REJECTED_AS.get(cause.kind, "other")',
+)
+
+
+@pytest.mark.parametrize("code", SORTS_BY_WORDS)
+def test_the_rule_catches_a_reason_sorted_by_its_words(code: str) -> None:
+    assert len(text_sorts_in(ast.parse(code))) >= 1, code
+
+
+@pytest.mark.parametrize("code", SORTS_BY_KIND)
+def test_the_rule_lets_kinds_and_pairs_be_read(code: str) -> None:
+    assert text_sorts_in(ast.parse(code)) == [], code

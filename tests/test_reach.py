@@ -46,13 +46,16 @@ def test_wrist_centre_reasons(chain: KinematicChain) -> None:
     k = math.hypot(C3, A2)
     far = make_transform(p=[3.0, 0.0, C1])  # flange z along base z: wrist centre 0.14 m lower
     pattern = r"out of reach \(wrist centre (\d\.\d\d) m from the shoulder, reach (\d\.\d\d) m\)"
-    m = re.fullmatch(pattern, opw_wrist_reason(opw, far[None]))
+    out = opw_wrist_reason(opw, far[None])
+    assert out.kind == "reach" and out.about_part
+    m = re.fullmatch(pattern, out.text)
     assert m is not None
     assert float(m.group(1)) == pytest.approx(math.hypot(3.0 - A1, C4), abs=0.006)
     assert float(m.group(2)) == pytest.approx(C2 + k, abs=0.006)
     # close in front of the shoulder, inside the arm's dead zone |c2 - k|
     near = make_transform(p=[A1, 0.0, C1 + C4])
-    assert opw_wrist_reason(opw, near[None]).startswith("too close (wrist centre 0.00 m")
+    close = opw_wrist_reason(opw, near[None])
+    assert close.kind == "reach" and close.text.startswith("too close (wrist centre 0.00 m")
 
 
 def test_batched_reasons_are_the_per_point_ones(chain: KinematicChain) -> None:
@@ -75,6 +78,8 @@ def test_batched_reasons_are_the_per_point_ones(chain: KinematicChain) -> None:
     T = T[none]
     expected = [no_ik_reason(model, solver, chain, t) for t in T]
     assert no_ik_reasons(model, solver, chain, T) == expected
-    kinds = {e.split(" (")[0] for e in expected}
-    assert {"out of reach", "joint 2 at limit", "joint 3 at limit"} <= kinds
+    words = {e.text.split(" (")[0] for e in expected}
+    assert {"out of reach", "joint 2 at limit", "joint 3 at limit"} <= words
+    assert {e.kind for e in expected} == {"reach", "joint_limit"}
+    assert all(e.about_part == e.text.startswith("out of reach") for e in expected)
     assert no_ik_reasons(model, solver, chain, T[:0]) == []

@@ -43,6 +43,7 @@ ADDED = {
     "redundancy",  # issue 27: the points whose gross error calibrate cannot see
     "cycle_time_s",  # issue 26: the program's estimated cycle time
     "cycle_time",
+    "reasons",  # issue 23: every reason of a point with its kind (and a collision's pair)
 }
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")

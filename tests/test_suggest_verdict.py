@@ -21,6 +21,7 @@ import planner.suggest.job as suggest_mod
 from calib.models import Misplacement
 from calib.plan.file import load_plan
 from planner.check.results import PlanCheck
+from planner.reasons import Reason
 from planner.suggest import SuggestError, suggest_plan
 
 PLANS = Path(__file__).resolve().parents[1] / "assets" / "plans"
@@ -40,12 +41,8 @@ def test_a_point_check_refuses_is_set_aside_and_the_layout_redone(
             return checked
         first = checked.points[0]
         refused.append(np.asarray(new_plan.points[0].position_m))
-        bad = dataclasses.replace(
-            first,
-            status="infeasible",
-            search_reason="landing: lands off its face in 5% of calibrations",
-            reason="landing: lands off its face in 5% of calibrations",
-        )
+        why = Reason("search", "lands off its face in 5% of calibrations")
+        bad = dataclasses.replace(first, status="infeasible", landing_cause=why)
         return dataclasses.replace(checked, points=(bad, *checked.points[1:]))
 
     monkeypatch.setattr(suggest_mod, "check_plan", check_once)

@@ -25,6 +25,7 @@ from planner.check.job import check_plan
 from planner.export import FORMATS
 from planner.export_plan.job import export_program
 from planner.plan_cell import open_cell
+from planner.reasons import Reason
 
 PLANS = Path(__file__).resolve().parents[1] / "assets" / "plans"
 DEMO = PLANS / "stator_section_ah.json"
@@ -239,11 +240,10 @@ def test_vias_are_checked_from_every_point_a_program_comes_from(
     def only_from_h(*args: object, point_name: str = "point") -> moves.ViaPath:
         name = str(args[-1])
         if point_name != "C":  # the moves into the other points: clear here
-            return moves.ViaPath((), "")
+            return moves.ViaPath(())
         seen.append(name)
-        return moves.ViaPath(
-            (), "move H -> via 1 at 50 %: link_4 hits table" if name == "H" else ""
-        )
+        hit = Reason("move", "move H -> via 1 at 50 %: link_4 hits table", ("link_4", "table"))
+        return moves.ViaPath((), hit if name == "H" else None)
 
     monkeypatch.setattr(moves, "check_via_path", only_from_h)
     plan = with_vias(demo, 2, [(poses["C"] + LIFT).tolist()])

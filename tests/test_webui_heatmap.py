@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import trimesh
 
+from planner.reasons import Reason
 from webui.heatmap import (
     CATEGORY_RGB,
     category_of,
@@ -18,13 +19,22 @@ from webui.testing import box_mesh
 
 
 def test_each_failure_has_its_colour() -> None:
-    assert category_of("feasible", "", True) == "feasible"
-    assert category_of("marginal", "joint 2 near its limit", True) == "marginal"
-    assert category_of("feasible", "", False) == "footprint"
-    assert category_of("infeasible", "out of reach (2.87 m from the shoulder)", True) == "reach"
-    assert category_of("infeasible", "joint 5 at limit (joint_5)", True) == "joint limit"
-    assert category_of("infeasible", "singular wrist", True) == "joint limit"
-    assert category_of("infeasible", "link_4 hits table (clearance -3.0 mm)", True) == "collision"
+    """By the kind of the sample's reason (issue 23, item 3), whatever its words."""
+    assert category_of("feasible", None, True) == "feasible"
+    near = Reason("joint_limit", "joint 2 near its limit")
+    assert category_of("marginal", near, True) == "marginal"
+    assert category_of("feasible", None, False) == "footprint"
+    far = Reason("reach", "out of reach (2.87 m from the shoulder)")
+    assert category_of("infeasible", far, True) == "reach"
+    close = Reason("reach", "too close (wrist centre 0.10 m from the shoulder, min 0.20 m)")
+    assert category_of("infeasible", close, True) == "reach"
+    limit = Reason("joint_limit", "joint 5 at limit (joint_5)")
+    assert category_of("infeasible", limit, True) == "joint limit"
+    assert category_of("infeasible", Reason("singularity", "singular wrist"), True) == "joint limit"
+    hit = Reason("collision", "link_4 hits table (clearance -3.0 mm)", ("link_4", "table"))
+    assert category_of("infeasible", hit, True) == "collision"
+    every = Reason("collision", "every checked pose hits an obstacle or is too near one")
+    assert category_of("infeasible", every, False) == "collision", "what fails, not the face"
     assert len(set(CATEGORY_RGB.values())) == len(CATEGORY_RGB), "one colour per meaning"
 
 

@@ -1,6 +1,7 @@
 """The points' status table (issue 22, item 6): one row per point with an icon, a short first
 cause without the part's repeated size note, details on demand; the role flag never hides an
-infeasible point."""
+infeasible point. The causes are the check's reasons with their kinds (issue 23, item 3): the
+note and the pair are read from them, never found in the words."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import math
 
 from calib.probing import ProbePoint
 from planner.check.job import PointCheck
+from planner.reasons import Reason
 from webui.plan_doc import UiPlan, UiPoint
 from webui.scene import STATUS_RGB
 from webui.status_table import (
@@ -16,25 +18,29 @@ from webui.status_table import (
     details_markdown,
     first_cause,
     part_note,
+    short_cause,
     shorten,
     status_cell,
-    strip_part_note,
     table_rows,
 )
 
 NOTE = "work object plate: 0.203 x 0.305 x 0.0127 m (file units 'm', given)"
-REACH = f"out of reach (2.87 m from the shoulder) ({NOTE})"
-PATH = (
-    "search path: search from the safe start at 46.0 mm: sensor_body is too near table "
-    "(clearance 4.7 mm)"
+REACH = Reason("reach", "out of reach (2.87 m from the shoulder)", about_part=True, note=NOTE)
+PATH = Reason(
+    "collision",
+    "search from the safe start at 46.0 mm: sensor_body is too near table (clearance 4.7 mm)",
+    ("sensor_body", "table"),
 )
+PATH_WORDS = f"search path: {PATH.text}"
 
 
-def _check(pid: str, status: str, reason: str) -> PointCheck:
+def _check(
+    pid: str, status: str, pose: Reason | None = None, path: Reason | None = None
+) -> PointCheck:
     return PointCheck(
         point_id=pid, role="primary", kind="approach", status=status,  # type: ignore[arg-type]
-        reason=reason, pose_status=status, pose_reason="",  # type: ignore[arg-type]
-        path_feasible=True, path_reason="", path_fail_at_m=math.nan, face_reason="",
+        pose_status=status, pose_cause=pose,  # type: ignore[arg-type]
+        path_feasible=path is None, path_cause=path, path_fail_at_m=math.nan, face_cause=None,
         clearance_m=0.0123, clearance_pair=("link_6", "table"), clearance_is_lower_bound=False,
         confdata=None, ik_kind="opw", q=None, q_path=None, T_base_flange=None,
     )  # fmt: skip
@@ -49,24 +55,35 @@ def _doc() -> UiPlan:
 
 
 def test_the_part_note_is_said_once_not_in_every_reason() -> None:
-    assert strip_part_note(REACH) == "out of reach (2.87 m from the shoulder)"
-    assert part_note(REACH) == NOTE
-    assert causes(f"{REACH}; {PATH}") == ["out of reach (2.87 m from the shoulder)", PATH]
-    assert part_note(PATH) == ""
+    check = _check("P1", "infeasible", REACH, PATH)
+    assert check.reason == f"out of reach (2.87 m from the shoulder) ({NOTE}); {PATH_WORDS}"
+    assert [c.text for c in causes(check)] == [
+        "out of reach (2.87 m from the shoulder)",
+        PATH_WORDS,
+    ]
+    assert [c.kind for c in causes(check)] == ["reach", "collision"]
+    assert part_note(check) == NOTE
+    assert part_note(_check("P2", "infeasible", path=PATH)) == "" and causes(None) == []
 
 
 def test_the_first_cause_is_short_and_cut_at_a_word() -> None:
-    short = shorten(PATH)
+    short = shorten(PATH_WORDS)
     assert len(short) <= SHORT_CHARS + 2 and short.endswith(" …")
-    assert PATH.startswith(short[:-2])
+    assert PATH_WORDS.startswith(short[:-2])
     assert shorten("joint 3 at limit (joint_3)") == "joint 3 at limit (joint_3)"
+    # a long collision is named by its kind and pair, which cutting the words would lose
+    (path,) = causes(_check("P1", "infeasible", path=PATH))
+    assert short_cause(path) == "collision: sensor_body – table"
+    move = Reason("move", "move B -> via 1 at 50 %: " + PATH.text, PATH.pair)
+    assert short_cause(move) == "move: sensor_body – table"
+    assert short_cause(REACH) == "out of reach (2.87 m from the shoulder)", "short: as it is"
 
 
 def test_rows_have_an_icon_a_short_cause_and_infeasible_wins_over_the_role_flag() -> None:
     doc = _doc()
     checks = {
-        "P1": _check("P1", "infeasible", f"{REACH}; {PATH}"),
-        "P2": _check("P2", "feasible", ""),
+        "P1": _check("P1", "infeasible", REACH, PATH),
+        "P2": _check("P2", "feasible"),
     }
     flags = {"P1": "role P1 is odd", "P2": "three_two_one: P2 must have normal (0, 0, 1)"}
     rows = table_rows(doc, checks, flags, "(none)")
@@ -84,7 +101,7 @@ def test_rows_have_an_icon_a_short_cause_and_infeasible_wins_over_the_role_flag(
 
 def test_details_give_every_cause_the_note_once_and_the_point() -> None:
     doc = _doc()
-    check = _check("P1", "infeasible", f"{REACH}; {PATH}")
+    check = _check("P1", "infeasible", REACH, PATH)
     md = details_markdown(doc.get("P1"), check, "")
     lines = md.splitlines()
     assert lines[0].startswith("**P1**: ") and "infeasible" in lines[0]

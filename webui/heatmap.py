@@ -9,9 +9,10 @@ map, not a verdict; a click checks its point fully), in chunks queued on the cel
 clicks from any tab slip in between chunks, the map grows on screen as chunks finish, and
 unticking the box stops it. A chunk's size adapts so that it takes about
 :data:`CHUNK_SECONDS`. Each sample is coloured by what fails (:data:`CATEGORY_RGB`: out of
-reach, joint limit or singular wrist, collision, sensor footprint off a planar face) or by its
-status; at the end each face of a refined copy of the surface takes one of those colours by a
-vote of the samples near it (:func:`face_colours`): one colour per face, never a blend.
+reach, joint limit or singular wrist, collision, sensor footprint off a planar face: the kind
+of its reason, :data:`CATEGORY_OF_KIND`) or by its status; at the end each face of a refined
+copy of the surface takes one of those colours by a vote of the samples near it
+(:func:`face_colours`): one colour per face, never a blend.
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ from calib.errors import InputError
 from planner.cell.probe_status import probe_statuses
 from planner.cell.reachability_map import sample_surface
 from planner.faces.checks import check_probe_faces
+from planner.reasons import Reason
 from webui.scene import STATUS_RGB
 
 if TYPE_CHECKING:
@@ -58,6 +60,14 @@ CATEGORY_MEANING: dict[str, str] = {
     "collision": "robot or tool collides",
     "footprint": "sensor footprint off a planar face",
 }
+#: The colour of an infeasible sample by the kind of its reason (any other, or none: ``reach``).
+CATEGORY_OF_KIND: dict[str, str] = {
+    "reach": "reach",
+    "joint_limit": "joint limit",
+    "singularity": "joint limit",
+    "collision": "collision",
+    "footprint": "footprint",
+}
 #: The map's search over the sensor's rotation: coarser than a click's (15 deg, 48 checks).
 ROTATION_STEP_DEG = 45.0
 MAX_CHECKS = 4
@@ -76,20 +86,13 @@ DENSE_FACES = 20_000
 BLEND_K = 6
 
 
-def category_of(status: str, reason: str, on_face: bool) -> str:
-    """What a sample's colour says (a key of :data:`CATEGORY_RGB`)."""
-    if status == "feasible" and not on_face:
-        return "footprint"
+def category_of(status: str, cause: Reason | None, on_face: bool) -> str:
+    """What a sample's colour says (a key of :data:`CATEGORY_RGB`): its status where it can
+    be probed, the footprint where that is off a planar face, else the kind of its ``cause``
+    (:data:`CATEGORY_OF_KIND`)."""
     if status in ("feasible", "marginal"):
         return status if on_face else "footprint"
-    text = reason.lower()
-    if "reach" in text or "no ik" in text or "no solution" in text:
-        return "reach"
-    if "limit" in text or "singular" in text:
-        return "joint limit"
-    if "hit" in text or "near" in text or "clearance" in text:
-        return "collision"
-    return "reach"
+    return "reach" if cause is None else CATEGORY_OF_KIND.get(cause.kind, "reach")
 
 
 def _features(points: NDArray[np.float64], normals: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -223,7 +226,7 @@ class HeatMap:
         nrm: NDArray[np.float64],
         tcp: str,
         stop: threading.Event,
-    ) -> tuple[list[tuple[str, str]], float]:
+    ) -> tuple[list[tuple[str, Reason | None]], float]:
         if stop.is_set() or session is None or session.cell is None:
             return [], 0.0
         t0 = time.perf_counter()
@@ -231,14 +234,14 @@ class HeatMap:
             session.cell, pts, nrm, tcp=tcp, rotation_step_deg=ROTATION_STEP_DEG,
             max_checks=MAX_CHECKS,
         )  # fmt: skip
-        return list(zip(res.statuses, res.reasons)), time.perf_counter() - t0
+        return list(zip(res.statuses, res.causes)), time.perf_counter() - t0
 
     def rgb(self) -> NDArray[np.uint8]:
         """``(n, 3)`` colours of the samples checked so far (by :data:`CATEGORY_RGB`)."""
         return np.array([CATEGORY_RGB[c] for c in self.categories], dtype=np.uint8).reshape(-1, 3)
 
     def _chunk_done(
-        self, fut: Future[tuple[list[tuple[str, str]], float]], stop: threading.Event
+        self, fut: Future[tuple[list[tuple[str, Reason | None]], float]], stop: threading.Event
     ) -> None:
         if stop is not self._stop:  # a chunk of an earlier, stopped map
             return
@@ -248,9 +251,9 @@ class HeatMap:
         try:
             results, seconds = fut.result()
             n0 = len(self.scores)
-            for i, (status, reason) in enumerate(results):
+            for i, (status, cause) in enumerate(results):
                 self.scores.append(SCORE.get(status, 0.0))
-                self.categories.append(category_of(status, reason, bool(self.on_face[n0 + i])))
+                self.categories.append(category_of(status, cause, bool(self.on_face[n0 + i])))
             if results:  # the next chunk takes about CHUNK_SECONDS
                 rate = len(results) / max(seconds, 1e-3)
                 self._chunk = int(min(MAX_CHUNK, max(1, CHUNK_SECONDS * rate)))

@@ -3,20 +3,22 @@
 One row per point: an icon and the status (✓ feasible, ⚠ marginal, ✗ infeasible, … being
 checked; the icon follows the check, so a point its procedure cannot use, flagged **role** in
 purple beside it, still shows ✗ when it cannot be probed), the point's id and role, and the
-first cause, short: the check's first reason (or the role flag's when the check passes), with
-the part's size note (``(work object NAME: 0.2 x 0.3 x 0.0127 m (file units 'm', given))``,
-which the check adds to every reason about the part) left out and cut at
-:data:`SHORT_CHARS`. :func:`details_markdown` gives every cause of one point, one per line,
-with the part's note once, its clearance, position and search: the Points tab shows it for
-the tab's selected point.
+first cause, short: the check's first reason (or the role flag's when the check passes)
+without the part's size note (``work object NAME: 0.2 x 0.3 x 0.0127 m (file units 'm',
+given)``, which the check adds to every reason about the part), cut at :data:`SHORT_CHARS`; a
+collision cut short names its pair (:func:`short_cause`). :func:`details_markdown` gives every
+cause of one point, one per line, with the part's note once, its clearance, position and
+search: the Points tab shows it for the tab's selected point. The causes are the check's
+:class:`planner.reasons.Reason` s (:attr:`planner.check.results.PointCheck.causes`): their
+text, note and pair, never words searched for.
 """
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping
 
 from planner.check.job import PointCheck
+from planner.reasons import Reason
 from webui.markdown_text import plain
 from webui.plan_doc import NO_ROLE, UiPlan, UiPoint
 from webui.scene import STATUS_RGB
@@ -25,8 +27,6 @@ from webui.scene import STATUS_RGB
 ICON: dict[str, str] = {"feasible": "✓", "marginal": "⚠", "infeasible": "✗", "checking": "…"}
 #: The first cause is cut at about this many characters (at a word), with "…".
 SHORT_CHARS = 64
-#: The note the check adds to reasons about the part: its name, size and file units.
-PART_NOTE = re.compile(r"\s*\((work object [^()]*\(file units [^()]*\))\)")
 #: The header of the table.
 HEADER = ("| status | point | role | first cause |", "|---|---|---|---|")
 #: Below the table: where the rest is.
@@ -38,21 +38,15 @@ def _colour(rgb: tuple[int, int, int], text: str) -> str:
     return f"<span style='color:rgb({r},{g},{b})'>{text}</span>"
 
 
-def strip_part_note(reason: str) -> str:
-    """``reason`` without the part's size note (``(work object ... (file units ...))``)."""
-    return PART_NOTE.sub("", reason)
+def causes(check: PointCheck | None) -> list[Reason]:
+    """The check's causes in order (``[]`` without a check)."""
+    return [] if check is None else list(check.causes)
 
 
-def part_note(reason: str) -> str:
-    """The part's size note in ``reason`` (``work object NAME: ... (file units 'm', given)``),
-    or ``""``."""
-    m = PART_NOTE.search(reason)
-    return "" if m is None else m.group(1)
-
-
-def causes(reason: str) -> list[str]:
-    """The causes in a check's reason (joined by ``"; "``), each without the part's note."""
-    return [c for c in (strip_part_note(x).strip() for x in reason.split("; ")) if c]
+def part_note(check: PointCheck | None) -> str:
+    """The part's size note the check added to its reasons about the part (``work object
+    NAME: ... (file units 'm', given)``), or ``""``."""
+    return next((r.note for r in causes(check) if r.note), "")
 
 
 def shorten(text: str, limit: int = SHORT_CHARS) -> str:
@@ -61,6 +55,15 @@ def shorten(text: str, limit: int = SHORT_CHARS) -> str:
         return text
     cut = text[:limit].rsplit(" ", 1)[0].rstrip(",;:(")
     return cut + " …"
+
+
+def short_cause(cause: Reason, limit: int = SHORT_CHARS) -> str:
+    """A cause for the table, without the part's note: its text when short; else one with a
+    pair (a collision, a move's collision) named by its kind and pair, e.g. ``"collision:
+    sensor_body – table"``, and any other cut at a word (:func:`shorten`)."""
+    if len(cause.text) <= limit or cause.pair is None:
+        return shorten(cause.text, limit)
+    return shorten(f"{cause.kind}: {cause.pair[0]} – {cause.pair[1]}", limit)
 
 
 def status_cell(check: PointCheck | None, flag: str) -> str:
@@ -78,12 +81,12 @@ def status_cell(check: PointCheck | None, flag: str) -> str:
 def first_cause(check: PointCheck | None, flag: str) -> str:
     """The short reason of a row: the check's first cause, or the role flag's when the check
     passes (``""``: nothing to say)."""
-    found = causes(check.reason) if check is not None else []
+    found = causes(check)
     if check is not None and check.status == "infeasible" and found:
-        return shorten(found[0])
+        return short_cause(found[0])
     if flag:
-        return shorten(strip_part_note(flag))
-    return shorten(found[0]) if found else ""
+        return shorten(flag)
+    return short_cause(found[0]) if found else ""
 
 
 def table_rows(
@@ -107,13 +110,13 @@ def details_markdown(point: UiPoint, check: PointCheck | None, flag: str) -> str
     cause of its check, the role flag, the part's note once, the clearance of the probe pose,
     its position (mm) and normal (wobj frame) and its search (mm)."""
     lines = [f"**{plain(point.id)}**: {status_cell(check, flag)}"]
-    reasons = [] if check is None else causes(check.reason)
-    lines += [f"- {plain(c)}" for c in reasons]
+    reasons = causes(check)
+    lines += [f"- {plain(c.text)}" for c in reasons]
     if flag:
-        lines.append(f"- role: {plain(strip_part_note(flag))}")
+        lines.append(f"- role: {plain(flag)}")
     if check is not None and not reasons and check.status == "feasible":
         lines.append("- reachable, search path clear")
-    note = part_note(check.reason if check is not None else "") or part_note(flag)
+    note = part_note(check)
     if note:
         lines.append(f"- part: {plain(note)}")
     if check is not None and check.clearance_m == check.clearance_m:  # not NaN

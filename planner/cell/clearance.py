@@ -11,6 +11,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from planner.reasons import Reason, ReasonKind
+
 
 @dataclass(frozen=True)
 class Clearance:
@@ -36,6 +38,11 @@ class Clearance:
             return "no collision"
         verb = "hits" if self.clearance_m < 0 else "is too near" if not self.ok else "is near"
         return f"{self.pair[0]} {verb} {self.pair[1]} (clearance {self.clearance_m * 1e3:.1f} mm)"
+
+    def reason(self, prefix: str = "", kind: ReasonKind = "collision") -> Reason:
+        """:meth:`describe` as a :class:`~planner.reasons.Reason` of ``kind`` (a collision;
+        ``"move"`` for a move between points) with the limiting pair, after ``prefix``."""
+        return Reason(kind, prefix + self.describe(), self.pair)
 
 
 @dataclass(frozen=True)

@@ -41,6 +41,7 @@ from planner.cell.probe_candidates import (
 )
 from planner.cell.probe_choice import ProbeSearch
 from planner.cell.probe_rule import CLEARANCE_TIE_M, Decision, select
+from planner.reasons import Reason
 
 if TYPE_CHECKING:
     from planner.cell.scene import CellScene
@@ -72,9 +73,12 @@ class ProbeFeasibility:
         feasible: True when a collision-free, within-limits, non-singular pose was found.
         status: ``"feasible"``, ``"marginal"`` (feasible with small clearance or joint-limit
             margin) or ``"infeasible"``.
-        reason: empty when ``status == "feasible"``; otherwise why, e.g. ``"out of reach
-            (2.87 m from the shoulder, reach 1.92 m)"``, ``"joint 5 at limit"``,
-            ``"singular wrist"``, ``"link_4 hits table (clearance -3.0 mm)"``.
+        cause: ``None`` when ``status == "feasible"``; otherwise why, with its kind
+            (:class:`planner.reasons.Reason`), e.g. ``"out of reach (2.87 m from the
+            shoulder, reach 1.92 m)"`` (``reach``), ``"joint 5 at limit"`` (``joint_limit``),
+            ``"singular wrist"`` (``singularity``), ``"link_4 hits table (clearance -3.0
+            mm)"`` (``collision``, with its pair); a marginal pose's small clearance is a
+            ``collision`` with its pair, its joint near a limit a ``joint_limit``.
         q: ``(n,)`` joint values of the chosen pose, rad; for an infeasible pose the least-bad
             candidate checked, ``None`` when there is no IK candidate at all.
         branch: IK branch of ``q`` (OPW configuration 0-7), -1 when unknown or none.
@@ -89,7 +93,7 @@ class ProbeFeasibility:
 
     feasible: bool
     status: Status
-    reason: str
+    cause: Reason | None
     q: FloatArray | None
     branch: int
     rotation_rad: float
@@ -98,15 +102,21 @@ class ProbeFeasibility:
     T_base_flange: FloatArray | None
     clearance_pair: tuple[str, str] | None = None
 
+    @property
+    def reason(self) -> str:
+        """The words of :attr:`cause` (``""`` when feasible)."""
+        return "" if self.cause is None else str(self.cause)
 
-def _near_limit_reason(chain: KinematicChain, q: FloatArray) -> str:
+
+def _near_limit_reason(chain: KinematicChain, q: FloatArray) -> Reason:
     """E.g. ``joint 3 near its upper limit (joint_3, 4.3 deg to go)`` for one ``q (n,)``."""
     to_lower, to_upper = q - chain.lower, chain.upper - q
     j = int(np.argmin(np.minimum(to_lower, to_upper)))
     side, left = ("lower", to_lower[j]) if to_lower[j] < to_upper[j] else ("upper", to_upper[j])
-    return (
+    return Reason(
+        "joint_limit",
         f"joint {j + 1} near its {side} limit ({chain.joint_names[j]}, "
-        f"{math.degrees(float(left)):.1f} deg to go)"
+        f"{math.degrees(float(left)):.1f} deg to go)",
     )
 
 
@@ -162,7 +172,7 @@ def check_probes(
         else:
             decisions = _reference(cell, cands, margin, max_checks)
     return [
-        feasibility_of(cell.chain, cands, i, d, margin) if d is not None else _none(why or "")
+        feasibility_of(cell.chain, cands, i, d, margin) if d is not None else _none(why)
         for i, (d, why) in enumerate(zip(decisions, cands.reasons))
     ]
 
@@ -228,20 +238,21 @@ def feasibility_of(
     joint_margin = float(cands.limit_margin[i, c])
     fine = cl.slack_m >= margin and joint_margin >= MARGINAL_LIMIT_RAD
     status: Status = "infeasible" if not d.chosen else "feasible" if fine else "marginal"
+    cause: Reason | None
     if status == "feasible":
-        reason = ""
+        cause = None
     elif status == "marginal":
-        reason = (
-            f"small clearance: {cl.describe()}"
+        cause = (
+            cl.reason("small clearance: ")
             if cl.slack_m < margin
             else _near_limit_reason(chain, cands.q[i, c])
         )
     else:
-        reason = cl.describe()
+        cause = cl.reason()
     return ProbeFeasibility(
         feasible=d.chosen,
         status=status,
-        reason=reason,
+        cause=cause,
         q=cands.q[i, c].copy(),
         branch=int(cands.branch[i, c]),
         rotation_rad=float(cands.angles[r]),
@@ -252,6 +263,6 @@ def feasibility_of(
     )
 
 
-def _none(reason: str) -> ProbeFeasibility:
+def _none(cause: Reason | None) -> ProbeFeasibility:
     nan = float("nan")
-    return ProbeFeasibility(False, "infeasible", reason, None, -1, nan, nan, nan, None)
+    return ProbeFeasibility(False, "infeasible", cause, None, -1, nan, nan, nan, None)

@@ -25,6 +25,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from planner.reasons import Reason
+
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
     from planner.robot.kinematics.chain import KinematicChain
@@ -41,13 +43,22 @@ class MoveCheck:
 
     Attributes:
         tcp_path_world: ``(steps, 3)`` the TCP along the move, world frame, m.
-        problem: where and what collides first (``""``: the move is clear).
-        pair: ``(moving link, other)`` of the first collision, or ``None``.
+        cause: where and what collides first, a ``move`` reason with the colliding pair
+            (``None``: the move is clear).
     """
 
     tcp_path_world: FloatArray
-    problem: str
-    pair: tuple[str, str] | None = None
+    cause: Reason | None = None
+
+    @property
+    def problem(self) -> str:
+        """The words of :attr:`cause` (``""``: the move is clear)."""
+        return "" if self.cause is None else str(self.cause)
+
+    @property
+    def pair(self) -> tuple[str, str] | None:
+        """``(moving link, other)`` of the first collision, or ``None``."""
+        return None if self.cause is None else self.cause.pair
 
 
 def joint_limit_problem(chain: KinematicChain, q: ArrayLike) -> str:
@@ -95,9 +106,9 @@ def check_joint_move(
             cell.set_joint_positions(q)
             c = cell.clearance()
             if not c.ok:
-                where = f"at {100 * k // (steps - 1)} %: {c.describe()}"
-                return MoveCheck(T[:, :3, 3].copy(), where, c.pair)
-    return MoveCheck(T[:, :3, 3].copy(), "")
+                where = c.reason(f"at {100 * k // (steps - 1)} %: ", kind="move")
+                return MoveCheck(T[:, :3, 3].copy(), where)
+    return MoveCheck(T[:, :3, 3].copy())
 
 
 @dataclass(frozen=True)
@@ -108,12 +119,18 @@ class ViaPath:
     Attributes:
         legs: ``(from, to, check)`` per move checked, named ``"start"``, ``"via 1"``, ...,
             ``"point"`` (a leg is missing when an end is not known).
-        problem: the first problem: a via outside the joint limits or a colliding leg, naming the
-            via and the clearance pair; ``""``: the path is clear.
+        cause: the first problem, a ``move`` reason: a via outside the joint limits or a
+            colliding leg, naming the via and the clearance pair (its ``pair``); ``None``: the
+            path is clear.
     """
 
     legs: tuple[tuple[str, str, MoveCheck], ...]
-    problem: str
+    cause: Reason | None = None
+
+    @property
+    def problem(self) -> str:
+        """The words of :attr:`cause` (``""``: the path is clear)."""
+        return "" if self.cause is None else str(self.cause)
 
 
 def check_via_path(
@@ -144,11 +161,12 @@ def check_via_path(
         n for n, t in zip(chain.joint_names, chain.joint_types, strict=True) if t == "prismatic"
     ]
     if vias_q and sliding:  # the programs write via joint targets in degrees (rad: URScript)
-        return ViaPath((), f"vias need a robot of rotary joints; {sliding[0]} is prismatic")
+        why = f"vias need a robot of rotary joints; {sliding[0]} is prismatic"
+        return ViaPath((), Reason("move", why))
     for k, q in enumerate(vias_q, start=1):
         why = joint_limit_problem(cell.chain, q)
         if why:
-            return ViaPath((), f"via {k}: {why}")
+            return ViaPath((), Reason("move", f"via {k}: {why}"))
     names = [f"via {k}" for k in range(1, len(vias_q) + 1)]
     stops: list[tuple[str, FloatArray]] = [
         (n, np.asarray(q, dtype=np.float64)) for n, q in zip(names, vias_q, strict=True)
@@ -161,6 +179,6 @@ def check_via_path(
     for (na, qa), (nb, qb) in itertools.pairwise(stops):
         move = check_joint_move(cell, qa, qb, tcp)
         legs.append((na, nb, move))
-        if move.problem:
-            return ViaPath(tuple(legs), f"move {na} -> {nb} {move.problem}")
-    return ViaPath(tuple(legs), "")
+        if move.cause is not None:
+            return ViaPath(tuple(legs), move.cause.worded(f"move {na} -> {nb} "))
+    return ViaPath(tuple(legs))

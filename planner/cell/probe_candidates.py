@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.frames import invert_transform
+from planner.reasons import Reason
 from planner.robot.reach import no_ik_reasons
 
 if TYPE_CHECKING:
@@ -34,6 +35,9 @@ WRIST_SINGULAR_RAD = math.radians(5.0)
 MIN_SINGULAR_VALUE = 0.05
 #: A joint closer than this to a limit makes a feasible pose marginal, rad.
 MARGINAL_LIMIT_RAD = math.radians(5.0)
+#: The reasons of :func:`singular`: an OPW arm's wrist, another arm's Jacobian.
+SINGULAR_WRIST = Reason("singularity", "singular wrist")
+NEAR_SINGULARITY = Reason("singularity", "near a singularity")
 
 
 def tcp_frames(points: FloatArray, normals: FloatArray, angles: FloatArray) -> FloatArray:
@@ -64,15 +68,15 @@ def limit_margin(chain: KinematicChain, q: FloatArray) -> FloatArray:
         return np.min(np.minimum(q - chain.lower, chain.upper - q), axis=-1)
 
 
-def singular(cell: CellScene, q: FloatArray) -> tuple[BoolArray, str]:
+def singular(cell: CellScene, q: FloatArray) -> tuple[BoolArray, Reason]:
     """Mask ``(M,)`` of configurations ``q (M, n)`` too near a singularity, and the reason."""
     if cell.solver.kind == "opw" and q.shape[1] == 6:
-        return np.abs(np.sin(q[:, 4])) < math.sin(WRIST_SINGULAR_RAD), "singular wrist"
+        return np.abs(np.sin(q[:, 4])) < math.sin(WRIST_SINGULAR_RAD), SINGULAR_WRIST
     _, J = cell.chain.fk_jacobian(q)
     Js = J.copy()
     Js[:, :3] /= max(cell.reach_model.reach_m, 1e-9)
     sv = np.linalg.svd(Js, compute_uv=False)[:, -1]
-    return sv < MIN_SINGULAR_VALUE, "near a singularity"
+    return sv < MIN_SINGULAR_VALUE, NEAR_SINGULARITY
 
 
 @dataclass(frozen=True)
@@ -99,7 +103,7 @@ class ProbeCandidates:
     limit_margin: FloatArray
     near_limit: BoolArray
     motion: FloatArray
-    reasons: tuple[str | None, ...]
+    reasons: tuple[Reason | None, ...]
 
     @property
     def per_rotation(self) -> int:
@@ -143,7 +147,7 @@ def probe_candidates(
     valid = sol.valid.reshape(N, R * K)
     q = sol.q.reshape(N, R * K, n)
     usable = valid.copy()
-    sing_reason = "singular wrist"
+    sing_reason = SINGULAR_WRIST
     margin = np.full((N, R * K), -np.inf)
     motion = np.full((N, R * K), np.inf)
     if valid.any():
@@ -155,7 +159,7 @@ def probe_candidates(
         mv = np.full(qv.shape[0], np.inf)
         mv[ok] = np.linalg.norm(qv[ok] - q_ref, axis=-1)
         motion[valid] = mv
-    reasons: list[str | None] = [None] * N
+    reasons: list[Reason | None] = [None] * N
     none_valid = np.flatnonzero(~valid.any(axis=1))
     for i, why in zip(
         none_valid.tolist(),

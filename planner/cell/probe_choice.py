@@ -273,14 +273,15 @@ class ProbeSearch:
         look = self.stages.look_slack_m
         rows = sorted(range(len(order)), key=lambda j: -min(bound.get(j, look), flags.upper(j)))
         for j in rows:
-            if flags.all_clear(j):
-                return Verdict("marginal")  # the look distance: no collision
+            if flags.all_clear(j):  # the look distance: no collision, so a joint near its limit
+                return Verdict("marginal", "joint_limit")
             if min(bound.get(j, look), flags.upper(j)) < 0.0 and j not in exact:
                 continue  # shown to collide
             if j not in exact:
                 run(j, 0.0, certify=True)
             if j in exact:
                 if exact[j].slack_m >= CLEARANCE_TIE_M:
-                    return Verdict("marginal")
+                    near = exact[j].slack_m >= self.margin  # clear enough: near a limit
+                    return Verdict("marginal", "joint_limit" if near else "collision")
                 tie = tie or exact[j].slack_m >= 0.0
-        return None if tie else Verdict("infeasible")
+        return None if tie else Verdict("infeasible", "collision")

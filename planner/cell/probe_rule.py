@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planner.cell.clearance import Clearance
+from planner.reasons import ReasonKind
 
 BoolArray = NDArray[np.bool_]
 
@@ -56,9 +57,13 @@ class Verdict:
     Attributes:
         status: ``"marginal"`` (the least-bad candidate does not collide) or
             ``"infeasible"`` (every candidate collides).
+        kind: what kept the candidate that settled it from passing: ``"collision"`` (it
+            collides, or comes nearer than the margin) or ``"joint_limit"`` (a joint near its
+            limit).
     """
 
     status: Literal["marginal", "infeasible"]
+    kind: ReasonKind
 
 
 def select(

@@ -30,13 +30,16 @@ from numpy.typing import ArrayLike, NDArray
 from planner.cell.feasibility import Status, feasibility_of, prepare_candidates
 from planner.cell.probe_choice import ProbeSearch
 from planner.cell.probe_rule import Verdict
+from planner.reasons import Reason
 
 if TYPE_CHECKING:
     from planner.cell.scene import CellScene
 
-#: The reason of a point whose every candidate collides, found without its least-bad pose.
+#: The reason of a point whose every candidate collides, found without its least-bad pose
+#: (so without the pair that limits it): a ``collision``.
 EVERY_POSE_HITS = "every checked pose hits an obstacle or is too near one"
-#: The reason of a marginal point found without its least-bad pose.
+#: The reason of a marginal point found without its least-bad pose; its kind is what kept the
+#: candidate that settled it from passing (:attr:`planner.cell.probe_rule.Verdict.kind`).
 NO_POSE_WITH_MARGIN = "no pose keeps the full clearance and joint margin; one does not collide"
 
 
@@ -47,16 +50,21 @@ class ProbeStatuses:
     Attributes:
         statuses: per point ``"feasible"``, ``"marginal"`` or ``"infeasible"``, those of
             :func:`planner.cell.feasibility.check_probes` with the same arguments.
-        reasons: per point, :func:`check_probes`'s reason where its pose was found (feasible
+        causes: per point, :func:`check_probes`'s cause where its pose was found (feasible
             points, points without any IK candidate within limits, and the rest where the
             shortcut could not decide); else :data:`EVERY_POSE_HITS` or
-            :data:`NO_POSE_WITH_MARGIN`.
-        exact: ``(N,)`` True where ``reasons[i]`` is :func:`check_probes`'s own.
+            :data:`NO_POSE_WITH_MARGIN`; ``None`` for a feasible point.
+        exact: ``(N,)`` True where ``causes[i]`` is :func:`check_probes`'s own.
     """
 
     statuses: tuple[Status, ...]
-    reasons: tuple[str, ...]
+    causes: tuple[Reason | None, ...]
     exact: NDArray[np.bool_]
+
+    @property
+    def reasons(self) -> tuple[str, ...]:
+        """The words of :attr:`causes` (``""`` for none)."""
+        return tuple("" if c is None else str(c) for c in self.causes)
 
 
 def probe_statuses(
@@ -85,18 +93,19 @@ def probe_statuses(
     with cell.saved_state():
         decisions = ProbeSearch(cell, margin, max_checks, statuses_only=True).run(cands)
     statuses: list[Status] = []
-    reasons: list[str] = []
+    causes: list[Reason | None] = []
     exact = np.ones(len(decisions), dtype=bool)
     for i, (d, why) in enumerate(zip(decisions, cands.reasons)):
         if d is None:
             statuses.append("infeasible")
-            reasons.append(why or "")
+            causes.append(why)
         elif isinstance(d, Verdict):
             statuses.append(d.status)
-            reasons.append(EVERY_POSE_HITS if d.status == "infeasible" else NO_POSE_WITH_MARGIN)
+            text = EVERY_POSE_HITS if d.status == "infeasible" else NO_POSE_WITH_MARGIN
+            causes.append(Reason(d.kind, text))
             exact[i] = False
         else:
             res = feasibility_of(cell.chain, cands, i, d, margin)
             statuses.append(res.status)
-            reasons.append(res.reason)
-    return ProbeStatuses(tuple(statuses), tuple(reasons), exact)
+            causes.append(res.cause)
+    return ProbeStatuses(tuple(statuses), tuple(causes), exact)

@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 
 from calib.errors import ShapeError
 from planner.cell.feasibility import check_probes
+from planner.reasons import Reason
 
 if TYPE_CHECKING:
     from planner.cell.scene import CellScene
@@ -40,7 +41,8 @@ class ReachabilityMap:
             pose was checked).
         joint_margin_rad: ``(M,)`` smallest joint-limit distance of the chosen pose, rad (NaN
             when none).
-        reasons: ``(M,)`` the reason strings (empty for feasible samples).
+        causes: ``(M,)`` why each sample is infeasible or marginal, with its kind (``None``
+            for feasible samples).
     """
 
     points_wobj: FloatArray
@@ -49,7 +51,12 @@ class ReachabilityMap:
     status: NDArray[np.int8]
     clearance_m: FloatArray
     joint_margin_rad: FloatArray
-    reasons: tuple[str, ...]
+    causes: tuple[Reason | None, ...]
+
+    @property
+    def reasons(self) -> tuple[str, ...]:
+        """``(M,)`` the words of :attr:`causes` (``""`` for feasible samples)."""
+        return tuple("" if c is None else str(c) for c in self.causes)
 
     @property
     def feasible(self) -> NDArray[np.bool_]:
@@ -104,5 +111,5 @@ def reachability_map(
         status=np.array([_CODES[r.status] for r in res], dtype=np.int8),
         clearance_m=np.array([r.clearance_m for r in res], dtype=float),
         joint_margin_rad=np.array([r.joint_margin_rad for r in res], dtype=float),
-        reasons=tuple(r.reason for r in res),
+        causes=tuple(r.cause for r in res),
     )

@@ -33,6 +33,7 @@ from planner.cell.feasibility import (
     tcp_frames,
 )
 from planner.cell.path_clearance import first_failure
+from planner.reasons import Reason
 from planner.robot.reach import no_ik_reason
 
 if TYPE_CHECKING:
@@ -48,8 +49,10 @@ class PathFeasibility:
 
     Attributes:
         feasible: True when the whole path passes.
-        reason: empty when feasible; else why, with the distance, e.g. ``"at 23.0 mm: link_5
-            hits clamp (clearance 2.1 mm)"``.
+        cause: ``None`` when feasible; else why, with the distance, e.g. ``"at 23.0 mm:
+            link_5 hits clamp (clearance 2.1 mm)"`` (a ``collision`` with its pair), ``"at 0.0
+            mm: out of reach (...)"`` (``reach``; leaving the pose's IK branch too), a joint at
+            its limit (``joint_limit``), a singularity or a joint's jump (``singularity``).
         fail_at_m: distance along the path of the first failing sample, m (NaN if feasible).
         s_m: ``(M,)`` distances of the samples from the start, m.
         q_path: ``(M', n)`` joint values of the samples that passed (all ``M`` when feasible),
@@ -61,13 +64,18 @@ class PathFeasibility:
     """
 
     feasible: bool
-    reason: str
+    cause: Reason | None
     fail_at_m: float
     s_m: FloatArray
     q_path: FloatArray
     rotation_rad: float
     branch: int
     min_clearance_m: float
+
+    @property
+    def reason(self) -> str:
+        """The words of :attr:`cause` (``""`` when feasible)."""
+        return "" if self.cause is None else str(self.cause)
 
 
 def check_search(
@@ -153,11 +161,11 @@ def check_search(
         if not starts.valid.any():
             reason = no_ik_reason(cell.reach_model, cell.solver, cell.chain, T_start @ T_tcp_flange)
         elif branch is not None and branch >= 0 and not (starts.branch == branch).any():
-            reason = f"no solution on IK branch {branch} (the probe pose's)"
+            reason = Reason("reach", f"no solution on IK branch {branch} (the probe pose's)")
         else:
-            reason = "singular at the start"
-
-        return PathFeasibility(False, f"at 0.0 mm: {reason}", 0.0, s, empty, math.nan, -1, math.nan)
+            reason = Reason("singularity", "singular at the start")
+        at_start = reason.worded("at 0.0 mm: ")
+        return PathFeasibility(False, at_start, 0.0, s, empty, math.nan, -1, math.nan)
     if sensor_x is None:  # free choice: least motion, away from the limits first
         motion = np.where(ok0, np.linalg.norm(np.nan_to_num(q0 - ref), axis=-1), np.inf)
         near = limit_margin(cell.chain, np.nan_to_num(q0)) < MARGINAL_LIMIT_RAD
@@ -210,24 +218,24 @@ def _walk(
     M = s.size
     q_path = np.empty((M, q_start.size))
     prev = q_start
-    fail_j, reason = M, ""
+    fail_j, reason = M, None
     for j in range(M):
         ok = sol.valid[j] & ((sol.branch[j] == branch) if branch >= 0 else True)
         if not ok.any():
             fail_j = j
-            why = (
+            reason = (
                 no_ik_reason(cell.reach_model, cell.solver, cell.chain, T_flange[j : j + 1])
                 if not sol.valid[j].any()
-                else (f"leaves IK branch {branch}")
+                else Reason("reach", f"leaves IK branch {branch}")
             )
-            reason = why
             break
         d = np.where(ok, np.abs(sol.q[j] - prev).max(axis=-1), np.inf)
         k = int(np.argmin(d))
         if j > 0 and d[k] > jump:
             fail_j = j
             jj = int(np.argmax(np.abs(sol.q[j, k] - prev)))
-            reason = f"joint {jj + 1} jumps {math.degrees(d[k]):.1f} deg"
+            # a joint flips between two samples: the path passes near a singularity
+            reason = Reason("singularity", f"joint {jj + 1} jumps {math.degrees(d[k]):.1f} deg")
             break
         q_path[j] = prev = sol.q[j, k]
     if fail_j > 0:
@@ -239,22 +247,22 @@ def _walk(
         skip = s[:fail_j] > skip_from
         j, cl = first_failure(cell, q_path[:fail_j], T_flange[:fail_j], skip, margin)
         if cl is not None:
-            fail_j, reason = j, cl.describe()
+            fail_j, reason = j, cl.reason()
         min_cl = math.nan
     for j in range(fail_j if exact_clearance else 0):
         cell.set_joint_positions(q_path[j])
         cl = cell.clearance(margin, sensor_wobj_allowed=True, skip_wobj=s[j] > skip_from)
         min_cl = min(min_cl, cl.clearance_m)
         if not cl.ok:
-            fail_j, reason = j, cl.describe()
+            fail_j, reason = j, cl.reason()
             break
     min_cl = min_cl if math.isfinite(min_cl) else math.nan
-    if fail_j == M:
-        return PathFeasibility(True, "", math.nan, s, q_path, rotation, branch, min_cl)
+    if fail_j == M or reason is None:
+        return PathFeasibility(True, None, math.nan, s, q_path, rotation, branch, min_cl)
     at = float(s[fail_j])
     return PathFeasibility(
         False,
-        f"at {at * 1e3:.1f} mm: {reason}",
+        reason.worded(f"at {at * 1e3:.1f} mm: "),
         at,
         s,
         q_path[:fail_j].copy(),

@@ -63,6 +63,7 @@ from planner.program.build import measuring_program, plan_settings, safety_spec
 from planner.program.controllers import controller
 from planner.program.execute import execute
 from planner.program.reach import search_problems
+from planner.reasons import Reason
 
 if TYPE_CHECKING:
     import trimesh
@@ -302,19 +303,15 @@ def _outlines(faces: PlanarFaces, radius_m: float) -> FaceOutlines:
     return out
 
 
-def _with_landing(checks: Sequence[PointCheck], problems: dict[str, str]) -> tuple[PointCheck, ...]:
+def _with_landing(
+    checks: Sequence[PointCheck], problems: dict[str, Reason]
+) -> tuple[PointCheck, ...]:
     """``checks`` with the points whose searches go wrong too often made infeasible."""
     out = []
     for c in checks:
-        why = problems.get(c.point_id, "")
-        if why:
-            search = "; ".join(x for x in (c.search_reason, why) if x)
-            c = replace(
-                c,
-                status="infeasible",
-                search_reason=search,
-                reason="; ".join(x for x in (c.reason, f"landing: {why}") if x),
-            )
+        why = problems.get(c.point_id)
+        if why is not None:
+            c = replace(c, status="infeasible", landing_cause=why)
         out.append(c)
     return tuple(out)
 
@@ -429,7 +426,7 @@ def check_via_moves(cell: Cell, plan: Plan, checks: Sequence[PointCheck]) -> tup
     for i, (p, c) in enumerate(zip(plan.points, checks, strict=True)):
         vias = p.via_points
         q_point = c.q_safe if c.pose_status != "infeasible" else None
-        problem = ""
+        problem: Reason | None = None
         for prev in before.get(i, [None]):
             q_prev = None
             if prev is not None and checks[prev].pose_status != "infeasible":
@@ -437,24 +434,16 @@ def check_via_moves(cell: Cell, plan: Plan, checks: Sequence[PointCheck]) -> tup
             name = "previous point" if prev is None else ids[prev]
             qs = [v.q_rad for v in vias]
             path = check_via_path(cell, q_prev, qs, q_point, tcp, name, point_name=p.id)
-            if path.problem:
-                problem = path.problem
+            if path.cause is not None:
+                problem = path.cause
                 break
-        if not vias and not problem:
+        if not vias and problem is None:
             continue
-        why = ""
-        if problem:
-            why = (
-                f"vias: {problem}"
-                if vias
-                else f"{problem} (add via points: Teach tab, or `wobjcal check --add-vias`)"
-            )
         out[i] = replace(
             c,
             n_vias=len(vias),
-            via_reason=problem,
-            status="infeasible" if why else c.status,
-            reason="; ".join(x for x in (c.reason, why) if x),
+            via_cause=problem,
+            status="infeasible" if problem is not None else c.status,
         )
     return tuple(out)
 
@@ -476,7 +465,7 @@ def _check(plan: Plan, points: list[PlanPoint], cell: Cell) -> tuple[tuple[Point
         faces = plan_face_reasons(wo.mesh, probes, name=wo.name, footprint_radius_m=radius)
     except NoPlanarFaceError as exc:  # the plan cannot work on this part
         error = str(exc)
-        faces = [error] * len(points)
+        faces = [Reason("footprint", error, about_part=True)] * len(points)
     P = np.array([p.position_m for p in points], dtype=float).reshape(-1, 3)
     N = np.array([p.normal for p in points], dtype=float).reshape(-1, 3)
     poses = cell.check_probes(P, N, tcp=plan.cell.tool.tcp)
@@ -495,12 +484,7 @@ def _check(plan: Plan, points: list[PlanPoint], cell: Cell) -> tuple[tuple[Point
         )
         check = _point_check(cell, p, pose, path, face, ik_kind, t0, T_flange_tcp)
         if p.id in reach:
-            check = replace(
-                check,
-                status="infeasible",
-                search_reason=reach[p.id],
-                reason="; ".join(x for x in (check.reason, f"search: {reach[p.id]}") if x),
-            )
+            check = replace(check, status="infeasible", search_cause=reach[p.id])
         out.append(_with_part_size(check, wo.name, part))
         t0 = time.perf_counter()
     return tuple(out), error
@@ -511,18 +495,16 @@ def _point_check(
     p: PlanPoint,
     pose: ProbeFeasibility,
     path: ProgramPath,
-    face: str,
+    face: Reason | None,
     ik_kind: str,
     t0: float,
     T_flange_tcp: FloatArray,
 ) -> PointCheck:
     from planner.cell.collision import DEFAULT_MARGIN_M, report_distance_m
 
-    path_reason = str(path.reason or "")
     status: Status = pose.status
-    if face or not path.feasible:
+    if face is not None or not path.feasible:
         status = "infeasible"
-    parts = [pose.reason, f"search path: {path_reason}" if path_reason else "", face]
     clearance = float(pose.clearance_m)
     capped = math.isfinite(clearance) and clearance >= report_distance_m(DEFAULT_MARGIN_M) - 1e-6
     return PointCheck(
@@ -530,13 +512,12 @@ def _point_check(
         role=p.role,
         kind=p.search.kind,
         status=status,
-        reason="; ".join(x for x in parts if x),
         pose_status=pose.status,
-        pose_reason=pose.reason,
+        pose_cause=pose.cause,
         path_feasible=bool(path.feasible),
-        path_reason=path_reason,
+        path_cause=path.cause,
         path_fail_at_m=float(path.fail_at_m),
-        face_reason=face,
+        face_cause=face,
         clearance_m=clearance,
         clearance_pair=None if capped else pose.clearance_pair,
         clearance_is_lower_bound=capped,
@@ -556,24 +537,18 @@ def _point_check(
 
 def _with_part_size(check: PointCheck, name: str, part: str) -> PointCheck:
     """The check with the part's size and units added to reasons about the part (out of
-    reach, off its surface, hitting it): a part read in the wrong units shows as such."""
+    reach, off its surface, no planar face on it: ``about_part``; a collision with it: its
+    pair): a part read in the wrong units shows as such."""
 
-    def add(reason: str) -> str:
-        about_part = name in reason or "out of reach" in reason or "from the surface" in reason
-        return f"{reason} ({part})" if reason and about_part else reason
+    def add(reason: Reason | None) -> Reason | None:
+        if reason is None or not (reason.about_part or name in (reason.pair or ())):
+            return reason
+        return reason.noted(part)
 
-    pose, path, face = add(check.pose_reason), add(check.path_reason), add(check.face_reason)
-    if (pose, path, face) == (check.pose_reason, check.path_reason, check.face_reason):
+    pose, path, face = add(check.pose_cause), add(check.path_cause), add(check.face_cause)
+    if (pose, path, face) == (check.pose_cause, check.path_cause, check.face_cause):
         return check
-    search = f"search: {check.search_reason}" if check.search_reason else ""
-    parts = [pose, f"search path: {path}" if path else "", face, search]
-    return replace(
-        check,
-        pose_reason=pose,
-        path_reason=path,
-        face_reason=face,
-        reason="; ".join(x for x in parts if x),
-    )
+    return replace(check, pose_cause=pose, path_cause=path, face_cause=face)
 
 
 def _confdata(cell: Cell, q: FloatArray | None) -> ConfData | None:

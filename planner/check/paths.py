@@ -23,6 +23,7 @@ from calib.plan.file import Plan
 from calib.probing import ProbePoint, SearchCommand
 from planner.program.safety import SafetySpec
 from planner.program.searches import ProgramSearch, program_searches
+from planner.reasons import Reason
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
@@ -37,7 +38,8 @@ class ProgramPath:
 
     Attributes:
         feasible: every search passes.
-        reason: why not, naming the search and the distance from its start (``""``).
+        cause: why not, naming the search and the distance from its start, with the kind of
+            :class:`planner.cell.search_paths.PathFeasibility`'s (``None`` when feasible).
         fail_at_m: distance of the first failing sample from the start of its search, m (NaN
             when feasible).
         q_path: ``(M, n)`` joint values of the samples that passed, all searches in order, rad
@@ -47,10 +49,15 @@ class ProgramPath:
     """
 
     feasible: bool
-    reason: str
+    cause: Reason | None
     fail_at_m: float
     q_path: FloatArray
     q_safe: FloatArray | None
+
+    @property
+    def reason(self) -> str:
+        """The words of :attr:`cause` (``""`` when feasible)."""
+        return "" if self.cause is None else str(self.cause)
 
 
 def check_program_path(
@@ -81,14 +88,16 @@ def check_program_path(
     if pose.q is None or pose.T_base_flange is None or pose.status == "infeasible":
         cmd = SearchCommand.from_point(point, T_base_wobj)
         res = cell.check_search(cmd, q_ref=pose.q, tcp=tcp)
-        return ProgramPath(res.feasible, res.reason, res.fail_at_m, res.q_path, None)
+        return ProgramPath(res.feasible, res.cause, res.fail_at_m, res.q_path, None)
     sensor_x = (np.asarray(pose.T_base_flange) @ T_flange_tcp)[:3, 0]
     path = _walk(cell, pose, sensor_x, tcp, program_searches(point, T_base_wobj, safety))
     if path.feasible and measured_start_wobj is not None:
         measured = program_searches(point, T_base_wobj, safety, measured_start_wobj)
         other = _walk(cell, pose, sensor_x, tcp, measured)
         if not other.feasible:
-            why = f"adaptive RAPID program (edge search from the measured point): {other.reason}"
+            why = _named(
+                other.cause, "adaptive RAPID program (edge search from the measured point):"
+            )
             return ProgramPath(False, why, other.fail_at_m, path.q_path, path.q_safe)
     return path
 
@@ -109,13 +118,13 @@ def _walk(
         if not res.feasible:
             q_path = np.concatenate(parts)
             q_safe = q_path[0].copy() if len(q_path) else None
-            return ProgramPath(False, f"{name} {res.reason}", res.fail_at_m, q_path, q_safe)
+            return ProgramPath(False, _named(res.cause, name), res.fail_at_m, q_path, q_safe)
         if k < len(searches) - 1:  # an approach stops at its nominal point
             at = float((cmd.nominal_m - cmd.start_m) @ cmd.direction)
             parts[-1] = res.q_path[res.s_m <= at + 1e-9]
         q_ref = parts[-1][-1] if len(parts[-1]) else res.q_path[-1]
     q_path = np.concatenate(parts)
-    return ProgramPath(True, "", math.nan, q_path, q_path[0].copy())
+    return ProgramPath(True, None, math.nan, q_path, q_path[0].copy())
 
 
 def measured_starts_wobj(plan: Plan) -> dict[str, FloatArray]:
@@ -138,3 +147,8 @@ def measured_starts_wobj(plan: Plan) -> dict[str, FloatArray]:
         n = np.asarray(p.normal, dtype=float)
         out[p.id] = np.asarray(q.position_m, dtype=float) + a.settings.edge_start_offset_m * n
     return out
+
+
+def _named(cause: Reason | None, search: str) -> Reason | None:
+    """``cause`` after the name of the search it is about."""
+    return None if cause is None else cause.worded(f"{search} ")

@@ -1,7 +1,10 @@
 """The results of the one plan check (:mod:`planner.check.job`): a point's and a whole plan's.
 
 Frozen dataclasses that the command line prints (table and ``--json``), the web UI colours its
-markers and table with, and ``wobjcal export`` takes orientations and configurations from.
+markers and table with, and ``wobjcal export`` takes orientations and configurations from. A
+point's reasons are :class:`planner.reasons.Reason` s, one per check that fails (the pose, its
+search path, the face, the search under the misplacement, the moves into it, the landing),
+each with its kind; the words (``reason``, ``pose_reason``, ...) are made from them.
 """
 
 from __future__ import annotations
@@ -13,6 +16,8 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from planner.reasons import Reason, joined
+
 if TYPE_CHECKING:
     from calib.estimators.gross_errors import Detectability
     from planner.program.cycle_time import CycleTime
@@ -23,6 +28,8 @@ FloatArray = NDArray[np.float64]
 Status = Literal["feasible", "marginal", "infeasible"]
 #: ABB ``confdata`` (cf1, cf4, cf6, cfx).
 ConfData = tuple[int, int, int, int]
+#: What the point's words say after a move problem of a point without vias.
+ADD_VIAS = " (add via points: Teach tab, or `wobjcal check --add-vias`)"
 
 
 @dataclass(frozen=True)
@@ -35,15 +42,16 @@ class PointCheck:
         kind: ``"approach"`` or ``"edge"`` search.
         status: ``feasible``, ``marginal`` or ``infeasible``: the pose, the path and the face
             together (see the module docstring).
-        reason: why not feasible, all parts joined with ``"; "`` (``""`` when feasible).
         pose_status: the probe pose alone.
-        pose_reason: why the pose is marginal or infeasible (``""`` when feasible).
+        pose_cause: why the pose is marginal or infeasible (``None`` when feasible): ``reach``,
+            ``joint_limit``, ``singularity`` or ``collision`` (with its pair).
         path_feasible: the whole search path can be run.
-        path_reason: why not, with the distance along the path (``""`` when feasible).
+        path_cause: why not, with the distance along the path (``None`` when feasible), of
+            the kinds a pose has.
         path_fail_at_m: distance of the first failing sample from the start of its search (the
             program's: from the safe start), m (NaN when the path is feasible).
-        face_reason: why the point is not on a planar face with the sensor footprint on it
-            (``""`` when it is).
+        face_cause: why the point is not on a planar face with the sensor footprint on it, a
+            ``footprint`` reason (``None`` when it is).
         clearance_m: clearance of the limiting pair at the chosen pose, m (NaN: no pose);
             nothing nearer than the query's look-ahead when ``clearance_is_lower_bound``.
         clearance_pair: ``(robot or tool link, obstacle)`` of that clearance, or ``None``.
@@ -61,13 +69,16 @@ class PointCheck:
         q_safe: ``(n,)`` joint values at the point's safe start (where the program arrives
             and leaves from), rad; ``None`` when it has none.
         n_vias: how many via points the plan gives the point (``points[i].vias``).
-        via_reason: why the moves from the previous point through the vias to this point
+        via_cause: why the moves from the previous point through the vias to this point
             cannot be run (a via outside the joint limits, a leg that collides, naming the via
-            and the clearance pair); ``""`` when clear or without vias
+            and the clearance pair), a ``move`` reason; ``None`` when clear or not checked
             (:func:`planner.cell.moves.check_via_path`).
-        search_reason: why the point's search cannot reach its face or edge wherever the
-            part may lie (:func:`planner.program.reach.search_problems`), or how likely it is
-            to fail or land off its face; ``""`` when it can.
+        search_cause: why the point's search cannot reach its face or edge wherever the
+            part may lie (:func:`planner.program.reach.search_problems`), a ``search``
+            reason; ``None`` when it can.
+        landing_cause: how likely the point's search is to fail or land off its face under
+            the misplacement (:meth:`planner.sim.landing.LandingRisk.point_problems`), a
+            ``search`` reason; ``None`` when rarely enough.
         branch: the IK branch of ``q`` (OPW configuration 0-7; -1 unknown or none): the
             configuration every program runs the point in (ABB ``confdata``, KUKA ``S``/``T``).
     """
@@ -76,13 +87,12 @@ class PointCheck:
     role: str
     kind: str
     status: Status
-    reason: str
     pose_status: Status
-    pose_reason: str
+    pose_cause: Reason | None
     path_feasible: bool
-    path_reason: str
+    path_cause: Reason | None
     path_fail_at_m: float
-    face_reason: str
+    face_cause: Reason | None
     clearance_m: float
     clearance_pair: tuple[str, str] | None
     clearance_is_lower_bound: bool
@@ -95,9 +105,58 @@ class PointCheck:
     T_base_tcp: FloatArray | None = None
     q_safe: FloatArray | None = None
     n_vias: int = 0
-    via_reason: str = ""
-    search_reason: str = ""
+    via_cause: Reason | None = None
+    search_cause: Reason | None = None
+    landing_cause: Reason | None = None
     branch: int = -1
+
+    @property
+    def causes(self) -> tuple[Reason, ...]:
+        """Every reason, in the order :attr:`reason` says them, worded as there: the pose's,
+        ``"search path: ..."``, the face's, ``"search: ..."``, the moves' (``"vias: ..."``,
+        or with the advice to add vias), ``"landing: ..."``."""
+        via = self.via_cause
+        if via is not None:
+            via = via.worded("vias: ") if self.n_vias else via.worded(suffix=ADD_VIAS)
+        out = (
+            self.pose_cause,
+            None if self.path_cause is None else self.path_cause.worded("search path: "),
+            self.face_cause,
+            None if self.search_cause is None else self.search_cause.worded("search: "),
+            via,
+            None if self.landing_cause is None else self.landing_cause.worded("landing: "),
+        )
+        return tuple(r for r in out if r is not None)
+
+    @property
+    def reason(self) -> str:
+        """Why not feasible, every part joined with ``"; "`` (``""`` when feasible)."""
+        return joined(self.causes)
+
+    @property
+    def pose_reason(self) -> str:
+        """The words of :attr:`pose_cause` (``""`` when feasible)."""
+        return joined([self.pose_cause])
+
+    @property
+    def path_reason(self) -> str:
+        """The words of :attr:`path_cause` (``""`` when feasible)."""
+        return joined([self.path_cause])
+
+    @property
+    def face_reason(self) -> str:
+        """The words of :attr:`face_cause` (``""`` when on a planar face)."""
+        return joined([self.face_cause])
+
+    @property
+    def via_reason(self) -> str:
+        """The words of :attr:`via_cause` (``""`` when clear)."""
+        return joined([self.via_cause])
+
+    @property
+    def search_reason(self) -> str:
+        """The words of :attr:`search_cause` and :attr:`landing_cause` (``""`` for none)."""
+        return joined([self.search_cause, self.landing_cause])
 
     @property
     def feasible(self) -> bool:
@@ -105,13 +164,16 @@ class PointCheck:
         return self.status != "infeasible"
 
     def to_json(self) -> dict[str, Any]:
-        """A JSON-ready dict (distances in metres; NaN as ``null``)."""
+        """A JSON-ready dict (distances in metres; NaN as ``null``); ``reasons``: every reason
+        with its kind (:attr:`causes`: ``{"kind", "text", "pair"?}``, the texts joined with
+        ``"; "`` being ``reason``)."""
         return {
             "id": self.point_id,
             "role": self.role,
             "kind": self.kind,
             "status": self.status,
             "reason": self.reason,
+            "reasons": [r.to_json() for r in self.causes],
             "pose_status": self.pose_status,
             "pose_reason": self.pose_reason,
             "path_feasible": self.path_feasible,

@@ -183,7 +183,7 @@ def preflight(plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh) -> No
     }
     edge_offset = float(getattr(models.settings, "edge_event_offset_m", 0.0) or 0.0)
     reach = search_problems([p for p in probes if p.id not in why], safety_spec(plan), edge_offset)
-    why.update(reach)
+    why.update((pid, str(r)) for pid, r in reach.items())
     if why:
         lines = "; ".join(f"{_name(plan, pid)}: {w}" for pid, w in why.items())
         raise PlanError(f"cannot validate this plan: {lines}")

@@ -28,6 +28,7 @@ from planner.faces.footprint import (
     footprint_hits,
     footprint_offsets,
 )
+from planner.reasons import Reason
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -48,7 +49,9 @@ class FaceCheck:
             without a face).
         face_normal: ``(3,)`` the face's unit outward normal, mesh frame (zeros without a face).
         ok: the point passes every test.
-        reason: why not (``""`` when ok), e.g. ``"footprint over a hole/edge: ..."``.
+        cause: why not, a ``footprint`` reason (``None`` when ok), e.g. ``"footprint over a
+            hole/edge: ..."``; a point's distance from the surface measures the part
+            (``about_part``: a part read in the wrong units shows there).
     """
 
     face_id: int
@@ -57,7 +60,12 @@ class FaceCheck:
     normal_angle_rad: float
     face_normal: FloatArray = field(repr=False)
     ok: bool
-    reason: str
+    cause: Reason | None
+
+    @property
+    def reason(self) -> str:
+        """The words of :attr:`cause` (``""`` when ok)."""
+        return "" if self.cause is None else str(self.cause)
 
 
 def _surface_under(
@@ -156,30 +164,33 @@ def check_probe_faces(
             (np.abs(pf.normals @ P[i] - offsets) <= pf.max_deviation_m)
             & (pf.normals @ unit[i] >= math.cos(max_normal_angle_rad))
         )
+        reason = None
         if dist[i] > max_distance_m and len(in_plane):
-            reason = (
+            reason = Reason(
+                "footprint",
                 f"footprint over a hole/edge: the point itself lies over a hole or past the "
-                f"edge of planar face {in_plane[0]} ({dist[i] * 1e3:.2f} mm from the surface)"
+                f"edge of planar face {in_plane[0]} ({dist[i] * 1e3:.2f} mm from the surface)",
+                about_part=True,
             )
         elif dist[i] > max_distance_m:
-            reason = f"point is {dist[i] * 1e3:.2f} mm from the surface"
+            why = f"point is {dist[i] * 1e3:.2f} mm from the surface"
+            reason = Reason("footprint", why, about_part=True)
         elif f < 0:
-            reason = pf.why_not_at(int(tri[i]), footprint_radius_m)
+            reason = Reason("footprint", pf.why_not_at(int(tri[i]), footprint_radius_m))
         elif not footprint_ok[i]:
-            reason = (
+            reason = Reason(
+                "footprint",
                 f"footprint over a hole/edge: {n_off[i]} of {n_samples} points of the "
-                f"{footprint_radius_m * 2e3:.0f} mm sensor face leave planar face {f}"
+                f"{footprint_radius_m * 2e3:.0f} mm sensor face leave planar face {f}",
             )
         elif ang > max_normal_angle_rad:
-            reason = (
+            reason = Reason(
+                "footprint",
                 f"plan normal is {math.degrees(ang):.1f} deg from the face normal "
-                f"(limit {math.degrees(max_normal_angle_rad):.1f} deg)"
+                f"(limit {math.degrees(max_normal_angle_rad):.1f} deg)",
             )
-        else:
-            reason = ""
-        out.append(
-            FaceCheck(f, float(dist[i]), bool(footprint_ok[i]), ang, fn.copy(), not reason, reason)
-        )
+        ok = reason is None
+        out.append(FaceCheck(f, float(dist[i]), bool(footprint_ok[i]), ang, fn.copy(), ok, reason))
     return out
 
 
@@ -218,7 +229,7 @@ def check_plan_faces(
             c.normal_angle_rad,
             c.face_normal,
             False,
-            f"at the edge search's start: {c.reason}",
+            c.cause.worded("at the edge search's start: ") if c.cause is not None else None,
         )
         for p, c in zip(probes, checks, strict=True)
     ]
@@ -231,15 +242,17 @@ def plan_face_reasons(
     name: str | None = None,
     raise_if_none: bool = True,
     footprint_radius_m: float = DEFAULT_FOOTPRINT_RADIUS_M,
-) -> list[str]:
-    """Why each plan point fails the planar-face check (``""`` when it passes), for reports.
+) -> list[Reason | None]:
+    """Why each plan point fails the planar-face check (``None`` when it passes): a
+    ``footprint`` reason each.
 
     Args:
         mesh: the work object, wobj frame, metres.
         probes: the plan's probe points (wobj frame).
         name: the work object's name in messages.
         raise_if_none: raise when the mesh has no planar face; else every point gets that
-            message as its reason (for the UI, which shows reasons per point).
+            message as its reason (for the UI, which shows reasons per point; it names the
+            part: ``about_part``).
         footprint_radius_m: the plan's sensor footprint radius, metres
             (``plan.validation.sensor.footprint_radius_m``).
 
@@ -253,5 +266,5 @@ def plan_face_reasons(
     except NoPlanarFaceError as exc:
         if raise_if_none:
             raise
-        return [str(exc)] * len(probes)
-    return [c.reason for c in checks]
+        return [Reason("footprint", str(exc), about_part=True)] * len(probes)
+    return [c.cause for c in checks]

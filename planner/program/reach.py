@@ -19,20 +19,22 @@ from collections.abc import Sequence
 
 from calib.probing import ProbePoint
 from planner.program.safety import SafetySpec
+from planner.reasons import Reason
 
 
 def search_problems(
     points: Sequence[ProbePoint], safety: SafetySpec, edge_offset_m: float = 0.0
-) -> dict[str, str]:
+) -> dict[str, Reason]:
     """``{point id: why}`` for the points whose search cannot reach its face or edge under
-    ``safety``'s misplacement (every problem of a point, joined with ``"; "``), and the fix.
+    ``safety``'s misplacement (every problem of a point, joined with ``"; "``), and the fix: a
+    ``search`` reason each.
 
     Args:
         points: the plan's points (wobj frame).
         safety: the misplacement bound and pivot the program's safe starts are sized for.
         edge_offset_m: how far past an edge the sensor reports it, m.
     """
-    out: dict[str, str] = {}
+    out: dict[str, Reason] = {}
     whole = (
         f" (misplaced up to {safety.max_translation_m * 1e3:.1f} mm and "
         f"{math.degrees(safety.max_angle_rad):.2f} deg)"
@@ -70,5 +72,5 @@ def search_problems(
                     f"{need * 1e3:.1f} mm"
                 )
         if why:
-            out[p.id] = "; ".join(why)
+            out[p.id] = Reason("search", "; ".join(why))
     return out

@@ -2,7 +2,9 @@
 
 The reasons name numbers a person can check: the flange's (or, for OPW arms, the wrist
 centre's) distance from the shoulder against the arm's reach, or the joint that breaks its
-limit in most of the analytic branches.
+limit in most of the analytic branches. Each is a :class:`planner.reasons.Reason` of kind
+``reach`` (out of reach, too close, no solution; "out of reach" measures the part, whose units
+may be wrong: ``about_part``) or ``joint_limit``.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.frames import invert_transform
+from planner.reasons import Reason
 
 if TYPE_CHECKING:
     from planner.robot.kinematics.chain import KinematicChain
@@ -67,9 +70,21 @@ def reach_model(chain: KinematicChain, rng: np.random.Generator) -> ReachModel:
     return ReachModel(zero[0, :3, 3].copy(), axis, zero[k, :3, 3].copy(), reach)
 
 
+def _out_of_reach(where: str) -> Reason:
+    return Reason("reach", f"out of reach ({where})", about_part=True)
+
+
+def _no_solution(where: str) -> Reason:
+    return Reason("reach", f"no IK solution within joint limits ({where})")
+
+
+def _at_limit(chain: KinematicChain, j: int) -> Reason:
+    return Reason("joint_limit", f"joint {j + 1} at limit ({chain.joint_names[j]})")
+
+
 def no_ik_reason(
     model: ReachModel, solver: IKSolver, chain: KinematicChain, T_flange: FloatArray
-) -> str:
+) -> Reason:
     """Why ``(R, 4, 4)`` flange poses (base frame, m) of one point have no valid IK solution.
 
     Args:
@@ -82,7 +97,7 @@ def no_ik_reason(
     dist = float(np.min(np.linalg.norm(p - model.shoulder_towards(p), axis=1)))
     where = f"{dist:.2f} m from the shoulder, reach {model.reach_m:.2f} m"
     if dist > model.reach_m:
-        return f"out of reach ({where})"
+        return _out_of_reach(where)
     opw = solver.opw
     if opw is not None:
         q8, ok8 = opw.ik_branches(T_flange)
@@ -98,17 +113,17 @@ def no_ik_reason(
                 best = np.minimum(best, np.maximum(lo - qk, 0) + np.maximum(qk - hi, 0))
         worst = np.argmax(best, axis=1)  # each candidate's worst joint
         j = int(np.bincount(worst, minlength=q.shape[1]).argmax())
-        return f"joint {j + 1} at limit ({chain.joint_names[j]})"
-    return f"no IK solution within joint limits ({where})"
+        return _at_limit(chain, j)
+    return _no_solution(where)
 
 
-def opw_wrist_reason(opw: Any, T_flange: FloatArray) -> str:
+def opw_wrist_reason(opw: Any, T_flange: FloatArray) -> Reason:
     """Why an OPW arm reaches none of the flange poses ``(R, 4, 4)``: the wrist centre's
     distance from the shoulder against the arm's range ``|c2 - k| .. c2 + k``."""
     return opw_wrist_reasons(opw, T_flange[None])[0]
 
 
-def opw_wrist_reasons(opw: Any, T_flange: FloatArray) -> list[str]:
+def opw_wrist_reasons(opw: Any, T_flange: FloatArray) -> list[Reason]:
     """:func:`opw_wrist_reason` of ``P`` points at once, ``T_flange (P, R, 4, 4)``."""
     P = opw.params
     T = invert_transform(opw.T_base_opw) @ T_flange @ invert_transform(opw.T_ee_tip)
@@ -123,20 +138,21 @@ def opw_wrist_reasons(opw: Any, T_flange: FloatArray) -> list[str]:
     out = []
     for di in d[np.arange(d.shape[0]), i].tolist():
         if di < lo:
-            out.append(f"too close (wrist centre {di:.2f} m from the shoulder, min {lo:.2f} m)")
+            why = f"too close (wrist centre {di:.2f} m from the shoulder, min {lo:.2f} m)"
+            out.append(Reason("reach", why))
         else:
             out.append(
-                f"out of reach (wrist centre {di:.2f} m from the shoulder, reach {hi:.2f} m)"
+                _out_of_reach(f"wrist centre {di:.2f} m from the shoulder, reach {hi:.2f} m")
             )
     return out
 
 
 def no_ik_reasons(
     model: ReachModel, solver: IKSolver, chain: KinematicChain, T_flange: FloatArray
-) -> list[str]:
+) -> list[Reason]:
     """:func:`no_ik_reason` of ``P`` points at once: ``T_flange (P, R, 4, 4)``, base frame, m.
 
-    The same strings as one call per point (``tests/test_reach.py`` compares them), with one
+    The same reasons as one call per point (``tests/test_reach.py`` compares them), with one
     batched IK call for all points instead of one per point.
     """
     T = np.asarray(T_flange, dtype=np.float64)
@@ -145,13 +161,12 @@ def no_ik_reasons(
         return []
     p = T[..., :3, 3].reshape(P * R, 3)
     dist = np.min(np.linalg.norm(p - model.shoulder_towards(p), axis=1).reshape(P, R), axis=1)
-    out: list[str | None] = [None] * P
+    out: list[Reason | None] = [None] * P
     rest = []
     for i, di in enumerate(dist.tolist()):
         if di > model.reach_m or solver.opw is None:
             where = f"{di:.2f} m from the shoulder, reach {model.reach_m:.2f} m"
-            why = "out of reach" if di > model.reach_m else "no IK solution within joint limits"
-            out[i] = f"{why} ({where})"
+            out[i] = _out_of_reach(where) if di > model.reach_m else _no_solution(where)
         else:
             rest.append(i)
     opw = solver.opw
@@ -184,5 +199,5 @@ def no_ik_reasons(
             out[rest[n]] = why
         for n in np.flatnonzero(any_ok).tolist():
             j = int(np.argmax(counts[n]))
-            out[rest[n]] = f"joint {j + 1} at limit ({chain.joint_names[j]})"
+            out[rest[n]] = _at_limit(chain, j)
     return [s for s in out if s is not None]

@@ -35,6 +35,7 @@ from calib.procedures.base import edge_offset_of
 from planner.faces.outline import FaceOutlines
 from planner.program.execute import execute
 from planner.program.model import FACE_APPROACH, MeasuringProgram, search_keys
+from planner.reasons import Reason
 from planner.sim.raycast import MeshRayCaster
 
 FloatArray = NDArray[np.float64]
@@ -96,9 +97,9 @@ class LandingRisk:
     searches: tuple[SearchRisk, ...]
     failed: float
 
-    def point_problems(self, limit: float = RISK_LIMIT) -> dict[str, str]:
+    def point_problems(self, limit: float = RISK_LIMIT) -> dict[str, Reason]:
         """``{point id: why, and what to change}`` for the points whose searches go wrong in
-        more than ``limit`` of calibrations."""
+        more than ``limit`` of calibrations: a ``search`` reason each."""
         out: dict[str, list[str]] = {}
         for s in self.searches:
             if s.worst <= limit:
@@ -132,7 +133,11 @@ class LandingRisk:
                     "calibrations: start it farther out, or a smaller misplacement bound"
                 )
             out.setdefault(s.point_id, []).extend(parts)
-        return {pid: f"{self.program}: " + "; ".join(parts) for pid, parts in out.items() if parts}
+        return {
+            pid: Reason("search", f"{self.program}: " + "; ".join(parts))
+            for pid, parts in out.items()
+            if parts
+        }
 
     def to_json(self) -> dict[str, object]:
         """JSON-ready: shares per search."""

@@ -604,6 +604,7 @@ def _design_until_checked(
             raise SuggestError(why + (f". {change}" if change else ""))
         new_plan = suggested_plan(plan, ctx, design, kind, add, at_m)
         say("moves between points", 0, 1)
+        vias_before = {p.id: p.via_points for p in new_plan.points}
         new_plan, via_notes = plan_with_vias(new_plan, ctx.cell)
         say("check", 0, 1)
         check = check_plan(new_plan, cell=ctx.cell, fmt=fmt)
@@ -626,7 +627,12 @@ def _design_until_checked(
     note = ""
     if set_aside:
         note = f"; {len(set_aside)} candidates check refused were set aside"
-    stuck = [f"{pid}: {what}" for pid, what in via_notes.items() if "added" not in what]
+    # the moves not cleared: the points plan_with_vias named but gave no (new) vias
+    stuck = [
+        f"{p.id}: {via_notes[p.id]}"
+        for p in new_plan.points
+        if p.id in via_notes and p.via_points == vias_before[p.id]
+    ]
     if stuck:
         note += "; moves between points not cleared: " + "; ".join(stuck)
     return new_plan, note, check, history

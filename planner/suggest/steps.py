@@ -31,6 +31,7 @@ from calib.procedures import ProcedureKind
 from planner.faces.candidates import Candidates, FaceTried
 from planner.plan_cell import nominal_T_base_wobj
 from planner.program.safety import SafetySpec
+from planner.reasons import Reason
 from planner.sim.rows import RowSpec, predicted_sigma
 from planner.suggest.order import Ordered, Sequencer
 from planner.suggest.search_sizing import MIN_OVERTRAVEL_M, MIN_START_M
@@ -47,17 +48,18 @@ PROBE_FIRST = 6
 EDGE_INSET_M = 0.003
 
 
-def _why(reason: str) -> str:
-    r = reason.lower()
-    if "reach" in r or "no ik" in r:
-        return "reach"
-    if "limit" in r:
-        return "joint limits"
-    if "singular" in r:
-        return "singularity"
-    if "hit" in r or "clearance" in r or "collision" in r:
-        return "collision"
-    return "other"
+#: What :func:`feasible_poses` counts a dropped candidate under, by the kind of its pose's
+#: reason (:class:`planner.reasons.Reason`); any other: ``"other"``.
+REJECTED_AS: dict[str, str] = {
+    "reach": "reach",
+    "joint_limit": "joint limits",
+    "singularity": "singularity",
+    "collision": "collision",
+}
+
+
+def _why(cause: Reason | None) -> str:
+    return "other" if cause is None else REJECTED_AS.get(cause.kind, "other")
 
 
 @dataclass
@@ -230,7 +232,7 @@ def feasible_poses(
         for i, x in zip(idx, res, strict=True):
             ok[i] = x.feasible
             if not x.feasible:
-                key = _why(x.reason)
+                key = _why(x.cause)
                 rejected[key] = rejected.get(key, 0) + 1
 
     run(first.tolist())

@@ -93,9 +93,9 @@ def test_unreachable_spot_is_infeasible_with_reason(ui: UiSession) -> None:
     from webui.status_table import causes, part_note
 
     # the row's first cause; every cause in the selected point's details, the part's note once
-    for cause in causes(check.reason):
+    for cause in (c.text for c in causes(check)):
         wait_for(lambda cause=cause: cause in ui.page.inner_text("body"), what=f"'{cause}'")
-    note = part_note(check.reason)
+    note = part_note(check)
     assert not note or ui.page.inner_text("body").count(note) == 1
 
 

@@ -88,7 +88,7 @@ def test_the_status_table_has_icons_short_causes_and_details(
     selected point's every cause below. A point under the part (its sensor in the table) with
     no role left (a ninth point of the A-H plan) is flagged **role** and stays ✗ and red."""
     from webui.scene import STATUS_RGB
-    from webui.status_table import causes
+    from webui.status_table import causes, short_cause
 
     app, page = demo.app, demo.page
     wait_for(lambda: len(app.checks()) == 8, what="the A-H checks")
@@ -113,10 +113,10 @@ def test_the_status_table_has_icons_short_causes_and_details(
             text = row.inner_text()
             assert c.status in text and "file units" not in text, text
         assert "role" in _row(page, "I").inner_text()
-        assert causes(bad.reason)[0][:30] in _row(page, "I").inner_text()
+        assert short_cause(causes(bad)[0])[:30] in _row(page, "I").inner_text()
         choose(page, "Selected", "I")
         wait_for(lambda: "wobj frame" in page.inner_text("body"), what="the details on the page")
-        for cause in causes(bad.reason):
+        for cause in (c.text for c in causes(bad)):
             wait_for(lambda cause=cause: cause in page.inner_text("body"), what=f"'{cause}'")
         wait_for(lambda: "role: point I has no role" in page.inner_text("body"), what="role")
         save_screenshot(page, "status_table.png", tmp_path)
