@@ -6,7 +6,8 @@
    switches at once) and resolved between rays (``planner.sim.subray``). Reference measured in
    the same run: plain rays at 256 (the time ratios).
 2. The thin box (200 x 300 x 10 mm, sides too thin for the footprint) of
-   ``tests/test_suggest_edges.py``: its suggested plan (4 approaches + 4 edge searches)
+   ``tests/planner/suggest/test_suggest_edges.py``: its suggested plan (4 approaches + 4 edge
+   searches)
    validated with ``--trials`` trials at 256, 512 and 1,024 rays: ms per trial (ratio against
    256 in the same run) and simulated / predicted of the 95.5 % rows (smallest and largest).
 

@@ -1,6 +1,7 @@
 """Plans of every procedure on an ideal box (a stator-sized block without holes or bulge).
 
-Used by ``bench/bench_validate.py`` and ``tests/test_box_prediction.py`` to compare the
+Used by ``bench/bench_validate.py`` and ``tests/planner/validate/test_box_prediction.py`` to
+compare the
 simulated intervals with the predicted ones: on a box there is nothing position-dependent
 (no hole, no bulge, flat faces), so the two must agree up to the Monte Carlo's own scatter and
 what the prediction leaves out on purpose (the ray bundle's residual error of edge events, kept

@@ -2,7 +2,7 @@
 
 Both are made from the placement in :mod:`planner.parts.stator_demo`. The plan is shipped as
 ``assets/plans/stator_section_ah.json`` (:data:`DEMO_PLAN`); ``wobjcal demo --write-plan FILE``
-writes it, and ``tests/test_cli.py`` checks that the shipped file equals
+writes it, and ``tests/planner/cli/test_cli.py`` checks that the shipped file equals
 :func:`stator_plan_text` byte for byte, so this module stays the single source.
 """
 

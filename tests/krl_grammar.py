@@ -13,7 +13,8 @@ the ~80 keywords the grammar knows.
 
 It does not check what a grammar cannot, nor what this one leaves out: names are any length
 and never resolved (no symbol table), so KRL's limit of 24 characters and its case-insensitive
-uniqueness of names are not seen (``tests/test_krl_program_runs.py`` checks those, and
+uniqueness of names are not seen (``tests/planner/export/test_krl_program_runs.py`` checks those,
+and
 :mod:`tests.krl_interp` at run time); nor are types, parameters (``:IN``/``:OUT``), where
 ``RESUME`` may stand, or keywords it does not know (``RESUME``, ``STEP`` parse as names). Any
 expression is a statement (``nResult==0`` on its own passes).

@@ -2,7 +2,7 @@
 shipped plate 3-2-1 plan on one simulated misplaced part (one validate trial, seed 2), from this
 project's interpreters of the four languages (:mod:`tests.controller_files`), and the true
 frame of that part (``truth.json``). ``docs/results.md`` shows them and
-``tests/test_results_samples.py`` calibrates from each.
+``tests/planner/results/test_results_samples.py`` calibrates from each.
 
 Run ``python3 -m tests.make_results_samples`` after a change of the plan or of the programs (the
 KRL and URScript samples carry the plan's digest: a stale sample is refused by the reader).
@@ -21,9 +21,9 @@ from planner.export.job import ToolData, build_job
 from tests.controller_files import fanuc_va, krl_saved_dat, ur_log
 from tests.fanuc_interp import TPMachine
 from tests.krl_interp import KrlMachine
+from tests.planner.export.test_fanuc_program_replay import tp_text
+from tests.planner.validate.test_program_trial_replay import _search_callback, _trial
 from tests.rapid_interp import Machine
-from tests.test_fanuc_program_replay import tp_text
-from tests.test_program_trial_replay import _search_callback, _trial
 from tests.urscript_interp import UrMachine
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -1,5 +1,7 @@
-"""Plans whose exported programs the grammar tests check (:mod:`tests.test_rapid_grammar`,
-:mod:`tests.test_krl_grammar`): the shipped plans and variants of them that reach every
+"""Plans whose exported programs the grammar tests check
+(:mod:`tests.planner.export.test_rapid_grammar`,
+:mod:`tests.planner.export.test_krl_grammar`): the shipped plans and variants of them that reach
+every
 procedure the exporters write, vias, the fewest points a frame takes, one point, 90 points, and
 hostile point ids and plan name.
 """

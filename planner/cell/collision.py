@@ -271,7 +271,8 @@ class CollisionChecker:
         distance ``slack_m + need_m`` (negative for a penetration) looks only at the triangles
         near enough to go that deep. Bullet computes each triangle's contact on its own, so
         this returns a subset of the full query's points, bit for bit (checked in
-        ``tests/test_probe_clearance.py``); when its deepest point is within ``slack_m`` it is
+        ``tests/planner/cell/test_probe_clearance.py``); when its deepest point is within
+        ``slack_m`` it is
         the full query's deepest. Only parts against the work object (a concave triangle mesh)
         are capped: between convex shapes the contact depends on the query distance (up to
         0.4 mm deeper was seen between two boxes).

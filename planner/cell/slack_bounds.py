@@ -13,7 +13,8 @@ only inflated) plus :data:`planner.cell.broad_parts.SAFETY_M`. Parts against mes
 bound here (the least of the others still bounds the candidate's slack).
 
 A bound never decides an answer: it only spares Bullet queries of candidates that cannot be
-chosen, so the answers stay the exact check's (``tests/test_slack_bounds.py`` compares every
+chosen, so the answers stay the exact check's (``tests/planner/cell/test_slack_bounds.py`` compares
+every
 bound with Bullet's slack).
 """
 

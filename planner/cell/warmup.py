@@ -37,7 +37,8 @@ from planner.cell.kernel_cache import CHILD_ENV, configure, marker_path
 
 #: The kernels a check calls from Python (module, function), in the order a map first needs
 #: them, with the argument types it calls them with (numba's signature syntax; checked against
-#: a real map by ``tests/test_warmup.py``). The helpers they call are compiled with them.
+#: a real map by ``tests/planner/cell/test_warmup.py``). The helpers they call are compiled with
+#: them.
 _I, _F, _M, _B = "int64[::1]", "float64[::1]", "float64[:, ::1]", "boolean[:, ::1]"
 _T3, _T4, _IM = "float64[:, :, ::1]", "float64[:, :, :, ::1]", "int64[:, ::1]"
 KERNELS: tuple[tuple[str, str, str], ...] = (

@@ -14,7 +14,8 @@ ideal part of the linearisation):
 - the adaptive A-H program is the procedure's own step-by-step run
   (:meth:`~calib.procedures.base.ProcedureKind.run`), each search commanded in the frame the
   program estimated so far (the RAPID module is proven equal to it in
-  ``tests/test_export_rapid_adaptive.py`` and ``tests/test_program.py``).
+  ``tests/planner/export/test_export_rapid_adaptive.py`` and
+  ``tests/planner/program/test_program.py``).
 
 Either way every search goes through :class:`ProgramProbe`, which runs it as the exported program
 does (:mod:`planner.program.searches`): from the point's safe start, an edge point first

@@ -1,6 +1,6 @@
 """Regenerate ``valid_three_two_one.json`` and the malformed-plan cases made from it.
 
-Run ``python tests/data/plans/make_cases.py``; ``tests/test_plan.py`` holds the expected
+Run ``python tests/data/plans/make_cases.py``; ``tests/calib/plan/test_plan.py`` holds the expected
 message of each case. The files are checked in so the CLI can be tried on them by hand.
 """
 

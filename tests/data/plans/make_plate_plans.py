@@ -1,7 +1,8 @@
 """Regenerate ``assets/plans/plate_holes_321.json`` and ``plate_holes_best_fit.json``.
 
 Run ``python tests/data/plans/make_plate_plans.py`` (with ``../shared/reference`` present);
-``tests/test_plate_plans.py`` checks that the shipped files equal :func:`plate_plans` byte for
+``tests/planner/check/test_plate_plans.py`` checks that the shipped files equal :func:`plate_plans`
+byte for
 byte, so this module stays their single source.
 
 The part is the machined plate of ``../shared/reference/parts/plate_holes.STL`` (millimetres:

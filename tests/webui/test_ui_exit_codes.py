@@ -1,0 +1,55 @@
+"""``wobjcal ui`` stops on SIGTERM with exit 143 and on Ctrl-C (SIGINT) with 130, as
+``docs/cli.md`` documents (it used to exit 0 either way)."""
+
+from __future__ import annotations
+
+import queue
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("sig", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_ui_exit_code_after_a_signal(sig: signal.Signals, code: int, tmp_path: Path) -> None:
+    from webui.testing import box_plan
+
+    plan = box_plan(tmp_path / "plan")  # a small cell: the server is up in seconds
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "planner", "ui", str(plan), "--port", "0", "--fresh"],
+        cwd=REPO,
+        stderr=subprocess.PIPE,
+        stdout=subprocess.DEVNULL,
+        text=True,
+    )
+    lines: queue.Queue[str] = queue.Queue()
+
+    def read() -> None:  # the pipe drained on its own thread: readline never blocks the test
+        assert proc.stderr is not None
+        for text in proc.stderr:
+            lines.put(text)
+
+    threading.Thread(target=read, daemon=True).start()
+    try:
+        deadline = time.monotonic() + 120.0
+        seen = ""
+        while "wobjcal UI on http://127.0.0.1:" not in seen:
+            left = deadline - time.monotonic()
+            assert left > 0 and proc.poll() is None, f"no server: {seen!r}"
+            try:
+                seen += lines.get(timeout=min(left, 1.0))
+            except queue.Empty:
+                continue
+        proc.send_signal(sig)
+        assert proc.wait(timeout=60) == code
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
