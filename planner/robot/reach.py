@@ -153,8 +153,7 @@ def no_ik_reasons(
     """:func:`no_ik_reason` of ``P`` points at once: ``T_flange (P, R, 4, 4)``, base frame, m.
 
     The same reasons as one call per point (``tests/planner/robot/test_reach.py`` compares them),
-    with one
-    batched IK call for all points instead of one per point.
+    with one batched IK call for all points instead of one per point.
     """
     T = np.asarray(T_flange, dtype=np.float64)
     P, R = T.shape[:2]

@@ -14,7 +14,7 @@ from calib.probing import SearchCommand
 from calib.procedure_run import ProbeStep, ProcedureRun, measured_by_key
 from calib.procedures import PROCEDURES
 from tests.box_part import BoxProbe
-from tests.test_procedures_registry import T_NOM, T_TRUE, role_points
+from tests.calib.procedures.test_procedures_registry import T_NOM, T_TRUE, role_points
 
 
 def test_measured_by_key_numbers_the_retakes() -> None:
