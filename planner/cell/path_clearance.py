@@ -18,7 +18,8 @@ clearance of the passing samples (the loop's running minimum): a verdict, not a 
 
 Used where only the verdict counts: the vetting of simulated searches
 (:func:`planner.sim.search_events.program_search_hook`, ``check_search(..., exact_clearance=
-False)``), thousands of short paths; ``tests/test_path_clearance.py`` holds it to the loop.
+False)``), thousands of short paths; ``tests/planner/cell/test_path_clearance.py`` holds it
+to the loop.
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ three times Embree's own cast for a sensor's bundle):
 
 Every dot product is summed in the order numpy's ``einsum("ij,ij->i")`` sums three terms
 (``(x0 y0 + x2 y2) + x1 y1``), so the distances are bit for bit those of the numpy version the
-caster had before (``tests/test_hit_kernel.py`` holds it to that version, ray by ray).
+caster had before (``tests/planner/sim/test_hit_kernel.py`` holds it to that version, ray by ray).
 
 The kernel is compiled (or loaded from numba's cache) on first use, in the process that uses
 it: numba's cache directory is the one in force at that moment (wobjcal's, once the cell
