@@ -94,6 +94,8 @@ class SessionState(Generic[D]):
         self._write_lock = threading.Lock()
         self._save_seq = 0  # the number of the latest autosave started
         self._written_seq = 0  # the number of the autosave the file holds
+        self._reported_seq = 0  # the number of the autosave last_autosave_error speaks of
+        self._latest: _Saving | None = None  # the autosave of the current document
 
     @property
     def doc(self) -> D:
@@ -188,6 +190,7 @@ class SessionState(Generic[D]):
             return None
         self._save_seq += 1
         saving = _Saving(self._save_seq)
+        self._latest = saving
         try:
             data = self._serialize(self._doc)
         except Exception as exc:  # a failed autosave must not lose the edit
@@ -214,18 +217,37 @@ class SessionState(Generic[D]):
                 return
             self._written_seq = saving.seq
 
+    def wait_saved(self, timeout: float | None = None) -> bool:
+        """Wait until the autosave file holds the current document (or its write failed).
+
+        :attr:`doc` shows an edit as soon as it is made, while its autosave is still being
+        written; a reader of the file waits here first. Returns True when the current document
+        is on disk, False when its write failed, there is no autosave, or ``timeout`` (s) ran out.
+        """
+        with self._lock:
+            saving = self._latest
+        if saving is None:
+            return False
+        if saving.thread is not None:
+            saving.thread.join(timeout)
+            if saving.thread.is_alive():
+                return False
+        return not saving.error
+
     def _finish_autosave(self, saving: _Saving | None) -> bool:
-        """Wait for the write; say how it went (:attr:`last_autosave_error`)."""
+        """Wait for the write; say how it went (:attr:`last_autosave_error`, which speaks
+        of the newest write that has finished, never of an older one finishing later)."""
         if saving is None:
             return False
         if saving.thread is not None:
             saving.thread.join()
         if saving.error:  # a failed autosave must not lose the edit
-            self.last_autosave_error = saving.error
             logger.warning("autosave to %s failed: %s", self._autosave_path, saving.error)
-            return False
-        self.last_autosave_error = ""
-        return True
+        with self._write_lock:
+            if saving.seq >= self._reported_seq:
+                self._reported_seq = saving.seq
+                self.last_autosave_error = saving.error
+        return not saving.error
 
     def _notify_saving(self, change: Change[D], saving: _Saving | None) -> None:
         """Tell the listeners while the autosave is written; return once both are done."""

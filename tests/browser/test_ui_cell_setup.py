@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 import trimesh
 from ui_helpers import (
+    TIMEOUT_S,
     UiSession,
     act_until,
     choose,
@@ -55,6 +56,8 @@ def _body(ui: UiSession) -> str:
 
 
 def _saved(ui: UiSession) -> dict[str, Any]:
+    """The autosaved plan, once the file holds the document the server shows."""
+    assert ui.app.state.wait_saved(timeout=TIMEOUT_S), ui.app.state.last_autosave_error
     return dict(json.loads(ui.app.state.autosave_path.read_text()))
 
 

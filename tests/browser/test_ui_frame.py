@@ -69,6 +69,7 @@ def test_three_clicks_define_the_frame_and_nothing_moves(ui: UiSession) -> None:
     after = _world_points(ui)
     for pid, p in before.items():
         np.testing.assert_allclose(after[pid], p, atol=1e-9)  # nothing moved in the world
+    assert ui.app.state.wait_saved(timeout=120.0), ui.app.state.last_autosave_error
     saved = json.loads(ui.app.state.autosave_path.read_text())  # type: ignore[union-attr]
     assert "T_wobj_mesh" in saved["work_object"]
     wait_for(lambda: all(ui.app.check_of(pid) for pid in before), what="the checks")

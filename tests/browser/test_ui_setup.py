@@ -121,6 +121,7 @@ def test_teach_as_via_point_in_the_page(demo: UiSession) -> None:
     wait_for(lambda: len(app.state.doc.get("B").vias) == 1, what="the via on the server")
     np.testing.assert_allclose(app.state.doc.get("B").vias[0].q_rad, lifted, atol=1e-12)
     # the autosaved plan is a valid plan with the via (joint values as taught)
+    assert app.state.wait_saved(timeout=120.0), app.state.last_autosave_error
     saved = plan_from_json(app.state._autosave_path.read_text())
     np.testing.assert_allclose(saved.point("B").via_points[0].q_rad, lifted, atol=1e-12)
     assert json.loads(app.state._autosave_path.read_text())["points"][0].get("vias") is None

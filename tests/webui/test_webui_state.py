@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from webui.state import SessionState, atomic_write_bytes
+from webui.state import Change, SessionState, atomic_write_bytes
 
 
 def _state(tmp_path: Path) -> SessionState[tuple[int, ...]]:
@@ -136,3 +136,70 @@ def test_overlapping_changes_leave_the_latest_document_in_the_file(tmp_path: Pat
         t.join()
     assert len(s.doc) == 100 and not s.last_autosave_error
     assert json.loads((tmp_path / "sub" / "autosave.json").read_text()) == list(s.doc)
+
+
+def test_a_reader_of_the_file_waits_for_the_write_of_the_shown_document(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``doc`` shows an edit before its autosave is on disk; ``wait_saved`` bridges the gap."""
+    import webui.state
+
+    write = webui.state.atomic_write_bytes
+    release = threading.Event()
+
+    def held_write(path: Path, data: bytes) -> None:
+        release.wait(5.0)
+        write(path, data)
+
+    s = _state(tmp_path)
+    s.apply((1,), "one")  # on disk before the slow disk
+    monkeypatch.setattr(webui.state, "atomic_write_bytes", held_write)
+    editor = threading.Thread(target=s.apply, args=((1, 2), "two"))
+    editor.start()
+    deadline = time.monotonic() + 5.0
+    while s.doc != (1, 2) and time.monotonic() < deadline:
+        time.sleep(0.005)
+    assert s.doc == (1, 2)
+    path = tmp_path / "sub" / "autosave.json"
+    assert json.loads(path.read_text()) == [1], "the file held the edit before its write"
+    assert not s.wait_saved(timeout=0.05)  # still being written
+    release.set()
+    assert s.wait_saved(timeout=5.0)
+    assert json.loads(path.read_text()) == [1, 2]
+    editor.join()
+
+
+def test_the_autosave_status_speaks_of_the_newest_write(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """When an older change finishes after a newer one (its listeners were slower), the status
+    still speaks of the newer write: here the newer write failed, so the file is not fine."""
+    import webui.state
+
+    write = webui.state.atomic_write_bytes
+
+    def fail_on_two(path: Path, data: bytes) -> None:
+        if data == b"[1, 2]":
+            raise OSError("disk full")
+        write(path, data)
+
+    monkeypatch.setattr(webui.state, "atomic_write_bytes", fail_on_two)
+    s = _state(tmp_path)
+    slow_listener_may_end = threading.Event()
+    in_slow_listener = threading.Event()
+
+    def listener(change: Change[tuple[int, ...]]) -> None:
+        if change.doc == (1,):
+            in_slow_listener.set()
+            slow_listener_may_end.wait(5.0)
+
+    s.subscribe(listener)
+    older = threading.Thread(target=s.apply, args=((1,), "one"))
+    older.start()
+    assert in_slow_listener.wait(5.0)
+    s.apply((1, 2), "two")  # its write fails and it finishes first
+    assert "disk full" in s.last_autosave_error
+    slow_listener_may_end.set()
+    older.join()
+    assert "disk full" in s.last_autosave_error, "an older write's success hid the newer failure"
+    assert not s.wait_saved(timeout=5.0)
