@@ -95,6 +95,9 @@ class WobjcalApp:
         self.picker: SurfacePicker | None = None
         self.robot: TabRobots | None = None  # one drawing per tab, each at its own pose
         self._checks: dict[str, tuple[ProbePoint, PointCheck]] = {}
+        # per point, bumped by every change that drops its check: a recheck started before the
+        # change (say, for a sensor an undo has taken back) must not store its result after
+        self._check_gen: dict[str, int] = {}
         #: the cell's generation: what was worked out in an earlier cell is not reused
         self._cell_gen = 0
         #: what undo and redo bring back with a plan object seen before (:mod:`webui.doc_memo`):
@@ -224,6 +227,9 @@ class WobjcalApp:
             return []
         edited = [plan_point(p) for p in points]
         as_edited = plan_as_edited(doc)
+        with self._lock:
+            cell_gen = self._cell_gen  # a new cell drops every check (load_cell)
+            gens = {p.id: self._check_gen.get(p.id, 0) for p in points}
         with self.busy(f"checking {', '.join(p.id for p in points[:6])}"):
             results = self.worker.call(
                 lambda s: [] if s is None else s.check_points(edited, as_edited)
@@ -231,8 +237,13 @@ class WobjcalApp:
         current = self.state.doc
         with self._lock:
             for point, check in zip(points, results, strict=False):
-                still = point.id in current.ids and current.get(point.id).probe == point.probe
-                if still:  # drop results of a point that moved on meanwhile
+                still = (
+                    point.id in current.ids
+                    and current.get(point.id).probe == point.probe
+                    and self._check_gen.get(point.id, 0) == gens[point.id]
+                    and self._cell_gen == cell_gen
+                )
+                if still:  # drop results of a point that moved on (or was undone) meanwhile
                     self._checks[point.id] = (point.probe, check)
         self._redraw([p.id for p in points])
         return results
@@ -353,6 +364,7 @@ class WobjcalApp:
         known = []  # points whose check in this very plan is known: undo or redo to it
         with self._lock:
             for pid in [*changed, *(set(before) - set(change.doc.ids))]:
+                self._check_gen[pid] = self._check_gen.get(pid, 0) + 1
                 entry = self._checks.pop(pid, None)
                 if entry is not None:  # for an undo back to the plan it was shown in
                     self._check_memo.put(change.previous, entry, (pid, self._cell_gen))
