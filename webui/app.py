@@ -107,6 +107,9 @@ class WobjcalApp:
         self._cycle_memo: DocMemo[tuple[tuple[tuple[str, PointCheck], ...], CycleTime | None]] = (
             DocMemo()
         )
+        #: tabs that did not take the table's updates in time: not waited for again until
+        #: they catch up (:func:`webui.gui_first.flush_gui_first`)
+        self._stalled_tabs: set[int] = set()
         #: the estimated cycle time of the plan as edited, from the latest checks
         self.cycle: CycleTime | None = None
         #: the latest cycle-time estimate (:meth:`update_cycle_time`)
@@ -266,7 +269,7 @@ class WobjcalApp:
         # GUI updates at once, one with scene updates only in its next frame (0.2-1 s with
         # software WebGL), and viser sends what is queued together (:mod:`webui.gui_first`)
         self.points_panel.refresh()
-        flush_gui_first(self.server)
+        flush_gui_first(self.server, stalled=self._stalled_tabs)
         self.scene.draw_points(doc, self.checks(), None, only=point_ids, flags=self.flags.by_point)
         self.server.flush()
         self.update_cycle_time()  # after the rows: a click or undo does not wait for it

@@ -12,7 +12,13 @@ plan it returns to (``bench/bench_ui_latency.py --demo-browser``).
 Entries are keyed by the plan's identity (``is``, never ``==``: two equal plans built apart
 may differ in what the key does not hold) and by a ``tag`` compared with ``==`` (e.g. the
 point id and the cell's generation); the memo holds its plans, so an identity is never
-reused while its entry lives. Only the last :attr:`DocMemo.size` entries are kept.
+reused while its entry lives.
+
+The bound is :attr:`DocMemo.size` entries in all, one per (plan, tag) pair, whatever the
+number of plans and tags (the oldest used goes first): the memory is bounded by the size, not by
+plans times points. A memo keyed by the plan alone (role flags, cycle time, layout quality) so
+reaches back ``size`` plans; one keyed by plan and point (the checks) ``size`` point checks, one
+per point a step changed (a single-point edit takes one entry, a new sensor one per point).
 """
 
 from __future__ import annotations
@@ -24,15 +30,17 @@ from typing import Generic, TypeVar
 
 V = TypeVar("V")
 
-#: Entries a memo keeps by default (an undo or redo reaches back this many results).
+#: Entries a memo keeps by default, in all (an undo or redo reaches back this many results).
 DEFAULT_SIZE = 64
 
 
 class DocMemo(Generic[V]):
-    """The last ``size`` values stored for a (plan object, tag) pair; thread-safe.
+    """Values stored by (plan object, tag) pair, one per pair and at most ``size`` in all;
+    thread-safe.
 
     Args:
-        size: how many entries to keep (the oldest used goes first).
+        size: how many entries to keep in all, over every plan and tag (the oldest used goes
+            first).
     """
 
     def __init__(self, size: int = DEFAULT_SIZE) -> None:

@@ -10,7 +10,9 @@ predicted error is painted on the part (:func:`planner.sim.quality.error_radius`
 to red large) and each point of interest carries a sphere of its predicted error (drawn 100
 times larger). "Suggest layout" and "Add best point" run :func:`planner.suggest.suggest_plan`
 in the cell's worker (it needs the cell) with a progress bar, for the procedure the user picks
-(by default the plan's own: an A-H plan is refused with what to pick, never switched silently)
+(by default the plan's own: an A-H plan is refused with what to pick, never switched silently;
+"Add best point" keeps a procedure whose layout grows, best fit or iterative best fit, and grows
+a 3-2-1 or A-H plan into a best fit, saying so: :func:`suggest_procedure`)
 and the objective (accuracy, or the least cycle time under the target). The suggestion is shown
 beside the current layout (:func:`comparison_markdown`: points, predicted error, landing risk,
 cycle time, what check refuses) and replaces the points (one undo step) only on "Accept
@@ -29,9 +31,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from calib.errors import InputError, PlanError
-from calib.procedures import DESIGNED, PROCEDURES
+from calib.procedures import DESIGNED, GROWN, PROCEDURES
 from planner.check.job import plan_detectability, plan_quality
 from planner.sim.quality import DOF_NAMES, LayoutQuality, error_radius
+from planner.suggest import DEFAULT_PROCEDURE
 from webui.doc_memo import DocMemo
 from webui.markdown_text import plain
 from webui.panel import Panel
@@ -83,6 +86,57 @@ def quality_markdown(q: LayoutQuality | None, note: str = "") -> str:
 KEEP = "keep the plan's"
 PROCEDURE_CHOICES = {KEEP: "", **{PROCEDURES[m].label: m for m in DESIGNED}}
 OBJECTIVE_CHOICES = {"accuracy": "accuracy", "least cycle time": "time"}
+
+
+def _labels(methods: tuple[str, ...]) -> str:
+    """The procedures' labels for a message: ``"3-2-1, best fit or iterative best fit"``."""
+    names = [PROCEDURES[m].label for m in methods]
+    return names[0] if len(names) == 1 else f"{', '.join(names[:-1])} or {names[-1]}"
+
+
+def suggest_procedure(picked: str, plan_method: str, add: int, objective: str) -> tuple[str, str]:
+    """The procedure and the objective a suggestion is designed for.
+
+    Args:
+        picked: the procedure picked under "Suggested procedure" (``""``: keep the plan's).
+        plan_method: the plan's own procedure.
+        add: points to add ("Add best point"), 0 for a whole new layout.
+        objective: ``"accuracy"`` or ``"time"`` (:data:`OBJECTIVE_CHOICES`).
+
+    With ``add``, a procedure whose layout grows (:data:`calib.procedures.GROWN`: best fit,
+    iterative best fit) is kept, and the objective is accuracy; a plan of one that takes
+    exactly its own points (3-2-1, A-H), kept, becomes a best fit of all its points
+    (:data:`planner.suggest.DEFAULT_PROCEDURE`; suggest's message says so).
+
+    Raises:
+        InputError: the procedure is one Suggest cannot design (A-H), one that cannot grow
+            picked for "Add best point", or the least cycle time asked of one that does not
+            grow; the message says what to pick.
+    """
+    procedure = picked or plan_method
+    if add:
+        if procedure in GROWN:
+            return procedure, "accuracy"
+        if picked:  # picked on purpose: not switched silently
+            raise InputError(
+                f"Add best point grows a layout point by point, which {PROCEDURES[picked].label} "
+                f"cannot (it takes exactly its own points): pick {_labels(GROWN)} under "
+                "Suggested procedure, or keep the plan's"
+            )
+        return DEFAULT_PROCEDURE, "accuracy"  # the plan of all the points, as suggest says
+    if procedure not in DESIGNED:
+        raise InputError(
+            f"the plan's procedure is {plan_method}, whose points Suggest cannot design: pick "
+            f"{_labels(DESIGNED)} under Suggested procedure to suggest one instead (the plan's "
+            "points are replaced only when you accept)"
+        )
+    if objective == "time" and procedure not in GROWN:
+        raise InputError(
+            f"the least cycle time is designed for a layout that grows point by point "
+            f"({_labels(GROWN)}): pick one of them under Suggested procedure, or accuracy "
+            "under Objective"
+        )
+    return procedure, objective
 
 
 def _layout_line(
@@ -283,33 +337,23 @@ class LayoutPanel(Panel):
         the suggestion is shown beside the current layout (:meth:`accept` applies it).
 
         Raises:
-            InputError: a suggestion is already running, there is no plan, or the plan's own
-                procedure (the default) is one Suggest cannot design (A-H): pick another.
+            InputError: a suggestion is already running, there is no plan, or the procedure
+                and objective do not go together (:func:`suggest_procedure`: the plan's own
+                procedure, the default, is one Suggest cannot design, A-H): pick another.
         """
         from planner.check.job import check_plan
-        from planner.suggest import DEFAULT_PROCEDURE, grown_procedures, suggest_plan
+        from planner.suggest import suggest_plan
 
         made_for = self._app.state.doc  # a suggestion is for this plan only
         plan = plan_from_ui(made_for)
         if self._suggesting.is_set():
             raise InputError("a suggestion is already running")
-        procedure = PROCEDURE_CHOICES.get(str(self.procedure.value), "") or plan.method
-        objective = OBJECTIVE_CHOICES.get(str(self.objective.value), "accuracy")
-        if add:  # added points: a best fit of all (the message says so), as wobjcal suggest
-            procedure = DEFAULT_PROCEDURE
-        elif procedure not in DESIGNED:
-            raise InputError(
-                f"the plan's procedure is {plan.method}, whose points Suggest cannot design: "
-                "pick best fit or 3-2-1 under Suggested procedure to suggest one instead (the "
-                "plan's points are replaced only when you accept)"
-            )
-        if add:
-            objective = "accuracy"
-        if objective == "time" and procedure not in grown_procedures():
-            raise InputError(
-                "the least cycle time is designed for a best fit: pick best fit under "
-                "Suggested procedure, or accuracy under Objective"
-            )
+        procedure, objective = suggest_procedure(
+            PROCEDURE_CHOICES.get(str(self.procedure.value), ""),
+            plan.method,
+            add,
+            OBJECTIVE_CHOICES.get(str(self.objective.value), "accuracy"),
+        )
         self.discard()
         self._suggesting.set()
         self.suggest_button.disabled = self.add_button.disabled = True

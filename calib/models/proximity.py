@@ -192,8 +192,9 @@ class ProximitySensor(Strict, frozen=True, kw_only=True, tag="proximity", tag_fi
         return self.travel_to_switch_m(float(self.signal(distances_m)), jitter_m)
 
     def travel_to_switch_m(self, signal: float, jitter_m: float = 0.0) -> float:
-        """:meth:`switch_travel_m` from the signal at the start, ``signal`` (m; ``inf`` for a
-        signal of 0: no metal), for callers that have the signals of many searches at once."""
+        """:meth:`switch_travel_m` from the signal at the start, ``signal`` (:meth:`signal`:
+        dimensionless, 1.0 over a full flat target at Sn), for callers that have the signals of
+        many searches at once; the travel is in m, ``inf`` for a signal of 0 (no metal)."""
         if signal <= 0.0:
             return math.inf
         return self.decay_length_m * math.log(self.on_level(jitter_m) / signal)

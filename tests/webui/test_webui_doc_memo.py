@@ -38,3 +38,17 @@ def test_the_oldest_used_entry_goes_first() -> None:
 def test_a_memo_of_no_entries_is_refused() -> None:
     with pytest.raises(ValueError, match="size: must be >= 1, got 0"):
         DocMemo(size=0)
+
+
+def test_the_bound_is_size_entries_in_all_not_per_plan_or_point() -> None:
+    """Plans times points tags stay within ``size`` entries: the memory does not grow with
+    them (one entry per (plan, tag) pair, a put again replaces it)."""
+    memo: DocMemo[int] = DocMemo(size=8)
+    plans = [object() for _ in range(5)]
+    for plan in plans:
+        for point in "ABCDEFGH":
+            memo.put(plan, 1, (point, 0))
+            memo.put(plan, 2, (point, 0))  # the same pair: replaced, not added
+        assert len(memo) == 8
+    assert [memo.get(plans[-1], (p, 0)) for p in "ABCDEFGH"] == [2] * 8  # the last plan's
+    assert all(memo.get(plan, ("A", 0)) is None for plan in plans[:-1])  # the older ones gone

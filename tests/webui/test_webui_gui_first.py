@@ -57,6 +57,55 @@ def test_gives_up_after_the_wait_and_without_tabs_does_not_wait() -> None:
     assert flush_gui_first(_Server(_Buffer(counter=10, cursors={})))  # type: ignore[arg-type]
 
 
+class _TabsServer(_Server):
+    """Each flush queues one message more; the ``healthy`` tabs take it at once, the others
+    (stalled) do not move."""
+
+    def __init__(self, buffer: _Buffer, healthy: set[int]) -> None:
+        super().__init__(buffer)
+        self.buffer, self.healthy = buffer, healthy
+
+    def flush(self) -> None:
+        super().flush()
+        self.buffer.message_counter += 1
+        for c in self.healthy:
+            self.buffer.generator_cursors[c] = self.buffer.message_counter - 1
+
+
+def test_a_stalled_tab_costs_one_wait_not_one_per_redraw() -> None:
+    buffer = _Buffer(counter=10, cursors={1: 9, 2: 3, 3: 3})  # tabs 2 and 3 stalled
+    server = _TabsServer(buffer, healthy={1})
+    stalled: set[int] = set()
+    t0 = time.monotonic()
+    assert not flush_gui_first(server, wait_s=0.1, stalled=stalled)  # type: ignore[arg-type]
+    first = time.monotonic() - t0
+    assert 0.09 < first < 1.0, "one wait in all for both stalled tabs, not one each"
+    assert stalled == {2, 3}
+    t0 = time.monotonic()
+    for _ in range(10):  # the next redraws: the healthy tab is not held up by the stalled ones
+        assert flush_gui_first(server, wait_s=0.2, stalled=stalled)  # type: ignore[arg-type]
+    assert time.monotonic() - t0 < 1.0, "10 redraws took no stalled tab's wait (2 s if they did)"
+    assert stalled == {2, 3}
+    # tab 2 catches up, tab 3 goes: both are waited for again (tab 2 from now on)
+    buffer.generator_cursors[2] = buffer.message_counter - 1
+    del buffer.generator_cursors[3]
+    server.healthy.add(2)
+    assert flush_gui_first(server, wait_s=0.1, stalled=stalled)  # type: ignore[arg-type]
+    assert stalled == set()
+    server.healthy.discard(2)  # and when it stalls again, it costs one wait again
+    assert not flush_gui_first(server, wait_s=0.05, stalled=stalled)  # type: ignore[arg-type]
+    assert stalled == {2}
+
+
+def test_without_a_stalled_set_every_flush_waits() -> None:
+    """The plain call (no state kept) waits for every tab each time, at most ``wait_s``."""
+    server = _TabsServer(_Buffer(counter=10, cursors={1: 9, 2: 3}), healthy={1})
+    for _ in range(2):
+        t0 = time.monotonic()
+        assert not flush_gui_first(server, wait_s=0.05)  # type: ignore[arg-type]
+        assert 0.04 < time.monotonic() - t0 < 1.0
+
+
 def test_a_viser_without_that_buffer_gets_a_plain_flush() -> None:
     server = _Server(buffer=None)
     assert not flush_gui_first(server)  # type: ignore[arg-type]

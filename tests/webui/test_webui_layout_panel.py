@@ -88,3 +88,70 @@ def test_suggest_keeps_the_procedure_and_applies_only_on_accept(app: WobjcalApp)
     assert panel.refresh().result(60) is not None
     app.state.undo()
     assert app.state.doc.ids == before
+
+
+def test_add_best_point_keeps_a_procedure_that_grows() -> None:
+    """ "Add best point" keeps the iterative best fit (and the best fit) rather than turning the
+    plan into a plain best fit; a 3-2-1 or A-H plan kept becomes a best fit, as suggest says."""
+    from webui.layout_panel import suggest_procedure
+
+    assert suggest_procedure("", "iterative", 1, "time") == ("iterative", "accuracy")
+    assert suggest_procedure("", "best_fit", 1, "accuracy") == ("best_fit", "accuracy")
+    assert suggest_procedure("iterative", "best_fit", 1, "accuracy") == ("iterative", "accuracy")
+    assert suggest_procedure("best_fit", "iterative", 1, "accuracy") == ("best_fit", "accuracy")
+    assert suggest_procedure("", "hultman2013", 1, "accuracy") == ("best_fit", "accuracy")
+    assert suggest_procedure("", "three_two_one", 1, "accuracy") == ("best_fit", "accuracy")
+    with pytest.raises(InputError, match="pick best fit or iterative best fit under Suggested"):
+        suggest_procedure("three_two_one", "iterative", 1, "accuracy")  # picked: not switched
+    # without add: the plan's procedure or the one picked, as before
+    assert suggest_procedure("", "iterative", 0, "time") == ("iterative", "time")
+    assert suggest_procedure("three_two_one", "hultman2013", 0, "accuracy")[0] == "three_two_one"
+
+
+def test_the_messages_name_every_procedure_suggest_offers() -> None:
+    from webui.layout_panel import suggest_procedure
+
+    with pytest.raises(InputError, match="pick 3-2-1, best fit or iterative best fit under"):
+        suggest_procedure("", "hultman2013", 0, "accuracy")
+    with pytest.raises(
+        InputError, match=r"grows point by point \(best fit or iterative best fit\)"
+    ):
+        suggest_procedure("three_two_one", "best_fit", 0, "time")
+
+
+def test_add_best_point_on_an_iterative_plan_suggests_an_iterative_plan(
+    app: WobjcalApp, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The panel passes the plan's iterative best fit to suggest (it used to force best_fit)."""
+    import planner.check.job
+    import planner.suggest.job
+    from calib.procedures import PROCEDURES
+    from planner.suggest.job import as_procedure
+    from webui.layout_panel import KEEP
+    from webui.plan_adapter import plan_from_ui, ui_plan_from_plan
+
+    asked: list[dict[str, Any]] = []
+
+    def fake_suggest(*_args: Any, **kwargs: Any) -> Any:
+        asked.append(kwargs)
+        raise InputError("not designed in this test")
+
+    def no_check(*_args: Any, **_kwargs: Any) -> Any:
+        raise InputError("not checked in this test")
+
+    monkeypatch.setattr(planner.suggest.job, "suggest_plan", fake_suggest)
+    monkeypatch.setattr(planner.check.job, "check_plan", no_check)
+    panel = app.layout_panel
+    before = app.state.doc
+    iterative = as_procedure(plan_from_ui(before), PROCEDURES["iterative"])
+    app.state.apply(ui_plan_from_plan(iterative, name=before.name), "iterative best fit")
+    try:
+        assert app.state.doc.method == "iterative"
+        panel.procedure.value = KEEP
+        panel.objective.value = "accuracy"
+        with pytest.raises(InputError, match="not designed in this test"):
+            panel.suggest(1).result(120)
+        assert asked and asked[-1]["procedure"] == "iterative" and asked[-1]["add"] == 1
+    finally:
+        app.state.undo()
+    assert app.state.doc is before
