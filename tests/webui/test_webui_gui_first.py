@@ -2,12 +2,38 @@
 
 from __future__ import annotations
 
+import functools
 import threading
 import time
+from collections.abc import Callable
 from typing import Any
 
 from webui.gui_first import _broadcast_buffer, flush_gui_first
 from webui.testing import free_port
+
+
+def _off_any_loop(test: Callable[[], None]) -> Callable[[], None]:
+    """Run ``test`` on a thread of its own: in a pytest worker that ran a browser test before,
+    Playwright's sync API keeps an event loop running on the main thread, where
+    :func:`flush_gui_first` rightly does not wait."""
+
+    @functools.wraps(test)
+    def run() -> None:
+        failure: list[BaseException] = []
+
+        def body() -> None:
+            try:
+                test()
+            except BaseException as exc:  # re-raised on the test's thread
+                failure.append(exc)
+
+        thread = threading.Thread(target=body)
+        thread.start()
+        thread.join()
+        if failure:
+            raise failure[0]
+
+    return run
 
 
 class _Buffer:
@@ -35,6 +61,7 @@ class _Server:
         self.flushes += 1
 
 
+@_off_any_loop
 def test_waits_until_every_tab_took_what_is_queued() -> None:
     buffer = _Buffer(counter=10, cursors={1: 9, 2: 4})  # tab 2 has not taken messages 5-9 yet
     server = _Server(buffer)
@@ -49,6 +76,7 @@ def test_waits_until_every_tab_took_what_is_queued() -> None:
     assert 0.015 < time.monotonic() - t0 < 4.0 and server.flushes == 1
 
 
+@_off_any_loop
 def test_gives_up_after_the_wait_and_without_tabs_does_not_wait() -> None:
     stuck = _Server(_Buffer(counter=10, cursors={1: 3}))
     t0 = time.monotonic()
@@ -72,6 +100,7 @@ class _TabsServer(_Server):
             self.buffer.generator_cursors[c] = self.buffer.message_counter - 1
 
 
+@_off_any_loop
 def test_a_stalled_tab_costs_one_wait_not_one_per_redraw() -> None:
     buffer = _Buffer(counter=10, cursors={1: 9, 2: 3, 3: 3})  # tabs 2 and 3 stalled
     server = _TabsServer(buffer, healthy={1})
@@ -97,6 +126,7 @@ def test_a_stalled_tab_costs_one_wait_not_one_per_redraw() -> None:
     assert stalled == {2}
 
 
+@_off_any_loop
 def test_without_a_stalled_set_every_flush_waits() -> None:
     """The plain call (no state kept) waits for every tab each time, at most ``wait_s``."""
     server = _TabsServer(_Buffer(counter=10, cursors={1: 9, 2: 3}), healthy={1})
@@ -106,12 +136,14 @@ def test_without_a_stalled_set_every_flush_waits() -> None:
         assert 0.04 < time.monotonic() - t0 < 1.0
 
 
+@_off_any_loop
 def test_a_viser_without_that_buffer_gets_a_plain_flush() -> None:
     server = _Server(buffer=None)
     assert not flush_gui_first(server)  # type: ignore[arg-type]
     assert server.flushes == 1
 
 
+@_off_any_loop
 def test_the_installed_viser_has_the_buffer_it_reads() -> None:
     """A viser that renamed its buffer's counter or cursors would lose the ordering silently."""
     import viser
@@ -124,6 +156,7 @@ def test_the_installed_viser_has_the_buffer_it_reads() -> None:
         server.stop()
 
 
+@_off_any_loop
 def test_on_an_event_loop_it_does_not_wait() -> None:
     """viser's sender runs on its event loop: waiting there would stop it."""
     import asyncio
