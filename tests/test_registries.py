@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 import re
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
@@ -312,6 +313,9 @@ READERS: dict[str, Callable[[PasteLines], np.ndarray]] = {
     "urscript": _urscript,
     "fanuc": _fanuc,
 }
+#: The module (of the project's test extras) a format's reader needs beyond the tests' own
+#: code: without it only that format's case is skipped.
+READER_NEEDS: dict[str, str] = {"rapid": "rapidchecker", "krl": "antlr4"}
 
 
 def test_every_format_has_a_reader() -> None:
@@ -320,12 +324,34 @@ def test_every_format_has_a_reader() -> None:
 
 @pytest.mark.parametrize("fmt", list(FORMATS))
 def test_the_paste_lines_parse_and_give_the_frame(fmt: str) -> None:
-    pytest.importorskip("rapidchecker")
+    if fmt in READER_NEEDS:
+        pytest.importorskip(READER_NEEDS[fmt])
     paste = FORMATS[fmt].paste_lines(T_CAL)
     assert paste.where and paste.lines
     T = READERS[fmt](paste)
     np.testing.assert_allclose(T[:3, 3], T_CAL[:3, 3], atol=1e-6)  # 0.001 mm
     np.testing.assert_allclose(T[:3, :3], T_CAL[:3, :3], atol=1e-6)  # about 6e-5 deg
+
+
+@pytest.mark.parametrize("fmt", list(FORMATS))
+def test_a_format_s_paste_lines_need_only_its_own_reader(
+    fmt: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Without the other formats' checkers (as if not installed) a format's case still runs;
+    without its own it is skipped (once, every format's case hung on rapidchecker)."""
+    own = READER_NEEDS.get(fmt)
+    if own is not None:
+        pytest.importorskip(own)
+    for other in set(READER_NEEDS.values()) - {own}:
+        monkeypatch.setitem(sys.modules, other, None)  # its import now fails
+    try:
+        test_the_paste_lines_parse_and_give_the_frame(fmt)
+    except pytest.skip.Exception as exc:
+        pytest.fail(f"{fmt}: skipped without another format's checker: {exc}")
+    if own is not None:
+        monkeypatch.setitem(sys.modules, own, None)
+        with pytest.raises(pytest.skip.Exception, match=own):
+            test_the_paste_lines_parse_and_give_the_frame(fmt)
 
 
 # ---------------------------------------------------------------- built-in parts

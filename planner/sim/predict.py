@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from calib.errors import InputError, WobjcalError
 from calib.frames import motion_between, small_motion
 from calib.plane_probe import PlaneProbe
 from calib.probing import Probe
@@ -99,6 +100,25 @@ def predict(setup: SimulationSetup, step_m: float = 1e-6, best_fit: bool = True)
         xoffset_sigma_m=x_sigma,
         n_searches=len(lin.commands),
     )
+
+
+def predict_report(setup: SimulationSetup) -> Prediction:
+    """:func:`predict` of a validation report's rows, on a worker process or in this one.
+
+    Its failure is one :class:`InputError` that says it is the prediction's and that a worker
+    process can send back (a :class:`calib.errors.ProbeFailedError` raised there would come
+    back as a broken pool: its arguments do not pickle).
+
+    Raises:
+        InputError: the prediction failed (the plan cannot calibrate even on the ideal part,
+            or its procedure is not smooth there); the message says why.
+    """
+    try:
+        return predict(setup)
+    except WobjcalError as exc:
+        raise InputError(
+            f"the prediction (the plan's procedure linearised on the ideal part) failed: {exc}"
+        ) from exc
 
 
 def misplacement_covariances(

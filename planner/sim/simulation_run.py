@@ -8,7 +8,9 @@ one, with the prediction of the rows (the procedure linearised) as their first t
 which is not shared), waits for the workers and builds the report. Between the two the caller
 is free: ``wobjcal validate`` opens the plan's cell and checks the plan there
 (:func:`planner.validate.job.validate_plan`) while the workers run, which takes the cell, the
-check and the prediction off the run's critical path.
+check and the prediction off the run's critical path. A prediction that fails on its worker
+stops the run at once, before the first vetted trial or between two of them, not after all of
+them.
 
 The numbers do not depend on it: the seeds are drawn before anything runs, each trial is seeded
 on its own, and the report puts the trials in seed order (vetted first), exactly as
@@ -33,7 +35,7 @@ from calib.errors import ShapeError
 from calib.limits import MAX_PROTOCOL_TRIALS
 from calib.plan.models import MAX_TRIALS
 from planner.sim.error_map import error_map
-from planner.sim.predict import predict
+from planner.sim.predict import predict_report
 from planner.sim.report import ValidationReport
 from planner.sim.rows import RowSpec
 from planner.sim.search_events import ReachabilityHook, cell_search_hook
@@ -106,7 +108,9 @@ class SimulationRun:
             progress: ``progress(done, total)`` while trials complete.
 
         Raises:
-            InputError: a plan that cannot calibrate even on the ideal part (the prediction).
+            InputError: a plan that cannot calibrate even on the ideal part (the prediction),
+                raised as soon as the prediction fails: before the first vetted trial, or
+                between two of them when the worker's prediction fails meanwhile.
         """
         total = len(self.seeds)
         n_reach = self.n_vetted
@@ -124,18 +128,32 @@ class SimulationRun:
             done_here = done
             report(0 if self.pool is None else self.pool.done)
 
+        pool = self.pool
+        pending = None if pool is None else pool.prediction  # computed on a worker meanwhile
+
+        def prediction_failed() -> None:
+            # a plan that cannot work fails at once, not after the vetted trials
+            if pending is not None and pending.done():
+                pending.result()  # its error, raised here
+
         try:
-            pool = self.pool
-            if pool is None or pool.prediction is None:
-                prediction = predict(self.nominal_setup)  # a plan that cannot work fails here
+            if pending is None:
+                prediction = predict_report(self.nominal_setup)  # a plan that cannot work
             results: list[TrialResult] = []
             if n_reach:  # here: they move the cell's part to where it really lies
                 results = run_all(
-                    self.setup, self.mesh, self.seeds[:n_reach], 1, reachability, vetted, cell
+                    self.setup,
+                    self.mesh,
+                    self.seeds[:n_reach],
+                    1,
+                    reachability,
+                    vetted,
+                    cell,
+                    before_trial=prediction_failed,
                 )
+            if pending is not None:
+                prediction = pending.result()
             if pool is not None:
-                if pool.prediction is not None:  # computed on a worker meanwhile
-                    prediction = pool.prediction.result()
                 results += pool.results(report)
             elif n_reach < total:
                 results += run_all(

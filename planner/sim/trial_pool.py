@@ -20,7 +20,7 @@ from typing import Any
 import trimesh
 
 from planner.sim.pool import kill_pool, open_pool
-from planner.sim.predict import Prediction, predict
+from planner.sim.predict import Prediction, predict_report
 from planner.sim.search_events import ReachabilityHook
 from planner.sim.setup import SimulationSetup
 from planner.sim.trial import (
@@ -51,7 +51,7 @@ class TrialPool:
         seeds: the trials' seeds, in report order.
         n_workers: worker processes (>= 1).
         predict_setup: also predict the rows of this setup on a worker, before the trials
-            (:func:`planner.sim.predict.predict`; :attr:`prediction`); None: not.
+            (:func:`planner.sim.predict.predict_report`; :attr:`prediction`); None: not.
 
     Close it with :meth:`results` (waits) or :meth:`cancel` (kills the workers at once).
     """
@@ -71,7 +71,7 @@ class TrialPool:
         try:
             #: the prediction computed on a worker (its error raised by ``result()``), or None
             self.prediction: Future[Prediction] | None = (
-                None if predict_setup is None else self._pool.submit(predict, predict_setup)
+                None if predict_setup is None else self._pool.submit(predict_report, predict_setup)
             )
             self._futures: list[Future[list[TrialResult]]] = [
                 self._pool.submit(run_chunk_in_worker, c) for c in chunks
@@ -117,11 +117,14 @@ def run_all(
     reach: ReachabilityHook | None,
     progress: ProgressCallback | None,
     cell: Any = None,
+    before_trial: Callable[[], None] | None = None,
 ) -> list[TrialResult]:
     """Run ``seeds`` in this process (1 worker; the only place a ``reach`` hook or a ``cell``
     is used) or on a :class:`TrialPool`, each process with its own
     :class:`~planner.sim.trial.TrialRunner`, built once per process;
-    ``progress(done, total)`` after every chunk."""
+    ``progress(done, total)`` after every chunk. In this process ``before_trial()`` is called
+    before every trial: what it raises stops the run there (a prediction that failed
+    meanwhile, :meth:`planner.sim.simulation_run.SimulationRun.finish`)."""
     total = len(seeds)
     if n_workers > 1:
         pool = TrialPool(setup, mesh, seeds, n_workers)
@@ -130,7 +133,10 @@ def run_all(
     runner = TrialRunner(setup, mesh, cell)
     out: list[TrialResult] = []
     for i in range(0, total, size):
-        out.extend(runner.run_chunk(seeds[i : i + size], reach))
+        for seed in seeds[i : i + size]:
+            if before_trial is not None:
+                before_trial()
+            out.append(runner.run_trial(seed, reach))
         if progress is not None:
             progress(len(out), total)
     return out
