@@ -28,6 +28,8 @@ measurement noise of the earlier points (micrometres): callers add a floor and a
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -56,17 +58,45 @@ def _skew(v: FloatArray) -> FloatArray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
-def _residual_motion(
-    point_m: ArrayLike,
+@dataclass(frozen=True)
+class EarlierUpdate:
+    """The step-by-step update after ``K`` earlier searches, the same for every later point
+    (computed once by :func:`earlier_update`, read by the single-point functions here and by
+    the batched ones of :mod:`calib.estimators.steering_many`).
+
+    Attributes:
+        centroid_m: ``(3,)`` the centroid ``c`` the update turns about, wobj frame, metres.
+        scale_m: the RMS size ``L`` rotations are scaled by (at least :data:`MIN_SCALE_M`),
+            metres.
+        residual: ``(6, 6)`` ``I - pinv(J_k) J_k`` in the scaled coordinates ``(t_c, L w)``
+            (the identity with no earlier search).
+        pinv: ``(6, K)`` ``pinv(J_k)``: the scaled update per metre of each earlier event.
+        to_scaled: ``(6, 6)`` ``S``: a misplacement ``(t, w)`` about the pivot (m, rad) in the
+            scaled coordinates.
+    """
+
+    centroid_m: FloatArray
+    scale_m: float
+    residual: FloatArray
+    pinv: FloatArray
+    to_scaled: FloatArray
+
+    @property
+    def count(self) -> int:
+        """``K``, the number of earlier searches."""
+        return int(self.pinv.shape[1])
+
+
+def earlier_update(
     earlier_m: ArrayLike,
     earlier_normals: ArrayLike,
     centroid_m: ArrayLike,
     scale_m: float,
     pivot_m: ArrayLike,
-) -> FloatArray:
-    """``(3, 6)``: the displacement at ``point_m`` of the estimate's error after the
-    ``earlier`` searches, for a misplacement ``(t, w)`` about ``pivot_m`` (module docstring)."""
-    p = np.asarray(point_m, dtype=np.float64).reshape(3)
+) -> EarlierUpdate:
+    """The update after the ``earlier`` searches (``(K, 3)`` points and their faces' normals,
+    wobj frame; ``K`` may be 0), with the centroid, scale and pivot of
+    :func:`inplane_shift_maps`."""
     X = np.asarray(earlier_m, dtype=np.float64).reshape(-1, 3)
     Nn = np.asarray(earlier_normals, dtype=np.float64).reshape(-1, 3)
     if X.shape != Nn.shape:
@@ -79,11 +109,32 @@ def _residual_motion(
     S[3:, 3:] *= L
     if len(X):
         J = np.hstack([Nn, np.cross(X - c, Nn) / L])
-        residual = np.eye(6) - np.linalg.pinv(J, rcond=FIXED_RCOND) @ J
+        pinv = np.linalg.pinv(J, rcond=FIXED_RCOND)
+        residual = np.eye(6) - pinv @ J
     else:
+        pinv = np.zeros((6, 0))
         residual = np.eye(6)
-    motion = np.hstack([np.eye(3), -_skew(p - c) / L])
-    out: FloatArray = motion @ residual @ S
+    return EarlierUpdate(c, L, residual, pinv, S)
+
+
+def _motion(point_m: ArrayLike, update: EarlierUpdate) -> FloatArray:
+    """``(3, 6)`` ``[I, -[p - c]x / L]``: the displacement at ``point_m`` of a scaled motion."""
+    p = np.asarray(point_m, dtype=np.float64).reshape(3)
+    return np.hstack([np.eye(3), -_skew(p - update.centroid_m) / update.scale_m])
+
+
+def _residual_motion(
+    point_m: ArrayLike,
+    earlier_m: ArrayLike,
+    earlier_normals: ArrayLike,
+    centroid_m: ArrayLike,
+    scale_m: float,
+    pivot_m: ArrayLike,
+) -> FloatArray:
+    """``(3, 6)``: the displacement at ``point_m`` of the estimate's error after the
+    ``earlier`` searches, for a misplacement ``(t, w)`` about ``pivot_m`` (module docstring)."""
+    u = earlier_update(earlier_m, earlier_normals, centroid_m, scale_m, pivot_m)
+    out: FloatArray = _motion(point_m, u) @ u.residual @ u.to_scaled
     return out
 
 
@@ -159,15 +210,8 @@ def _noise_gain(
 ) -> FloatArray:
     """``(3, K)``: the displacement at ``point_m`` of the estimate per metre of error in each
     of the ``K`` earlier searches (the min-norm update's gain)."""
-    p = np.asarray(point_m, dtype=np.float64).reshape(3)
-    X = np.asarray(earlier_m, dtype=np.float64).reshape(-1, 3)
-    Nn = np.asarray(earlier_normals, dtype=np.float64).reshape(-1, 3)
-    c = np.asarray(centroid_m, dtype=np.float64).reshape(3)
-    L = max(float(scale_m), MIN_SCALE_M)
-    J = np.hstack([Nn, np.cross(X - c, Nn) / L])
-    out: FloatArray = np.hstack([np.eye(3), -_skew(p - c) / L]) @ np.linalg.pinv(
-        J, rcond=FIXED_RCOND
-    )
+    u = earlier_update(earlier_m, earlier_normals, centroid_m, scale_m, centroid_m)
+    out: FloatArray = _motion(point_m, u) @ u.pinv
     return out
 
 

@@ -25,11 +25,9 @@ import importlib.metadata
 import logging
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Protocol
 
 import numpy as np
 import trimesh
-from numpy.typing import NDArray
 
 from calib.units import AUTO, METRES_PER_UNIT
 from planner.cad.occt_read import ALL_BODIES, MODEL_UNIT_M, choose_bodies, read_cad_file
@@ -40,6 +38,7 @@ from planner.cad.tessellate import (
     tessellate,
 )
 from planner.errors import MeshError
+from planner.faces.array_cache import ArrayCache as ArrayCache
 from planner.faces.brep import BREP_PLANE
 
 log = logging.getLogger(__name__)
@@ -150,19 +149,6 @@ def _key(
 
 def _strings(values: tuple[str, ...]) -> np.ndarray:
     return np.array(values, dtype=str) if values else np.zeros(0, dtype="<U1")
-
-
-class ArrayCache(Protocol):
-    """A store of named arrays by kind, key and version (the cell's disk cache,
-    :mod:`planner.cell.disk_cache`, which this layer does not import)."""
-
-    def load_arrays(self, kind: str, key: str, version: int) -> dict[str, NDArray] | None:
-        """The arrays stored under ``kind`` and ``key`` for ``version``, or ``None``."""
-        ...
-
-    def save_arrays(self, kind: str, key: str, version: int, arrays: dict[str, NDArray]) -> None:
-        """Store ``arrays``; a failure only costs the next read its time."""
-        ...
 
 
 def load_cad_mesh(

@@ -216,6 +216,7 @@ def plan_landing_risk(
     """How often each search of the program of ``fmt`` (``None``: the default) misses, starts
     too close or lands off its face under the plan's misplacement (:mod:`planner.sim.landing`),
     on the work object ``mesh`` (wobj, metres); ``None`` when the plan cannot be simulated."""
+    from planner.cell import disk_cache
     from planner.check.simulatable import check_simulatable
     from planner.check.simulation_setup import prediction_setup
     from planner.faces.checks import check_plan_faces
@@ -225,7 +226,9 @@ def plan_landing_risk(
     try:
         setup = prediction_setup(plan, check_simulatable(plan), fmt)
         r = max(float(plan.validation.sensor.footprint_radius_m), 1e-4)
-        faces = find_planar_faces(mesh, min_area_m2=math.pi * r**2, footprint_radius_m=r)
+        faces = find_planar_faces(
+            mesh, min_area_m2=math.pi * r**2, footprint_radius_m=r, cache=disk_cache
+        )
     except (InputError, NoPlanarFaceError):
         return None
     key = (
@@ -284,23 +287,13 @@ def _caster(mesh: trimesh.Trimesh) -> MeshRayCaster:
     return out
 
 
-#: The face outlines of recent parts (their unions take a second on a stator): ``{(id of the
-#: faces, radius): (faces, outlines)}``, the faces kept so the id stays theirs.
-_OUTLINES: dict[tuple[int, float], tuple[object, object]] = {}
-
-
 def _outlines(faces: PlanarFaces, radius_m: float) -> FaceOutlines:
-    """The outlines of ``faces`` with a footprint of ``radius_m`` (kept for the next check)."""
-    from planner.faces.outline import FaceOutlines
+    """The outlines of ``faces`` with a footprint of ``radius_m``: kept for the next check,
+    and the ones a design on the same faces built
+    (:func:`planner.faces.outline.shared_outlines`)."""
+    from planner.faces.outline import shared_outlines
 
-    key = (id(faces), float(radius_m))
-    if key not in _OUTLINES:
-        if len(_OUTLINES) >= 8:
-            _OUTLINES.pop(next(iter(_OUTLINES)))
-        _OUTLINES[key] = (faces, FaceOutlines(faces, radius_m))
-    out = _OUTLINES[key][1]
-    assert isinstance(out, FaceOutlines)
-    return out
+    return shared_outlines(faces, radius_m)
 
 
 def _with_landing(

@@ -28,7 +28,8 @@ Default tolerances, and why: ``angle_tol_rad`` 3 deg, ``flatness_tol_m`` 0.1 mm 
 stricter 0.05 mm RMS would reject it. A raw scan with sub-millimetre noise fails on RMS.
 
 Results are cached by a hash of the mesh's vertices and faces and the tolerances, so the UI and
-the command line detect once per mesh.
+the command line detect once per mesh; given a disk store, the footprint test (most of the time)
+is also kept across commands (:mod:`planner.faces.footprint_cache`).
 """
 
 from __future__ import annotations
@@ -46,10 +47,12 @@ from numpy.typing import ArrayLike, NDArray
 from calib.arguments import check_points
 from calib.tolerances import FACE_ANGLE_TOL_RAD, FACE_FLATNESS_RMS_M, FACE_MAX_DEVIATION_M
 from planner.errors import MeshError
+from planner.faces.array_cache import ArrayCache
 from planner.faces.brep import brep_plane_labels, brep_regions
-from planner.faces.footprint import DEFAULT_FOOTPRINT_RADIUS_M, holds_footprint
+from planner.faces.footprint import DEFAULT_FOOTPRINT_RADIUS_M
 from planner.faces.footprint import N_RIM_SAMPLES as N_RIM_SAMPLES
 from planner.faces.footprint import RAY_LIFT_M as RAY_LIFT_M
+from planner.faces.footprint_cache import holds_footprint_cached
 from planner.faces.regions import RegionStats as RegionStats
 from planner.faces.regions import fit_planes, flat_regions, region_stats
 
@@ -185,6 +188,8 @@ def _detect(
     flatness_tol_m: float,
     max_deviation_m: float,
     footprint_radius_m: float,
+    digest: str = "",
+    cache: ArrayCache | None = None,
 ) -> PlanarFaces:
     nf = len(mesh.faces)
     shift = np.asarray(mesh.bounds, dtype=np.float64).mean(axis=0)  # less round-off in moments
@@ -208,7 +213,9 @@ def _detect(
     cnt = np.bincount(labels[labels >= 0], minlength=len(area_r))
     cand = np.flatnonzero((area_r >= min_area_m2) & (rms <= flatness_tol_m))
     holds = np.zeros(len(area_r), dtype=bool)
-    holds[cand] = holds_footprint(mesh, labels, cand, n, d, footprint_radius_m, max_deviation_m)
+    holds[cand] = holds_footprint_cached(
+        mesh, digest, labels, cand, n, d, footprint_radius_m, max_deviation_m, cache
+    )
     good = np.flatnonzero(holds)
     good = good[np.argsort(-area_r[good], kind="stable")]
     remap = np.full(len(area_r), -1, dtype=np.int64)
@@ -255,6 +262,7 @@ def find_planar_faces(
     max_deviation_m: float = MAX_DEVIATION_M,
     footprint_radius_m: float = DEFAULT_FOOTPRINT_RADIUS_M,
     name: str | None = None,
+    cache: ArrayCache | None = None,
 ) -> PlanarFaces:
     """Find the planar faces of a mesh (cached by mesh content and tolerances).
 
@@ -267,6 +275,9 @@ def find_planar_faces(
         max_deviation_m: largest distance of any vertex of a face from its plane, metres.
         footprint_radius_m: sensor face radius, metres: a face must hold this disc somewhere.
         name: name for messages; default ``mesh.metadata["name"]`` or ``"work object"``.
+        cache: a disk store for the footprint test, most of the detection's time
+            (:mod:`planner.faces.footprint_cache`; the jobs pass
+            :mod:`planner.cell.disk_cache`); ``None``: only this process's memory.
 
     Returns:
         The planar faces (possibly none: see :meth:`PlanarFaces.require_any`).
@@ -287,13 +298,14 @@ def find_planar_faces(
         if not (math.isfinite(val) and val > 0):
             raise MeshError(f"{tol_name} must be a positive number, got {val!r}")
     label = name or str((mesh.metadata or {}).get("name") or "work object")
-    key = (mesh_digest(mesh), *tols.values())  # the name is for messages only
+    digest = mesh_digest(mesh)
+    key = (digest, *tols.values())  # the name is for messages only
     with _cache_lock:
         hit = _cache.get(key)
         if hit is not None:
             _cache.move_to_end(key)
             return hit if hit.name == label else replace(hit, name=label)
-    found = _detect(mesh, label, **tols)
+    found = _detect(mesh, label, **tols, digest=digest, cache=cache)
     with _cache_lock:
         _cache[key] = found
         while len(_cache) > _CACHE_SIZE:

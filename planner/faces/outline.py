@@ -11,6 +11,8 @@ footprint on the face when the point plus that set, grown by a floor, lies in it
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 import shapely
 from numpy.typing import NDArray
@@ -100,10 +102,39 @@ class FaceOutlines:
         """The footprint at ``point_m`` (``(3,)``, on the face) stays on the face for every
         shift in the convex hull of ``shifts_m`` (``(M, 2)``, in :meth:`basis` coordinates,
         metres), grown by ``floor_m``."""
-        c = np.asarray(point_m, dtype=np.float64) @ self.basis(face_id)
-        pts = c[None, :] + np.asarray(shifts_m, dtype=np.float64).reshape(-1, 2)
-        region = shapely.MultiPoint(pts).convex_hull.buffer(max(floor_m, _WELD_M), quad_segs=4)
-        return bool(self.free(face_id).contains(region))
+        shifts = np.asarray(shifts_m, dtype=np.float64).reshape(1, -1, 2)
+        return bool(self.holds_many([face_id], np.reshape(point_m, (1, 3)), shifts, floor_m)[0])
+
+    def holds_many(
+        self,
+        face_ids: Sequence[int] | NDArray[np.int64],
+        points_m: FloatArray,
+        shifts_m: FloatArray,
+        floor_m: float,
+    ) -> NDArray[np.bool_]:
+        """:meth:`holds` of many footprints in one batch of geometry calls.
+
+        Args:
+            face_ids: ``(C,)`` each footprint's face.
+            points_m: ``(C, 3)`` the footprints' centres, on their faces, wobj frame, metres.
+            shifts_m: ``(C, M, 2)`` each one's shifts, in its face's :meth:`basis`
+                coordinates, metres.
+            floor_m: what every shift is grown by, metres.
+
+        Returns:
+            ``(C,)`` whether each footprint stays on its face.
+        """
+        ids = [int(f) for f in face_ids]
+        P = np.asarray(points_m, dtype=np.float64).reshape(len(ids), 3)
+        shifts = np.asarray(shifts_m, dtype=np.float64).reshape(len(ids), -1, 2)
+        if not ids:
+            return np.zeros(0, dtype=bool)
+        c = np.stack([p @ self.basis(f) for p, f in zip(P, ids, strict=True)])
+        hulls = shapely.convex_hull(shapely.multipoints(c[:, None, :] + shifts))
+        regions = shapely.buffer(hulls, max(floor_m, _WELD_M), quad_segs=4)
+        free = np.empty(len(ids), dtype=object)
+        free[:] = [self.free(f) for f in ids]
+        return np.asarray(shapely.contains(free, regions), dtype=bool)
 
     def clearance_m(self, face_id: int, point_m: FloatArray) -> float:
         """How far the footprint at ``point_m`` may move in any direction and stay on the
@@ -116,6 +147,26 @@ class FaceOutlines:
             d = float(free.boundary.distance(c))
             self._clearance[key] = d if free.contains(c) else -d
         return self._clearance[key]
+
+
+#: The outlines of recent parts (their unions take a second on a stator), shared by the jobs
+#: of one process (suggest's design and the check of the plan it writes): ``{(ids of the
+#: mesh, the triangles' face ids and the faces; radius): (faces, outlines)}``, the faces kept
+#: so the ids stay theirs. A detection renamed for messages shares its outlines.
+_SHARED: dict[tuple[int, int, int, float], tuple[PlanarFaces, FaceOutlines]] = {}
+_SHARED_MAX = 8
+
+
+def shared_outlines(faces: PlanarFaces, footprint_radius_m: float) -> FaceOutlines:
+    """The :class:`FaceOutlines` of ``faces`` with a footprint of ``footprint_radius_m``
+    (metres), the same object for the same detection and radius (built once, then its
+    faces' outlines built once each)."""
+    key = (id(faces.mesh), id(faces.face_id), id(faces.faces), float(footprint_radius_m))
+    if key not in _SHARED:
+        if len(_SHARED) >= _SHARED_MAX:
+            _SHARED.pop(next(iter(_SHARED)))
+        _SHARED[key] = (faces, FaceOutlines(faces, footprint_radius_m))
+    return _SHARED[key][1]
 
 
 def _union(uv: FloatArray) -> shapely.Geometry:

@@ -69,13 +69,14 @@ from calib.probing import ProbePoint, SearchSpec
 from calib.procedures import DESIGNED, GROWN, ProcedureKind
 from calib.procedures import PROCEDURES as ALL_PROCEDURES
 from calib.registry import lookup
+from planner.cell import disk_cache
 from planner.check.job import check_plan
 from planner.check.results import PlanCheck
 from planner.check.vias import plan_with_vias
 from planner.faces.candidates import Candidates, FaceTried, face_candidates
 from planner.faces.detection import find_planar_faces
 from planner.faces.edges import edge_candidates
-from planner.faces.outline import FaceOutlines
+from planner.faces.outline import shared_outlines
 from planner.plan_cell import open_cell
 from planner.program.controllers import CONTROLLERS, controller
 from planner.program.safety import SafetySpec
@@ -317,7 +318,9 @@ def suggest_plan(
     sensor = plan.validation.sensor
     r = max(float(sensor.footprint_radius_m), 1e-4)
     say("planar faces", 0, 1)
-    faces = find_planar_faces(mesh, min_area_m2=math.pi * r**2, footprint_radius_m=r, name=wo.name)
+    faces = find_planar_faces(
+        mesh, min_area_m2=math.pi * r**2, footprint_radius_m=r, name=wo.name, cache=disk_cache
+    )
     try:
         faces.require_any()
     except InputError as exc:
@@ -334,7 +337,7 @@ def suggest_plan(
     pool = cands.subset(feasible)
     if len(pool) == 0:
         raise SuggestError(nothing_message(tried, rejected, len(cands)))
-    outlines = FaceOutlines(faces, r)
+    outlines = shared_outlines(faces, r)  # the check of the written plan reads them too
     lo, hi = mesh.bounds
     # the most a point moves in its face when the part lies misplaced about its middle
     worst_shift = m.max_translation_m + m.max_angle_rad * float(np.linalg.norm(hi - lo))

@@ -26,11 +26,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.estimators.layout import MIN_SCALE_M
-from calib.estimators.steering import (
-    ellipse_support,
-    inplane_noise_cov,
-    inplane_shift_maps,
-    shift_outline,
+from calib.estimators.steering import EarlierUpdate, earlier_update, plane_basis
+from calib.estimators.steering_many import (
+    ellipse_support_many,
+    inplane_noise_cov_many,
+    inplane_shift_maps_many,
+    shift_outline_many,
 )
 from calib.models import Misplacement
 from planner.faces.outline import FaceOutlines
@@ -104,25 +105,83 @@ class Sequencer:
         self.fixed_n = (
             np.zeros((0, 3)) if fixed_normals is None else np.reshape(fixed_normals, (-1, 3))
         )
+        # remembered answers (shared by shallow copies: keyed by everything they may change)
+        self._known: dict[tuple[object, ...], dict[tuple[int, tuple[int, ...]], bool]] = {}
+        self._updates: dict[tuple[tuple[int, ...], tuple[int, ...], bool], EarlierUpdate] = {}
+        self._bases: dict[int, FloatArray] = {}
 
     def fits(self, i: int, earlier: Sequence[int], layout: Sequence[int]) -> bool:
         """Candidate ``i``'s footprint stays on its face when measured after the fixed points
         and ``earlier``, in a layout of the fixed points and ``layout`` (its centroid is the
         misplacement's pivot and the update's centre)."""
-        allp = np.concatenate([self.fixed_m, self.P[list(layout)]])
-        c = allp.mean(axis=0)
-        L = max(float(np.sqrt(np.mean(np.sum((allp - c) ** 2, axis=1)))), MIN_SCALE_M)
-        X = np.concatenate([self.fixed_m, self.P[list(earlier)]])
-        Nn = np.concatenate([self.fixed_n, self.N[list(earlier)]])
-        if not self.steered:  # a nominal program: nothing measured before steers the search
-            X, Nn = X[:0], Nn[:0]
-        G_t, G_w = inplane_shift_maps(self.P[i], self.N[i], X, Nn, c, L, c)
-        factor = SAFETY if len(X) else 1.0
-        cov = inplane_noise_cov(self.P[i], self.N[i], X, Nn, c, L, np.full(len(X), self.var))
-        shifts = factor * shift_outline(G_t, G_w, self.a, self.b) + ellipse_support(
-            cov, NOISE_SIGMAS
+        return self.fits_many([(i, earlier)], layout)[0]
+
+    def fits_many(
+        self, queries: Sequence[tuple[int, Sequence[int]]], layout: Sequence[int]
+    ) -> list[bool]:
+        """:meth:`fits` of each ``(i, earlier)`` in ``queries``, in one layout.
+
+        Each answer is computed once per sequencer and bound (remembered by candidate, the
+        order of ``earlier`` and of ``layout``, the bound and ``steered``); the update of each
+        distinct ``earlier`` is computed once and its candidates' shifts stacked
+        (:mod:`calib.estimators.steering_many`, the same numbers as one at a time), and every
+        footprint of the call is tested in one batch (:meth:`FaceOutlines.holds_many`).
+        """
+        lay = tuple(int(j) for j in layout)
+        keys = [(int(i), tuple(int(j) for j in e)) for i, e in queries]
+        known = self._known.setdefault((self.a, self.b, self.var, self.steered, lay), {})
+        todo = list(dict.fromkeys(k for k in keys if k not in known))
+        if todo:
+            groups: dict[tuple[int, ...], list[int]] = {}
+            for i, e in todo:
+                groups.setdefault(e, []).append(i)
+            judged = iter(self._judge(groups, lay))
+            for e, cands in groups.items():
+                known.update(((i, e), bool(next(judged))) for i in cands)
+        return [known[k] for k in keys]
+
+    def _judge(
+        self, groups: dict[tuple[int, ...], list[int]], layout: tuple[int, ...]
+    ) -> NDArray[np.bool_]:
+        """Whether each candidate of ``groups`` (earlier points -> candidates) stays on its
+        face, in the groups' order."""
+        shifts: list[FloatArray] = []
+        for earlier, cands in groups.items():
+            u = self._update(earlier, layout)
+            idx = np.asarray(cands, dtype=np.int64)
+            B = np.stack([self._basis(i) for i in cands])
+            G_t, G_w = inplane_shift_maps_many(self.P[idx], B, u)
+            factor = SAFETY if u.count else 1.0
+            cov = inplane_noise_cov_many(self.P[idx], B, u, np.full(u.count, self.var))
+            shifts.append(
+                factor * shift_outline_many(G_t, G_w, self.a, self.b)
+                + ellipse_support_many(cov, NOISE_SIGMAS)
+            )
+        idx = np.asarray([i for cands in groups.values() for i in cands], dtype=np.int64)
+        return self.outlines.holds_many(
+            self.face[idx], self.P[idx], np.concatenate(shifts), FLOOR_M
         )
-        return self.outlines.holds(int(self.face[i]), self.P[i], shifts, FLOOR_M)
+
+    def _update(self, earlier: tuple[int, ...], layout: tuple[int, ...]) -> EarlierUpdate:
+        """The update after the fixed points and ``earlier`` (none for a nominal program),
+        about the centroid of the fixed points and ``layout`` (also the pivot); remembered."""
+        key = (earlier, layout, self.steered)
+        if key not in self._updates:
+            allp = np.concatenate([self.fixed_m, self.P[list(layout)]])
+            c = allp.mean(axis=0)
+            L = max(float(np.sqrt(np.mean(np.sum((allp - c) ** 2, axis=1)))), MIN_SCALE_M)
+            X = np.concatenate([self.fixed_m, self.P[list(earlier)]])
+            Nn = np.concatenate([self.fixed_n, self.N[list(earlier)]])
+            if not self.steered:  # a nominal program: nothing measured before steers the search
+                X, Nn = X[:0], Nn[:0]
+            self._updates[key] = earlier_update(X, Nn, c, L, c)
+        return self._updates[key]
+
+    def _basis(self, i: int) -> FloatArray:
+        """``(3, 2)`` the in-plane basis of candidate ``i``'s normal; remembered."""
+        if i not in self._bases:
+            self._bases[i] = plane_basis(self.N[i])
+        return self._bases[i]
 
     def alike(self, stuck: Sequence[int], radius_m: float = NEIGHBOUR_M) -> list[int]:
         """Candidates as stuck as ``stuck``: on the same face, within ``radius_m`` of one,
@@ -146,14 +205,18 @@ class Sequencer:
         left = [i for i in chosen if not self.edge[i]]
         done: list[int] = []
         while left:
-            now = [i for i in left if self.fits(i, done, layout)]
+            flags = self.fits_many([(i, done) for i in left], layout)
+            now = [i for i, ok in zip(left, flags, strict=True) if ok]
             if not now:
                 return Ordered(tuple(done + edges), tuple(left))
-
-            def after(i: int) -> int:
-                return sum(self.fits(j, [*done, i], layout) for j in left if j != i)
-
-            best = max(now, key=after) if len(now) > 1 else now[0]
+            best = now[0]
+            if len(now) > 1:  # how many of the others fit after each (all in one batch)
+                others = [(i, [j for j in left if j != i]) for i in now]
+                after = iter(
+                    self.fits_many([(j, [*done, i]) for i, js in others for j in js], layout)
+                )
+                count = {i: sum(next(after) for _ in js) for i, js in others}
+                best = max(now, key=count.__getitem__)
             done.append(best)
             left.remove(best)
         return Ordered(tuple(done + edges), ())
@@ -165,6 +228,7 @@ class Sequencer:
         done: list[int] = []
         stuck: list[int] = []
         for g in groups:
-            stuck += [i for i in g if not self.fits(i, done, layout)]
+            flags = self.fits_many([(i, done) for i in g], layout)
+            stuck += [i for i, ok in zip(g, flags, strict=True) if not ok]
             done += list(g)
         return Ordered(tuple(layout), tuple(stuck))
