@@ -8,17 +8,22 @@ Every feasibility and search outcome carries a kind beside the English words use
 ``singularity`` a singular wrist, or near a singularity (:mod:`planner.cell.probe_candidates`)
 ``collision``   a robot or tool link hits, or comes too near, an obstacle: with its ``pair``
 ``footprint``   the point is not on a planar face with the sensor footprint on it
-                (:mod:`planner.faces.checks`)
+                (:mod:`planner.faces.checks`); a simulated search's footprint landed off its
+                face or partly over a hole or an edge (:mod:`planner.sim.search_events`)
 ``move``        the joint move between points, through its vias (:mod:`planner.cell.moves`)
 ``search``      the search cannot reach its face or edge wherever the part may lie, or goes
                 wrong too often under the misplacement (:mod:`planner.program.reach`,
-                :mod:`planner.sim.landing`)
+                :mod:`planner.sim.landing`); a simulated search finds nothing within its
+                length, starts inside the part or already detecting, or its sensor face runs
+                into the part (:mod:`planner.sim.proximity`, :mod:`planner.sim.touch`)
 ==============  ==========================================================================
 
 The code that decides an outcome gives it its kind; everything after it (``wobjcal check
---json``, the heat map's colours, suggest's counts of dropped candidates, the UI's status table)
-reads ``kind`` and ``pair``, never the words: ``tests/test_import_graph.py`` fails on a module
-that sorts a reason by searching its text.
+--json``, the heat map's colours, suggest's counts of dropped candidates, the UI's status table,
+``wobjcal validate``'s counts of failed searches and trials) reads ``kind`` and ``pair``, never
+the words: ``tests/test_import_graph.py`` fails on a module that sorts a reason by searching
+its text. A simulated search that the reachability hook refuses keeps the cell's kind and pair
+(:func:`planner.sim.search_events.cell_search_hook`).
 """
 
 from __future__ import annotations

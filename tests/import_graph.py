@@ -191,17 +191,58 @@ def _chain(node: ast.AST) -> list[str] | None:
             return None
 
 
-def is_reason_text(node: ast.AST) -> bool:
+def is_reason_text(node: ast.AST, bound: frozenset[str] = frozenset()) -> bool:
     """``node`` holds a reason's words: its last name is a reason's (:data:`REASON_NAME`),
-    or it is a reason's ``text`` or ``note`` (``cause.text``); a reason's ``kind`` or
-    ``pair`` is not words."""
+    or it is a reason's ``text`` or ``note`` (``cause.text``), or it is a name ``bound`` to
+    a reason's words by a loop (:func:`_bound_words`); a reason's ``kind`` or ``pair`` is not
+    words."""
     names = _chain(node)
     if not names:
         return False
     last = names[-1]
-    if REASON_NAME.match(last):
+    if REASON_NAME.match(last) or (len(names) == 1 and last in bound):
         return True
     return last in WORDS and any(REASON_NAME.match(n) for n in names[:-1])
+
+
+#: Calls looked through to the collection they are made on (``sorted(failures)``).
+_COLLECTIONS = {"sorted", "list", "set", "tuple", "reversed"}
+
+
+def _loop_words(iter_: ast.AST, target: ast.AST) -> set[str]:
+    """The names ``target`` binds to a reason's words when a loop runs over ``iter_``: the
+    items of a collection of words (``for why in reasons``), the keys of a mapping keyed by
+    words (``for label in report.failures``, ``for label, n in failures.items()``, also
+    through ``sorted(...)`` and the like)."""
+    while (
+        isinstance(iter_, ast.Call)
+        and isinstance(iter_.func, ast.Name)
+        and iter_.func.id in _COLLECTIONS
+        and len(iter_.args) == 1
+    ):
+        iter_ = iter_.args[0]
+    if is_reason_text(iter_):
+        return {target.id} if isinstance(target, ast.Name) else set()
+    f = iter_.func if isinstance(iter_, ast.Call) and not iter_.args else None
+    if isinstance(f, ast.Attribute) and f.attr in ("keys", "items") and is_reason_text(f.value):
+        if f.attr == "keys" and isinstance(target, ast.Name):
+            return {target.id}
+        if f.attr == "items" and isinstance(target, ast.Tuple) and target.elts:
+            first = target.elts[0]
+            return {first.id} if isinstance(first, ast.Name) else set()
+    return set()
+
+
+def _bound_words(node: ast.AST) -> frozenset[str]:
+    """The names a ``for`` statement or a comprehension binds to a reason's words (over its
+    body, or the comprehension: :func:`_loop_words`)."""
+    names: set[str] = set()
+    if isinstance(node, ast.For | ast.AsyncFor):
+        names |= _loop_words(node.iter, node.target)
+    elif isinstance(node, ast.ListComp | ast.SetComp | ast.GeneratorExp | ast.DictComp):
+        for gen in node.generators:
+            names |= _loop_words(gen.iter, gen.target)
+    return frozenset(names)
 
 
 def _words(node: ast.AST) -> bool:
@@ -216,39 +257,56 @@ def _texts(node: ast.AST) -> bool:
     return isinstance(node, ast.Tuple | ast.List | ast.Set) and any(_words(e) for e in node.elts)
 
 
+def _sorts(node: ast.AST, bound: frozenset[str]) -> bool:
+    """``node`` sorts a reason by its words (see :func:`text_sorts_in`)."""
+    hit = False
+    if isinstance(node, ast.Compare):
+        left = node.left
+        for op, right in zip(node.ops, node.comparators, strict=True):
+            if isinstance(op, ast.In | ast.NotIn):
+                hit |= _words(left) and is_reason_text(right, bound)
+                hit |= is_reason_text(left, bound) and _texts(right)
+            elif isinstance(op, ast.Eq | ast.NotEq):
+                hit |= _words(left) and is_reason_text(right, bound)
+                hit |= _words(right) and is_reason_text(left, bound)
+            left = right
+    elif isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute):
+        attr, owner, args = node.func.attr, node.func.value, node.args
+        if attr in SEARCHES and is_reason_text(owner, bound):
+            hit = any(_words(a) for a in args)
+        elif attr in CASES and not args:
+            hit = is_reason_text(owner, bound)
+        if attr in REGEX and not hit:
+            # re.search(pattern, text), re.sub(pattern, repl, text); compiled: one less
+            is_re = isinstance(owner, ast.Name) and owner.id == "re"
+            at = int(is_re) + int(attr in ("sub", "subn"))
+            hit = len(args) > at and is_reason_text(args[at], bound)
+    return hit
+
+
 def text_sorts_in(tree: ast.AST, module: str = "<snippet>") -> list[TextSort]:
     """Where ``tree`` sorts a reason by its words: a literal searched for in it (``"reach" in
     reason``), compared with it (``reason == "singular wrist"``), looked for with a ``str``
     method (``why.startswith("joint")``, ``reason.split("; ")``), a regular expression run on
     it (``re.search(p, reason)``, ``PATTERN.sub("", reason)``), it put in one case
-    (``reason.lower()``), or it looked up among literals (``reason in ("a", "b")``)."""
-    out = []
+    (``reason.lower()``), or it looked up among literals (``reason in ("a", "b")``). A name a
+    loop binds to a reason's words counts as one inside the loop (``for label in failures:
+    if "no detection" in label``)."""
+    found: dict[tuple[int, int, str], TextSort] = {}  # a node found twice counts once
+
+    def scan(root: ast.AST, bound: frozenset[str]) -> None:
+        for node in ast.walk(root):
+            if _sorts(node, bound):
+                line, code = getattr(node, "lineno", 0), ast.unparse(node)
+                at = (line, getattr(node, "col_offset", 0), code)
+                found.setdefault(at, TextSort(module, line, code))
+
+    scan(tree, frozenset())
     for node in ast.walk(tree):
-        hit = False
-        if isinstance(node, ast.Compare):
-            left = node.left
-            for op, right in zip(node.ops, node.comparators, strict=True):
-                if isinstance(op, ast.In | ast.NotIn):
-                    hit |= _words(left) and is_reason_text(right)
-                    hit |= is_reason_text(left) and _texts(right)
-                elif isinstance(op, ast.Eq | ast.NotEq):
-                    hit |= _words(left) and is_reason_text(right)
-                    hit |= _words(right) and is_reason_text(left)
-                left = right
-        elif isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute):
-            attr, owner, args = node.func.attr, node.func.value, node.args
-            if attr in SEARCHES and is_reason_text(owner):
-                hit = any(_words(a) for a in args)
-            elif attr in CASES and not args:
-                hit = is_reason_text(owner)
-            if attr in REGEX and not hit:
-                # re.search(pattern, text), re.sub(pattern, repl, text); compiled: one less
-                is_re = isinstance(owner, ast.Name) and owner.id == "re"
-                at = int(is_re) + int(attr in ("sub", "subn"))
-                hit = len(args) > at and is_reason_text(args[at])
-        if hit:
-            out.append(TextSort(module, getattr(node, "lineno", 0), ast.unparse(node)))
-    return out
+        bound = _bound_words(node)
+        if bound:
+            scan(node, bound)
+    return [found[k] for k in sorted(found)]
 
 
 def text_sorts(root: Path = ROOT) -> list[TextSort]:

@@ -32,6 +32,7 @@ from planner.export_plan.job import export_program
 from planner.plan_cell import nominal_T_base_wobj, open_cell
 from planner.program import measuring_program
 from planner.program.model import search_keys
+from planner.reasons import Reason
 from planner.sim.search_events import ProgramPose, program_search_hook
 from planner.validate.job import validate_plan
 
@@ -263,7 +264,7 @@ def test_the_vetting_passes_at_the_nominal_pose_what_check_passes(
         if not c.path_feasible:
             continue
         cmd = SearchCommand.from_point(by_id[c.point_id].to_probe_point(), T_nom)
-        assert hook(cmd) == "", c.point_id
+        assert hook(cmd) is None, c.point_id
 
 
 class _Spy:
@@ -316,7 +317,9 @@ def test_the_vetting_turns_the_sensor_with_the_frame_the_search_is_commanded_in(
     first = plan.points[0].id
     lost = program_search_hook(spy, {}, keys, T_nom, plan.cell.tool.tcp)
     cmd = SearchCommand.from_point(plan.points[0].to_probe_point(), T_nom)
-    assert lost(cmd) == f"unreachable or colliding: check found no pose for point {first}"
+    assert lost(cmd) == Reason(
+        "reach", f"unreachable or colliding: check found no pose for point {first}"
+    )
     px = program_search_hook(spy, poses, keys, T_nom, plan.cell.tool.tcp, other_searches=first)
     px(dataclasses.replace(cmd, point_id="PX1_1"))
     assert np.abs(spy.asked[-1]["sensor_x"] - poses[first].sensor_x_base).max() < 1e-12

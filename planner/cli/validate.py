@@ -23,7 +23,8 @@ from planner.program.controllers import CONTROLLERS, DEFAULT_CONTROLLER
 MAX_WORKERS = 64
 
 if TYPE_CHECKING:
-    from planner.sim.report import ValidationReport
+    from planner.reasons import Reason
+    from planner.sim.report import FailureCount, ValidationReport
 
 
 def protocol_arg(text: str) -> tuple[int, int]:
@@ -154,8 +155,32 @@ def check_budget(
         check_run_size(size, "--sensitivity")
 
 
+def _counted(failed: dict[Reason, int]) -> list[dict[str, Any]]:
+    """A search's failures, one object each: ``{"kind", "text", "pair"?, "count"}``, by text."""
+    rows = [cause.to_json() | {"count": n} for cause, n in failed.items()]
+    return sorted(rows, key=lambda r: (r["text"], r["kind"]))
+
+
+def _failure_json(f: FailureCount) -> dict[str, Any]:
+    """One line of the failures: ``{"label", "run", "count", "search", "kind", "text",
+    "pair"?}``; ``search`` and ``kind`` ``null`` when no search failed (the measurements
+    define no frame: the text is the label)."""
+    head: dict[str, Any] = {"label": f.label, "run": f.run, "count": f.count}
+    if f.failed is None:
+        return head | {"search": None, "kind": None, "text": f.label}
+    return head | {"search": f.failed.search} | f.failed.cause.to_json()
+
+
 def report_json(report: ValidationReport) -> dict[str, Any]:
-    """The JSON of a ``ValidationReport``: rows (display units), outcomes, failures, landings."""
+    """The JSON of a ``ValidationReport``: rows (display units), outcomes, failures, landings.
+
+    Besides the words (``failed`` of each search, ``failures``: text -> count), every failure
+    is listed with its kind (``reach``, ``joint_limit``, ``singularity``, ``collision`` with
+    its ``pair``, ``search``: :mod:`planner.reasons`): ``failed_reasons`` of each search and
+    ``failure_reasons`` of the trials.
+    """
+    from planner.sim.report import failed_by_words
+
     return {
         "program": {"name": report.program, "steps": list(report.program_steps)},
         "check_problems": list(report.check_problems),
@@ -188,7 +213,8 @@ def report_json(report: ValidationReport) -> dict[str, Any]:
             {
                 "search": o.point_id,
                 "runs": o.searches,
-                "failed": o.failed,
+                "failed": failed_by_words(o.failed),
+                "failed_reasons": _counted(o.failed),
                 "landed_off": o.landed_off,
                 "partly_off": o.partly_off,
                 "off_fraction_mean": o.off_fraction_mean,
@@ -197,6 +223,7 @@ def report_json(report: ValidationReport) -> dict[str, Any]:
             for o in report.outcomes
         ],
         "failures": report.failures,
+        "failure_reasons": [_failure_json(f) for f in report.failure_counts],
         "landings": report.landings,
     }
 

@@ -15,8 +15,9 @@ TCP position at the switching event, in the base frame.
 
 Failures are returned as :class:`~calib.probing.ProbeResult` with a reason, never as a number:
 no detection within the search length, already detecting at the start, not detecting at the
-start of an edge search, the face touching the part, or an unreachable commanded path (when a
-reachability hook is given). Every approach's landing is judged over the whole sensor face: the
+start of an edge search, the face touching the part (``search`` reasons, decided here and
+recorded on the search's event), or an unreachable commanded path (when a reachability hook is
+given: the cell's kind and pair). Every approach's landing is judged over the whole sensor face: the
 triangles the ray bundle hits are looked up in the part's planar faces
 (:class:`~planner.sim.search_events.FaceLookup`), and a face partly over a hole or an edge is
 recorded with the fraction of its area that is off.
@@ -33,18 +34,30 @@ from numpy.typing import NDArray
 
 from calib.models.proximity import ProximitySensor
 from calib.probing import ProbeResult, SearchCommand
+from planner.reasons import Reason
 from planner.sim.search_events import (
     ProbeEvent,
     ReachabilityHook,
     cell_search_hook,
     robot_offset,
 )
-from planner.sim.sensor_base import SimulatedSensor
+from planner.sim.sensor_base import SimulatedSensor, no_event_within
 from planner.sim.subray import CellSignal, cell_width_m, first_switch
 
 __all__ = ["ProbeEvent", "ReachabilityHook", "SimulatedProbe", "cell_search_hook", "robot_offset"]
 
 FloatArray = NDArray[np.float64]
+
+#: The sensor's face starts inside the (misplaced) part.
+FACE_INSIDE = Reason("search", "sensor face inside the part at start")
+#: An approach starts where the sensor already switches.
+ALREADY_DETECTING = Reason("search", "sensor already detecting at start")
+#: An edge search starts where the sensor does not detect the face it should slide over.
+NOT_DETECTING = Reason("search", "sensor not detecting at start of edge search")
+#: An approach's face meets the part before the sensor switches.
+TOUCHED = Reason("search", "sensor face touched the part before switching")
+#: A scanning search's face runs into the part before its event.
+COLLIDED = Reason("search", "sensor face collided with the part during the search")
 
 
 @dataclass
@@ -164,7 +177,7 @@ class SimulatedProbe(SimulatedSensor):
         for k, (cmd, _, _, jitter) in enumerate(searches):
             tri = tri_all[k * n_rays : (k + 1) * n_rays]
             if inside[k]:
-                res = self._fail(cmd, "sensor face inside the part at start")
+                res = self._fail(cmd, FACE_INSIDE)
             else:
                 travel = self.sensor.travel_to_switch_m(float(signal[k]), jitter)
                 res = self._judged(cmd, travel, float(nearest[k]), tri)
@@ -180,7 +193,7 @@ class SimulatedProbe(SimulatedSensor):
         axis_part = np.broadcast_to(self._T_wobj_base[:3, :3] @ axis, origins.shape)
         dist, tri = self.caster.first_hits_ids(origins, axis_part)
         if np.any(dist <= 0.0):
-            return self._fail(cmd, "sensor face inside the part at start")
+            return self._fail(cmd, FACE_INSIDE)
         return self._judge_approach(cmd, dist, tri, self.sensor.sample_jitter_m(self.rng))
 
     def _judge_approach(
@@ -189,7 +202,7 @@ class SimulatedProbe(SimulatedSensor):
         """Where an approach along the sensor axis switches, from its rays' distances ``dist``
         and triangles ``tri`` at the start and the switching jitter (m)."""
         if np.any(dist <= 0.0):
-            return self._fail(cmd, "sensor face inside the part at start")
+            return self._fail(cmd, FACE_INSIDE)
         travel = self.sensor.switch_travel_m(dist, jitter)
         return self._judged(cmd, travel, float(dist.min()), tri)
 
@@ -200,11 +213,11 @@ class SimulatedProbe(SimulatedSensor):
         ray meeting metal ``nearest`` away (m), its rays' triangles ``tri``."""
         length = float(cmd.length_m)
         if travel <= 0.0:
-            return self._fail(cmd, "sensor already detecting at start")
+            return self._fail(cmd, ALREADY_DETECTING)
         if not math.isfinite(travel) or travel > length:
-            return self._fail(cmd, f"no detection within {length * 1e3:.0f} mm")
+            return self._fail(cmd, no_event_within("detection", length))
         if travel >= nearest:
-            return self._fail(cmd, "sensor face touched the part before switching")
+            return self._fail(cmd, TOUCHED)
         return self._succeed(cmd, travel, tri)  # along the axis the rays are the footprint's
 
     def _scan(
@@ -242,15 +255,15 @@ class SimulatedProbe(SimulatedSensor):
         s0 = float(self._signal_of(dist[None, :n_fine])[0])
         coarse = self._signal_of(dist[n_fine:].reshape(len(s_grid), -1))
         if s0 < 0:
-            return self._fail(cmd, "sensor face inside the part at start")
+            return self._fail(cmd, FACE_INSIDE)
         if want_on and s0 >= on:
-            return self._fail(cmd, "sensor already detecting at start")
+            return self._fail(cmd, ALREADY_DETECTING)
         if not want_on and s0 < on:
-            return self._fail(cmd, "sensor not detecting at start of edge search")
+            return self._fail(cmd, NOT_DETECTING)
         if np.any(coarse < 0):
             first_hit = int(np.argmax(coarse < 0))
             if not np.any(event(coarse[1:first_hit])):
-                return self._fail(cmd, "sensor face collided with the part during the search")
+                return self._fail(cmd, COLLIDED)
         hits = np.flatnonzero(event(coarse[1:]) & (coarse[1:] >= 0)) + 1
         k = int(hits[0]) if len(hits) else n_steps
 
@@ -266,7 +279,7 @@ class SimulatedProbe(SimulatedSensor):
             k += 1
             if k > n_steps:
                 what = "detection" if want_on else "edge (sensor still detecting)"
-                return self._fail(cmd, f"no {what} within {length * 1e3:.0f} mm")
+                return self._fail(cmd, no_event_within(what, length))
             d_lo, d_hi = d_hi, full([float(s_grid[k])])[0]
         # the switch between rays (planner.sim.subray): in the bracket widened by a ray cell on
         # each side, the rays whose surface changes count by their share across their cell
@@ -298,7 +311,7 @@ class SimulatedProbe(SimulatedSensor):
         else:
             hi, s_hi = found
         if s_hi < 0:
-            return self._fail(cmd, "sensor face collided with the part during the search")
+            return self._fail(cmd, COLLIDED)
         triangles = None
         if want_on and self.faces is not None:  # an approach across the axis: its footprint
             at = (tcp0 + hi * direction)[None]

@@ -12,19 +12,24 @@ and for the built-in stator the paper's Table 1.
 
 Per-point outcomes (:class:`PointOutcome`) count every search by the id the procedure gives it
 (``"D"``, its retake ``"D2"``): failures with their reason, and landings off the face or with
-part of the footprint over a hole or an edge (with the fraction of the footprint).
+part of the footprint over a hole or an edge (with the fraction of the footprint). Failures are
+counted by their :class:`planner.reasons.Reason` (kind, words, pair), per search and per trial
+(:class:`FailureCount`), so a reader sorts them by kind, never by their words.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
 from calib.paper.table1 import PAPER_TABLE1 as PAPER_TABLE1  # the paper's Table 1
+from planner.reasons import Reason
 from planner.sim.error_map import ErrorMap
+from planner.sim.search_events import SearchFailure
 
 FloatArray = NDArray[np.float64]
 
@@ -72,7 +77,8 @@ class PointOutcome:
     Attributes:
         point_id: the search's id as the procedure names it (``"D"``, a retake ``"D2"``).
         searches: searches run.
-        failed: failures by reason.
+        failed: failures by reason (its kind, words and pair; the markdown and the JSON list
+            the words, the JSON the kinds beside them).
         landed_off: approaches whose footprint centre was not on the face meant.
         partly_off: approaches with part of the footprint over a hole or an edge.
         off_fraction_mean: mean fraction of the footprint off the face over ``partly_off``.
@@ -81,11 +87,31 @@ class PointOutcome:
 
     point_id: str
     searches: int
-    failed: dict[str, int]
+    failed: dict[Reason, int]
     landed_off: int
     partly_off: int
     off_fraction_mean: float
     off_fraction_max: float
+
+
+@dataclass(frozen=True)
+class FailureCount:
+    """Trials that failed alike: the same search for the same reason (one line of the report's
+    failures).
+
+    Attributes:
+        label: the line's words, ``"<search>: <reason>"``, ``"x-offset <search>: <reason>"``
+            or ``"procedure: <why>"`` (a :attr:`ValidationReport.failures` key).
+        run: ``"procedure"`` (the calibration) or ``"x-offset"`` (the x-offset run after it).
+        failed: the search the run stopped at, with its reason (kind, words, pair); ``None``
+            when no search failed (the measurements define no frame).
+        count: trials.
+    """
+
+    label: str
+    run: Literal["procedure", "x-offset"]
+    failed: SearchFailure | None
+    count: int
 
 
 @dataclass(frozen=True)
@@ -102,6 +128,8 @@ class ValidationReport:
         delta_procedure: ``(n_ok, 6)`` raw frame errors of the procedure (m, rad).
         delta_best_fit: ``(n_ok, 6)`` raw frame errors of the best fit (m, rad).
         failures: ``"<search>: <reason>"`` -> number of failed trials.
+        failure_counts: the same trials by the search and reason (with its kind) they failed
+            at, in the order of their labels.
         landings: ``"<search>: <landing>"`` -> number of such approaches.
         elapsed_s: wall time, seconds.
         workers: worker processes used.
@@ -153,6 +181,7 @@ class ValidationReport:
     program: str = ""
     program_steps: tuple[str, ...] = ()
     check_problems: tuple[str, ...] = ()
+    failure_counts: tuple[FailureCount, ...] = ()
 
     def row(self, key: str, level_percent: float) -> IntervalRow:
         """The row ``key`` at ``level_percent``; raises KeyError when absent."""
@@ -205,6 +234,14 @@ def _row_cells(r: IntervalRow, protocol: bool, paper: bool) -> list[str]:
     return cells
 
 
+def failed_by_words(failed: dict[Reason, int]) -> dict[str, int]:
+    """``failed`` by the words users read, sorted (reasons of one text counted together)."""
+    out: dict[str, int] = {}
+    for cause, n in failed.items():
+        out[str(cause)] = out.get(str(cause), 0) + n
+    return dict(sorted(out.items()))
+
+
 def report_markdown(report: ValidationReport) -> str:
     """The report's rows, per-point outcomes, failures and notes."""
     protocol = bool(report.protocol)
@@ -250,7 +287,7 @@ def report_markdown(report: ValidationReport) -> str:
             "|---|---|---|---|---|---|",
         ]
         for o in report.outcomes:
-            failed = "; ".join(f"{why}: {n}" for why, n in sorted(o.failed.items())) or "0"
+            failed = "; ".join(f"{w}: {n}" for w, n in failed_by_words(o.failed).items()) or "0"
             frac = f"{o.off_fraction_mean:.0%} / {o.off_fraction_max:.0%}" if o.partly_off else "—"
             lines.append(
                 f"| {o.point_id} | {o.searches} | {failed} | {o.landed_off} | {o.partly_off} "

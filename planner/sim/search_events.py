@@ -6,6 +6,13 @@ with the reason), and to vet the path a search really ran against a
 :class:`planner.cell.cell.Cell`. Landings are judged over the whole footprint against the
 planar faces of the true mesh (:class:`FaceLookup`), so a sensor face partly over a hole or an
 edge is counted with the fraction of its area that is off the face.
+
+Every outcome is a :class:`planner.reasons.Reason`, its kind given where it is decided: a
+search the sensor runs and finds nothing, or starts inside or already detecting, is a
+``search`` (the simulators); a path the reachability hook refuses keeps the cell's kind and
+pair (``reach``, ``joint_limit``, ``singularity``, ``collision``: :func:`cell_search_hook`);
+a footprint that lands off its face or partly over a hole or an edge is a ``footprint``
+(:class:`FaceLookup`, :data:`LANDED_OFF_FACE`, :data:`PARTLY_OFF_FACE`).
 """
 
 from __future__ import annotations
@@ -21,11 +28,26 @@ from numpy.typing import NDArray
 from calib.models.robot_error import AccuracyField, RobotErrorModel
 from calib.models.sensor import tool_rotation
 from calib.probing import SearchCommand
+from planner.reasons import Reason
 
 FloatArray = NDArray[np.float64]
 
-#: A reachability hook: returns "" when the commanded search is feasible, else the reason.
-ReachabilityHook = Callable[[SearchCommand], str]
+#: A reachability hook: ``None`` when the commanded search is feasible, else why not.
+ReachabilityHook = Callable[[SearchCommand], Reason | None]
+
+#: Said before the reason of a search the reachability hook refuses.
+UNREACHABLE = "unreachable or colliding: "
+
+
+def _refusal(result: Any) -> Reason | None:
+    """``None`` for a feasible :class:`planner.cell.search_paths.PathFeasibility`, else its
+    cause (kind and pair as the cell gave them) after :data:`UNREACHABLE`."""
+    if result.feasible:
+        return None
+    cause = result.cause
+    if not isinstance(cause, Reason):
+        raise TypeError(f"an infeasible search path must carry its cause (a Reason), got {cause!r}")
+    return cause.worded(UNREACHABLE)
 
 
 def cell_search_hook(cell: Any, step_m: float = 0.002) -> ReachabilityHook:
@@ -33,14 +55,14 @@ def cell_search_hook(cell: Any, step_m: float = 0.002) -> ReachabilityHook:
     :class:`planner.cell.cell.Cell`); place the cell's work object where the part really is, so a
     search that collides because the part moved is caught.
 
-    The reason returned is ``"unreachable or colliding: <the cell's reason>"``. Only the
-    verdict is computed (``exact_clearance=False``: the broad phase clears most of each
-    sample's collision query, :mod:`planner.cell.path_clearance`; the same verdict and reason).
+    The reason returned is the cell's (its kind, and the pair of a collision) worded
+    ``"unreachable or colliding: <the cell's reason>"``. Only the verdict is computed
+    (``exact_clearance=False``: the broad phase clears most of each sample's collision query,
+    :mod:`planner.cell.path_clearance`; the same verdict and reason).
     """
 
-    def hook(command: SearchCommand) -> str:
-        res = cell.check_search(command, step_m=step_m, exact_clearance=False)
-        return "" if res.feasible else f"unreachable or colliding: {res.reason}"
+    def hook(command: SearchCommand) -> Reason | None:
+        return _refusal(cell.check_search(command, step_m=step_m, exact_clearance=False))
 
     return hook
 
@@ -81,15 +103,17 @@ def program_search_hook(
     pose for (a plan simulated though check refuses it) is reported as such, never vetted with
     a pose no program runs.
 
-    The reason returned is ``"unreachable or colliding: <the cell's reason>"``; as
-    :func:`cell_search_hook`, only the verdict is computed.
+    The reason returned is the cell's worded ``"unreachable or colliding: <the cell's
+    reason>"`` (its kind and pair kept); a point without a pose is a ``reach`` reason (check
+    found no pose the robot can take there). As :func:`cell_search_hook`, only the verdict is
+    computed.
     """
     R_nom_T = np.asarray(T_base_wobj_nominal, dtype=float)[:3, :3].T
 
-    def hook(command: SearchCommand) -> str:
+    def hook(command: SearchCommand) -> Reason | None:
         pid = keys.get(command.point_id)
         if pid is not None and pid not in poses:
-            return f"unreachable or colliding: check found no pose for point {pid}"
+            return Reason("reach", f"{UNREACHABLE}check found no pose for point {pid}")
         pose = poses.get(pid if pid is not None else (other_searches or ""))
         if pose is None:
             res = cell.check_search(command, step_m=step_m, tcp=tcp, exact_clearance=False)
@@ -105,7 +129,7 @@ def program_search_hook(
                 max_starts=1,
                 exact_clearance=False,
             )
-        return "" if res.feasible else f"unreachable or colliding: {res.reason}"
+        return _refusal(res)
 
     return hook
 
@@ -143,9 +167,9 @@ def search_group(search_id: str) -> str:
 
 
 #: Landing of an approach whose footprint centre is not on the face it was meant for.
-LANDED_OFF_FACE = "landed off its face"
+LANDED_OFF_FACE = Reason("footprint", "landed off its face")
 #: Landing of an approach with part of its footprint over a hole or past an edge of its face.
-PARTLY_OFF_FACE = "footprint partly over a hole or an edge"
+PARTLY_OFF_FACE = Reason("footprint", "footprint partly over a hole or an edge")
 
 
 @dataclass(frozen=True)
@@ -154,10 +178,12 @@ class ProbeEvent:
 
     Attributes:
         point_id: the search's id as the procedure names it (``"D"``, a retake ``"D2"``).
-        kind: ``"approach"`` or ``"edge"``.
-        reason: empty on success, else why the search failed.
-        landing: ``""``, :data:`LANDED_OFF_FACE` or :data:`PARTLY_OFF_FACE`: where an
-            approach really landed.
+        kind: ``"approach"`` or ``"edge"`` (the search's kind; a failure's kind is
+            ``cause.kind``).
+        cause: ``None`` on success, else why the search failed, with its kind (``search``
+            from the sensor, the cell's kind and pair from the reachability hook).
+        landing: ``None``, :data:`LANDED_OFF_FACE` or :data:`PARTLY_OFF_FACE` (``footprint``
+            reasons): where an approach really landed.
         off_fraction: the part of the footprint (sensor face, or the ball's contact) not over
             the face the point was meant for, 0 to 1.
         travel_m: travel from the start to the event, m (``nan`` on failure).
@@ -165,10 +191,35 @@ class ProbeEvent:
 
     point_id: str
     kind: str
-    reason: str = ""
-    landing: str = ""
+    cause: Reason | None = None
+    landing: Reason | None = None
     off_fraction: float = 0.0
     travel_m: float = float("nan")
+
+    @property
+    def reason(self) -> str:
+        """The words of :attr:`cause` (``""`` on success)."""
+        return "" if self.cause is None else str(self.cause)
+
+
+@dataclass(frozen=True)
+class SearchFailure:
+    """The search a trial's calibration (or its x-offset run) stopped at, and why.
+
+    Attributes:
+        search: the failed search's id as the procedure names it (``"D"``, ``"C2"``,
+            ``"PX1_11"``).
+        cause: why, in the words the procedure reports it (the sensor's or the hook's, or the
+            program's around them: ``"approach to the face: ..."``), with the kind and pair
+            of the search's event (:func:`planner.sim.trial.search_failure`).
+    """
+
+    search: str
+    cause: Reason
+
+    def __str__(self) -> str:
+        """``"<search>: <reason>"``, as the report lists it."""
+        return f"{self.search}: {self.cause}"
 
 
 @dataclass(frozen=True)
@@ -186,22 +237,23 @@ class FaceLookup:
     triangle_face: NDArray[np.int64]
     intended: Mapping[str, int]
 
-    def landing(self, point_id: str, triangles: NDArray[np.int64]) -> tuple[str, float]:
+    def landing(self, point_id: str, triangles: NDArray[np.int64]) -> tuple[Reason | None, float]:
         """Classify a footprint from the triangles its samples hit (``-1``: nothing).
 
         The first sample is the footprint's centre (or nearest it); the samples are of equal
         area, so the fraction of samples off the intended face is that of the footprint.
 
         Returns:
-            ``(landing, off_fraction)``: ``("", 0.0)`` when the whole footprint is on its face.
+            ``(landing, off_fraction)``: :data:`LANDED_OFF_FACE` or :data:`PARTLY_OFF_FACE`
+            and the fraction off; ``(None, 0.0)`` when the whole footprint is on its face.
         """
         want = self.intended.get(point_id, -1)
         if want < 0 or len(triangles) == 0:
-            return "", 0.0
+            return None, 0.0
         tri = np.asarray(triangles, dtype=np.int64)
         face = np.where(tri >= 0, self.triangle_face[np.maximum(tri, 0)], -1)
         off = face != want
         frac = float(np.mean(off))
         if bool(off[0]):
             return LANDED_OFF_FACE, frac
-        return (PARTLY_OFF_FACE, frac) if frac > 0.0 else ("", 0.0)
+        return (PARTLY_OFF_FACE, frac) if frac > 0.0 else (None, 0.0)

@@ -18,6 +18,12 @@ sensor, a search goes the same way, and that way is written here once:
    (:meth:`_fail`). Every search, success or failure, leaves one :class:`ProbeEvent` in
    :attr:`events`, in the order run.
 
+A failure is a :class:`planner.reasons.Reason` given where it is decided: the sensor's own
+(nothing within the search's length, :func:`no_event_within`; a start inside the part or
+already detecting; a refused search) are ``search`` reasons; the reachability hook's keep the
+cell's kind and pair. The :class:`~calib.probing.ProbeResult` the procedure reads carries its
+words (``reason``); the event carries the reason itself (``cause``).
+
 :meth:`run_in_turn` runs a list of searches one after the other up to and including the first
 that fails (the x-offset run); a subclass may run them as one batch (one ray cast for all:
 :class:`planner.sim.proximity.SimulatedProbe`) as long as the results, events and noise are
@@ -37,10 +43,17 @@ from numpy.typing import ArrayLike, NDArray
 from calib.frames import check_transform, invert_transform
 from calib.models.robot_error import AccuracyField, RobotErrorModel
 from calib.probing import ProbeResult, SearchCommand
+from planner.reasons import Reason
 from planner.sim.raycast import MeshRayCaster
 from planner.sim.search_events import FaceLookup, ProbeEvent, ReachabilityHook, robot_offset
 
 FloatArray = NDArray[np.float64]
+
+
+def no_event_within(event: str, length_m: float) -> Reason:
+    """The ``search`` reason of a search that ran its whole length, ``length_m`` (m), without
+    its ``event`` (``"detection"``, ``"contact"``): ``"no detection within 50 mm"``."""
+    return Reason("search", f"no {event} within {length_m * 1e3:.0f} mm")
 
 
 @dataclass
@@ -60,7 +73,7 @@ class SimulatedSensor(ABC):
             classify landings over the whole footprint; ``None``: not classified.
         tcp_error_m: ``(3,)`` this calibration's TCP error, sensor tool frame, m, or None.
         reachability: optional hook that vets the path each successful search really ran (the
-            command cut at the event); its reason fails the search.
+            command cut at the event); its reason (kind and pair kept) fails the search.
         edge_inset_m: an edge search runs its track this far inside the commanded path along
             the sensor axis, m (sensors that run edge searches).
         edge_tolerance_m: tolerance of an edge event, m (sensors that run edge searches).
@@ -88,7 +101,7 @@ class SimulatedSensor(ABC):
     def __call__(self, cmd: SearchCommand) -> ProbeResult:
         """Run one commanded search against the true part."""
         why = self._refusal(cmd)
-        if why:
+        if why is not None:
             return self._fail(cmd, why)
         start = np.asarray(cmd.start_m, float)
         axis = np.asarray(cmd.sensor_axis, float)
@@ -103,10 +116,10 @@ class SimulatedSensor(ABC):
                 break
         return out
 
-    def _refusal(self, cmd: SearchCommand) -> str:
-        """Why this sensor cannot run ``cmd`` at all (``""``: it can); checked before any
+    def _refusal(self, cmd: SearchCommand) -> Reason | None:
+        """Why this sensor cannot run ``cmd`` at all (``None``: it can); checked before any
         noise is drawn."""
-        return ""
+        return None
 
     @abstractmethod
     def _search(
@@ -128,10 +141,11 @@ class SimulatedSensor(ABC):
         T = self._T_wobj_base
         return p_base @ T[:3, :3].T + T[:3, 3]
 
-    def _fail(self, cmd: SearchCommand, reason: str) -> ProbeResult:
-        """A failed search: its event with ``reason``, and no point."""
-        self.events.append(ProbeEvent(cmd.point_id, cmd.kind, reason=reason))
-        return ProbeResult(point_m=None, reason=reason)
+    def _fail(self, cmd: SearchCommand, reason: Reason) -> ProbeResult:
+        """A failed search: its event with ``reason`` (its kind and pair), and no point, with
+        the reason's words for the procedure."""
+        self.events.append(ProbeEvent(cmd.point_id, cmd.kind, cause=reason))
+        return ProbeResult(point_m=None, reason=str(reason))
 
     def _vet(self, cmd: SearchCommand, travel: float) -> ProbeResult | None:
         """The failure of a search the reachability hook refuses (the path from the start
@@ -139,15 +153,15 @@ class SimulatedSensor(ABC):
         if self.reachability is None:
             return None
         why = self.reachability(replace(cmd, length_m=max(travel, 1e-6)))
-        return self._fail(cmd, why) if why else None
+        return None if why is None else self._fail(cmd, why)
 
     def _landing(
         self, cmd: SearchCommand, triangles: NDArray[np.int64] | None
-    ) -> tuple[str, float]:
+    ) -> tuple[Reason | None, float]:
         """``(landing, off_fraction)`` of a footprint whose samples hit ``triangles``
-        (:meth:`FaceLookup.landing`); ``("", 0.0)`` when landings are not classified."""
+        (:meth:`FaceLookup.landing`); ``(None, 0.0)`` when landings are not classified."""
         if self.faces is None or triangles is None:
-            return "", 0.0
+            return None, 0.0
         return self.faces.landing(cmd.point_id, triangles)
 
     def _record(
@@ -155,10 +169,11 @@ class SimulatedSensor(ABC):
         cmd: SearchCommand,
         travel: float,
         point: FloatArray,
-        landing: tuple[str, float] = ("", 0.0),
+        landing: tuple[Reason | None, float] = (None, 0.0),
     ) -> ProbeResult:
-        """A successful search: its event and what the controller records, ``point`` ``(3,)``
-        (base frame, m) after ``travel`` m."""
+        """A successful search: its event (with where it landed, a ``footprint`` reason, and
+        the fraction off its face) and what the controller records, ``point`` ``(3,)`` (base
+        frame, m) after ``travel`` m."""
         self.events.append(
             ProbeEvent(
                 cmd.point_id, cmd.kind, landing=landing[0], off_fraction=landing[1], travel_m=travel

@@ -3,7 +3,10 @@
 :func:`build_rows` turns each estimator's frame errors (and predicted covariance) into the
 report's :class:`~planner.sim.report.IntervalRow` s (:mod:`planner.sim.rows` has what each row
 measures); :func:`point_outcomes` counts every search by its id, with the reason of a failure
-and the landing of an approach (the x-offset run's searches pooled under one id).
+and the landing of an approach (the x-offset run's searches pooled under one id);
+:func:`failure_counts` counts the failed trials by the search and the reason they stopped at.
+Both group by the :class:`planner.reasons.Reason` itself (kind, words, pair), never by
+reading its words.
 """
 
 from __future__ import annotations
@@ -18,8 +21,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.stats import confidence_intervals
+from planner.reasons import Reason
 from planner.sim.predict import Prediction
-from planner.sim.report import IntervalRow, PointOutcome, ValidationReport
+from planner.sim.report import FailureCount, IntervalRow, PointOutcome, ValidationReport
 from planner.sim.report_points import XOFFSET_KEYS
 from planner.sim.rows import SCALE, RowSpec, predicted_sigma, samples_and_bias, z_values
 from planner.sim.search_events import (
@@ -55,10 +59,10 @@ def point_outcomes(searched: list[str], events: list[ProbeEvent]) -> tuple[Point
     out = []
     for pid in order:
         mine = [e for e in events if e.point_id == pid]
-        failed: dict[str, int] = {}
+        failed: dict[Reason, int] = {}
         for e in mine:
-            if e.reason:
-                failed[e.reason] = failed.get(e.reason, 0) + 1
+            if e.cause is not None:
+                failed[e.cause] = failed.get(e.cause, 0) + 1
         partly = [e.off_fraction for e in mine if e.landing == PARTLY_OFF_FACE]
         out.append(
             PointOutcome(
@@ -72,6 +76,23 @@ def point_outcomes(searched: list[str], events: list[ProbeEvent]) -> tuple[Point
             )
         )
     return tuple(out)
+
+
+def failure_counts(results: list[TrialResult]) -> tuple[FailureCount, ...]:
+    """The failed trials of ``results`` grouped by the search and reason (kind, words, pair)
+    their calibration or x-offset run stopped at (or by the words of a procedure that got no
+    frame), ordered by label."""
+    count: Counter[FailureCount] = Counter()
+    for r in results:
+        if r.failure:
+            count[FailureCount(r.failure, "procedure", r.failed_search, 0)] += 1
+        if r.xoffset_failure:
+            label = f"x-offset {r.xoffset_failure}"
+            count[FailureCount(label, "x-offset", r.xoffset_failed_search, 0)] += 1
+    rows = [dataclasses.replace(f, count=n) for f, n in count.items()]
+    return tuple(
+        sorted(rows, key=lambda f: (f.label, "" if f.failed is None else f.failed.cause.kind))
+    )
 
 
 def _half_widths(samples: FloatArray, unit: str, levels: tuple[float, ...]) -> list[float]:
@@ -197,8 +218,10 @@ def build_report(
         paper,
     )
     all_results = results + proto
-    failures = Counter(r.failure for r in all_results if r.failure)
-    failures.update(f"x-offset {r.xoffset_failure}" for r in all_results if r.xoffset_failure)
+    counted = failure_counts(all_results)
+    failures: Counter[str] = Counter()
+    for f in counted:
+        failures[f.label] += f.count
     landings = Counter(item for r in all_results for item in r.landings)
     outcomes = point_outcomes(
         [pid for r in all_results for pid in r.searched],
@@ -213,6 +236,7 @@ def build_report(
         delta_procedure=dp[ok],
         delta_best_fit=df[ok],
         failures=dict(failures),
+        failure_counts=counted,
         landings=dict(landings),
         elapsed_s=elapsed,
         workers=n_workers,

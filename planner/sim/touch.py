@@ -12,10 +12,11 @@ along the face normal of the estimate the search was commanded in (``calib.model
 that compensated point is returned.
 
 Failures are reasons, never numbers: no contact within the search length, the ball already
-inside the part at the start, an edge search (a touch probe cannot run one), or an unreachable
-commanded path (reachability hook). Every approach's landing is judged over the ball's
-silhouette against the planar faces of the part, and a ball that meets an edge or another face
-first is counted as landed off its face.
+inside the part at the start, an edge search (a touch probe cannot run one): ``search``
+reasons, decided here; or an unreachable commanded path (reachability hook: the cell's kind and
+pair). Every approach's landing is judged over the ball's silhouette against the planar faces
+of the part, and a ball that meets an edge or another face first is counted as landed off its
+face (``footprint`` reasons).
 """
 
 from __future__ import annotations
@@ -28,11 +29,21 @@ from numpy.typing import NDArray
 
 from calib.models.touch import TouchProbe
 from calib.probing import ProbeResult, SearchCommand
+from planner.reasons import Reason
 from planner.sim.raycast import MeshRayCaster
 from planner.sim.search_events import LANDED_OFF_FACE
-from planner.sim.sensor_base import SimulatedSensor
+from planner.sim.sensor_base import SimulatedSensor, no_event_within
 
 FloatArray = NDArray[np.float64]
+
+#: A touch probe is asked for an edge search.
+NO_EDGE_SEARCH = Reason("search", "a touch probe cannot run an edge search")
+#: A touch probe is asked to approach along another direction than its stylus.
+OFF_AXIS = Reason("search", "touch probe: only approaches along the stylus axis")
+#: The ball starts inside the (misplaced) part.
+BALL_INSIDE = Reason("search", "stylus ball inside the part at start")
+#: The ball starts touching the part.
+BALL_TOUCHING = Reason("search", "stylus ball touching the part at start")
 
 
 @dataclass
@@ -47,8 +58,8 @@ class SimulatedTouchProbe(SimulatedSensor):
 
     sensor: TouchProbe = field(default_factory=TouchProbe)
 
-    def _refusal(self, cmd: SearchCommand) -> str:
-        return "" if cmd.kind == "approach" else "a touch probe cannot run an edge search"
+    def _refusal(self, cmd: SearchCommand) -> Reason | None:
+        return None if cmd.kind == "approach" else NO_EDGE_SEARCH
 
     def _search(
         self, cmd: SearchCommand, start: FloatArray, axis: FloatArray, tcp0: FloatArray
@@ -56,7 +67,7 @@ class SimulatedTouchProbe(SimulatedSensor):
         """Run one commanded approach against the true part."""
         direction = np.asarray(cmd.direction, float)
         if float(direction @ axis) < 1.0 - 1e-9:
-            return self._fail(cmd, "touch probe: only approaches along the stylus axis")
+            return self._fail(cmd, OFF_AXIS)
         r = self.sensor.radius_m
         R, t = self._T_wobj_base[:3, :3], self._T_wobj_base[:3, 3]
         centre0 = R @ (tcp0 - r * axis) + t  # part frame from here on
@@ -65,26 +76,26 @@ class SimulatedTouchProbe(SimulatedSensor):
         dist, tri = self.caster.first_hits_ids(origins, np.broadcast_to(a, origins.shape))
         length = float(cmd.length_m)
         if np.any(dist <= 0.0):
-            return self._fail(cmd, "stylus ball inside the part at start")
+            return self._fail(cmd, BALL_INSIDE)
         if not np.any(np.isfinite(dist)):
-            return self._fail(cmd, f"no contact within {length * 1e3:.0f} mm")
+            return self._fail(cmd, no_event_within("contact", length))
         # the exact first contact of the sweeping ball with the triangles the rays met near
         # the first hit: a face (tangent point inside it), an edge or a corner
         near = np.unique(tri[np.isfinite(dist) & (dist <= float(dist.min()) + 0.25 * r)])
         travel, normal, on_face_of = sweep_contact(self.caster, centre0, a, r, near)
         if travel <= 0.0:
-            return self._fail(cmd, "stylus ball touching the part at start")
+            return self._fail(cmd, BALL_TOUCHING)
         normal_base = R.T @ normal  # the lobes turn with the probe: its tool frame is in base
         travel += self.sensor.pretravel_error_m(normal_base, axis) + self.sensor.sample_trigger_m(
             self.rng
         )
         if travel > length:
-            return self._fail(cmd, f"no contact within {length * 1e3:.0f} mm")
+            return self._fail(cmd, no_event_within("contact", length))
         refused = self._vet(cmd, travel)
         if refused is not None:
             return refused
         landing, frac = self._landing(cmd, tri)
-        if self.faces is not None and not landing:
+        if self.faces is not None and landing is None:
             want = self.faces.intended.get(cmd.point_id, -1)
             face = self.faces.triangle_face[on_face_of] if on_face_of >= 0 else -1
             if want >= 0 and face != want:  # the ball met an edge or another face first

@@ -9,10 +9,17 @@ the program a controller runs, nominal or adaptive) with the simulator registere
 sensor, so every procedure validates the same way and as the robot runs it; then
 the best fit of the same measurements fed as the procedure is fed
 (:class:`calib.procedures.comparison.FedFit`), and the x-offset run when the plan has one.
+
+A trial that stops at a failed search keeps the search and its reason
+(:class:`~planner.sim.search_events.SearchFailure`, :func:`search_failure`): the words the
+procedure reports, the kind and pair of the search's event, so that the report counts the
+failures by kind without reading their words.
 """
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -24,8 +31,10 @@ from calib.errors import InputError, ProbeFailedError
 from calib.frames import motion_between
 from calib.procedures.comparison import FedFit
 from planner.program.execute import execute
+from planner.program.model import FACE_APPROACH
+from planner.reasons import Reason
 from planner.sim.raycast import MeshRayCaster
-from planner.sim.search_events import ProbeEvent, ReachabilityHook, search_group
+from planner.sim.search_events import ProbeEvent, ReachabilityHook, SearchFailure, search_group
 from planner.sim.sensors import sensor_kind
 from planner.sim.setup import DEFAULT_EDGE_INSET_M, SimulationSetup
 from planner.sim.xoffset import run_xoffset
@@ -37,6 +46,7 @@ __all__ = [
     "TrialRunner",
     "init_worker",
     "run_chunk_in_worker",
+    "search_failure",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -49,7 +59,8 @@ class TrialResult:
     """One trial.
 
     Attributes:
-        failure: ``""`` or ``"<search>: <reason>"``.
+        failure: ``""``, ``"<search>: <reason>"`` (``str(failed_search)``), or ``"procedure:
+            <why>"`` when the measurements define no frame.
         searched: the id of every search run, in order.
         events: the searches that failed or landed off their face (or partly).
         delta_procedure: ``(6,)`` procedure frame error ``(dx, dy, dz, rx, ry, rz)`` in the true
@@ -57,7 +68,12 @@ class TrialResult:
         delta_best_fit: ``(6,)`` the same for the best fit of the same measurements.
         xoffset_x_m: ``(H,)`` x errors of the slot targets with the x-offset matrix (true wobj
             axes, m), or ``None`` without an x-offset run (NaN when it failed).
-        xoffset_failure: ``""`` or ``"<search>: <reason>"`` of a failed x-offset run.
+        xoffset_failure: ``""``, ``"<search>: <reason>"`` of a failed x-offset run, or
+            ``"x-offset: <why>"``.
+        failed_search: the search the calibration stopped at, with its reason and kind;
+            ``None`` when it did not stop at a search (it calibrated, or its measurements
+            define no frame).
+        xoffset_failed_search: the same for the x-offset run.
     """
 
     failure: str
@@ -67,6 +83,8 @@ class TrialResult:
     delta_best_fit: FloatArray
     xoffset_x_m: FloatArray | None = None
     xoffset_failure: str = ""
+    failed_search: SearchFailure | None = None
+    xoffset_failed_search: SearchFailure | None = None
 
     @property
     def landings(self) -> tuple[str, ...]:
@@ -124,6 +142,8 @@ class TrialRunner:
         )
         nan6 = np.full(6, np.nan)
         failure = xfail = ""
+        failed: SearchFailure | None = None
+        xfailed: SearchFailure | None = None
         d_proc = d_fit = nan6
         x_err: FloatArray | None = None
         try:
@@ -131,7 +151,8 @@ class TrialRunner:
             d_proc = motion_between(T_true, run.T_base_wobj)
             d_fit = motion_between(T_true, self.fed_fit(run).T_base_wobj)
         except ProbeFailedError as exc:
-            failure = f"{exc.point_id}: {exc.reason}"
+            failed = search_failure(exc, probe.events)
+            failure = str(failed)
             d_proc = d_fit = nan6
         except InputError as exc:  # degenerate measurements: a failed calibration, not a crash
             failure = f"procedure: {exc}"
@@ -142,18 +163,38 @@ class TrialRunner:
                 try:
                     x_err = run_xoffset(setup.xoffset, probe, run.T_base_wobj, T_true)[:, 0]
                 except ProbeFailedError as exc:
-                    xfail = f"{exc.point_id}: {exc.reason}"
+                    xfailed = search_failure(exc, probe.events)
+                    xfail = str(xfailed)
                 except InputError as exc:
                     xfail = f"x-offset: {exc}"
         searched = tuple(e.point_id for e in probe.events)
-        notable = tuple(e for e in probe.events if e.reason or e.landing)
-        return TrialResult(failure, searched, notable, d_proc, d_fit, x_err, xfail)
+        notable = tuple(e for e in probe.events if e.cause is not None or e.landing is not None)
+        return TrialResult(failure, searched, notable, d_proc, d_fit, x_err, xfail, failed, xfailed)
 
     def run_chunk(
         self, seeds: list[TrialSeed], reach: ReachabilityHook | None = None
     ) -> list[TrialResult]:
         """Trials of ``seeds`` in order."""
         return [self.run_trial(s, reach) for s in seeds]
+
+
+def search_failure(exc: ProbeFailedError, events: Sequence[ProbeEvent]) -> SearchFailure:
+    """The search ``exc`` names and why it failed, with the kind of its event.
+
+    Every program and procedure stops at its first failed search, so a search the simulated
+    sensor failed is the last event (an edge point's approach to its face, ``"F@face"``, stands
+    for its edge search ``"F"``): the reason keeps that event's kind and pair (``search`` from
+    the sensor, the cell's from the reachability hook) in the words the procedure reports
+    (``exc.reason``: the event's, or the program's around them, ``"approach to the face:
+    ..."``). A search the program or the procedure refused before running it (a measured start
+    past the search's end) has no failed event: a ``search`` reason.
+    """
+    words = exc.reason or "no reason given"
+    last = events[-1] if events else None
+    ran = last is not None and last.point_id in (exc.point_id, exc.point_id + FACE_APPROACH)
+    if last is None or last.cause is None or not ran:
+        return SearchFailure(exc.point_id, Reason("search", words))
+    return SearchFailure(exc.point_id, dataclasses.replace(last.cause, text=words, note=""))
 
 
 #: The runner of a worker process (set by :func:`init_worker`, the pool's initializer).

@@ -73,7 +73,8 @@ def run_xoffset(
         wobj axes (target in the true part minus the true hole), metres.
 
     Raises:
-        ProbeFailedError: a search failed (its id and reason).
+        ProbeFailedError: a search failed (its id and reason's words; its kind is on the
+            probe's event of that search: :func:`planner.sim.trial.search_failure`).
     """
     T_wobj_base = invert_transform(T_base_wobj_cal)
     points = [p for row in xs.points for p in row]

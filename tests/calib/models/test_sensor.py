@@ -110,7 +110,7 @@ def test_slot_hole_reads_farther_than_tooth_by_the_predicted_amount() -> None:
     measured = reading(*hole) - reading(*tooth)
     assert predicted > 0.3e-3  # the effect is real: a few tenths of a millimetre
     assert measured == pytest.approx(predicted, abs=0.03e-3)
-    assert [e.landing for e in probe.events] == ["", ""]  # no face lookup given: unjudged
+    assert [e.landing for e in probe.events] == [None, None]  # no face lookup given: unjudged
 
 
 def test_bad_parameters_name_the_field() -> None:

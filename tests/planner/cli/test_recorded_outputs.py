@@ -44,6 +44,9 @@ ADDED = {
     "cycle_time_s",  # issue 26: the program's estimated cycle time
     "cycle_time",
     "reasons",  # issue 23: every reason of a point with its kind (and a collision's pair)
+    # issue 23: validate's failed searches and trials with their kinds beside their words
+    "failed_reasons",
+    "failure_reasons",
 }
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")

@@ -111,5 +111,8 @@ def test_cell_vets_every_search_and_counts_unreachable_ones() -> None:
         bad = simulate_stator_ah(POINTS, GEOM, far, 2, np.random.default_rng(4), cell=cell)
         assert bad.n_ok == 0
         assert all("unreachable or colliding" in k for k in bad.failures), bad.failures
+        # the cell's kind, carried from the hook to the report: out of reach, not a search
+        kinds = {f.failed.cause.kind if f.failed else None for f in bad.failure_counts}
+        assert kinds == {"reach"}, bad.failure_counts
     finally:
         cell.close()

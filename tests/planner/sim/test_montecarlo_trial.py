@@ -17,7 +17,9 @@ from planner.parts.stator_mesh import build_stator_mesh
 from planner.program.build import build_program
 from planner.program.controllers import controller
 from planner.program.settings import DEFAULT_EDGE_INSET_M, resolved_settings
+from planner.reasons import Reason
 from planner.sim.montecarlo import stator_setup
+from planner.sim.search_events import SearchFailure
 from planner.sim.setup import default_settings
 from planner.sim.trial import TrialRunner
 
@@ -59,12 +61,49 @@ def test_a_shared_position_seed_gives_the_same_misplacement() -> None:
 
 def test_failed_probe_is_recorded_with_point_and_reason() -> None:
     points = stator_ah_points(G, approach=SearchSpec("approach", 0.050, 0.060))
-    res = _runner(points).run_trial(
-        np.random.SeedSequence(1), lambda cmd: "unreachable: joint 5 at limit"
-    )
+    why = Reason("joint_limit", "unreachable: joint 5 at limit")
+    res = _runner(points).run_trial(np.random.SeedSequence(1), lambda cmd: why)
     assert res.failure == "A: unreachable: joint 5 at limit"
+    assert res.failed_search == SearchFailure("A", why)  # the hook's kind, the same words
     assert np.all(np.isnan(res.delta_procedure)) and np.all(np.isnan(res.delta_best_fit))
     assert res.events[0].reason == "unreachable: joint 5 at limit"
+    assert res.events[0].cause == why
+
+
+def test_a_failed_face_approach_keeps_the_hooks_kind_and_pair_in_the_programs_words() -> None:
+    """The adaptive RAPID program runs F's approach to its face before F's edge search: a
+    collision the cell finds there stops the trial at F, in the program's words around the
+    hook's, with the collision's kind and pair."""
+    hit = Reason("collision", "unreachable or colliding: link_6 hits clamp", ("link_6", "clamp"))
+    res = _runner(stator_ah_points(G)).run_trial(
+        np.random.SeedSequence(1), lambda cmd: hit if cmd.point_id == "F@face" else None
+    )
+    words = "approach to the face: unreachable or colliding: link_6 hits clamp"
+    assert res.failure == f"F: {words}"
+    assert res.failed_search == SearchFailure("F", Reason("collision", words, ("link_6", "clamp")))
+    assert res.events[-1].point_id == "F@face" and res.events[-1].cause == hit
+
+
+def test_search_failure_takes_the_kind_of_the_failed_searchs_event() -> None:
+    """The last event is the search that failed (a program stops there): its kind and pair,
+    the procedure's words; a search refused before it ran (no failed event of it) is a
+    ``search`` reason."""
+    from calib.errors import ProbeFailedError
+    from planner.sim.search_events import ProbeEvent
+    from planner.sim.trial import search_failure
+
+    missed = Reason("search", "no detection within 50 mm")
+    ok = ProbeEvent("C", "approach", travel_m=0.03)
+    failed = ProbeEvent("D", "approach", cause=missed)
+    exc = ProbeFailedError("D", "no detection within 50 mm")
+    assert search_failure(exc, [ok, failed]) == SearchFailure("D", missed)
+    face = ProbeEvent("F@face", "approach", cause=missed)
+    got = search_failure(ProbeFailedError("F", f"approach to the face: {missed}"), [ok, face])
+    assert got.cause == Reason("search", f"approach to the face: {missed}")
+    past = ProbeFailedError("D2", "the measured start lies past the end of the search")
+    assert search_failure(past, [ok]) == SearchFailure("D2", Reason("search", past.reason))
+    assert search_failure(past, [failed]).cause.kind == "search"  # not D2's event
+    assert search_failure(past, []).search == "D2"
 
 
 @pytest.mark.parametrize("method", list(PROCEDURES))

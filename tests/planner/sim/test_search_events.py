@@ -14,6 +14,7 @@ from calib.procedures import RolePoint
 from planner.parts.stator import StatorGeometry
 from planner.parts.stator_mesh import build_stator_mesh
 from planner.program.model import search_keys
+from planner.reasons import Reason
 from planner.sim.proximity import SimulatedProbe
 from planner.sim.raycast import MeshRayCaster
 from planner.sim.search_events import (
@@ -31,10 +32,11 @@ X = (1.0, 0.0, 0.0)
 
 def test_landing_counts_the_footprint_off_its_face() -> None:
     faces = FaceLookup(np.array([0, 0, 1, -1]), {"A": 0})
-    assert faces.landing("A", np.array([0, 1, 0, 0])) == ("", 0.0)
+    assert faces.landing("A", np.array([0, 1, 0, 0])) == (None, 0.0)
     assert faces.landing("A", np.array([0, 2, 3, -1])) == (PARTLY_OFF_FACE, 0.75)
     assert faces.landing("A", np.array([3, 0, 0, 0])) == (LANDED_OFF_FACE, 0.25)
-    assert faces.landing("unknown", np.array([3, 3])) == ("", 0.0)
+    assert faces.landing("unknown", np.array([3, 3])) == (None, 0.0)
+    assert LANDED_OFF_FACE.kind == PARTLY_OFF_FACE.kind == "footprint"
 
 
 @pytest.fixture(scope="module")
@@ -71,7 +73,7 @@ def test_stator_landings_over_the_whole_footprint(probe_on_stator) -> None:
     probe, frac = probe_on_stator
     landing = {e.point_id: e.landing for e in probe.events}
     assert landing == {
-        "web": "",
+        "web": None,
         "hole": LANDED_OFF_FACE,
         "tooth_at_layer": PARTLY_OFF_FACE,
         "top": PARTLY_OFF_FACE,
@@ -105,18 +107,46 @@ def test_search_ids_of_roles_and_retakes() -> None:
     assert search_group("PX1_3") == search_group("PX6_41") != search_group("P1")
 
 
-def test_cell_hook_reports_the_cells_reason() -> None:
+def test_cell_hook_reports_the_cells_reason_with_its_kind_and_pair() -> None:
     seen = []
+    causes = {
+        "far": Reason("joint_limit", "at 0.0 mm: joint 3 at limit (j3)"),
+        "hit": Reason(
+            "collision", "at 12.0 mm: link_6 hits clamp (clearance -1.0 mm)", ("link_6", "clamp")
+        ),
+    }
 
     def check_search(command, step_m, exact_clearance):  # the Cell method's arguments
         assert exact_clearance is False  # the verdict only
         seen.append((command.point_id, step_m))
-        bad = command.point_id == "far"
-        return SimpleNamespace(feasible=not bad, reason="joint 3 at limit" if bad else "")
+        cause = causes.get(command.point_id)
+        return SimpleNamespace(feasible=cause is None, cause=cause)
 
     hook = cell_search_hook(SimpleNamespace(check_search=check_search), step_m=0.004)
-    near = SearchCommand.from_point(ProbePoint("near", (0, 0, 0), (1, 0, 0)), np.eye(4))
-    far = SearchCommand.from_point(ProbePoint("far", (0, 0, 0), (1, 0, 0)), np.eye(4))
-    assert hook(near) == ""
-    assert hook(far) == "unreachable or colliding: joint 3 at limit"
-    assert seen == [("near", 0.004), ("far", 0.004)]
+    near, far, hit = (
+        SearchCommand.from_point(ProbePoint(pid, (0, 0, 0), (1, 0, 0)), np.eye(4))
+        for pid in ("near", "far", "hit")
+    )
+    assert hook(near) is None
+    assert hook(far) == Reason(
+        "joint_limit", "unreachable or colliding: at 0.0 mm: joint 3 at limit (j3)"
+    )
+    refused = hook(hit)
+    assert refused is not None and (refused.kind, refused.pair) == (
+        "collision",
+        ("link_6", "clamp"),
+    )
+    assert str(refused) == (
+        "unreachable or colliding: at 12.0 mm: link_6 hits clamp (clearance -1.0 mm)"
+    )
+    assert seen == [("near", 0.004), ("far", 0.004), ("hit", 0.004)]
+
+
+def test_cell_hook_refuses_an_infeasible_answer_without_its_cause() -> None:
+    def check_search(command, step_m, exact_clearance):
+        return SimpleNamespace(feasible=False, cause=None, reason="words only")
+
+    hook = cell_search_hook(SimpleNamespace(check_search=check_search))
+    cmd = SearchCommand.from_point(ProbePoint("p", (0, 0, 0), (1, 0, 0)), np.eye(4))
+    with pytest.raises(TypeError, match="must carry its cause"):
+        hook(cmd)

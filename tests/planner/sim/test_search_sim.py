@@ -12,6 +12,7 @@ from calib.frames import make_transform, matrix_from_rotvec
 from calib.models.proximity import ProximitySensor
 from calib.models.robot_error import RobotErrorModel
 from calib.probing import ProbePoint, SearchCommand, SearchSpec
+from planner.reasons import Reason
 from planner.sim.proximity import SimulatedProbe
 from planner.sim.raycast import MeshRayCaster
 
@@ -113,9 +114,10 @@ def test_repeatability_noise_has_the_modelled_spread(rng) -> None:
 
 
 def test_reachability_hook_fails_the_probe_with_its_reason() -> None:
-    probe = _probe(reachability=lambda cmd: "unreachable: joint 5 at limit")
+    why = Reason("joint_limit", "unreachable: joint 5 at limit")
+    probe = _probe(reachability=lambda cmd: why)
     res = probe(SearchCommand.from_point(ProbePoint("p", (0.0, -0.2, 0.0), TOP), np.eye(4)))
-    assert res.reason == "unreachable: joint 5 at limit"
+    assert res.reason == "unreachable: joint 5 at limit" and probe.events[-1].cause == why
 
 
 def _commands(T: np.ndarray) -> list[SearchCommand]:

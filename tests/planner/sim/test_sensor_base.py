@@ -13,8 +13,9 @@ import trimesh
 from calib.frames import make_transform, matrix_from_rotvec
 from calib.models import ProximitySensor, RobotErrorModel, TouchProbe
 from calib.probing import ProbePoint, SearchCommand, SearchSpec
+from planner.reasons import Reason
 from planner.sim.raycast import MeshRayCaster
-from planner.sim.search_events import PARTLY_OFF_FACE, FaceLookup
+from planner.sim.search_events import LANDED_OFF_FACE, PARTLY_OFF_FACE, FaceLookup
 from planner.sim.sensor_base import SimulatedSensor
 from planner.sim.sensors import SENSORS
 
@@ -61,7 +62,8 @@ def test_an_ideal_approach_measures_the_true_face_and_records_one_event(kind: st
     assert np.allclose(p_wobj[:3], [0.05, -0.03, 0.0], atol=1e-9)
     assert res.travel_m == pytest.approx(0.02, abs=1e-9)
     (event,) = probe.events
-    assert (event.point_id, event.kind, event.reason, event.landing) == ("p", "approach", "", "")
+    assert (event.point_id, event.kind, event.cause, event.landing) == ("p", "approach", None, None)
+    assert event.reason == ""
     assert event.travel_m == res.travel_m
 
 
@@ -75,20 +77,48 @@ def test_failures_are_reasons_recorded_as_events(kind: str) -> None:
     assert all(np.isnan(e.travel_m) for e in probe.events)
 
 
+def test_a_search_that_runs_out_of_travel_or_starts_inside_is_a_search_reason(kind: str) -> None:
+    """The sensor decides these: a ``search`` reason on the event, without a pair, its words
+    the result's."""
+    probe = _probe(kind)
+    inside = probe(_command(0.0, 0.0, z=-0.03, offset=0.01))
+    beyond = probe(_command(0.5, 0.0))
+    for res, event in zip((inside, beyond), probe.events, strict=True):
+        assert event.cause is not None and event.cause.kind == "search", event
+        assert event.cause.pair is None and str(event.cause) == res.reason
+    what = "detection" if kind == "proximity" else "contact"
+    assert probe.events[1].cause == Reason("search", f"no {what} within 40 mm")
+
+
 def test_the_hook_vets_the_path_cut_at_the_event(kind: str) -> None:
     seen: list[SearchCommand] = []
 
-    def refuse(cmd: SearchCommand) -> str:
+    def refuse(cmd: SearchCommand) -> Reason:
         seen.append(cmd)
-        return "unreachable or colliding: test"
+        return Reason("reach", "unreachable or colliding: test")
 
     probe = _probe(kind, reachability=refuse)
     res = probe(_command(0.05, -0.03))
     assert res.reason == "unreachable or colliding: test" and res.point_m is None
     assert seen[0].length_m == pytest.approx(0.02, abs=1e-9)  # start to the event, not 40 mm
     assert probe.events[-1].reason == res.reason
-    passing = _probe(kind, reachability=lambda cmd: "")
+    passing = _probe(kind, reachability=lambda cmd: None)
     assert passing(_command(0.05, -0.03)).ok
+
+
+def test_a_search_the_hook_refuses_keeps_the_hooks_kind_and_pair(kind: str) -> None:
+    """A collision the cell finds on the path run fails the search with the cell's kind and
+    pair; an unreachable path with its own kind."""
+    hit = Reason(
+        "collision", "unreachable or colliding: at 3.0 mm: link_6 hits clamp", ("link_6", "clamp")
+    )
+    probe = _probe(kind, reachability=lambda cmd: hit)
+    assert probe(_command(0.05, -0.03)).reason == str(hit)
+    assert probe.events[-1].cause == hit and probe.events[-1].cause.pair == ("link_6", "clamp")
+    limit = Reason("joint_limit", "unreachable or colliding: at 0.0 mm: joint 5 at limit (j5)")
+    probe = _probe(kind, reachability=lambda cmd: limit)
+    assert not probe(_command(0.05, -0.03)).ok
+    assert probe.events[-1].cause == limit and probe.events[-1].cause.pair is None
 
 
 def test_a_footprint_partly_over_an_edge_is_judged_on_its_face(kind: str) -> None:
@@ -102,6 +132,19 @@ def test_a_footprint_partly_over_an_edge_is_judged_on_its_face(kind: str) -> Non
     res = probe(_command(0.2 - 0.5 * r, 0.0))  # the footprint's centre 0.5 r inside the edge
     assert res.ok
     assert probe.events[-1].landing == PARTLY_OFF_FACE and 0.0 < probe.events[-1].off_fraction < 0.5
+    assert probe.events[-1].landing.kind == "footprint" and probe.events[-1].cause is None
+
+
+def test_a_footprint_off_its_face_is_a_footprint_reason(kind: str) -> None:
+    """An approach meant for a face it misses (here: the face is another one) succeeds, and
+    its event says where it landed with a ``footprint`` reason."""
+    face_id = np.zeros(len(BOX.faces), dtype=np.int64)  # every triangle on face 0
+    faces = FaceLookup(face_id, {"p": 1})  # but the search was meant for face 1
+    probe = _probe(kind, faces=faces)
+    assert probe(_command(0.05, -0.03)).ok
+    event = probe.events[-1]
+    assert event.landing == LANDED_OFF_FACE and event.landing.kind == "footprint"
+    assert str(event.landing) == "landed off its face" and event.cause is None
 
 
 def test_the_same_seed_gives_the_same_numbers(kind: str) -> None:

@@ -69,7 +69,7 @@ def test_square_face_is_measured_exactly() -> None:
     probe = _probe(np.eye(4), TouchProbe.ideal())
     res = probe(SearchCommand.from_point(TOP, np.eye(4)))
     assert res.ok and np.abs(res.point_m - TOP.position_m).max() < 1e-12
-    assert res.travel_m == pytest.approx(0.02, abs=1e-12) and probe.events[0].landing == ""
+    assert res.travel_m == pytest.approx(0.02, abs=1e-12) and probe.events[0].landing is None
 
 
 @pytest.mark.filterwarnings("error")
