@@ -15,7 +15,7 @@ the answer of the whole query: :mod:`planner.cell.probe_clearance` uses this to 
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -56,6 +56,8 @@ __all__ = [
 DEFAULT_MARGIN_M = 0.005
 #: Default clearance between robot/tool links that the ACL does not allow, m.
 DEFAULT_SELF_MARGIN_M = 0.002
+#: A self part with at most this many pairs to query tests their boxes in plain Python.
+FEW_SELF_PAIRS = 8
 
 
 def report_distance_m(margin_m: float) -> float:
@@ -310,6 +312,8 @@ class CollisionChecker:
             keep = np.flatnonzero(pairs)
             if keep.size == 0:
                 return None
+            if keep.size <= FEW_SELF_PAIRS:
+                return self._few_self_pairs(part, keep.tolist())
             used = np.unique(np.concatenate([pa[keep], pb_[keep]]))
             boxes = np.zeros((len(bodies), 2, 3))
             for i in used.tolist():
@@ -322,8 +326,33 @@ class CollisionChecker:
         lo, hi = boxes[:, 0], boxes[:, 1]
         a_, b_ = pa[keep], pb_[keep]
         apart = np.any((lo[a_] > hi[b_] + look) | (lo[b_] > hi[a_] + look), axis=1)
+        return self._closest_self(part, keep[~apart].tolist())
+
+    def _few_self_pairs(self, part: QueryPart, keep: list[int]) -> Clearance | None:
+        """:meth:`_self_part` of a few pairs (ascending indices ``keep`` into
+        :meth:`_self_pair_table`) in plain Python: the same boxes, tests and queries in the
+        same order, without numpy's per-call cost on arrays of a few elements."""
+        c, look = self.client, part.dist_m
+        bodies, links, pa, pb_ = self._self_pair_table()
+        boxes: dict[int, tuple[Sequence[float], Sequence[float]]] = {}
+        near: list[int] = []
+        for k in keep:
+            a, b = int(pa[k]), int(pb_[k])
+            for i in (a, b):
+                if i not in boxes:
+                    boxes[i] = pb.getAABB(bodies[i], links[i], physicsClientId=c)
+            (lo_a, hi_a), (lo_b, hi_b) = boxes[a], boxes[b]
+            if not any(lo_a[x] > hi_b[x] + look or lo_b[x] > hi_a[x] + look for x in range(3)):
+                near.append(k)
+        return self._closest_self(part, near)
+
+    def _closest_self(self, part: QueryPart, near: list[int]) -> Clearance | None:
+        """The limiting point of the self pairs ``near`` (indices into
+        :meth:`_self_pair_table`), in that order (``None``: nothing within the look)."""
+        c, look = self.client, part.dist_m
+        bodies, links, pa, pb_ = self._self_pair_table()
         best: Clearance | None = None
-        for k in keep[~apart].tolist():
+        for k in near:
             a, b = int(pa[k]), int(pb_[k])
             for pt in pb.getClosestPoints(
                 bodies[a],

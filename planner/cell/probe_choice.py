@@ -19,14 +19,16 @@ The work is done in four passes; the answers do not depend on them:
    those of the parts already known), a candidate dropped as soon as its slack is shown to be
    more than the tie below the best exact slack found. With ``statuses_only`` (the heat map's
    :func:`planner.cell.probe_status.probe_statuses`), a point none of whose candidates passes
-   stops at its status instead (:meth:`ProbeSearch._status`).
+   stops at its status instead (:meth:`ProbeSearch._status`). A point that needs more of its
+   candidates' broad-phase rows than the first block waits: the rest of the rows of all such
+   points go to the broad phase in one call, then each point goes on where it stopped.
 """
 
 from __future__ import annotations
 
 import heapq
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Generator
 from functools import partial
 from typing import TYPE_CHECKING
 
@@ -37,7 +39,7 @@ from planner.cell.broad_arrays import EnvArrays, PartMap
 from planner.cell.broad_kernels import FIELD
 from planner.cell.broad_phase import BroadPhase, broad_phase_of
 from planner.cell.clearance import Clearance, QueryPart
-from planner.cell.probe_clearance import ProbeClearance
+from planner.cell.probe_clearance import PointState, ProbeClearance
 from planner.cell.probe_flags import Block, CandidateFlags, clear_ahead
 from planner.cell.probe_parts import OpenParts
 from planner.cell.probe_rule import CLEARANCE_TIE_M, Decision, Verdict, least_bad, passes
@@ -53,6 +55,20 @@ BoolArray = NDArray[np.bool_]
 #: Candidates of an open point whose broad phase runs with the batch (most such points pass
 #: within them); a point that needs more gets the rest in one call.
 FIRST_BLOCK = 16
+
+#: Pass 4 of one point (:meth:`ProbeSearch._search`): yields when it needs rows of its flags not
+#: yet known, returns its decision.
+_Steps = Generator[None, None, "Decision | Verdict"]
+
+
+def _finish(steps: _Steps) -> Decision | Verdict:
+    """Run a point's pass 4 to its decision (rows still missing are computed one point at a
+    time by its flags)."""
+    while True:
+        try:
+            next(steps)
+        except StopIteration as done:
+            return done.value
 
 
 class ProbeSearch:
@@ -101,9 +117,11 @@ class ProbeSearch:
         pc, sc, _ = self._broad(cands, idx, c0)
         near = cands.near_limit[idx, c0]
         look = Clearance(True, self.stages.plan.look_m, self.stages.look_slack_m, None)
+        all_clear = ((pc == 1).all(axis=1) & (sc == 1).all(axis=1)).tolist()
+        fails = ((pc == -1).any(axis=1) | (sc == -1).any(axis=1)).tolist()
         open_pts = []
         for n, i in enumerate(idx.tolist()):
-            if (pc[n] == 1).all() and (sc[n] == 1).all():  # nothing within the look distance
+            if all_clear[n]:  # nothing within the look distance
                 out[i] = Decision(int(c0[n]), look, True)
                 self.decided_by["broad"] += 1
             else:
@@ -111,7 +129,7 @@ class ProbeSearch:
         rest = []
         for n in open_pts:
             i, c = int(idx[n]), int(c0[n])
-            if (pc[n] == -1).any() or (sc[n] == -1).any():
+            if fails[n]:
                 rest.append(i)  # it cannot pass
                 continue
             self.stages.start_point(cands.T_base_flange[i])
@@ -128,6 +146,7 @@ class ProbeSearch:
             pts = np.repeat(np.array(rest), [len(h) for h in heads])
             pc_all, sc_all, op_all, ub_all = self._block(cands, pts, np.concatenate(heads))
             start = 0
+            waiting: list[tuple[int, _Steps, CandidateFlags, PointState]] = []
             for i, order, head in zip(rest, orders, heads):
                 sl = slice(start, start + len(head))
                 start += len(head)
@@ -138,8 +157,19 @@ class ProbeSearch:
                     continue
                 flags = CandidateFlags(order, partial(self._point_block, cands, i))
                 flags.put((pc_all[sl], sc_all[sl], op_all[sl], ub_all[sl]))
-                out[i] = self._search(cands, i, order, flags)
+                steps = self._search(cands, i, order, flags)
                 self.decided_by["search"] += 1
+                try:
+                    next(steps)
+                except StopIteration as done:
+                    out[i] = done.value
+                    continue
+                waiting.append((i, steps, flags, self.stages.point_state()))
+            # the points that need more rows: the rest of their orders in one broad-phase call
+            self._fill(cands, [(i, flags) for i, _, flags, _ in waiting])
+            for i, steps, _, state in waiting:
+                self.stages.resume_point(state)
+                out[i] = _finish(steps)
         return out
 
     # ------------------------------------------------------------------ passes
@@ -165,15 +195,36 @@ class ProbeSearch:
         pc, sc, opened = self.broad.states(self.parts, self.env, T_links)
         return pc, sc, opened, self.bounds.upper(T_links, pc, sc)
 
+    def _fill(self, cands: ProbeCandidates, points: list[tuple[int, CandidateFlags]]) -> None:
+        """The missing rows of the flags of ``points`` (point, its flags) in one call."""
+        missing = [flags.missing() for _, flags in points]
+        sizes = [m.size for m in missing]
+        if sum(sizes) == 0:
+            return
+        pts = np.repeat(np.array([i for i, _ in points]), sizes)
+        pc, sc, op, ub = self._block(cands, pts, np.concatenate(missing))
+        start = 0
+        for (_, flags), size in zip(points, sizes):
+            sl = slice(start, start + size)
+            start += size
+            if size:
+                flags.put((pc[sl], sc[sl], op[sl], ub[sl]))
+
     def _search(
         self, cands: ProbeCandidates, i: int, order: NDArray[np.int_], flags: CandidateFlags
-    ) -> Decision | Verdict:
-        """Pass 4 for point ``i``: candidates ``order``, broad-phase flags from ``flags``."""
+    ) -> _Steps:
+        """Pass 4 for point ``i``: candidates ``order``, broad-phase flags from ``flags``.
+
+        A generator: it stops (yields) before it reads a row of ``flags`` not yet known, so
+        that the caller can compute the missing rows of many points in one call
+        (:meth:`_fill`) and then resume it; it returns the decision. Rows asked for without
+        that are computed by ``flags`` itself, one point at a time.
+        """
         K = cands.per_rotation
         near = cands.near_limit[i]
         self.stages.start_point(cands.T_base_flange[i])
-        results: list[dict[int, Clearance | None]] = [{} for _ in order]
-        tried: list[dict[int, float]] = [{} for _ in order]
+        results: list[dict[int, Clearance | None]] = [{} for _ in range(order.size)]
+        tried: list[dict[int, float]] = [{} for _ in range(order.size)]
         exact: dict[int, Clearance] = {}
         bound: dict[int, float] = {}  # j -> upper bound of the slack
         look = self.stages.look_slack_m
@@ -197,6 +248,8 @@ class ProbeSearch:
         for j, c in enumerate(order.tolist()):
             if near[c]:
                 break  # the rest are near a limit too: none can be chosen outright
+            if j >= flags.rows:
+                yield  # the caller computes the missing rows
             u = flags.upper(j)
             if flags.fails(j):
                 u = min(u, below_margin)  # shown below the margin
@@ -209,6 +262,8 @@ class ProbeSearch:
             run(j, self.margin)
             if j in exact and passes(exact[j], self.margin):
                 return Decision(c, exact[j], True)
+        if flags.rows < len(order):
+            yield  # the phases below read every row
         if self.statuses_only:
             verdict = self._status(order, flags, exact, bound, run)
             if verdict is not None:

@@ -36,6 +36,11 @@ if TYPE_CHECKING:
 
 FloatArray = NDArray[np.float64]
 _TWO_PI = 2.0 * math.pi
+#: One point's state in :class:`ProbeClearance`: ``(T_world_flange (R, 4, 4), tool part
+#: results by (rotation, part), robot part results by joint key)``.
+PointState = tuple[
+    FloatArray, dict[tuple[int, int], Clearance | None], dict[tuple[float, ...], Clearance | None]
+]
 
 
 class ProbeClearance:
@@ -78,6 +83,18 @@ class ProbeClearance:
         self._T_world_flange = self._cell.T_world_base @ T_base_flange
         self._tool = {}
         self._robot = {}
+        self._tool_at = None
+
+    def point_state(self) -> PointState:
+        """The current point's flange poses and cached part results, for :meth:`resume_point`
+        (a search set aside while other points are decided)."""
+        return (self._T_world_flange, self._tool, self._robot)
+
+    def resume_point(self, state: PointState) -> None:
+        """Continue a point set aside with :meth:`point_state`: its flange poses and cached
+        results back (the simulator's state is whatever it is now: the tool is placed again
+        before a tool part)."""
+        self._T_world_flange, self._tool, self._robot = state
         self._tool_at = None
 
     def known(self, rotation: int, q: FloatArray, part: QueryPart) -> bool:
@@ -157,7 +174,7 @@ class ProbeClearance:
         (the self part: GJK between two links answers within ~1e-6 m of a pose ~1e-7 m
         away)."""
         if not self._tool_on_flange or self._q_at is None or not np.array_equal(self._q_at, q):
-            self._cell.set_joint_positions(q)
+            self._cell.place_robot(q)  # q is a candidate's: checked
             self._q_at = q
             self._tool_on_flange = True
             self._tool_at = None

@@ -4,7 +4,8 @@
 phase's part and pair states (:meth:`planner.cell.broad_phase.BroadPhase.states`) and an upper
 bound of its slack (:class:`planner.cell.slack_bounds.SlackBounds`), computed in blocks: the
 first with the batch, the next ones when the search reaches them, each as large as all before
-it. :func:`clear_ahead` picks the candidate the search would choose first when the broad phase
+it (or all the rest at once, batched over points, with :meth:`CandidateFlags.missing`).
+:func:`clear_ahead` picks the candidate the search would choose first when the broad phase
 alone decides it.
 """
 
@@ -67,6 +68,15 @@ class CandidateFlags:
         self._upper.extend(upper.tolist())
         self._all_clear.extend(((pc == 1).all(axis=1) & (sc == 1).all(axis=1)).tolist())
         self._fails.extend(((pc == -1).any(axis=1) | (sc == -1).any(axis=1)).tolist())
+
+    @property
+    def rows(self) -> int:
+        """How many leading rows of the order are known."""
+        return len(self._pc)
+
+    def missing(self) -> NDArray[np.int_]:
+        """The candidates of the order not known yet (for one batched :meth:`put`)."""
+        return self._order[len(self._pc) :]
 
     def _get(self, j: int) -> tuple[NDArray[np.int8], NDArray[np.int8]]:
         while j >= len(self._pc):  # the next block, twice as many as computed so far

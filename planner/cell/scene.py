@@ -271,9 +271,13 @@ class CellScene:
         Raises:
             ShapeError, NonFiniteError: ``q`` is not a finite ``(n,)`` vector.
         """
-        qa = check_shape(q, (self.chain.n_joints,), "q")
+        self.place_robot(check_shape(q, (self.chain.n_joints,), "q"))
+
+    def place_robot(self, q: FloatArray) -> None:
+        """:meth:`set_joint_positions` without the checks, for hot loops whose ``q (n,)``
+        (rad, float64, finite) is already checked."""
         c = self.client
-        self.robot_body.set_q(c, qa)
+        self.robot_body.set_q(c, q)
         if self.tool_body is not None:
             flange = world_link_pose(c, self.robot, self.robot_body.flange_index)
             set_link_pose(c, self.tool_body, flange @ self.T_flange_tool)

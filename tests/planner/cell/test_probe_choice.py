@@ -140,3 +140,20 @@ def test_points_near_the_table_answer_as_the_exact_check() -> None:
     assert [i for i, (a, b) in enumerate(zip(fast, exact)) if not same(a, b)] == []
     hits_table = sum("hits table" in r.reason for r in exact)
     assert hits_table >= 40, hits_table
+
+
+def test_points_that_wait_for_more_rows_answer_as_one_by_one(
+    cell: Cell, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With a first block of one candidate, most searched points stop for more broad-phase
+    rows and go on after one batched call, each with its own cached part results: the same
+    answers as each point checked alone (where nothing waits)."""
+    import planner.cell.probe_choice as probe_choice
+
+    rng = np.random.default_rng(5)
+    pts, nrm, _ = sample_surface(cell.work_object.mesh, 120, rng)
+    pts[60:] += nrm[60:] * rng.uniform(-0.012, 0.0, size=(60, 1))
+    monkeypatch.setattr(probe_choice, "FIRST_BLOCK", 1)
+    batch = cell.check_probes(pts, nrm)
+    alone = [cell.check_probes(pts[i : i + 1], nrm[i : i + 1])[0] for i in range(120)]
+    assert all(same(a, b) for a, b in zip(batch, alone))
