@@ -5,7 +5,8 @@ point's first candidate pose is taken (``--n`` points), and each clearance part 
 tool link against the part or the table; self pairs aside) is asked "is anything within the
 part's look distance?" five ways, in the same run:
 
-1. ``numba``: the shipped kernel (:func:`planner.cell.broad_kernels.parts_state`: sphere trees
+1. ``numba``: the shipped kernel (:func:`planner.cell.kernels.broad_kernels.parts_state`: sphere
+trees
    against the distance field, GJK on the triangles near the open leaves);
 2. ``numpy``: the same sphere leaves against the same field, flat and vectorized (no tree,
    no exact step), what plain numpy gives;
@@ -34,10 +35,10 @@ from rich.table import Table
 
 from bench.feasibility_cell import bench_cell, work_object
 from calib.atomic_io import write_text_atomic
-from planner.cell.broad_phase import broad_phase_of
-from planner.cell.collision import DEFAULT_MARGIN_M
-from planner.cell.probe_candidates import probe_candidates
-from planner.cell.reachability_map import sample_surface
+from planner.cell.broad.broad_phase import broad_phase_of
+from planner.cell.probe.probe_candidates import probe_candidates
+from planner.cell.probe.reachability import sample_surface
+from planner.cell.scene.collision import DEFAULT_MARGIN_M
 
 RESULTS = Path(__file__).resolve().parent / "results" / "broad_phase.json"
 

@@ -1,5 +1,5 @@
 """What a click ray hits first on the robot (issue 14): PyBullet ``rayTest`` against the cell's
-collision bodies (:func:`planner.cell.ray_hit.first_hit`) against trimesh rays on the robot's
+collision bodies (:func:`planner.cell.scene.first_hit`) against trimesh rays on the robot's
 visual meshes (one Embree intersector per link, built once; the ray moved into each link's
 frame at the click's joint values), on the vendor UR5 of ``../shared/reference`` (STL meshes,
 which PyBullet turns into convex hulls), rays aimed at random points around the arm.
@@ -23,7 +23,7 @@ import yourdfpy
 from bench.result_file import write_result
 from calib.frames import invert_transform
 from planner.cell.cell import Cell
-from planner.cell.ray_hit import first_hit
+from planner.cell.scene.ray_hit import first_hit
 
 UR5 = Path(__file__).resolve().parents[2] / "shared" / "reference" / "robots" / "ur5" / "ur5.urdf"
 

@@ -47,9 +47,9 @@ from bench.feasibility_cell import bench_cell, work_object
 from bench.feasibility_rates import POSE_STEP_DEG, disagreements, run_rates
 from bench.feasibility_worst import print_worst, run_worst_case
 from calib.atomic_io import write_text_atomic
-from planner.cell.broad_phase import broad_phase_of
-from planner.cell.kernel_cache import kernel_cache_dir
-from planner.cell.reachability_map import reachability_map, sample_surface
+from planner.cell.broad.broad_phase import broad_phase_of
+from planner.cell.kernels.kernel_cache import kernel_cache_dir
+from planner.cell.probe.reachability import reachability_map, sample_surface
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench/results/feasibility.json"
@@ -66,7 +66,7 @@ def _cold(samples: int, seed: int, fresh_kernels: bool, helper: bool = True) -> 
     field and, unless ``NUMBA_CACHE_DIR`` says otherwise, the compiled kernels); with
     ``fresh_kernels=False`` numba is pointed at this process's (warm) kernel cache (what the
     first use after the install's warm-up finds). ``helper``: the background compile of
-    :mod:`planner.cell.warmup` (the default) or not; the run waits for a helper to finish
+    :mod:`planner.cell.kernels.warmup` (the default) or not; the run waits for a helper to finish
     before the next one starts."""
     with tempfile.TemporaryDirectory(prefix="wobjcal_cold_") as tmp:
         env = dict(os.environ, WOBJCAL_CACHE_DIR=str(Path(tmp) / "cache"))

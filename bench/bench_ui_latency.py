@@ -213,7 +213,7 @@ def bench_demo_browser(clicks: int, rng: np.random.Generator) -> dict[str, objec
     the DOM, and the next animation frame, which paints it (:mod:`bench.page_timing`)."""
     from playwright.sync_api import sync_playwright
 
-    from planner.cell.reachability_map import sample_surface
+    from planner.cell.probe.reachability import sample_surface
     from webui.heatmap import N_SAMPLES
 
     args = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]

@@ -86,7 +86,7 @@ def _reference_ms(app: Any, page: Any, n: int) -> list[float]:
 
 
 def _clicks(app: Any, page: Any, n: int, rng: np.random.Generator, ws: list) -> dict[str, Any]:
-    from planner.cell.reachability_map import sample_surface
+    from planner.cell.probe.reachability import sample_surface
 
     client = next(iter(app.server.get_clients().values()))
     cam, view = client.camera, app.view

@@ -94,7 +94,7 @@ def _stator(n: int, workers: int, seed: int) -> Any:
 
 def dense_plate(target_triangles: int = 100_000) -> trimesh.Trimesh:
     """The plate of the best-fit plan, its triangles split to about ``target_triangles``."""
-    from planner.cell.workobject import load_work_object
+    from planner.cell.scene.workobject import load_work_object
 
     plan = load_plan(PLATE_PLAN)
     ref = PLATE_PLAN.parent / plan.work_object.mesh

@@ -13,10 +13,10 @@ import pybullet as pb
 import trimesh
 
 from calib.frames import invert_transform, make_transform
-from planner.cell.bodies import pb_pose
 from planner.cell.cell import Cell
-from planner.cell.collision import DEFAULT_MARGIN_M
-from planner.cell.feasibility import tcp_frames
+from planner.cell.probe.feasibility import tcp_frames
+from planner.cell.scene.bodies import pb_pose
+from planner.cell.scene.collision import DEFAULT_MARGIN_M
 
 T_WORLD_WOBJ = make_transform(p=[1.5, 0.0, 0.4])
 #: The table under the box: its top at the box's bottom face (z = 0.2 m).

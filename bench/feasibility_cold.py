@@ -26,7 +26,7 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
     from bench.feasibility_cell import bench_cell
-    from planner.cell.reachability_map import reachability_map
+    from planner.cell.probe.reachability import reachability_map
 
     t_import = time.perf_counter() - T0
     with bench_cell() as cell:

@@ -39,8 +39,8 @@ def main() -> None:
     ap.add_argument("--samples", type=int, default=500)
     args = ap.parse_args()
     from bench.feasibility_cell import bench_cell
-    from planner.cell.kernel_cache import kernel_cache_dir, marker_path
-    from planner.cell.reachability_map import reachability_map
+    from planner.cell.kernels.kernel_cache import kernel_cache_dir, marker_path
+    from planner.cell.probe.reachability import reachability_map
 
     cache = kernel_cache_dir()
     with bench_cell() as cell:

@@ -3,7 +3,7 @@
 Two units, as issue 11 words them:
 
 - **poses/s**: a probe *pose* is a TCP target with its sensor rotation fixed (here the rotation
-  0 of :func:`planner.cell.feasibility.tcp_frames`: ``rotation_step_deg=360``), decided for IK
+  0 of :func:`planner.cell.probe.feasibility.tcp_frames`: ``rotation_step_deg=360``), decided for IK
   (every branch), limits, singularity and collision with 5 mm clearance against the part and
   the table, and self-collision: the first passing branch in the product's order, else the
   least-bad one, with a reason.

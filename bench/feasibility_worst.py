@@ -18,9 +18,9 @@ from rich.table import Table
 
 from bench.feasibility_cell import run_plain_loop
 from planner.cell.cell import Cell
-from planner.cell.feasibility import check_probes
-from planner.cell.probe_status import probe_statuses
-from planner.cell.reachability_map import reachability_map, sample_surface
+from planner.cell.probe.feasibility import check_probes
+from planner.cell.probe.probe_status import probe_statuses
+from planner.cell.probe.reachability import reachability_map, sample_surface
 
 
 def _timed_points(cell: Cell, pts: np.ndarray, nrm: np.ndarray, staged: bool) -> dict:

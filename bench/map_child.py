@@ -4,7 +4,8 @@ Run as a file with ``python3 -P bench/map_child.py`` (``-P``: not this folder on
 working directory and ``PYTHONPATH`` set to the tree under test, so that ``planner`` and
 ``bench.feasibility_cell`` come from that tree: this file imports nothing of the project at
 the top and uses only what the reference commit has too (``bench.feasibility_cell.bench_cell``,
-``planner.cell.reachability_map.reachability_map``). Prints one JSON line.
+``planner.cell.probe.reachability.reachability_map``, before issue 23's
+subpackages ``planner.cell.reachability_map.reachability_map``). Prints one JSON line.
 
 ``--mode cold``: the whole cold command as ``bench.feasibility_cold`` times it: seconds from
 the start of this file (before any project import) to the map done. ``--mode warm``: the cell
@@ -53,7 +54,11 @@ def main() -> None:
     args = ap.parse_args()
     import planner
     from bench.feasibility_cell import bench_cell
-    from planner.cell.reachability_map import reachability_map
+
+    try:
+        from planner.cell.probe.reachability import reachability_map
+    except ImportError:  # a reference commit from before planner/cell's subpackages
+        from planner.cell.reachability_map import reachability_map  # type: ignore
 
     t_import = time.perf_counter() - T0
     out: dict[str, object] = {"planner": planner.__file__, "imports_s": round(t_import, 3)}

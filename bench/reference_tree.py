@@ -11,7 +11,7 @@ version of the kernels per cache directory and deletes the others, so two trees 
 would compile at every turn.
 
 The commands run in a session of their own: a background compile helper a command starts
-(``planner.cell.kernel_cache.start_background``) is waited for (and, past a bound, ended by
+(``planner.cell.kernels.kernel_cache.start_background``) is waited for (and, past a bound, ended by
 its process group) before the next command, so that it does not load the machine under the
 next measurement. The load average is read before and after every command.
 

@@ -122,7 +122,8 @@ MAX_CELL_TRIANGLES: Final = 500_000
 #: Most links (and most joints) of a URDF, refused before they are parsed (a 16 MiB URDF can
 #: hold 500,000): an arm has 7 to 10 links, with a track, a positioner and a tool changer a few
 #: dozen. Up to this many the file is read (~5 kB a link) and the robot is then refused by
-#: PyBullet's own bound, 128 links in one body (:data:`planner.cell.bodies.PYBULLET_MAX_LINKS`).
+#: PyBullet's own bound, 128 links in one body
+#: (:data:`planner.cell.scene.bodies.PYBULLET_MAX_LINKS`).
 MAX_URDF_LINKS: Final = 10_000
 #: Most bytes of the mesh files a URDF refers to (all distinct files together): PyBullet and the
 #: drawings load every one (a vendor arm's meshes are 5-40 MB).

@@ -9,7 +9,7 @@ refused too). The limits, per kind of file, are here:
 - :data:`MAX_JSON_BYTES` 16 MiB: plans and measurements (the shipped plan is 12 kB);
 - :data:`MAX_URDF_BYTES` 16 MiB: robot and tool descriptions (a vendor URDF is ~30 kB);
 - :data:`MAX_MESH_BYTES` 256 MiB: mesh files (a 2-million-triangle binary STL is 100 MB; the
-  triangle limit is checked by the loader, :mod:`planner.cell.workobject`).
+  triangle limit is checked by the loader, :mod:`planner.cell.scene.workobject`).
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """Length units of mesh files: the one table the plan (``calib``) and the loaders (``planner``) use.
 
 A plan's ``work_object.units`` and ``cell.fixtures[i].units`` take a canonical name from
-:data:`MESH_UNITS`; :func:`planner.cell.workobject.load_work_object` also accepts the spellings in
+:data:`MESH_UNITS`; :func:`planner.cell.scene.load_work_object` also accepts the spellings in
 :data:`ALIASES` (e.g. ``"inch"``) for scripts, and ``"auto"``, which guesses metres or
 millimetres from the mesh size.
 """

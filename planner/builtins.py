@@ -4,7 +4,7 @@ A string that starts with ``builtin:`` names a built-in; any other string is a f
 
 - robots (:data:`BUILTIN_ROBOTS`): name -> URDF shipped in ``assets/robots``;
 - tools (:data:`BUILTIN_TOOLS`): name -> tool description JSON in ``assets/tools``
-  (see :mod:`planner.cell.tool`);
+  (see :mod:`planner.cell.scene.tool`);
 - parts (:data:`BUILTIN_PARTS`): name -> :class:`BuiltinPart`, the ``"module:function"`` of a
   factory that returns the part's mesh in metres, in its own (wobj) frame, and, for a part the
   validation simulates from its geometry (the stators' slot holes and bulge), the
@@ -41,7 +41,7 @@ BUILTIN_ROBOTS: dict[str, Path] = {
     "irb4400": ASSETS / "robots" / "irb4400" / "irb4400.urdf",
 }
 
-#: Built-in tools: name -> tool description JSON (see :mod:`planner.cell.tool`).
+#: Built-in tools: name -> tool description JSON (see :mod:`planner.cell.scene.tool`).
 BUILTIN_TOOLS: dict[str, Path] = {
     "cable_feeder": ASSETS / "tools" / "cable_feeder" / "tool.json",
 }

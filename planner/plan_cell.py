@@ -20,7 +20,7 @@ from calib.plan.file import Plan, resolve_ref
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
-    from planner.cell.workobject import WorkObject
+    from planner.cell.scene import WorkObject
 
 FloatArray = NDArray[np.float64]
 
@@ -98,7 +98,7 @@ def plan_work_object(plan: Plan, plan_dir: Path, reach_m: float | None = None) -
 
     The mesh file (or built-in) is loaded in its ``units`` (a CAD file: the unit it
     declares, and the plan's ``body``) and lightly repaired
-    (:func:`planner.cell.workobject.load_work_object`), then put at
+    (:func:`planner.cell.scene.load_work_object`), then put at
     ``work_object.T_wobj_mesh`` (identity when the plan leaves it out).
 
     Args:
@@ -109,7 +109,7 @@ def plan_work_object(plan: Plan, plan_dir: Path, reach_m: float | None = None) -
     Raises:
         MeshError: the mesh cannot be loaded (the message names the file).
     """
-    from planner.cell.workobject import WorkObject, load_work_object
+    from planner.cell.scene import WorkObject, load_work_object
 
     wo = plan.work_object
     loaded = load_work_object(
@@ -172,14 +172,14 @@ def controller_T_flange_tool(plan: Plan, plan_dir: Path) -> FloatArray:
     """``(4, 4)`` the tool's root frame in the robot controller's flange frame, m.
 
     Controllers put the flange's +z out of the flange; the tool's mount
-    (:func:`planner.cell.tool.tool_mount`) turns the URDF's tip frame that way. The controller's
+    (:func:`planner.cell.scene.tool_mount`) turns the URDF's tip frame that way. The controller's
     flange is the tip frame turned by the mount's rotation, so what is left is the mount's
     offset (an adapter plate): ``[I, R_m^T t_m]`` (identity for a mount found from the axis).
 
     Raises:
         ToolMountError: the mount cannot be worked out (names ``cell.tool.T_flange_tool``).
     """
-    from planner.cell.tool import tool_mount
+    from planner.cell.scene import tool_mount
     from planner.robot.kinematics.chain import KinematicChain
 
     urdf = plan_robot_urdf(plan, plan_dir)
@@ -198,7 +198,7 @@ def tool_data(plan: Plan, plan_dir: Path) -> tuple[Any, str]:
     Returns:
         A :class:`planner.export.job.ToolData` and a note (``""``, or what was estimated).
     """
-    from planner.cell.tool import load_tool
+    from planner.cell.scene import load_tool
     from planner.export.job import ToolData
     from planner.robot.urdf import load_urdf
 

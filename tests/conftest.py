@@ -15,7 +15,7 @@ from hypothesis import settings
 settings.register_profile("wobjcal", derandomize=True, deadline=None, print_blob=True)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "wobjcal"))
 
-# No background compile of the numba kernels (planner.cell.warmup) in tests: a test that
+# No background compile of the numba kernels (planner.cell.kernels.warmup) in tests: a test that
 # points the cache at a temporary directory would start a helper compiling into it. The test
 # of the helper itself turns it back on in its subprocess.
 os.environ.setdefault("WOBJCAL_BACKGROUND_COMPILE", "0")

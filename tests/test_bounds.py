@@ -227,8 +227,8 @@ def _sparse_stl(path: Path, n: int) -> Path:
 def test_a_mesh_above_500000_triangles_is_refused_from_its_header(tmp_path: Path) -> None:
     """Before: 2,000,000 triangles were taken (a 786,432-triangle part took `check` to
     1,420 MB and `validate` to 2,324 MB, so 2 million would be ~6 GB)."""
-    from planner.cell.fixtures import Fixture
-    from planner.cell.workobject import load_work_object
+    from planner.cell.scene.fixtures import Fixture
+    from planner.cell.scene.workobject import load_work_object
 
     big = _sparse_stl(tmp_path / "scan.stl", 1_500_000)
     t0 = time.perf_counter()

@@ -225,3 +225,72 @@ def test_the_rule_catches_a_reason_sorted_by_its_words(code: str) -> None:
 @pytest.mark.parametrize("code", SORTS_BY_KIND)
 def test_the_rule_lets_kinds_and_pairs_be_read(code: str) -> None:
     assert text_sorts_in(ast.parse(code)) == [], code
+
+
+#: ``planner.cell`` by concept (issue 23, item 5), lowest first: a module of one layer imports
+#: only modules of its own layer and of those before it. A layer is a subpackage or one of the
+#: two modules directly in ``planner/cell/`` (``docs/ARCHITECTURE.md``).
+CELL_LAYERS = ("disk_cache", "kernels", "scene", "broad", "probe", "moves", "cell")
+
+
+def cell_layer(module: str) -> str | None:
+    """The layer of a module of ``planner.cell`` (``None``: outside it, or its ``__init__``)."""
+    parts = module.split(".")
+    if parts[:2] != ["planner", "cell"] or len(parts) < 3:
+        return None
+    assert parts[2] in CELL_LAYERS, f"{module}: a module of no known layer of planner.cell"
+    return parts[2]
+
+
+def test_cell_layers_import_only_the_layers_below(graph: list[Edge]) -> None:
+    bad = []
+    for e in graph:
+        src, dst = cell_layer(e.source), cell_layer(e.target)
+        if src is None or dst is None or src == dst:
+            continue
+        if CELL_LAYERS.index(dst) > CELL_LAYERS.index(src):
+            bad.append(f"{e.source}:{e.line} imports {e.target} ({src} -> {dst})")
+    assert bad == []
+    cell = Path(__file__).resolve().parents[1] / "planner" / "cell"
+    found = {p.stem for p in cell.iterdir() if p.suffix == ".py" or (p / "__init__.py").is_file()}
+    assert found - {"__init__"} == set(CELL_LAYERS)
+
+
+def _public(package: str) -> set[str]:
+    """The names in ``__all__`` of ``package``'s ``__init__``, read from the source."""
+    tree = ast.parse(modules()[package].read_text())
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and any(
+            isinstance(t, ast.Name) and t.id == "__all__" for t in node.targets
+        ):
+            return set(ast.literal_eval(node.value))
+    raise AssertionError(f"{package}: no __all__")
+
+
+def test_code_outside_a_cell_subpackage_imports_its_public_names(graph: list[Edge]) -> None:
+    """The modules of ``planner.cell``'s subpackages are private: from outside one, code imports
+    the subpackage (its ``__all__``), or a module its ``__all__`` names (the kernels')."""
+    bad = []
+    for e in graph:
+        parts = e.target.split(".")
+        if parts[:2] != ["planner", "cell"] or len(parts) < 4:
+            continue
+        package = ".".join(parts[:3])
+        if e.source == package or e.source.startswith(package + "."):
+            continue
+        if parts[3] not in _public(package):
+            bad.append(f"{e.source}:{e.line} imports {e.target}, private to {package}")
+    assert bad == []
+
+
+def test_every_public_name_of_a_cell_subpackage_is_there() -> None:
+    import importlib
+
+    for name in CELL_LAYERS:
+        package = f"planner.cell.{name}"
+        if package not in modules() or modules()[package].name != "__init__.py":
+            continue
+        module = importlib.import_module(package)
+        for public in sorted(_public(package)):
+            if not hasattr(module, public):
+                importlib.import_module(f"{package}.{public}")  # a public module

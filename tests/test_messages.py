@@ -117,7 +117,7 @@ def _chain(path: Path, n_links: int) -> Path:
 
 @pytest.fixture
 def client() -> Iterator[int]:
-    from planner.cell.pybullet_client import connect_direct, pb
+    from planner.cell.scene.pybullet_client import connect_direct, pb
 
     c = connect_direct()
     yield c
@@ -126,7 +126,7 @@ def client() -> Iterator[int]:
 
 def test_more_links_than_pybullet_poses_is_named(tmp_path: Path, client: int) -> None:
     """Was (5,000 links): 'internal error: error: GetBasePositionAndOrientation failed.'"""
-    from planner.cell.bodies import PYBULLET_MAX_LINKS, load_urdf_body, world_link_pose
+    from planner.cell.scene.bodies import PYBULLET_MAX_LINKS, load_urdf_body, world_link_pose
 
     ok = load_urdf_body(client, _chain(tmp_path / "ok.urdf", PYBULLET_MAX_LINKS), np.eye(4), "x")
     assert world_link_pose(client, ok, -1).shape == (4, 4)

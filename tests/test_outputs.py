@@ -258,7 +258,7 @@ def test_a_full_kernel_cache_compiles_in_memory_with_one_warning(
     same, one warning. Before: the OSError failed the command (``check`` exit 2)."""
     from numba.core import caching
 
-    from planner.cell.kernel_cache import guard_cache_io
+    from planner.cell.kernels.kernel_cache import guard_cache_io
 
     guard_cache_io()
     monkeypatch.setenv("WOBJCAL_CACHE_DIR", str(tmp_path / "cache"))  # a fresh "once"

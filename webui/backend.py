@@ -19,8 +19,7 @@ from calib.frames import invert_transform
 from calib.plan.file import Plan, PlanPoint, resolve_ref
 from planner.cell.cell import Cell
 from planner.cell.moves import MoveCheck, ViaPath, check_joint_move, check_via_path
-from planner.cell.ray_hit import RayHit, first_hit
-from planner.cell.workobject import load_work_object
+from planner.cell.scene import RayHit, first_hit, load_work_object
 from planner.check.cycle import plan_cycle_time
 from planner.check.job import PointCheck, check_points
 from planner.plan_cell import open_cell, plan_robot_urdf
@@ -107,7 +106,8 @@ class JogStatus:
 
 
 def load_mesh(ref: str, units: str, plan_dir: Path) -> trimesh.Trimesh:
-    """A work-object or fixture mesh in metres, loaded and repaired by ``planner.cell.workobject``.
+    """A work-object or fixture mesh in metres, loaded and repaired by
+    ``planner.cell.scene.workobject``.
 
     Raises:
         MeshError: the file is missing, unreadable or empty, or its units are unknown.
@@ -241,7 +241,7 @@ class CellSession:
         self, origin_world: ArrayLike, direction_world: ArrayLike, q: ArrayLike | None
     ) -> RayHit | None:
         """What the ray (world) meets first in the cell with the robot at ``q`` (rad; ``None``
-        or a length that is not the chain's: its current pose): :func:`planner.cell.ray_hit.
+        or a length that is not the chain's: its current pose): :func:`planner.cell.scene.ray_hit.
         first_hit`."""
         cell = self._cell()
         qa = None if q is None else np.asarray(q, dtype=np.float64).reshape(-1)

@@ -19,7 +19,7 @@ from calib.errors import InputError
 from calib.frames import make_transform, matrix_from_quat_wxyz, quat_wxyz_from_matrix
 from calib.models import ProximitySensor
 from calib.plan.file import Plan
-from planner.cell.tool_face import gap_mismatch
+from planner.cell.scene import gap_mismatch
 from webui import cell_edits
 from webui.cell_edits import ROBOT_BASE, WORK_OBJECT
 from webui.cell_fixtures import FixturesSection
@@ -88,8 +88,8 @@ class CellPanel(Panel):
 
     def _tcp_mismatch(self, plan: Plan) -> str:
         """Why the plan's proximity sensor does not fit its tool's sensor TCP (its sensing
-        distance is not the TCP's distance from the sensor face, :func:`planner.cell.tool_face.
-        gap_mismatch`), or ``""``."""
+        distance is not the TCP's distance from the sensor face,
+        :func:`planner.cell.scene.tool_face. gap_mismatch`), or ``""``."""
         sensor = plan.validation.sensor
         if not isinstance(sensor, ProximitySensor):
             return ""

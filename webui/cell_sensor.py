@@ -8,7 +8,7 @@ applied together with **Apply sensor**: one undoable, autosaved step, after whic
 is checked again (the footprint on the face and the search's standoff follow the sensor).
 Numbers beyond plausible (:data:`webui.cell_setup_edits.SENSOR_LIMITS`) are refused. The tool's
 sensor TCP must be where the sensor switches: when the detection range is not the TCP's
-distance from the tool's sensor face (:func:`planner.cell.tool_face.gap_mismatch`), the folder
+distance from the tool's sensor face (:func:`planner.cell.scene.gap_mismatch`), the folder
 says so in red, since every measured point would be off by the difference.
 Picking another kind shows that kind's defaults (or the plan's, when it has that kind).
 """

@@ -26,7 +26,7 @@ from calib.plan.cell import FixtureSpec, Pose
 from calib.plan.file import Plan
 from calib.registry import unknown_name
 from calib.units import MESH_UNITS
-from planner.cell.tool import FLANGE, Tool
+from planner.cell.scene import FLANGE, Tool
 from webui.cell_edits import pose_from_fields
 from webui.plan_adapter import with_source
 from webui.plan_doc import UiPlan

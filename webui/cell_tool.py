@@ -6,7 +6,7 @@ included); picking one lists its TCPs under **TCP**; **Apply tool** makes both t
 (one undoable step: the new cell is built first, then every point is checked again). An upload
 is applied at once. A mesh tool is one body (its convex hull) with one TCP, ``sensor``, at the
 position (mm) and z-y'-x'' angles (deg) in the flange frame given in the fields; the UI writes
-its tool description JSON (:func:`planner.cell.tool.mesh_tool_description`) beside the mesh in
+its tool description JSON (:func:`planner.cell.scene.mesh_tool_description`) beside the mesh in
 the upload cache, named by its own digest, so an earlier plan's description never changes.
 """
 
@@ -23,7 +23,7 @@ from calib.plan.base import resolve_ref
 from calib.plan.file import Plan
 from calib.units import MESH_UNITS
 from planner.builtins import BUILTIN_TOOLS, PREFIX, is_builtin
-from planner.cell.tool import Tool, load_tool, mesh_tool_description
+from planner.cell.scene import Tool, load_tool, mesh_tool_description
 from webui.cell_edits import pose_from_fields
 from webui.cell_setup_edits import tcp_choice, with_tool
 from webui.cell_uploads import CellUploads

@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike
 
 from calib.errors import InputError
 from calib.frames import transform_points
-from planner.cell.ray_hit import RayHit
+from planner.cell.scene import RayHit
 from webui.scene import MARKER_RADIUS_M
 from webui.surface import marker_on_ray
 

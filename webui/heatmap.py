@@ -1,6 +1,6 @@
 """The reachability heat map: surface samples checked as probe poses, drawn on the work object.
 
-The samples go through :func:`planner.cell.probe_status.probe_statuses`: the statuses of the
+The samples go through :func:`planner.cell.probe.probe_statuses`: the statuses of the
 fast batched check of a click (a broad phase decides most clearance parts, Bullet only the
 rest) without the least-bad pose of a point that cannot be probed (the map asks whether and
 why not, not which pose: it stops at the first candidate that settles the status), with a
@@ -29,8 +29,7 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from calib.errors import InputError
-from planner.cell.probe_status import probe_statuses
-from planner.cell.reachability_map import sample_surface
+from planner.cell.probe import probe_statuses, sample_surface
 from planner.faces.checks import check_probe_faces
 from planner.reasons import Reason
 from webui.scene import STATUS_RGB

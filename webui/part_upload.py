@@ -3,7 +3,7 @@ no longer lie on the new surface (listed, then dropped or projected onto it).
 
 :class:`PendingPart` holds an uploaded mesh until the user accepts it: the mesh is read once
 (raw file coordinates) and :meth:`PendingPart.describe` gives its size in the chosen units,
-including what ``auto`` would pick (:func:`planner.cell.workobject.load_work_object`, the
+including what ``auto`` would pick (:func:`planner.cell.scene.load_work_object`, the
 loader every plan uses). :func:`off_surface` lists the points farther than
 :data:`OFF_SURFACE_M` from a mesh; :func:`project_points` and :func:`drop_points` are the two
 fixes, each a pure edit of the UI plan. A new part starts with its file's own frame as the
@@ -20,7 +20,7 @@ import trimesh
 
 from calib.units import AUTO, metres_per_unit
 from planner.cad.occt_read import is_cad_path
-from planner.cell.workobject import load_work_object
+from planner.cell.scene import load_work_object
 from webui import plan_doc
 from webui.plan_doc import UiPlan
 from webui.surface import SurfacePicker

@@ -1,13 +1,13 @@
 """How far a new point's approach search may run past the surface before it meets something.
 
 An approach search runs the sensor TCP along ``-normal`` to ``overtravel`` past the nominal
-point; the sensor face stands the sensing distance behind the TCP (:mod:`planner.cell.tool`).
+point; the sensor face stands the sensing distance behind the TCP (:mod:`planner.cell.scene.tool`).
 Behind a point of a thin plate the part ends after its thickness and a table often follows:
 the UI's default overtravel (20 mm) ran the 18 mm sensor of the built-in tool into the table
 under a 12.7 mm plate. :func:`room_behind_m` casts a ray from the point along ``-normal``
 through the part (wobj mesh) and the fixtures; :func:`overtravel_cap_m` turns that room into
 the longest overtravel that keeps the sensor face the cell's collision clearance
-(:data:`planner.cell.collision.DEFAULT_MARGIN_M`, plus :data:`SPARE_M`) short of it.
+(:data:`planner.cell.scene.DEFAULT_MARGIN_M`, plus :data:`SPARE_M`) short of it.
 :func:`webui.plan_doc.place_point` takes that cap for a new point's default.
 """
 
@@ -21,7 +21,7 @@ import trimesh
 from numpy.typing import ArrayLike, NDArray
 
 from calib.frames import invert_transform, transform_directions, transform_points
-from planner.cell.collision import DEFAULT_MARGIN_M
+from planner.cell.scene import DEFAULT_MARGIN_M
 
 if TYPE_CHECKING:
     from calib.plan.file import Plan

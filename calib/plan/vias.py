@@ -15,7 +15,7 @@ written when the via is taught and never read back by ``check`` or the exporters
 The plan cannot know the robot's joint count or limits (``calib`` parses no URDF): this module
 checks what it can (finite numbers, at most :data:`MAX_JOINTS`, the same count for every via of
 the plan); ``wobjcal check`` checks the count against the robot, the joint limits and the
-collisions of the moves (:mod:`planner.cell.moves`).
+collisions of the moves (:mod:`planner.cell.moves.joint_moves`).
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ Owns:
     - :mod:`planner.cad.tessellate`: one body's triangulation at a stated chord tolerance,
       with the B-rep face each triangle comes from and which B-rep faces are planes;
     - :mod:`planner.cad.part`: the whole load, cached on disk by the file's hash
-      (:func:`load_cad_mesh`, what :func:`planner.cell.workobject.load_work_object` calls for a
+      (:func:`load_cad_mesh`, what :func:`planner.cell.scene.load_work_object` calls for a
       ``.step``/``.stp``/``.iges``/``.igs`` file).
 
 The triangles keep their B-rep plane in ``mesh.face_attributes[BREP_PLANE]``

@@ -5,9 +5,9 @@
         cell.add_fixture("table", size_m=(1, 1, 0.05), T_world_fixture=T_table)
         results = cell.check_probes(points_wobj, normals_wobj, tcp="sensor")
 
-The queries are functions of a scene in their own modules (:mod:`planner.cell.feasibility`,
-:mod:`planner.cell.search_paths`, :mod:`planner.cell.reachability_map`); the methods here only
-forward to them, so the modules depend on the scene and never on this class.
+The queries are functions of a scene in their own modules (:mod:`planner.cell.probe.feasibility`,
+:mod:`planner.cell.probe.search_paths`, :mod:`planner.cell.probe.reachability`); the methods here
+only forward to them, so the modules depend on the scene and never on this class.
 """
 
 from __future__ import annotations
@@ -18,10 +18,15 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from calib.probing import SearchCommand
-from planner.cell.feasibility import ProbeFeasibility, check_probes
-from planner.cell.reachability_map import ReachabilityMap, reachability_map
+from planner.cell.probe import (
+    PathFeasibility,
+    ProbeFeasibility,
+    ReachabilityMap,
+    check_probes,
+    check_search,
+    reachability_map,
+)
 from planner.cell.scene import CellScene
-from planner.cell.search_paths import PathFeasibility, check_search
 
 
 class Cell(CellScene):
@@ -36,15 +41,15 @@ class Cell(CellScene):
     def check_probes(
         self, points_wobj: ArrayLike, normals_wobj: ArrayLike, **kw: Any
     ) -> list[ProbeFeasibility]:
-        """Feasibility of probe poses; see :func:`planner.cell.feasibility.check_probes`."""
+        """Feasibility of probe poses; see :func:`planner.cell.probe.check_probes`."""
         return check_probes(self, points_wobj, normals_wobj, **kw)
 
     def check_search(self, command: SearchCommand, **kw: Any) -> PathFeasibility:
-        """Feasibility of a search path; see :func:`planner.cell.search_paths.check_search`."""
+        """Feasibility of a search path; see :func:`planner.cell.probe.check_search`."""
         return check_search(self, command, **kw)
 
     def reachability_map(
         self, n_samples: int, rng: np.random.Generator, **kw: Any
     ) -> ReachabilityMap:
-        """Surface reachability map; see :func:`planner.cell.reachability_map.reachability_map`."""
+        """Surface reachability map; see :func:`planner.cell.probe.reachability_map`."""
         return reachability_map(self, n_samples, rng, **kw)

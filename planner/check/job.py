@@ -7,7 +7,7 @@ points, in an open cell, as the UI does after an edit); the rules below hold for
 
 Per point, three checks:
 
-1. the probe pose (:func:`planner.cell.feasibility.check_probes`): IK, joint limits, wrist
+1. the probe pose (:func:`planner.cell.probe.check_probes`): IK, joint limits, wrist
    singularity, collisions with clearance; ``marginal`` when little clearance or near a limit;
 2. the search path (:func:`planner.check.paths.check_program_path`): the searches the exported
    program runs, from the point's safe start to the end of travel, with the pose's orientation
@@ -70,7 +70,7 @@ if TYPE_CHECKING:
 
     from calib.estimators.gross_errors import Detectability
     from planner.cell.cell import Cell
-    from planner.cell.feasibility import ProbeFeasibility
+    from planner.cell.probe import ProbeFeasibility
     from planner.faces.detection import PlanarFaces
     from planner.faces.outline import FaceOutlines
     from planner.sim.landing import LandingRisk
@@ -161,7 +161,7 @@ def base_in_part(cell: Cell) -> str:
     the part's bounds (wobj frame), or a robot link no joint moves (the base link) overlapping
     the part. Every point then fails, each for a reason of its own (a joint at its limit, the
     base hitting the tool); this names the one cause."""
-    from planner.cell.pybullet_client import pb
+    from planner.cell.scene import pb
 
     wo = cell.work_object
     if wo is None or cell.checker.wobj_body is None:
@@ -493,7 +493,7 @@ def _point_check(
     t0: float,
     T_flange_tcp: FloatArray,
 ) -> PointCheck:
-    from planner.cell.collision import DEFAULT_MARGIN_M, report_distance_m
+    from planner.cell.scene import DEFAULT_MARGIN_M, report_distance_m
 
     status: Status = pose.status
     if face is not None or not path.feasible:

@@ -27,7 +27,7 @@ from planner.reasons import Reason
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
-    from planner.cell.feasibility import ProbeFeasibility
+    from planner.cell.probe import ProbeFeasibility
 
 FloatArray = NDArray[np.float64]
 
@@ -39,7 +39,7 @@ class ProgramPath:
     Attributes:
         feasible: every search passes.
         cause: why not, naming the search and the distance from its start, with the kind of
-            :class:`planner.cell.search_paths.PathFeasibility`'s (``None`` when feasible).
+            :class:`planner.cell.probe.PathFeasibility`'s (``None`` when feasible).
         fail_at_m: distance of the first failing sample from the start of its search, m (NaN
             when feasible).
         q_path: ``(M, n)`` joint values of the samples that passed, all searches in order, rad

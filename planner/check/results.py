@@ -221,7 +221,7 @@ class PlanCheck:
         part_units: the length unit the work object's file was read in (``"mm"``, ``"in"``,
             ...: as given, detected for ``auto``, or declared by a CAD file), ``""``: not known.
         part_note: how that unit was chosen and the part's size, in words
-            (:attr:`planner.cell.workobject.RepairReport.units_note`).
+            (:attr:`planner.cell.scene.workobject.RepairReport.units_note`).
     """
 
     points: tuple[PointCheck, ...]

@@ -2,7 +2,7 @@
 
 :func:`plan_with_vias` checks the plan's points and the moves between them, and for every
 point whose move in collides (:func:`planner.check.job.check_via_moves`) and that has no vias yet,
-asks :func:`planner.cell.via_search.suggest_vias` for vias clearing the moves from every point a
+asks :func:`planner.cell.moves.suggest_vias` for vias clearing the moves from every point a
 program may come from (:func:`planner.program.build.predecessors`), and returns the plan with
 them. Vias the engineer taught are never replaced; a point the search cannot clear is named.
 """
@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 import msgspec
 
 from calib.plan.file import Plan, ViaPoint
-from planner.cell.via_search import suggest_vias
+from planner.cell.moves import suggest_vias
 from planner.check.job import check_points, check_via_moves
 from planner.program.build import predecessors
 

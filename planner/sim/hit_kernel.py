@@ -20,7 +20,7 @@ caster had before (``tests/planner/sim/test_hit_kernel.py`` holds it to that ver
 
 The kernel is compiled (or loaded from numba's cache) on first use, in the process that uses
 it: numba's cache directory is the one in force at that moment (wobjcal's, once the cell
-package has set it; see :mod:`planner.cell.kernel_cache`).
+package has set it; see :mod:`planner.cell.kernels.kernel_cache`).
 """
 
 from __future__ import annotations

@@ -40,7 +40,7 @@ UNREACHABLE = "unreachable or colliding: "
 
 
 def _refusal(result: Any) -> Reason | None:
-    """``None`` for a feasible :class:`planner.cell.search_paths.PathFeasibility`, else its
+    """``None`` for a feasible :class:`planner.cell.probe.PathFeasibility`, else its
     cause (kind and pair as the cell gave them) after :data:`UNREACHABLE`."""
     if result.feasible:
         return None
@@ -58,7 +58,7 @@ def cell_search_hook(cell: Any, step_m: float = 0.002) -> ReachabilityHook:
     The reason returned is the cell's (its kind, and the pair of a collision) worded
     ``"unreachable or colliding: <the cell's reason>"``. Only the verdict is computed
     (``exact_clearance=False``: the broad phase clears most of each sample's collision query,
-    :mod:`planner.cell.path_clearance`; the same verdict and reason).
+    :mod:`planner.cell.broad.path_clearance`; the same verdict and reason).
     """
 
     def hook(command: SearchCommand) -> Reason | None:

@@ -14,7 +14,7 @@ from calib.errors import InputError
 from calib.plan.base import MeshUnits
 from calib.plan.file import PlanError, load_plan, plan_from_json, resolve_ref
 from calib.units import ALIASES, MESH_UNITS, METRES_PER_UNIT, canonical_unit, metres_per_unit
-from planner.cell.workobject import load_work_object
+from planner.cell.scene.workobject import load_work_object
 from webui.backend import load_mesh
 
 REPO = Path(__file__).resolve().parents[2]

@@ -63,7 +63,7 @@ def test_demo_cell_holds_the_stator_at_the_nominal_pose() -> None:
 
 
 def test_demo_points_are_reachable() -> None:
-    pytest.importorskip("planner.cell.feasibility")
+    pytest.importorskip("planner.cell.probe.feasibility")
     pts = stator_ah_points(GEOM)
     cell = make_demo_cell(GEOM)
     try:

@@ -19,7 +19,7 @@ from calib.frames import make_transform, matrix_from_tait_bryan_zyx
 from calib.models import ProximitySensor, TouchProbe
 from calib.plan.cell import FixtureSpec, Pose
 from calib.plan.file import load_plan, plan_digest, plan_from_json, plan_to_json
-from planner.cell.tool import load_tool, mesh_tool_description
+from planner.cell.scene.tool import load_tool, mesh_tool_description
 from planner.errors import MeshError, UnknownFrameError, URDFError
 from webui import cell_setup_edits as edits
 from webui.plan_adapter import plan_point, ui_plan_from_plan
@@ -268,7 +268,7 @@ def test_an_older_description_with_sensor_keys_still_loads(
     }
     path = tmp_path / "old.tool.json"
     path.write_text(json.dumps(desc))
-    with caplog.at_level("WARNING", logger="planner.cell.tool"):
+    with caplog.at_level("WARNING", logger="planner.cell.scene.tool"):
         tool = load_tool(path)
     assert tool.name == "old_feeder" and tool.sensor_tcp == "sensor"
     assert "sensing_distance_m" in caplog.text and "ignored" in caplog.text
@@ -295,7 +295,7 @@ def test_implausible_sensor_numbers_are_refused_naming_the_field(
 def test_a_detection_range_the_tool_does_not_have_is_named() -> None:
     """The built-in cable feeder's sensor TCP lies 8 mm in front of its sensor's face (a ray
     back from the TCP into the tool): a 5 mm sensor is 3 mm off, and said so."""
-    from planner.cell.tool_face import gap_mismatch, sensor_face_gap_m
+    from planner.cell.scene.tool_face import gap_mismatch, sensor_face_gap_m
 
     tool = load_tool("builtin:cable_feeder")
     assert sensor_face_gap_m(tool) == pytest.approx(0.008, abs=1e-9)

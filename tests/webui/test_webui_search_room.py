@@ -28,7 +28,7 @@ from calib.plan.file import (
 )
 from calib.probing import ProbePoint, SearchSpec
 from calib.procedures import ThreeTwoOne
-from planner.cell.collision import DEFAULT_MARGIN_M
+from planner.cell.scene.collision import DEFAULT_MARGIN_M
 from webui import plan_doc
 from webui.plan_adapter import plan_point, ui_plan_from_plan
 from webui.search_room import SPARE_M, overtravel_cap_m, room_behind_m

@@ -28,7 +28,7 @@ from calib.plan.file import PlanPoint, Pose, Search, file_sha256, load_plan, sav
 from calib.procedures import ThreeTwoOne
 from planner.cad.occt_read import _quiet
 from planner.cell import disk_cache
-from planner.cell.workobject import load_work_object
+from planner.cell.scene.workobject import load_work_object
 from planner.errors import MeshError
 from planner.faces.detection import find_planar_faces
 from planner.faces.outline import FaceOutlines

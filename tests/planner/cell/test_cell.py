@@ -13,7 +13,7 @@ import trimesh
 from calib.errors import NonFiniteError, ShapeError
 from calib.frames import invert_transform, make_transform, matrix_from_rotvec
 from planner.cell.cell import Cell
-from planner.cell.tool import Tool
+from planner.cell.scene.tool import Tool
 from planner.errors import MeshError, UnknownBuiltinError, UnknownFrameError, URDFError
 
 T_WORLD_BASE = make_transform(matrix_from_rotvec([0, 0, 0.3]), [0.5, -0.2, 0.1])

@@ -1,5 +1,5 @@
 """The joint moves between points are checked, and vias that clear them can be searched
-(:mod:`planner.cell.via_search`, :mod:`planner.check.vias`, ``wobjcal check --add-vias``)."""
+(:mod:`planner.cell.moves.via_search`, :mod:`planner.check.vias`, ``wobjcal check --add-vias``)."""
 
 from __future__ import annotations
 
@@ -12,8 +12,8 @@ import pytest
 
 from calib.plan.file import Plan, load_plan
 from calib.plan.vias import ViaPoint
-from planner.cell.moves import check_via_path
-from planner.cell.via_search import suggest_vias
+from planner.cell.moves.joint_moves import check_via_path
+from planner.cell.moves.via_search import suggest_vias
 from planner.check.job import check_plan
 from planner.check.vias import plan_with_vias
 from planner.cli.main import main

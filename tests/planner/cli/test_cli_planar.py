@@ -10,7 +10,7 @@ from typing import Any
 import pytest
 
 from calib.plan.file import load_plan
-from planner.cell.workobject import load_work_object
+from planner.cell.scene.workobject import load_work_object
 from planner.cli.main import main
 from planner.faces.checks import plan_face_reasons
 

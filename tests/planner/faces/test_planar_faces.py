@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 
 from calib.errors import ShapeError
 from calib.probing import ProbePoint, SearchSpec
-from planner.cell.workobject import load_work_object
+from planner.cell.scene.workobject import load_work_object
 from planner.errors import MeshError
 from planner.faces.checks import check_plan_faces, check_probe_faces
 from planner.faces.detection import NoPlanarFaceError, find_planar_faces

@@ -233,7 +233,7 @@ def test_vias_are_checked_from_every_point_a_program_comes_from(
 ) -> None:
     """C is probed after B (plan order) and after H (the RAPID program's retake): both legs
     into its vias are checked, and a problem on the retake's leg only is reported with H."""
-    import planner.cell.moves as moves
+    import planner.cell.moves as moves  # where check_plan imports check_via_path
 
     seen: list[str] = []
 
@@ -259,7 +259,7 @@ def test_vias_on_a_robot_with_a_prismatic_joint_are_refused() -> None:
     metres x 57.3, so the check refuses the vias and names the joint."""
     from types import SimpleNamespace
 
-    from planner.cell.moves import check_via_path
+    from planner.cell.moves.joint_moves import check_via_path
 
     chain = SimpleNamespace(joint_names=("j1", "rail"), joint_types=("revolute", "prismatic"))
     path = check_via_path(SimpleNamespace(chain=chain), None, [[0.0, 0.1]], None, "tcp")  # type: ignore[arg-type]

@@ -15,8 +15,8 @@ import numpy as np
 import pybullet_data
 import pytest
 
-from planner.cell.bodies import pb_transform
-from planner.cell.pybullet_client import connect_direct, pb
+from planner.cell.scene.bodies import pb_transform
+from planner.cell.scene.pybullet_client import connect_direct, pb
 from planner.robot.urdf import load_urdf
 
 ASSETS = Path(__file__).resolve().parents[3] / "assets"

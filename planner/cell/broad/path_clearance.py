@@ -1,0 +1,97 @@
+"""The clearance verdict of a sampled path: its first sample whose clearance query fails.
+
+:func:`first_failure` gives what the plain loop gives up to its first failing sample::
+
+    for j, q in enumerate(q_path):
+        cell.set_joint_positions(q)
+        cl = cell.clearance(margin_m, sensor_wobj_allowed=True, skip_wobj=skip_wobj[j])
+        if not cl.ok:
+            return j, cl
+
+that sample and its whole query's :class:`~planner.cell.scene.Clearance` (so its reason
+reads exactly the same), or none. The broad phase (:mod:`planner.cell.broad.broad_phase`) shows,
+for every sample of the path at once, which parts of the query report nothing in Bullet; only
+the others are asked, one part at a time, and a sample stops at its first part that fails
+(a sample fails when any part has a point nearer than it needs; a part the broad phase clears
+has none). The whole query runs only at a failing sample. What it does not give is the
+clearance of the passing samples (the loop's running minimum): a verdict, not a measure.
+
+Used where only the verdict counts: the vetting of simulated searches
+(:func:`planner.sim.search_events.program_search_hook`, ``check_search(..., exact_clearance=
+False)``), thousands of short paths; ``tests/planner/cell/broad/test_path_clearance.py`` holds it
+to the loop.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planner.cell.broad.broad_phase import broad_phase_of
+from planner.cell.scene import Clearance
+
+if TYPE_CHECKING:
+    from planner.cell.scene import CellScene
+
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+
+def first_failure(
+    cell: CellScene,
+    q_path: FloatArray,
+    T_base_flange: FloatArray,
+    skip_wobj: BoolArray,
+    margin_m: float,
+) -> tuple[int, Clearance | None]:
+    """The first sample of a path whose clearance query fails (module docstring).
+
+    Args:
+        cell: the cell (its joint state changes; restore it with ``cell.saved_state()``).
+        q_path: ``(M, n)`` joint values of the samples, rad.
+        T_base_flange: ``(M, 4, 4)`` the flange pose of each sample (where the tool sits),
+            robot base frame, m.
+        skip_wobj: ``(M,)`` samples checked without the work object (an approach past its
+            nominal point).
+        margin_m: required distance of robot and tool to the work object and fixtures, m.
+
+    Returns:
+        ``(j, clearance)`` of the first failing sample, or ``(M, None)`` when all pass.
+    """
+    M = int(q_path.shape[0])
+    if M == 0:
+        return 0, None
+    checker = cell.checker
+    plan = checker.plan(margin_m, cell.self_margin_m, None, True, False)
+    broad = broad_phase_of(cell)
+    env = broad.environment(cell)
+    parts = broad.part_map(cell, plan, env)
+    T_links = broad.link_poses(cell, np.asarray(q_path, float), np.asarray(T_base_flange, float))
+    part_state, pair_state, _ = broad.states(parts, env, T_links)
+    env_parts = [plan.parts[int(i)] for i in parts.part_index]
+    on_wobj = np.array([p.env == checker.wobj_body for p in env_parts], dtype=bool)
+    self_part = plan.parts[-1]
+    open_parts = part_state != 1
+    open_pairs = pair_state != 1
+    for j in range(M):
+        todo = open_parts[j] & ~on_wobj if skip_wobj[j] else open_parts[j]
+        pairs = open_pairs[j]
+        if not todo.any() and not pairs.any():
+            continue
+        cell.set_joint_positions(q_path[j])
+        failed = False
+        for k in np.flatnonzero(todo).tolist():
+            res = checker.evaluate(env_parts[k])
+            if res is not None and not res.ok:
+                failed = True
+                break
+        if not failed and pairs.any():
+            res = checker.evaluate(self_part, pairs)
+            failed = res is not None and not res.ok
+        if failed:  # the whole query, for its reason (it fails as its part did)
+            whole = cell.clearance(margin_m, sensor_wobj_allowed=True, skip_wobj=bool(skip_wobj[j]))
+            if not whole.ok:
+                return j, whole
+    return M, None
