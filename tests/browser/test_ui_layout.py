@@ -84,7 +84,7 @@ def test_suggest_keeps_the_plans_procedure_unless_another_is_picked(demo: UiSess
     )
     assert (
         "the plan's procedure is hultman2013" in text
-        and "pick best fit or 3-2-1 under Suggested procedure" in text
+        and "pick 3-2-1, best fit or iterative best fit under Suggested procedure" in text
     )
     assert app.state.doc is ah
     assert not page.get_by_role("button", name="Accept suggestion").is_visible()
