@@ -5,9 +5,8 @@ point's first candidate pose is taken (``--n`` points), and each clearance part 
 tool link against the part or the table; self pairs aside) is asked "is anything within the
 part's look distance?" five ways, in the same run:
 
-1. ``numba``: the shipped kernel (:func:`planner.cell.kernels.broad_kernels.parts_state`: sphere
-trees
-   against the distance field, GJK on the triangles near the open leaves);
+1. ``numba``: the shipped kernel (:func:`planner.cell.kernels.broad_kernels.parts_state`:
+   sphere trees against the distance field, GJK on the triangles near the open leaves);
 2. ``numpy``: the same sphere leaves against the same field, flat and vectorized (no tree,
    no exact step), what plain numpy gives;
 3. ``coal``: ``coal.collide`` with a security margin, one call per part (a BVH of the part's

@@ -5,14 +5,15 @@ Every feasibility and search outcome carries a kind beside the English words use
 ==============  ==========================================================================
 ``reach``       out of reach, too close, no IK solution (:mod:`planner.robot.reach`)
 ``joint_limit`` a joint at (or, marginal, near) its limit
-``singularity`` a singular wrist, or near a singularity (:mod:`planner.cell.probe.probe_candidates`)
+``singularity`` a singular wrist, or near a singularity
+                (:mod:`planner.cell.probe.probe_candidates`)
 ``collision``   a robot or tool link hits, or comes too near, an obstacle: with its ``pair``
 ``footprint``   the point is not on a planar face with the sensor footprint on it
                 (:mod:`planner.faces.checks`); a simulated search's footprint landed off its
                 face or partly over a hole or an edge (:mod:`planner.sim.search_events`)
 ``move``        the joint move between points, through its vias
-(:mod:`planner.cell.moves.joint_moves`) ``search``      the search cannot reach its face or edge
-wherever the part may lie, or goes
+                (:mod:`planner.cell.moves.joint_moves`)
+``search``      the search cannot reach its face or edge wherever the part may lie, or goes
                 wrong too often under the misplacement (:mod:`planner.program.reach`,
                 :mod:`planner.sim.landing`); a simulated search finds nothing within its
                 length, starts inside the part or already detecting, or its sensor face runs

@@ -98,6 +98,10 @@ class WobjcalApp:
         # per point, bumped by every change that drops its check: a recheck started before the
         # change (say, for a sensor an undo has taken back) must not store its result after
         self._check_gen: dict[str, int] = {}
+        # per point, the plan its stored check was made in (or a copy of it with the cell's
+        # source, load_cell): a check made in the plan a change brings is not memoised as the
+        # previous plan's
+        self._checked_in: dict[str, UiPlan] = {}
         #: the cell's generation: what was worked out in an earlier cell is not reused
         self._cell_gen = 0
         #: what undo and redo bring back with a plan object seen before (:mod:`webui.doc_memo`):
@@ -172,6 +176,7 @@ class WobjcalApp:
             self.view, self.picker = view, picker
             self._cell_key = _cell_key(plan)
             self._checks.clear()
+            self._checked_in.clear()
             self._cell_gen += 1
             self._check_memo.clear()
             self._cycle_memo.clear()
@@ -224,15 +229,15 @@ class WobjcalApp:
 
         ``doc``: the plan to check them in (default the session's; a new cell's plan before
         the session takes it, :meth:`load_cell`)."""
+        with self._lock:  # before the plan is read: a change after this read bumps them
+            cell_gen = self._cell_gen  # a new cell drops every check (load_cell)
+            gens = {pid: self._check_gen.get(pid, 0) for pid in point_ids}
         doc = self.state.doc if doc is None else doc
         points = [doc.get(pid) for pid in point_ids if pid in doc.ids]
         if not points:
             return []
         edited = [plan_point(p) for p in points]
         as_edited = plan_as_edited(doc)
-        with self._lock:
-            cell_gen = self._cell_gen  # a new cell drops every check (load_cell)
-            gens = {p.id: self._check_gen.get(p.id, 0) for p in points}
         with self.busy(f"checking {', '.join(p.id for p in points[:6])}"):
             results = self.worker.call(
                 lambda s: [] if s is None else s.check_points(edited, as_edited)
@@ -248,6 +253,7 @@ class WobjcalApp:
                 )
                 if still:  # drop results of a point that moved on (or was undone) meanwhile
                     self._checks[point.id] = (point.probe, check)
+                    self._checked_in[point.id] = doc
         self._redraw([p.id for p in points])
         return results
 
@@ -369,12 +375,16 @@ class WobjcalApp:
             for pid in [*changed, *(set(before) - set(change.doc.ids))]:
                 self._check_gen[pid] = self._check_gen.get(pid, 0) + 1
                 entry = self._checks.pop(pid, None)
-                if entry is not None:  # for an undo back to the plan it was shown in
+                checked_in = self._checked_in.pop(pid, None)
+                # for an undo back to the plan it was shown in; not a check of the new plan
+                # itself (a recheck that stored it before this change's listener ran)
+                if entry is not None and checked_in is not change.doc:
                     self._check_memo.put(change.previous, entry, (pid, self._cell_gen))
             for pid in changed:
                 entry = self._check_memo.get(change.doc, (pid, self._cell_gen))
                 if entry is not None and entry[0] == change.doc.get(pid).probe:
                     self._checks[pid] = entry
+                    self._checked_in[pid] = change.doc
                     known.append(pid)
         if len(changed) > 2 or not changed:  # grey "pending" markers for bulk changes
             self._redraw(changed)

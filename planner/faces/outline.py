@@ -11,6 +11,7 @@ footprint on the face when the point plus that set, grown by a floor, lies in it
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Sequence
 
 import numpy as np
@@ -155,6 +156,7 @@ class FaceOutlines:
 #: so the ids stay theirs. A detection renamed for messages shares its outlines.
 _SHARED: dict[tuple[int, int, int, float], tuple[PlanarFaces, FaceOutlines]] = {}
 _SHARED_MAX = 8
+_SHARED_LOCK = threading.Lock()  # suggest (cell worker) and the layout panel share them
 
 
 def shared_outlines(faces: PlanarFaces, footprint_radius_m: float) -> FaceOutlines:
@@ -162,11 +164,15 @@ def shared_outlines(faces: PlanarFaces, footprint_radius_m: float) -> FaceOutlin
     (metres), the same object for the same detection and radius (built once, then its
     faces' outlines built once each)."""
     key = (id(faces.mesh), id(faces.face_id), id(faces.faces), float(footprint_radius_m))
-    if key not in _SHARED:
+    with _SHARED_LOCK:
+        hit = _SHARED.get(key)
+        if hit is not None:
+            return hit[1]
         if len(_SHARED) >= _SHARED_MAX:
             _SHARED.pop(next(iter(_SHARED)))
-        _SHARED[key] = (faces, FaceOutlines(faces, footprint_radius_m))
-    return _SHARED[key][1]
+        outlines = FaceOutlines(faces, footprint_radius_m)  # cheap: the unions come lazily
+        _SHARED[key] = (faces, outlines)
+        return outlines
 
 
 def _union(uv: FloatArray) -> shapely.Geometry:

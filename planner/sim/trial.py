@@ -69,7 +69,7 @@ class TrialResult:
         xoffset_x_m: ``(H,)`` x errors of the slot targets with the x-offset matrix (true wobj
             axes, m), or ``None`` without an x-offset run (NaN when it failed).
         xoffset_failure: ``""``, ``"<search>: <reason>"`` of a failed x-offset run, or
-            ``"x-offset: <why>"``.
+            the ``<why>`` of an x-offset run refused as bad input.
         failed_search: the search the calibration stopped at, with its reason and kind;
             ``None`` when it did not stop at a search (it calibrated, or its measurements
             define no frame).
@@ -166,7 +166,7 @@ class TrialRunner:
                     xfailed = search_failure(exc, probe.events)
                     xfail = str(xfailed)
                 except InputError as exc:
-                    xfail = f"x-offset: {exc}"
+                    xfail = str(exc)  # said as "x-offset <why>" (planner.sim.summary)
         searched = tuple(e.point_id for e in probe.events)
         notable = tuple(e for e in probe.events if e.cause is not None or e.landing is not None)
         return TrialResult(failure, searched, notable, d_proc, d_fit, x_err, xfail, failed, xfailed)

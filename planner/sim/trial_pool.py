@@ -126,6 +126,8 @@ def run_all(
     before every trial: what it raises stops the run there (a prediction that failed
     meanwhile, :meth:`planner.sim.simulation_run.SimulationRun.finish`)."""
     total = len(seeds)
+    if n_workers > 1 and before_trial is not None:
+        raise ValueError("before_trial is called in this process only: run with n_workers=1")
     if n_workers > 1:
         pool = TrialPool(setup, mesh, seeds, n_workers)
         return pool.results(None if progress is None else lambda done: progress(done, total))

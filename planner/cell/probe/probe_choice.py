@@ -10,7 +10,8 @@ The work is done in four passes; the answers do not depend on them:
 2. a lean loop over the others: the open parts of the first candidate with Bullet (often just
    the sensor, which stands at the sensing distance from the surface);
 3. one broad-phase call for the first :data:`FIRST_BLOCK` candidates of the points still open
-   (more of a point's, up to ``max_checks``, in doubling blocks when it needs them); a point
+   (the rest of the rows of the points that need more, up to ``max_checks``, in one call
+   after pass 4 has paused them: see the end of this docstring); a point
    whose first candidate not shown below the margin is clear of everything is decided here;
 4. per point: candidates in order until one passes (a candidate whose slack is shown below the
    margin, by the broad phase or by its GJK upper bound, :mod:`planner.cell.broad.slack_bounds`, is
