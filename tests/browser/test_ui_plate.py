@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ui_helpers import REPO, UiSession, open_page, open_tab, start_ui, wait_for
+from ui_helpers import REPO, UiSession, act_until, open_page, open_tab, start_ui, wait_for
 
 from webui.validation import error_colours
 
@@ -33,7 +33,13 @@ def test_plate_plan_validates_and_paints_the_error(plate: UiSession) -> None:
     panel = plate.app.validate_panel
     panel.trials.value = 40
     open_tab(plate.page, "Validate")
-    plate.page.get_by_role("button", name="Validate plan").click()
+    # a click that lands while the panel is redrawn is lost on a loaded machine: click again
+    # until the validation has started (a click while it runs is refused, not queued)
+    act_until(
+        lambda: plate.page.get_by_role("button", name="Validate plan").click(),
+        lambda: panel.running or panel.last_report is not None,
+        what="the validation to start",
+    )
     wait_for(
         lambda: panel.last_report is not None and not panel.running,
         timeout=120,
