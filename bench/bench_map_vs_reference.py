@@ -27,14 +27,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import shutil
 import statistics
 import tempfile
 from pathlib import Path
 from typing import Any
 
-from bench.reference_tree import ROOT, head_commit, planner_file, run_in_tree
+from bench.reference_tree import ROOT, run_header, run_in_tree
 from bench.result_file import write_result
 
 RESULTS = ROOT / "bench" / "results"
@@ -124,20 +123,8 @@ def main(argv: list[str] | None = None) -> int:
     ours, reference = args.ours.resolve(), args.reference.resolve()
     out_path = args.out or RESULTS / f"map_vs_{args.name}.json"
     result: dict[str, Any] = json.loads(out_path.read_text()) if out_path.exists() else {}
-    result.update(
-        {
-            "reference": args.name,
-            "reference_commit": head_commit(reference),
-            "ours_commit": head_commit(ours),
-            "planner_imported_from": {
-                "ours": planner_file(ours),
-                "reference": planner_file(reference),
-            },
-            "interpreter": "the same Python for both trees, PYTHONPATH isolation (no second venv)",
-            "cpu_count": os.cpu_count(),
-            "call": f"reachability_map(bench_cell(), {args.samples}, default_rng(0))",
-        }
-    )
+    result.update(run_header(ours, reference, args.name))
+    result["call"] = f"reachability_map(bench_cell(), {args.samples}, default_rng(0))"
     with tempfile.TemporaryDirectory(prefix="wobjcal-map-bench-") as tmp:
         for mode in args.modes.split(","):
             result[mode] = compare(

@@ -24,13 +24,12 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
-import os
 import statistics
 import tempfile
 from pathlib import Path
 from typing import Any
 
-from bench.reference_tree import ROOT, head_commit, planner_file, run_in_tree
+from bench.reference_tree import ROOT, run_header, run_in_tree
 from bench.result_file import write_result
 
 RESULTS = ROOT / "bench" / "results"
@@ -162,20 +161,8 @@ def main(argv: list[str] | None = None) -> int:
     ours, reference = args.ours.resolve(), args.reference.resolve()
     out_path = args.out or RESULTS / f"suggest_vs_{args.name}.json"
     result: dict[str, Any] = json.loads(out_path.read_text()) if out_path.exists() else {}
-    result.update(
-        {
-            "reference": args.name,
-            "reference_commit": head_commit(reference),
-            "ours_commit": head_commit(ours),
-            "planner_imported_from": {
-                "ours": planner_file(ours),
-                "reference": planner_file(reference),
-            },
-            "interpreter": "the same Python for both trees, PYTHONPATH isolation (no second venv)",
-            "cpu_count": os.cpu_count(),
-            "command": "python3 -m planner suggest PLAN ARGS -o OUT",
-        }
-    )
+    result.update(run_header(ours, reference, args.name))
+    result["command"] = "python3 -m planner suggest PLAN ARGS -o OUT"
     with tempfile.TemporaryDirectory(prefix="wobjcal-suggest-bench-") as tmp:
         for case in args.cases.split(","):
             result[case] = compare(

@@ -73,6 +73,22 @@ def head_commit(tree: Path) -> str:
     return rev + ("+dirty" if dirty else "")
 
 
+def run_header(ours: Path, reference: Path, name: str) -> dict[str, Any]:
+    """What a result file says of the two trees it compared (commits, where ``planner`` came
+    from, the interpreter, the CPUs)."""
+    return {
+        "reference": name,
+        "reference_commit": head_commit(reference),
+        "ours_commit": head_commit(ours),
+        "planner_imported_from": {
+            "ours": planner_file(ours),
+            "reference": planner_file(reference),
+        },
+        "interpreter": "the same Python for both trees, PYTHONPATH isolation (no second venv)",
+        "cpu_count": os.cpu_count(),
+    }
+
+
 def _children_cpu_s() -> float:
     r = resource.getrusage(resource.RUSAGE_CHILDREN)
     return r.ru_utime + r.ru_stime
