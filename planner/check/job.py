@@ -442,6 +442,7 @@ def check_via_moves(cell: Cell, plan: Plan, checks: Sequence[PointCheck]) -> tup
 
 
 def _check(plan: Plan, points: list[PlanPoint], cell: Cell) -> tuple[tuple[PointCheck, ...], str]:
+    from planner.cell import disk_cache  # the faces' footprint test, kept across commands
     from planner.faces.checks import plan_face_reasons
     from planner.faces.detection import NoPlanarFaceError
 
@@ -455,7 +456,9 @@ def _check(plan: Plan, points: list[PlanPoint], cell: Cell) -> tuple[tuple[Point
     radius = plan.validation.sensor.footprint_radius_m
     error = ""
     try:
-        faces = plan_face_reasons(wo.mesh, probes, name=wo.name, footprint_radius_m=radius)
+        faces = plan_face_reasons(
+            wo.mesh, probes, name=wo.name, footprint_radius_m=radius, cache=disk_cache
+        )
     except NoPlanarFaceError as exc:  # the plan cannot work on this part
         error = str(exc)
         faces = [Reason("footprint", error, about_part=True)] * len(points)

@@ -170,6 +170,7 @@ def preflight(plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh) -> No
     Raises:
         PlanError: naming every point that fails, and why.
     """
+    from planner.cell import disk_cache  # the faces' footprint test, kept across commands
     from planner.faces.checks import plan_face_reasons
 
     probes = [p.to_probe_point() for p in plan.points]
@@ -177,7 +178,9 @@ def preflight(plan: Plan, models: ValidationModels, mesh: trimesh.Trimesh) -> No
     why = {
         p.id: f"not on a planar face: {reason}"
         for p, reason in zip(
-            plan.points, plan_face_reasons(mesh, probes, footprint_radius_m=r), strict=True
+            plan.points,
+            plan_face_reasons(mesh, probes, footprint_radius_m=r, cache=disk_cache),
+            strict=True,
         )
         if reason
     }

@@ -44,10 +44,14 @@ def simulation_setup(
             )
         # the true hole of each target: at its y and z, pushed out by the bolts' bulge
         xs = xoffset_setup(xo, np.stack([g.side_face_offset_m(y, z), y, z], axis=-1))
+    from planner.cell import disk_cache  # the faces' footprint test, kept across commands
+
     px = tuple(RolePoint("xoffset", p) for row in (xs.points if xs else ()) for p in row)
     return dataclasses.replace(
         prediction_setup(plan, models, fmt),
-        faces=face_lookup(mesh, models.points + px, models.sensor.footprint_radius_m),
+        faces=face_lookup(
+            mesh, models.points + px, models.sensor.footprint_radius_m, cache=disk_cache
+        ),
         xoffset=xs,
     )
 

@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 from calib.arguments import check_points
 from calib.errors import ShapeError
 from calib.probing import ProbePoint
+from planner.faces.array_cache import ArrayCache
 from planner.faces.detection import NoPlanarFaceError, PlanarFaces, find_planar_faces
 from planner.faces.footprint import (
     DEFAULT_FOOTPRINT_RADIUS_M,
@@ -102,6 +103,7 @@ def check_probe_faces(
     max_normal_angle_rad: float = MAX_NORMAL_ANGLE_RAD,
     max_distance_m: float = 1.0e-3,
     name: str | None = None,
+    cache: ArrayCache | None = None,
 ) -> list[FaceCheck]:
     """Check that probe points lie on planar faces with the sensor footprint on the same face.
 
@@ -114,6 +116,8 @@ def check_probe_faces(
         max_normal_angle_rad: largest angle between a plan normal and its face's normal, rad.
         max_distance_m: largest distance of a point from the mesh surface, metres.
         name: the mesh's name in messages (when a mesh is given).
+        cache: the disk store of the faces' footprint test when a mesh is given
+            (:func:`find_planar_faces`; the jobs pass :mod:`planner.cell.disk_cache`).
 
     Returns:
         One :class:`FaceCheck` per point.
@@ -130,6 +134,7 @@ def check_probe_faces(
             min_area_m2=math.pi * footprint_radius_m**2,
             footprint_radius_m=footprint_radius_m,
             name=name,
+            cache=cache,
         )
     )
     pf.require_any()
@@ -199,6 +204,7 @@ def check_plan_faces(
     probes: Sequence[ProbePoint],
     *,
     name: str | None = None,
+    cache: ArrayCache | None = None,
     **kw: float,
 ) -> list[FaceCheck]:
     """:func:`check_probe_faces` for plan points (wobj frame), with edge searches handled.
@@ -210,6 +216,7 @@ def check_plan_faces(
         mesh_or_faces: the work-object mesh or its :class:`PlanarFaces`.
         probes: the plan's probe points.
         name: the mesh's name in messages.
+        cache: the disk store of the faces' footprint test (:func:`check_probe_faces`).
         **kw: tolerances passed to :func:`check_probe_faces`.
     """
     P = np.zeros((len(probes), 3))
@@ -218,7 +225,7 @@ def check_plan_faces(
         P[i], N[i] = p.position_m, p.normal
         if p.search.kind == "edge" and p.search.edge_direction is not None:
             P[i] -= p.search.start_offset_m * np.asarray(p.search.edge_direction)
-    checks = check_probe_faces(mesh_or_faces, P, N, name=name, **kw)
+    checks = check_probe_faces(mesh_or_faces, P, N, name=name, cache=cache, **kw)
     return [
         c
         if c.ok or p.search.kind != "edge"
@@ -242,6 +249,7 @@ def plan_face_reasons(
     name: str | None = None,
     raise_if_none: bool = True,
     footprint_radius_m: float = DEFAULT_FOOTPRINT_RADIUS_M,
+    cache: ArrayCache | None = None,
 ) -> list[Reason | None]:
     """Why each plan point fails the planar-face check (``None`` when it passes): a
     ``footprint`` reason each.
@@ -255,6 +263,7 @@ def plan_face_reasons(
             part: ``about_part``).
         footprint_radius_m: the plan's sensor footprint radius, metres
             (``plan.validation.sensor.footprint_radius_m``).
+        cache: the disk store of the faces' footprint test (:func:`check_probe_faces`).
 
     Raises:
         NoPlanarFaceError: the mesh has no planar face and ``raise_if_none`` is true.
@@ -262,7 +271,9 @@ def plan_face_reasons(
     if not probes:
         return []
     try:
-        checks = check_plan_faces(mesh, probes, name=name, footprint_radius_m=footprint_radius_m)
+        checks = check_plan_faces(
+            mesh, probes, name=name, footprint_radius_m=footprint_radius_m, cache=cache
+        )
     except NoPlanarFaceError as exc:
         if raise_if_none:
             raise

@@ -23,6 +23,7 @@ from calib.paper.settings import Hultman2013
 from calib.probing import ProbePoint
 from calib.procedures import RolePoint
 from calib.procedures.base import edge_offset_of
+from planner.faces.array_cache import ArrayCache
 from planner.faces.checks import check_plan_faces
 from planner.faces.detection import find_planar_faces
 from planner.program.model import MeasuringProgram, search_keys
@@ -53,15 +54,21 @@ def default_pivot(points: Sequence[RolePoint] | Mapping[str, ProbePoint]) -> Flo
 
 
 def face_lookup(
-    mesh: trimesh.Trimesh, points: Sequence[RolePoint], footprint_radius_m: float
+    mesh: trimesh.Trimesh,
+    points: Sequence[RolePoint],
+    footprint_radius_m: float,
+    cache: ArrayCache | None = None,
 ) -> FaceLookup:
     """The true part's planar faces and the face each search should land on.
 
     The faces are found with the sensor's footprint (:func:`find_planar_faces`, cached per
-    mesh); each point's face is the one :func:`check_plan_faces` finds under it.
+    mesh in memory, and in ``cache`` when given: the jobs pass the cell's disk cache); each
+    point's face is the one :func:`check_plan_faces` finds under it.
     """
     radius = max(float(footprint_radius_m), 1e-4)
-    faces = find_planar_faces(mesh, min_area_m2=np.pi * radius**2, footprint_radius_m=radius)
+    faces = find_planar_faces(
+        mesh, min_area_m2=np.pi * radius**2, footprint_radius_m=radius, cache=cache
+    )
     checks = check_plan_faces(faces, [rp.point for rp in points], footprint_radius_m=radius)
     by_id = {rp.point.id: c.face_id for rp, c in zip(points, checks, strict=True)}
     intended = {alias: by_id[pid] for alias, pid in search_keys(points).items()}
