@@ -12,6 +12,7 @@ only forward to them, so the modules depend on the scene and never on this class
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -20,10 +21,12 @@ from numpy.typing import ArrayLike
 from calib.probing import SearchCommand
 from planner.cell.probe import (
     PathFeasibility,
+    PosedSearch,
     ProbeFeasibility,
     ReachabilityMap,
     check_probes,
     check_search,
+    check_searches,
     reachability_map,
 )
 from planner.cell.scene import CellScene
@@ -47,6 +50,23 @@ class Cell(CellScene):
     def check_search(self, command: SearchCommand, **kw: Any) -> PathFeasibility:
         """Feasibility of a search path; see :func:`planner.cell.probe.check_search`."""
         return check_search(self, command, **kw)
+
+    def check_searches(
+        self,
+        commands: Sequence[SearchCommand],
+        sensor_x: Sequence[ArrayLike],
+        q_ref: Sequence[ArrayLike],
+        branch: Sequence[int],
+        **kw: Any,
+    ) -> list[PathFeasibility]:
+        """Feasibility of many search paths, each with its program's pose (sensor x axis,
+        reference joints, IK branch; base frame, rad); see
+        :func:`planner.cell.probe.check_searches`."""
+        searches = [
+            PosedSearch(c, np.asarray(x, dtype=float), np.asarray(q, dtype=float), int(b))
+            for c, x, q, b in zip(commands, sensor_x, q_ref, branch, strict=True)
+        ]
+        return check_searches(self, searches, **kw)
 
     def reachability_map(
         self, n_samples: int, rng: np.random.Generator, **kw: Any

@@ -99,8 +99,14 @@ class SimulatedProbe(SimulatedSensor):
         cmd: SearchCommand,
         travel: float,
         triangles: NDArray[np.int64] | None = None,
+        vetted: tuple[Reason | None] | None = None,
     ) -> ProbeResult:
-        refused = self._vet(cmd, travel)  # the path the robot really ran: start to the event
+        """The search's result after ``travel`` m, unless the hook refuses its path (vetted
+        here, or ahead: ``vetted`` holds that verdict)."""
+        if vetted is None:  # the path the robot really ran: start to the event
+            refused = self._vet(cmd, travel)
+        else:
+            refused = None if vetted[0] is None else self._fail(cmd, vetted[0])
         if refused is not None:
             return refused
         point = np.asarray(cmd.start_m, float) + travel * np.asarray(cmd.direction, float)
@@ -173,14 +179,25 @@ class SimulatedProbe(SimulatedSensor):
         inside = np.any(dist <= 0.0, axis=1)
         signal = self.sensor.signal(dist)
         nearest = dist.min(axis=1)
+        travels = [
+            math.nan if inside[k] else self.sensor.travel_to_switch_m(float(signal[k]), jitter)
+            for k, (_, _, _, jitter) in enumerate(searches)
+        ]
+        # the paths of the searches the sensor ends, up to the first it fails, vetted at once
+        ran = []
+        for k, (cmd, *_) in enumerate(searches):
+            if inside[k] or _sensor_refusal(cmd, travels[k], float(nearest[k])) is not None:
+                break
+            ran.append((cmd, travels[k]))
+        ahead = self._vet_ahead(ran)
         out: list[ProbeResult] = []
-        for k, (cmd, _, _, jitter) in enumerate(searches):
+        for k, (cmd, *_) in enumerate(searches):
             tri = tri_all[k * n_rays : (k + 1) * n_rays]
             if inside[k]:
                 res = self._fail(cmd, FACE_INSIDE)
             else:
-                travel = self.sensor.travel_to_switch_m(float(signal[k]), jitter)
-                res = self._judged(cmd, travel, float(nearest[k]), tri)
+                vetted = (ahead[k],) if k < len(ahead) else None
+                res = self._judged(cmd, travels[k], float(nearest[k]), tri, vetted)
             out.append(res)
             if not res.ok:
                 break
@@ -207,18 +224,21 @@ class SimulatedProbe(SimulatedSensor):
         return self._judged(cmd, travel, float(dist.min()), tri)
 
     def _judged(
-        self, cmd: SearchCommand, travel: float, nearest: float, tri: NDArray[np.int64]
+        self,
+        cmd: SearchCommand,
+        travel: float,
+        nearest: float,
+        tri: NDArray[np.int64],
+        vetted: tuple[Reason | None] | None = None,
     ) -> ProbeResult:
         """An approach along the sensor axis that switches after ``travel`` (m), its nearest
-        ray meeting metal ``nearest`` away (m), its rays' triangles ``tri``."""
-        length = float(cmd.length_m)
-        if travel <= 0.0:
-            return self._fail(cmd, ALREADY_DETECTING)
-        if not math.isfinite(travel) or travel > length:
-            return self._fail(cmd, no_event_within("detection", length))
-        if travel >= nearest:
-            return self._fail(cmd, TOUCHED)
-        return self._succeed(cmd, travel, tri)  # along the axis the rays are the footprint's
+        ray meeting metal ``nearest`` away (m), its rays' triangles ``tri``; ``vetted``: the
+        hook's verdict of its path when it was vetted ahead (:meth:`_succeed`)."""
+        why = _sensor_refusal(cmd, travel, nearest)
+        if why is not None:
+            return self._fail(cmd, why)
+        # along the axis the rays are the footprint's
+        return self._succeed(cmd, travel, tri, vetted)
 
     def _scan(
         self,
@@ -321,3 +341,17 @@ class SimulatedProbe(SimulatedSensor):
             d_part = np.broadcast_to(self._T_wobj_base[:3, :3] @ axis, origins[0].shape)
             triangles = self.caster.first_hits_ids(origins[0], d_part)[1]
         return self._succeed(cmd, hi, triangles)
+
+
+def _sensor_refusal(cmd: SearchCommand, travel: float, nearest: float) -> Reason | None:
+    """Why an approach along the sensor axis that would switch after ``travel`` (m), its
+    nearest ray meeting metal ``nearest`` away (m), fails in the sensor; ``None`` when the
+    sensor ends it."""
+    length = float(cmd.length_m)
+    if travel <= 0.0:
+        return ALREADY_DETECTING
+    if not math.isfinite(travel) or travel > length:
+        return no_event_within("detection", length)
+    if travel >= nearest:
+        return TOUCHED
+    return None

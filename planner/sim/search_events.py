@@ -18,7 +18,7 @@ a footprint that lands off its face or partly over a hole or an edge is a ``foot
 from __future__ import annotations
 
 import re
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -92,7 +92,7 @@ def program_search_hook(
     tcp: str,
     step_m: float = 0.002,
     other_searches: str | None = None,
-) -> ReachabilityHook:
+) -> ProgramSearchHook:
     """A hook that vets each commanded search the way ``wobjcal check`` walks it: with the
     sensor rotation and IK branch of the point's checked pose (``poses`` by plan id; a
     search's key maps to its plan id through ``keys``, :func:`planner.program.model.search_keys`),
@@ -108,30 +108,92 @@ def program_search_hook(
     found no pose the robot can take there). As :func:`cell_search_hook`, only the verdict is
     computed.
     """
-    R_nom_T = np.asarray(T_base_wobj_nominal, dtype=float)[:3, :3].T
+    return ProgramSearchHook(
+        cell, poses, keys, np.asarray(T_base_wobj_nominal, dtype=float), tcp, step_m, other_searches
+    )
 
-    def hook(command: SearchCommand) -> Reason | None:
-        pid = keys.get(command.point_id)
-        if pid is not None and pid not in poses:
+
+class ProgramSearchHook:
+    """The hook of :func:`program_search_hook`: called with one search, or with many through
+    :meth:`many` (the same verdicts, the cell's paths checked together:
+    ``cell.check_searches``)."""
+
+    def __init__(
+        self,
+        cell: Any,
+        poses: Mapping[str, ProgramPose],
+        keys: Mapping[str, str],
+        T_base_wobj_nominal: FloatArray,
+        tcp: str,
+        step_m: float,
+        other_searches: str | None,
+    ) -> None:
+        self.cell = cell
+        self.poses = poses
+        self.keys = keys
+        self.R_nom_T = T_base_wobj_nominal[:3, :3].T
+        self.tcp = tcp
+        self.step_m = step_m
+        self.other_searches = other_searches
+
+    def _pose(self, command: SearchCommand) -> ProgramPose | Reason | None:
+        """The pose ``command`` runs with, the refusal of a point check found no pose for, or
+        ``None`` (any rotation and branch)."""
+        pid = self.keys.get(command.point_id)
+        if pid is not None and pid not in self.poses:
             return Reason("reach", f"{UNREACHABLE}check found no pose for point {pid}")
-        pose = poses.get(pid if pid is not None else (other_searches or ""))
+        return self.poses.get(pid if pid is not None else (self.other_searches or ""))
+
+    def _sensor_x(self, command: SearchCommand, pose: ProgramPose) -> FloatArray:
+        """The pose's sensor x axis turned with the frame the search is commanded in."""
+        R = np.asarray(command.T_base_wobj_estimate, dtype=float)[:3, :3] @ self.R_nom_T
+        return R @ pose.sensor_x_base
+
+    def __call__(self, command: SearchCommand) -> Reason | None:
+        pose = self._pose(command)
+        if isinstance(pose, Reason):
+            return pose
         if pose is None:
-            res = cell.check_search(command, step_m=step_m, tcp=tcp, exact_clearance=False)
+            res = self.cell.check_search(
+                command, step_m=self.step_m, tcp=self.tcp, exact_clearance=False
+            )
         else:
-            R = np.asarray(command.T_base_wobj_estimate, dtype=float)[:3, :3] @ R_nom_T
-            res = cell.check_search(
+            res = self.cell.check_search(
                 command,
-                step_m=step_m,
-                tcp=tcp,
+                step_m=self.step_m,
+                tcp=self.tcp,
                 q_ref=pose.q,
-                sensor_x=R @ pose.sensor_x_base,
+                sensor_x=self._sensor_x(command, pose),
                 branch=pose.branch,
                 max_starts=1,
                 exact_clearance=False,
             )
         return _refusal(res)
 
-    return hook
+    def many(self, commands: Sequence[SearchCommand]) -> list[Reason | None]:
+        """``[self(c) for c in commands]``, the searches with a pose checked together."""
+        out: list[Reason | None] = [None] * len(commands)
+        posed: list[tuple[int, ProgramPose]] = []
+        for i, command in enumerate(commands):
+            pose = self._pose(command)
+            if isinstance(pose, Reason):
+                out[i] = pose
+            elif pose is None:
+                out[i] = self(command)
+            else:
+                posed.append((i, pose))
+        if posed:
+            results = self.cell.check_searches(
+                [commands[i] for i, _ in posed],
+                [self._sensor_x(commands[i], pose) for i, pose in posed],
+                [pose.q for _, pose in posed],
+                [pose.branch for _, pose in posed],
+                step_m=self.step_m,
+                tcp=self.tcp,
+            )
+            for (i, _), res in zip(posed, results, strict=True):
+                out[i] = _refusal(res)
+        return out
 
 
 def robot_offset(

@@ -155,6 +155,18 @@ class SimulatedSensor(ABC):
         why = self.reachability(replace(cmd, length_m=max(travel, 1e-6)))
         return None if why is None else self._fail(cmd, why)
 
+    def _vet_ahead(self, runs: Sequence[tuple[SearchCommand, float]]) -> list[Reason | None]:
+        """The hook's verdicts of searches ``(command, travel)`` not run yet, all at once (a
+        hook with a ``many`` method checks them together); no event is recorded. ``[]`` when
+        there is no hook. :meth:`_vet` then takes each search's verdict (``refusal=``)."""
+        if self.reachability is None or not runs:
+            return []
+        ran = [replace(cmd, length_m=max(travel, 1e-6)) for cmd, travel in runs]
+        many = getattr(self.reachability, "many", None)
+        if many is not None:
+            return list(many(ran))
+        return [self.reachability(c) for c in ran]
+
     def _landing(
         self, cmd: SearchCommand, triangles: NDArray[np.int64] | None
     ) -> tuple[Reason | None, float]:

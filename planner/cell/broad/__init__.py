@@ -29,7 +29,15 @@ Modules:
 
 from planner.cell.broad.broad_arrays import EnvArrays, PartMap
 from planner.cell.broad.broad_phase import BroadPhase, broad_phase_of
-from planner.cell.broad.path_clearance import first_failure
+from planner.cell.broad.path_clearance import first_failure, first_failures
 from planner.cell.broad.slack_bounds import SlackBounds
 
-__all__ = ["BroadPhase", "EnvArrays", "PartMap", "SlackBounds", "broad_phase_of", "first_failure"]
+__all__ = [
+    "BroadPhase",
+    "EnvArrays",
+    "PartMap",
+    "SlackBounds",
+    "broad_phase_of",
+    "first_failure",
+    "first_failures",
+]

@@ -24,6 +24,7 @@ to the loop.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -60,38 +61,72 @@ def first_failure(
     Returns:
         ``(j, clearance)`` of the first failing sample, or ``(M, None)`` when all pass.
     """
-    M = int(q_path.shape[0])
-    if M == 0:
-        return 0, None
+    return first_failures(cell, [(q_path, T_base_flange, skip_wobj)], margin_m)[0]
+
+
+def first_failures(
+    cell: CellScene,
+    paths: Sequence[tuple[FloatArray, FloatArray, BoolArray]],
+    margin_m: float,
+) -> list[tuple[int, Clearance | None]]:
+    """:func:`first_failure` of each of many paths ``(q_path, T_base_flange, skip_wobj)``,
+    the same answers; the broad phase runs once over the samples of all of them.
+
+    Args:
+        cell: the cell (its joint state changes; restore it with ``cell.saved_state()``).
+        paths: each path's ``(M_i, n)`` joint values (rad), ``(M_i, 4, 4)`` flange poses
+            (robot base frame, m) and ``(M_i,)`` samples checked without the work object.
+        margin_m: required distance of robot and tool to the work object and fixtures, m.
+
+    Returns:
+        Per path, ``(j, clearance)`` of its first failing sample, or ``(M_i, None)``.
+    """
+    sizes = [int(np.asarray(q).shape[0]) for q, _, _ in paths]
+    out: list[tuple[int, Clearance | None]] = [(0, None)] * len(paths)
+    if sum(sizes) == 0:
+        return out
+    live = [i for i, m in enumerate(sizes) if m > 0]
+    q_all = np.concatenate([np.asarray(paths[i][0], float) for i in live])
+    T_all = np.concatenate([np.asarray(paths[i][1], float) for i in live])
     checker = cell.checker
     plan = checker.plan(margin_m, cell.self_margin_m, None, True, False)
     broad = broad_phase_of(cell)
     env = broad.environment(cell)
     parts = broad.part_map(cell, plan, env)
-    T_links = broad.link_poses(cell, np.asarray(q_path, float), np.asarray(T_base_flange, float))
+    T_links = broad.link_poses(cell, q_all, T_all)
     part_state, pair_state, _ = broad.states(parts, env, T_links)
     env_parts = [plan.parts[int(i)] for i in parts.part_index]
     on_wobj = np.array([p.env == checker.wobj_body for p in env_parts], dtype=bool)
     self_part = plan.parts[-1]
     open_parts = part_state != 1
     open_pairs = pair_state != 1
-    for j in range(M):
-        todo = open_parts[j] & ~on_wobj if skip_wobj[j] else open_parts[j]
-        pairs = open_pairs[j]
-        if not todo.any() and not pairs.any():
-            continue
-        cell.set_joint_positions(q_path[j])
-        failed = False
-        for k in np.flatnonzero(todo).tolist():
-            res = checker.evaluate(env_parts[k])
-            if res is not None and not res.ok:
-                failed = True
-                break
-        if not failed and pairs.any():
-            res = checker.evaluate(self_part, pairs)
-            failed = res is not None and not res.ok
-        if failed:  # the whole query, for its reason (it fails as its part did)
-            whole = cell.clearance(margin_m, sensor_wobj_allowed=True, skip_wobj=bool(skip_wobj[j]))
-            if not whole.ok:
-                return j, whole
-    return M, None
+    at = 0
+    for i in live:
+        q_path, _, skip_wobj = paths[i]
+        M = sizes[i]
+        out[i] = (M, None)
+        for j in range(M):
+            row = at + j
+            todo = open_parts[row] & ~on_wobj if skip_wobj[j] else open_parts[row]
+            pairs = open_pairs[row]
+            if not todo.any() and not pairs.any():
+                continue
+            cell.set_joint_positions(q_path[j])
+            failed = False
+            for k in np.flatnonzero(todo).tolist():
+                res = checker.evaluate(env_parts[k])
+                if res is not None and not res.ok:
+                    failed = True
+                    break
+            if not failed and pairs.any():
+                res = checker.evaluate(self_part, pairs)
+                failed = res is not None and not res.ok
+            if failed:  # the whole query, for its reason (it fails as its part did)
+                whole = cell.clearance(
+                    margin_m, sensor_wobj_allowed=True, skip_wobj=bool(skip_wobj[j])
+                )
+                if not whole.ok:
+                    out[i] = (j, whole)
+                    break
+        at += M
+    return out

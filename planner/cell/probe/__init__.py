@@ -29,21 +29,26 @@ Modules:
 - :mod:`~planner.cell.probe.reachability`: surface reachability map: area-weighted samples on the
   work object, feasibility per sample;
 - :mod:`~planner.cell.probe.search_paths`: search-path feasibility: can the robot run a whole
-  approach or edge search?.
+  approach or edge search?;
+- :mod:`~planner.cell.probe.search_paths_many`: many search paths at once, each run with its
+  program's pose: the vetting of simulated searches.
 """
 
 from planner.cell.probe.feasibility import ProbeFeasibility, check_probes
 from planner.cell.probe.probe_status import ProbeStatuses, probe_statuses
 from planner.cell.probe.reachability import ReachabilityMap, reachability_map, sample_surface
 from planner.cell.probe.search_paths import PathFeasibility, check_search
+from planner.cell.probe.search_paths_many import PosedSearch, check_searches
 
 __all__ = [
     "PathFeasibility",
+    "PosedSearch",
     "ProbeFeasibility",
     "ProbeStatuses",
     "ReachabilityMap",
     "check_probes",
     "check_search",
+    "check_searches",
     "probe_statuses",
     "reachability_map",
     "sample_surface",

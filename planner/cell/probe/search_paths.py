@@ -126,8 +126,8 @@ def check_search(
     """
 
     start = check_vector3(command.start_m, "command.start_m")
-    direction = _unit(command.direction, "command.direction")
-    axis = _unit(command.sensor_axis, "command.sensor_axis")
+    direction = unit_vector(command.direction, "command.direction")
+    axis = unit_vector(command.sensor_axis, "command.sensor_axis")
     length = check_positive(command.length_m, "command.length_m")
     step = check_positive(step_m, "step_m")
     jump = check_positive(max_joint_jump_rad, "max_joint_jump_rad")
@@ -142,7 +142,7 @@ def check_search(
         rot_step = math.radians(check_positive(rotation_step_deg, "rotation_step_deg"))
         angles = np.arange(0.0, 2 * np.pi - 1e-9, rot_step)
     else:
-        angles = np.array([_angle_of(check_vector3(sensor_x, "sensor_x"), start, axis)])
+        angles = np.array([sensor_angle(check_vector3(sensor_x, "sensor_x"), start, axis)])
     # T_base_tcp of every (rotation, sample): normals are -axis, points along the path
     points = start + s[:, None] * direction
     T_start = tcp_frames(start[None], -axis[None], angles)[0]  # (R, 4, 4)
@@ -215,33 +215,9 @@ def _walk(
 ) -> PathFeasibility:
     """Follow one start solution along the sampled path (see the module docstring)."""
     sol = cell.solver.solve(T_flange, seeds=q_start[None])
-    M = s.size
-    q_path = np.empty((M, q_start.size))
-    prev = q_start
-    fail_j, reason = M, None
-    for j in range(M):
-        ok = sol.valid[j] & ((sol.branch[j] == branch) if branch >= 0 else True)
-        if not ok.any():
-            fail_j = j
-            reason = (
-                no_ik_reason(cell.reach_model, cell.solver, cell.chain, T_flange[j : j + 1])
-                if not sol.valid[j].any()
-                else Reason("reach", f"leaves IK branch {branch}")
-            )
-            break
-        d = np.where(ok, np.abs(sol.q[j] - prev).max(axis=-1), np.inf)
-        k = int(np.argmin(d))
-        if j > 0 and d[k] > jump:
-            fail_j = j
-            jj = int(np.argmax(np.abs(sol.q[j, k] - prev)))
-            # a joint flips between two samples: the path passes near a singularity
-            reason = Reason("singularity", f"joint {jj + 1} jumps {math.degrees(d[k]):.1f} deg")
-            break
-        q_path[j] = prev = sol.q[j, k]
-    if fail_j > 0:
-        sing, why = singular(cell, q_path[:fail_j])
-        if sing.any():
-            fail_j, reason = int(np.argmax(sing)), why
+    q_path, fail_j, reason = follow_branch(
+        cell, sol.q, sol.valid, sol.branch, T_flange, q_start, branch, jump
+    )
     min_cl = math.inf
     if not exact_clearance:  # the verdict only: the first sample that fails, broad phase first
         skip = s[:fail_j] > skip_from
@@ -256,7 +232,78 @@ def _walk(
         if not cl.ok:
             fail_j, reason = j, cl.reason()
             break
+    return path_verdict(s, q_path, fail_j, reason, rotation, branch, min_cl)
+
+
+def follow_branch(
+    cell: CellScene,
+    q: FloatArray,
+    valid: NDArray[np.bool_],
+    branches: NDArray[np.int64],
+    T_flange: FloatArray,
+    q_start: FloatArray,
+    branch: int,
+    jump: float,
+) -> tuple[FloatArray, int, Reason | None]:
+    """The joint path of one start solution along a sampled path, before any clearance test.
+
+    Args:
+        cell: the cell (its chain, solver and reach model, for the reasons).
+        q, valid, branches: the IK solutions of the ``M`` samples (:class:`IKSolutions`'
+            ``(M, K, n)``, ``(M, K)``, ``(M, K)``).
+        T_flange: ``(M, 4, 4)`` the samples' flange poses, base frame, m.
+        q_start: ``(n,)`` the start solution, rad.
+        branch: its IK branch (``-1``: any).
+        jump: largest joint change between samples, rad.
+
+    Returns:
+        ``(q_path (M, n), fail_j, reason)``: every sample takes the solution of ``branch``
+        nearest the previous one (max-abs); ``fail_j`` is the first sample without one, with a
+        joint jump or near a singularity (``M`` when none), ``reason`` why (``None`` when none).
+    """
+    M = T_flange.shape[0]
+    q_path = np.empty((M, q_start.size))
+    prev = q_start
+    fail_j, reason = M, None
+    for j in range(M):
+        ok = valid[j] & ((branches[j] == branch) if branch >= 0 else True)
+        if not ok.any():
+            fail_j = j
+            reason = (
+                no_ik_reason(cell.reach_model, cell.solver, cell.chain, T_flange[j : j + 1])
+                if not valid[j].any()
+                else Reason("reach", f"leaves IK branch {branch}")
+            )
+            break
+        d = np.where(ok, np.abs(q[j] - prev).max(axis=-1), np.inf)
+        k = int(np.argmin(d))
+        if j > 0 and d[k] > jump:
+            fail_j = j
+            jj = int(np.argmax(np.abs(q[j, k] - prev)))
+            # a joint flips between two samples: the path passes near a singularity
+            reason = Reason("singularity", f"joint {jj + 1} jumps {math.degrees(d[k]):.1f} deg")
+            break
+        q_path[j] = prev = q[j, k]
+    if fail_j > 0:
+        sing, why = singular(cell, q_path[:fail_j])
+        if sing.any():
+            fail_j, reason = int(np.argmax(sing)), why
+    return q_path, fail_j, reason
+
+
+def path_verdict(
+    s: FloatArray,
+    q_path: FloatArray,
+    fail_j: int,
+    reason: Reason | None,
+    rotation: float,
+    branch: int,
+    min_cl: float,
+) -> PathFeasibility:
+    """The :class:`PathFeasibility` of a path whose first failing sample is ``fail_j``
+    (``len(s)``: none) for ``reason``; ``min_cl`` the smallest clearance seen, m."""
     min_cl = min_cl if math.isfinite(min_cl) else math.nan
+    M = s.size
     if fail_j == M or reason is None:
         return PathFeasibility(True, None, math.nan, s, q_path, rotation, branch, min_cl)
     at = float(s[fail_j])
@@ -272,7 +319,7 @@ def _walk(
     )
 
 
-def _angle_of(x: FloatArray, start: FloatArray, axis: FloatArray) -> float:
+def sensor_angle(x: FloatArray, start: FloatArray, axis: FloatArray) -> float:
     """The rotation about the sensor ``axis`` (:func:`tcp_frames`' angle) whose TCP x axis
     is ``x`` projected off the axis, rad."""
     T0 = tcp_frames(start[None], -axis[None], np.zeros(1))[0, 0]
@@ -282,7 +329,12 @@ def _angle_of(x: FloatArray, start: FloatArray, axis: FloatArray) -> float:
     return math.atan2(v, u)
 
 
-def _unit(v: ArrayLike, name: str) -> FloatArray:
+def unit_vector(v: ArrayLike, name: str) -> FloatArray:
+    """``v`` (a 3-vector, checked as ``name``) made unit length.
+
+    Raises:
+        DegenerateGeometryError: ``v`` is the zero vector.
+    """
     a = check_vector3(v, name)
     n = float(np.linalg.norm(a))
     if n < 1e-12:

@@ -160,3 +160,55 @@ def test_searches_in_turn_equal_one_by_one(stop_at: str | None) -> None:
     assert batch.events == one.events
     if stop_at is None:  # the same noise drawn: both generators are in the same state
         assert batch.rng.random() == one.rng.random()
+
+
+class _ManyHook:
+    """A reachability hook that refuses one search and counts how it is asked."""
+
+    def __init__(self, refuse: str) -> None:
+        self.refuse = refuse
+        self.single: list[str] = []
+        self.batches: list[list[tuple[str, float]]] = []
+
+    def _why(self, cmd: SearchCommand) -> Reason | None:
+        return (
+            Reason("collision", f"{cmd.point_id} hits a clamp")
+            if cmd.point_id == self.refuse
+            else None
+        )
+
+    def __call__(self, cmd: SearchCommand) -> Reason | None:
+        self.single.append(cmd.point_id)
+        return self._why(cmd)
+
+    def many(self, cmds: list[SearchCommand]) -> list[Reason | None]:
+        self.batches.append([(c.point_id, c.length_m) for c in cmds])
+        return [self._why(c) for c in cmds]
+
+
+@pytest.mark.parametrize("refuse", ["t5", "none"])
+def test_a_hook_asked_for_many_searches_at_once_gives_the_same_run(refuse: str) -> None:
+    """The x-offset run's approaches are vetted in one call of the hook's ``many`` (the cell
+    checks their paths together): the same results and events as each vetted in turn, the
+    run ending at the refused search; the paths asked for are those the sensor ends, each as
+    long as its travel."""
+    T = _tilted()
+    cmds = [c for c in _commands(T) if c.point_id not in ("f", "o")]  # approaches only
+    noise = {"robot_error": RobotErrorModel(repeatability_sigma_m=2e-5)}
+    plain_hook, many_hook = _ManyHook(refuse), _ManyHook(refuse)
+    one = _probe(T, reachability=plain_hook, **noise)
+    batch = _probe(T, reachability=many_hook, **noise)
+    expected = []
+    for c in cmds:
+        expected.append(one(c))
+        if not expected[-1].ok:
+            break
+    got = batch.run_in_turn(cmds)
+    assert [r.reason for r in got] == [r.reason for r in expected]
+    assert len(got) == (6 if refuse == "t5" else len(cmds))
+    assert batch.events == one.events
+    assert many_hook.single == [] and len(many_hook.batches) == 1
+    asked = many_hook.batches[0]
+    assert [pid for pid, _ in asked] == [c.point_id for c in cmds]  # the sensor ends them all
+    travels = [r.travel_m for r in expected if r.ok]
+    assert [length for _, length in asked][: len(travels)] == travels
