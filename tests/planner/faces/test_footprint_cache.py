@@ -87,3 +87,30 @@ def _tols() -> dict[str, float]:
         "max_deviation_m": detection.MAX_DEVIATION_M,
         "footprint_radius_m": 0.009,
     }
+
+
+def test_check_and_validate_keep_the_faces_of_the_plan_on_disk(
+    fresh: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The plan's face check before a validation (``preflight``, which ``wobjcal check``'s
+    point check shares) and the trials' setup keep detection's answer on disk: the next
+    command reads it (they computed it again in every command)."""
+    from calib.plan.file import load_plan
+    from planner.check.simulatable import check_simulatable, preflight, work_object_mesh
+    from planner.check.simulation_setup import simulation_setup
+
+    path = Path(__file__).resolve().parents[3] / "assets" / "plans" / "stator_section_ah.json"
+    plan = load_plan(path)
+    models = check_simulatable(plan)
+    mesh = work_object_mesh(plan, path.parent, models)
+    preflight(plan, models, mesh)
+    assert len(list((fresh / footprint_cache.CACHE_KIND).glob("*.npz"))) == 1
+
+    def no_rays(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the footprint test ran again")
+
+    monkeypatch.setattr(detection, "_cache", OrderedDict())  # a new command
+    monkeypatch.setattr(footprint, "holds_footprint", no_rays)
+    preflight(plan, models, mesh)
+    monkeypatch.setattr(detection, "_cache", OrderedDict())
+    assert simulation_setup(plan, models, mesh).faces is not None
