@@ -3,20 +3,23 @@
 Each case runs ``python3 -m planner validate PLAN --trials N --seed 1`` (the user's command: its
 defaults, i.e. the check before the run, 20 vetted trials and up to 2 workers) once in this
 tree and once in the reference tree (a git worktree of the reference commit, e.g.
-``git worktree add --detach /tmp/wt-b68 b68e00a``), then again, A B A B, so that both see the
+``git worktree add --detach ../wt-b68 b68e00a``: beside this tree, so that a plan's relative
+references to ``../shared/reference`` resolve there too), then again, A B A B, so that both see the
 same machine load; the ratio of each pair is reference / ours (> 1: ours is faster). Each
 command runs in its own tree with ``PYTHONPATH`` set to that tree, so neither picks up the
 other's code (checked before the runs: ``planner.__file__`` of each environment is recorded).
 The reference keeps its caches (numba kernels, distance fields, allowed-collision lists) in a
 directory of its own (``$TMPDIR/wobjcal-cache-<tree name>``): numba keeps one version of the
 kernels per cache directory and deletes the others, so the two trees sharing one would compile
-their kernels at every turn. An untimed run of each side first fills both caches.
+their kernels at every turn. An untimed run of each side first fills both caches. A pair where
+either side refuses the command (exit code 2: e.g. a reference tree where the plan's mesh is
+not found) gives no ratio: the case is recorded as ``void`` with the refusal.
 
 The load average is read before and after every command (``os.getloadavg``): the machine is
 shared, so the pairs, not the absolute seconds, are the measurement.
 
-    python -m bench.bench_validate_vs_reference --reference /tmp/wt-b68
-    python -m bench.bench_validate_vs_reference --reference /tmp/wt-b68 --trials 10000 \\
+    python -m bench.bench_validate_vs_reference --reference ../wt-b68
+    python -m bench.bench_validate_vs_reference --reference ../wt-b68 --trials 10000 \\
         --repeats 1 --cases stator
 """
 
@@ -109,6 +112,15 @@ def compare(
         if a["exit_code"] == 2:  # bad input (e.g. over the run-size budget): nothing to time
             return {"plan": plan, "trials": trials, "refused": a["error"]}
         b = run_command(reference, plan, trials, seed)
+        if b["exit_code"] == 2 or a["exit_code"] == 2:  # one side did not run the plan
+            why = b["error"] or a["error"]
+            print(f"{plan}: no ratio, a command was refused: {why}", flush=True)
+            return {
+                "plan": plan,
+                "trials": trials,
+                "void": why,
+                "pairs": [{"ours": a, "reference": b}],
+            }
         pairs.append({"ours": a, "reference": b, "ratio": round(b["wall_s"] / a["wall_s"], 3)})
         print(
             f"{plan} x{trials} #{k + 1}: ours {a['wall_s']:.1f} s, reference {b['wall_s']:.1f} s,"
