@@ -29,6 +29,7 @@ from numpy.typing import NDArray
 
 from calib.errors import InputError, ProbeFailedError
 from calib.frames import motion_between
+from calib.probing import SearchCommand
 from calib.procedures.comparison import FedFit
 from planner.program.execute import execute
 from planner.program.model import FACE_APPROACH
@@ -115,7 +116,25 @@ class TrialRunner:
 
         ``seed`` may be a pair ``(noise, position)``: the misplacement is then drawn from the
         position seed, so trials that share it see the same part pose (the paper's protocol).
+
+        A hook that vets many paths at once (a ``many`` method: the cell's
+        :class:`~planner.sim.search_events.ProgramSearchHook`) is asked after the trial, about
+        every path the trial ran, in one call; only when it refuses one is the trial run again
+        with the hook asked search by search, to stop where the robot would. A hook's pass
+        changes nothing in a trial (it draws no noise and records no event), so the result is
+        the one the hook asked search by search gives.
         """
+        many = getattr(reach, "many", None)
+        if reach is None or many is None:
+            return self._run(seed, reach)
+        asked = _PathsRun()
+        result = self._run(seed, asked)
+        if all(why is None for why in many(asked.commands)):
+            return result
+        return self._run(seed, reach)
+
+    def _run(self, seed: TrialSeed, reach: ReachabilityHook | None) -> TrialResult:
+        """:meth:`run_trial` with ``reach`` asked search by search."""
         setup = self.setup
         noise_seed, position_seed = seed if isinstance(seed, tuple) else (seed, None)
         rng = np.random.default_rng(noise_seed)
@@ -176,6 +195,21 @@ class TrialRunner:
     ) -> list[TrialResult]:
         """Trials of ``seeds`` in order."""
         return [self.run_trial(s, reach) for s in seeds]
+
+
+class _PathsRun:
+    """A reachability hook that passes every path and keeps them (:meth:`TrialRunner.run_trial`
+    asks the real hook about all of them at once afterwards)."""
+
+    def __init__(self) -> None:
+        self.commands: list[SearchCommand] = []
+
+    def __call__(self, command: SearchCommand) -> None:
+        self.commands.append(command)
+
+    def many(self, commands: Sequence[SearchCommand]) -> list[None]:
+        self.commands.extend(commands)
+        return [None] * len(commands)
 
 
 def search_failure(exc: ProbeFailedError, events: Sequence[ProbeEvent]) -> SearchFailure:
