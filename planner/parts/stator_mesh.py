@@ -10,6 +10,7 @@ the result is watertight by construction, with outward normals.
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -187,15 +188,33 @@ def build_stator_mesh(geom: StatorGeometry, deformed: bool = True) -> trimesh.Tr
         deformed: apply the tightening-bolt bulge to the side face.
 
     Returns:
-        The mesh; its side face lies at ``x = side_face_offset_m(y, z)`` (``x = 0`` undeformed).
+        A new mesh each call (the caller may change it); its side face lies at
+        ``x = side_face_offset_m(y, z)`` (``x = 0`` undeformed). The triangulation is kept per
+        geometry (a few of them in this process): ``wobjcal validate`` builds the part for the
+        trials and again for its cell.
     """
-    grid = side_face_grid(geom)
-    vertices, faces = triangulate_section(grid, geom.depth_m)
-    if deformed:
-        front = vertices[:, 0] == 0.0
-        vertices[front, 0] = geom.side_face_offset_m(vertices[front, 1], vertices[front, 2])
-    mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=True, validate=False)
-    return mesh
+    key = (geom, deformed)
+    with _built_lock:
+        kept = _built.get(key)
+    if kept is None:
+        grid = side_face_grid(geom)
+        vertices, faces = triangulate_section(grid, geom.depth_m)
+        if deformed:
+            front = vertices[:, 0] == 0.0
+            vertices[front, 0] = geom.side_face_offset_m(vertices[front, 1], vertices[front, 2])
+        mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=True, validate=False)
+        kept = (np.array(mesh.vertices), np.array(mesh.faces))
+        with _built_lock:
+            _built[key] = kept
+            while len(_built) > _BUILT_SIZE:
+                _built.pop(next(iter(_built)))
+    return trimesh.Trimesh(vertices=kept[0].copy(), faces=kept[1].copy(), process=False)
+
+
+#: The processed vertices and faces of the last few stator meshes built, by (geometry, deformed).
+_built: dict[tuple[StatorGeometry, bool], tuple[NDArray[np.float64], NDArray[np.int64]]] = {}
+_built_lock = threading.Lock()
+_BUILT_SIZE = 4
 
 
 def full_section_mesh() -> trimesh.Trimesh:
