@@ -39,6 +39,27 @@ def browser() -> Iterator[Any]:
         b.close()
 
 
+@pytest.fixture(scope="module", autouse=True)
+def server_memory_only(request: pytest.FixtureRequest) -> Iterator[None]:
+    """The validate panel's memory budget counts what this module's UI adds to the process.
+
+    The UI server runs inside the pytest worker, which has held every earlier test's arrays,
+    cells and caches (3 GB late in a full run): the panel read that as the server's and refused
+    a 40-trial validation as over its 2 GB budget, and the test waited 120 s for a run that never
+    started. The budget itself is tested in ``tests/webui/test_webui_validate_budget.py``.
+    """
+    from webui import validate_panel
+
+    real = validate_panel._rss_bytes
+    baseline = real()
+    mp = pytest.MonkeyPatch()
+    mp.setattr(validate_panel, "_rss_bytes", lambda: max(real() - baseline, 0))
+    try:
+        yield
+    finally:
+        mp.undo()
+
+
 @pytest.fixture(scope="session")
 def box_plan_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A 3-2-1 plan on a box work object (mesh file next to the plan)."""
