@@ -73,6 +73,15 @@ def planner_file(tree: Path) -> str:
     return out.stdout.strip()
 
 
+def _commit(tree: Path) -> str:
+    """The commit ``tree`` is at, ``+`` when its tracked files differ from it."""
+    head = subprocess.run(
+        ["git", "rev-parse", "--short", "HEAD"], cwd=tree, capture_output=True, text=True
+    ).stdout.strip()
+    dirty = subprocess.run(["git", "diff", "--quiet", "HEAD", "--", "*.py"], cwd=tree).returncode
+    return head + ("+" if dirty else "")
+
+
 def _last_line(text: str) -> str:
     return (text.strip().splitlines() or [""])[-1]
 
@@ -112,14 +121,13 @@ def compare(
         if a["exit_code"] == 2:  # bad input (e.g. over the run-size budget): nothing to time
             return {"plan": plan, "trials": trials, "refused": a["error"]}
         b = run_command(reference, plan, trials, seed)
-        if b["exit_code"] == 2 or a["exit_code"] == 2:  # one side did not run the plan
-            why = b["error"] or a["error"]
-            print(f"{plan}: no ratio, a command was refused: {why}", flush=True)
+        if b["exit_code"] == 2:  # the reference did not run the plan: no ratio
+            print(f"{plan}: no ratio, the reference refused it: {b['error']}", flush=True)
             return {
                 "plan": plan,
                 "trials": trials,
-                "void": why,
-                "pairs": [{"ours": a, "reference": b}],
+                "void": b["error"],
+                "pairs": [*pairs, {"ours": a, "reference": b}],
             }
         pairs.append({"ours": a, "reference": b, "ratio": round(b["wall_s"] / a["wall_s"], 3)})
         print(
@@ -171,14 +179,16 @@ def main(argv: list[str] | None = None) -> int:
             "command": "python3 -m planner validate PLAN --trials N --seed 1 (defaults otherwise)",
         }
     )
+    ours_commit = _commit(ROOT)
     for case in args.cases.split(","):
         plan = CASES[case]
         if not args.no_warmup:  # numba kernels into the caches of both trees
             run_command(ROOT, plan, 50, args.seed)
             run_command(reference, plan, 50, args.seed)
-        result[f"{case}_{args.trials}"] = compare(
-            ROOT, reference, plan, args.trials, args.repeats, args.seed
-        )
+        result[f"{case}_{args.trials}"] = {
+            "ours_commit": ours_commit,
+            **compare(ROOT, reference, plan, args.trials, args.repeats, args.seed),
+        }
         write_result(out_path, result, echo=False)  # after every case: a long run keeps its part
     write_result(out_path, result)
     return 0

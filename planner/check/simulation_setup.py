@@ -32,6 +32,8 @@ def simulation_setup(
     """What every trial of ``plan`` shares (the part ``mesh`` in wobj, metres) for the program
     of the controller ``fmt`` (``None``: the default), with the x-offset run's targets on the
     stator's bulged slot holes when the plan has one."""
+    from planner.cell import disk_cache  # the faces' footprint test, kept across commands
+
     xo = getattr(models.settings, "xoffset", None)
     xs = None
     if xo is not None and models.geometry is not None:
@@ -44,8 +46,6 @@ def simulation_setup(
             )
         # the true hole of each target: at its y and z, pushed out by the bolts' bulge
         xs = xoffset_setup(xo, np.stack([g.side_face_offset_m(y, z), y, z], axis=-1))
-    from planner.cell import disk_cache  # the faces' footprint test, kept across commands
-
     px = tuple(RolePoint("xoffset", p) for row in (xs.points if xs else ()) for p in row)
     return dataclasses.replace(
         prediction_setup(plan, models, fmt),

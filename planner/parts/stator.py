@@ -74,6 +74,8 @@ class StatorGeometry:
     reach_length_m: float = 1.000
 
     def __post_init__(self) -> None:
+        # a tuple, whatever sequence was given: the geometry is a key (its mesh is kept by it)
+        object.__setattr__(self, "bolt_slots", tuple(int(k) for k in self.bolt_slots))
         for name in (
             "length_m",
             "height_m",

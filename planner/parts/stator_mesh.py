@@ -211,7 +211,8 @@ def build_stator_mesh(geom: StatorGeometry, deformed: bool = True) -> trimesh.Tr
     return trimesh.Trimesh(vertices=kept[0].copy(), faces=kept[1].copy(), process=False)
 
 
-#: The processed vertices and faces of the last few stator meshes built, by (geometry, deformed).
+#: The processed vertices and faces of stator meshes built, by (geometry, deformed); the oldest
+#: built is dropped first.
 _built: dict[tuple[StatorGeometry, bool], tuple[NDArray[np.float64], NDArray[np.int64]]] = {}
 _built_lock = threading.Lock()
 _BUILT_SIZE = 4

@@ -116,7 +116,20 @@ def program_search_hook(
 class ProgramSearchHook:
     """The hook of :func:`program_search_hook`: called with one search, or with many through
     :meth:`many` (the same verdicts, the cell's paths checked together:
-    ``cell.check_searches``)."""
+    ``cell.check_searches``).
+
+    Attributes:
+        cell: the open cell (a :class:`planner.cell.cell.Cell`, its work object where the part
+            really lies).
+        poses: the checked pose of each plan point, by plan id.
+        keys: the plan id of each search id (:func:`planner.program.model.search_keys`).
+        R_nom_T: ``(3, 3)`` the nominal part's rotation in the robot base frame, transposed
+            (``R_wobj_base``): turns a commanded frame's rotation into the turn from nominal.
+        tcp: the TCP that runs the searches.
+        step_m: the paths' sampling step, m.
+        other_searches: the plan point whose pose runs searches of no plan point (the
+            x-offset run), or ``None``: any rotation and branch.
+    """
 
     def __init__(
         self,
@@ -150,6 +163,8 @@ class ProgramSearchHook:
         return R @ pose.sensor_x_base
 
     def __call__(self, command: SearchCommand) -> Reason | None:
+        """``None`` when the robot can run ``command`` (base frame) with its point's pose,
+        else why not (the cell's kind and pair, worded after :data:`UNREACHABLE`)."""
         pose = self._pose(command)
         if isinstance(pose, Reason):
             return pose

@@ -156,16 +156,35 @@ class SimulatedSensor(ABC):
         return None if why is None else self._fail(cmd, why)
 
     def _vet_ahead(self, runs: Sequence[tuple[SearchCommand, float]]) -> list[Reason | None]:
-        """The hook's verdicts of searches ``(command, travel)`` not run yet, all at once (a
-        hook with a ``many`` method checks them together); no event is recorded. ``[]`` when
-        there is no hook. :meth:`_vet` then takes each search's verdict (``refusal=``)."""
+        """The hook's verdicts of searches ``(command, travel)`` that run in turn, asked before
+        they run, without recording any event (``[]`` when there is no hook).
+
+        A hook with a ``many`` method is asked about all of them at once (the cell checks
+        their paths together); another is asked one by one up to its first refusal, the paths
+        the robot runs. The verdicts end early where a hook raises: the search's own
+        :meth:`_vet` asks it again when the search runs, so it raises there, as without this.
+        The caller gives each search its verdict (:meth:`SimulatedProbe._succeed`'s
+        ``vetted``) and asks :meth:`_vet` for the searches past the list's end.
+        """
         if self.reachability is None or not runs:
             return []
         ran = [replace(cmd, length_m=max(travel, 1e-6)) for cmd, travel in runs]
         many = getattr(self.reachability, "many", None)
         if many is not None:
-            return list(many(ran))
-        return [self.reachability(c) for c in ran]
+            try:
+                return list(many(ran))
+            except Exception:  # asked again, and raised, where the search runs
+                return []
+        out: list[Reason | None] = []
+        for cmd in ran:
+            try:
+                why = self.reachability(cmd)
+            except Exception:  # as above
+                break
+            out.append(why)
+            if why is not None:
+                break
+        return out
 
     def _landing(
         self, cmd: SearchCommand, triangles: NDArray[np.int64] | None

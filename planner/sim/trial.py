@@ -122,16 +122,20 @@ class TrialRunner:
         every path the trial ran, in one call; only when it refuses one is the trial run again
         with the hook asked search by search, to stop where the robot would. A hook's pass
         changes nothing in a trial (it draws no noise and records no event), so the result is
-        the one the hook asked search by search gives.
+        the one the hook asked search by search gives. Anything raised on the way (by the
+        trial run without the hook, or by ``many``) runs the trial again search by search too:
+        it then raises, or fails the trial, where the robot's run would.
         """
         many = getattr(reach, "many", None)
         if reach is None or many is None:
             return self._run(seed, reach)
         asked = _PathsRun()
-        result = self._run(seed, asked)
-        if all(why is None for why in many(asked.commands)):
-            return result
-        return self._run(seed, reach)
+        try:
+            result = self._run(seed, asked)
+            passed = all(why is None for why in many(asked.commands))
+        except Exception:  # the search-by-search run below says what it is
+            passed = False
+        return result if passed else self._run(seed, reach)
 
     def _run(self, seed: TrialSeed, reach: ReachabilityHook | None) -> TrialResult:
         """:meth:`run_trial` with ``reach`` asked search by search."""

@@ -1,8 +1,10 @@
 """Many search paths at once, each run with its program's pose: the vetting of simulated searches.
 
-A simulated trial's x-offset run commands 42 searches, each vetted in the cell with the sensor
-rotation and IK branch of the point's checked pose (:func:`planner.sim.search_events.
-program_search_hook`): :func:`check_searches` gives, for each, exactly what
+A vetted simulated trial runs about 54 searches (the A-H program's and the x-offset run's 42),
+each vetted in the cell with the sensor rotation and IK branch of the point's checked pose
+(:func:`planner.sim.search_events.program_search_hook`), all of them in one call after the trial
+(:meth:`planner.sim.trial.TrialRunner.run_trial`): :func:`check_searches` gives, for each,
+exactly what
 :func:`~planner.cell.probe.search_paths.check_search` gives with that pose, ``max_starts=1``
 and ``exact_clearance=False``, but solves the IK of all starts in one call, of all paths'
 samples in another, and runs the broad phase once over every sample
@@ -26,6 +28,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from calib.arguments import check_positive, check_shape, check_vector3
 from calib.frames import invert_transform
 from planner.cell.broad import first_failures
 from planner.cell.probe.feasibility import singular, tcp_frames
@@ -117,6 +120,9 @@ def check_searches(
             done = _batched(cell, searches, batch, step_m, max_joint_jump_rad, tcp, margin_m)
             for i, res in done:
                 out[i] = res if res is not None else one(i)
+    missing = [i for i, r in enumerate(out) if r is None]
+    if missing:  # every search is answered above, batched or alone
+        raise RuntimeError(f"searches {missing} were not checked")
     return [r for r in out if r is not None]
 
 
@@ -132,8 +138,6 @@ def _batched(
     """The searches ``batch`` (indices into ``searches``) checked together; ``None`` for a
     search whose start has no usable solution (the caller asks :func:`check_search`, which
     words the reason)."""
-    from calib.arguments import check_positive, check_vector3
-
     step = check_positive(step_m, "step_m")
     jump = check_positive(max_joint_jump_rad, "max_joint_jump_rad")
     margin = DEFAULT_MARGIN_M if margin_m is None else check_positive(margin_m, "margin_m", True)
@@ -169,7 +173,7 @@ def _batched(
         if not ok.any():
             q_start.append(None)
             continue
-        ref = np.asarray(ps.q_ref, dtype=float)
+        ref = check_shape(ps.q_ref, (cell.chain.n_joints,), "q_ref")
         motion = np.where(ok, np.abs(np.nan_to_num(starts.q[row] - ref)).max(axis=-1), np.inf)
         q_start.append(starts.q[row, int(np.argmin(motion))])
     # the paths: one IK call over every sample of the searches that start

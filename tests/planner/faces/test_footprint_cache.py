@@ -92,9 +92,9 @@ def _tols() -> dict[str, float]:
 def test_check_and_validate_keep_the_faces_of_the_plan_on_disk(
     fresh: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """The plan's face check before a validation (``preflight``, which ``wobjcal check``'s
-    point check shares) and the trials' setup keep detection's answer on disk: the next
-    command reads it (they computed it again in every command)."""
+    """The plan's face check before a validation (``preflight``), the trials' setup and
+    ``wobjcal check``'s point check keep detection's answer on disk: the next command reads it
+    (they computed it again in every command)."""
     from calib.plan.file import load_plan
     from planner.check.simulatable import check_simulatable, preflight, work_object_mesh
     from planner.check.simulation_setup import simulation_setup
@@ -114,3 +114,7 @@ def test_check_and_validate_keep_the_faces_of_the_plan_on_disk(
     preflight(plan, models, mesh)
     monkeypatch.setattr(detection, "_cache", OrderedDict())
     assert simulation_setup(plan, models, mesh).faces is not None
+    monkeypatch.setattr(detection, "_cache", OrderedDict())
+    from planner.check.job import check_plan
+
+    assert all(c.face_cause is None for c in check_plan(plan, path.parent).points)

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from calib.errors import NonFiniteError
 from calib.plan.file import load_plan
 from calib.probing import SearchCommand
 from planner.check.simulatable import check_simulatable, work_object_mesh
@@ -85,3 +86,24 @@ def test_a_hook_of_many_paths_gives_the_trial_of_a_hook_asked_one_by_one(
         failed = expected.failed_search or expected.xoffset_failed_search
         assert failed is not None and failed.search == refuse
         assert failed.cause.kind == "collision"
+
+
+class _RaisingManyHook(_ManyHook):
+    """Asked about many paths at once it raises; asked one by one it refuses ``refuse``."""
+
+    def many(self, cmds: list[SearchCommand]) -> list[Reason | None]:
+        self.batches.append(len(cmds))
+        raise NonFiniteError("a path's pose is not finite")
+
+
+def test_a_hook_that_raises_when_asked_for_many_gives_the_trial_asked_one_by_one(
+    runner: TrialRunner,
+) -> None:
+    """What ``many`` raises does not escape the trial: it runs again search by search, as the
+    hook asked one by one gives it (here the refusal of F)."""
+    seed = np.random.SeedSequence(11)
+    expected = runner.run_trial(seed, _Hook("F"))
+    hook = _RaisingManyHook("F")
+    _same(runner.run_trial(seed, hook), expected)
+    assert hook.batches and hook.single > 0
+    assert expected.failed_search is not None and expected.failed_search.search == "F"
