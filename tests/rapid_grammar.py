@@ -5,8 +5,9 @@ written here), allowing for the two RAPID constructs that tool does not know.
   tool ends the string there. Each ``""`` inside a string is replaced by ``'`` first.
 - An array index is any integer expression in RAPID (``nH{(r+1)*(c-1)+c}``); the tool takes
   only a literal or a name. Each index that is not is replaced by a name, innermost first,
-  and every expression taken out is checked by the tool on its own as the right-hand side of
-  an assignment (``xIdx:=<expression>;``), so nothing escapes the grammar.
+  and every expression taken out is checked by the tool as the right-hand side of an
+  assignment (``xIdx:=<expression>;``: all of them in one routine, each on its own when that
+  fails, to name it), so nothing escapes the grammar.
 
 Everything else, from the module's layout (data declarations before routines) to every
 statement, is the tool's verdict. Indentation is checked at the module's 4 spaces.
@@ -83,10 +84,17 @@ def rapid_errors(text: str) -> list[str]:
     check_format = _checker()
     module, taken = _normalised(text)
     out = [f"module {e}" for e in check_format(module)]
-    for expr in sorted(set(taken)):
-        probe = (
-            "MODULE WobjcalIndex\n    VAR num xIdx;\n\n    PROC p()\n"
-            f"        xIdx:={expr};\n    ENDPROC\nENDMODULE\n"
-        )
-        out += [f"index {expr!r}: {e}" for e in check_format(probe)]
+    exprs = sorted(set(taken))
+    # all index expressions in one routine first (one parse, not one per expression: a
+    # routine's statements parse each on its own, so it passes exactly when each does); only
+    # when it fails is each checked alone, to name the ones that fail (and where)
+    if exprs and check_format(_index_probe(exprs)):
+        for expr in exprs:
+            out += [f"index {expr!r}: {e}" for e in check_format(_index_probe([expr]))]
     return out
+
+
+def _index_probe(exprs: list[str]) -> str:
+    """A module whose routine assigns each of ``exprs`` to an index variable."""
+    body = "".join(f"        xIdx:={expr};\n" for expr in exprs)
+    return f"MODULE WobjcalIndex\n    VAR num xIdx;\n\n    PROC p()\n{body}    ENDPROC\nENDMODULE\n"
