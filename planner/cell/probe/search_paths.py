@@ -125,19 +125,12 @@ def check_search(
         zero direction or sensor axis; UnknownFrameError: unknown TCP.
     """
 
-    start = check_vector3(command.start_m, "command.start_m")
-    direction = unit_vector(command.direction, "command.direction")
-    axis = unit_vector(command.sensor_axis, "command.sensor_axis")
-    length = check_positive(command.length_m, "command.length_m")
     step = check_positive(step_m, "step_m")
+    start, direction, axis, s, skip_from = sampled_path(command, step)
     jump = check_positive(max_joint_jump_rad, "max_joint_jump_rad")
     margin = DEFAULT_MARGIN_M if margin_m is None else check_positive(margin_m, "margin_m", True)
-    nominal = check_vector3(command.nominal_m, "command.nominal_m")
     ref = cell.home_q if q_ref is None else check_shape(q_ref, (cell.chain.n_joints,), "q_ref")
     T_tcp_flange = invert_transform(cell.T_flange_tcp(tcp))
-    s = np.linspace(0.0, length, math.ceil(length / step - 1e-9) + 1)
-    s_nominal = float((nominal - start) @ direction)
-    skip_from = s_nominal + 1e-9 if command.kind == "approach" else np.inf
     if sensor_x is None:
         rot_step = math.radians(check_positive(rotation_step_deg, "rotation_step_deg"))
         angles = np.arange(0.0, 2 * np.pi - 1e-9, rot_step)
@@ -233,6 +226,29 @@ def _walk(
             fail_j, reason = j, cl.reason()
             break
     return path_verdict(s, q_path, fail_j, reason, rotation, branch, min_cl)
+
+
+def sampled_path(
+    command: SearchCommand, step_m: float
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, float]:
+    """A search's checked path: ``(start (3,), unit direction (3,), unit sensor axis (3,),
+    s (M,), skip_from)``, base frame, m: the samples' distances from the start at ``<=
+    step_m``, and the distance past which an approach is not checked against the work object
+    (its nominal point; ``inf`` for an edge search).
+
+    Raises:
+        ShapeError, NonFiniteError: bad vectors; DegenerateGeometryError: a zero direction or
+        sensor axis; a length that is not positive.
+    """
+    start = check_vector3(command.start_m, "command.start_m")
+    direction = unit_vector(command.direction, "command.direction")
+    axis = unit_vector(command.sensor_axis, "command.sensor_axis")
+    length = check_positive(command.length_m, "command.length_m")
+    nominal = check_vector3(command.nominal_m, "command.nominal_m")
+    s = np.linspace(0.0, length, math.ceil(length / step_m - 1e-9) + 1)
+    s_nominal = float((nominal - start) @ direction)
+    skip_from = s_nominal + 1e-9 if command.kind == "approach" else math.inf
+    return start, direction, axis, s, skip_from
 
 
 def follow_branch(

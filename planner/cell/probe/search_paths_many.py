@@ -37,8 +37,8 @@ from planner.cell.probe.search_paths import (
     check_search,
     follow_branch,
     path_verdict,
+    sampled_path,
     sensor_angle,
-    unit_vector,
 )
 from planner.cell.scene import DEFAULT_MARGIN_M
 
@@ -145,21 +145,14 @@ def _batched(
     # per search, as check_search computes it: the samples and the start frame
     s_of, frames, skip_of, angle_of = [], [], [], []
     for i in batch:
-        cmd = searches[i].command
-        start = check_vector3(cmd.start_m, "command.start_m")
-        direction = unit_vector(cmd.direction, "command.direction")
-        axis = unit_vector(cmd.sensor_axis, "command.sensor_axis")
-        length = check_positive(cmd.length_m, "command.length_m")
-        nominal = check_vector3(cmd.nominal_m, "command.nominal_m")
-        s = np.linspace(0.0, length, math.ceil(length / step - 1e-9) + 1)
-        s_nominal = float((nominal - start) @ direction)
+        start, direction, axis, s, skip_from = sampled_path(searches[i].command, step)
         angle = sensor_angle(check_vector3(searches[i].sensor_x, "sensor_x"), start, axis)
         T_start = tcp_frames(start[None], -axis[None], np.array([angle]))[0, 0]
         T_path = T_start[None].repeat(s.size, axis=0)
         T_path[:, :3, 3] = start + s[:, None] * direction
         s_of.append(s)
         frames.append(T_path @ T_tcp_flange)  # (M, 4, 4) flange poses; the first is the start
-        skip_of.append(s_nominal + 1e-9 if cmd.kind == "approach" else np.inf)
+        skip_of.append(skip_from)
         angle_of.append(angle)
     # the starts: one IK call; each search's start solution nearest its reference (max-abs)
     starts = cell.solver.solve(np.stack([f[0] for f in frames]))
