@@ -51,8 +51,8 @@ def run_validation(
     """Simulate the plan's calibration ``trials`` times with its error models and seed.
 
     The same :func:`planner.validate.job.validate_plan` as ``wobjcal validate`` (the same mesh,
-    loaded from the plan, the same check first), with one in-process worker (no ``fork()`` of
-    a threaded server). A plan ``wobjcal check`` refuses is simulated anyway, as
+    loaded from the plan, the same check first), with one in-process worker (no worker
+    processes beside a threaded server). A plan ``wobjcal check`` refuses is simulated anyway, as
     ``validate --force`` does: the report and the headline say check refuses it and why.
 
     Raises:

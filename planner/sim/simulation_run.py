@@ -199,6 +199,14 @@ class SimulationRun:
         )
 
 
+def pool_workers(n_seeds: int, vetted: int, workers: int | None) -> int:
+    """Worker processes a run of ``n_seeds`` trials (the protocol's included) starts, the
+    first ``vetted`` of them run in this process: ``workers`` (default ``min(2, cpus)``), or
+    1 when fewer than :data:`MIN_POOL_TRIALS` trials would go to them."""
+    n_workers = min(2, os.cpu_count() or 1) if workers is None else max(1, int(workers))
+    return 1 if n_seeds - min(int(vetted), n_seeds) < MIN_POOL_TRIALS else n_workers
+
+
 def start_simulation(
     setup: SimulationSetup,
     mesh: trimesh.Trimesh,
@@ -244,10 +252,8 @@ def start_simulation(
         base = np.random.SeedSequence(int(rng.integers(2**63)))
         for pos in base.spawn(protocol[0]):
             seeds += [(noise, pos) for noise in pos.spawn(protocol[1])]
-    n_workers = min(2, os.cpu_count() or 1) if workers is None else max(1, int(workers))
     n_reach = min(int(vetted), n_trials)
-    if len(seeds) - n_reach < MIN_POOL_TRIALS:
-        n_workers = 1
+    n_workers = pool_workers(len(seeds), n_reach, workers)
     pool = None
     if n_workers > 1:  # the prediction first, on a worker: off this process's critical path
         pool = TrialPool(run_setup, mesh, seeds[n_reach:], n_workers, predict_setup=setup)

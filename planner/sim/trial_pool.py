@@ -1,6 +1,6 @@
 """Trials on worker processes, running in the background while this process does other work.
 
-:class:`TrialPool` forks its worker processes (:func:`planner.sim.pool.open_pool`, each with its
+:class:`TrialPool` starts its worker processes (:func:`planner.sim.pool.open_pool`, each with its
 own :class:`~planner.sim.trial.TrialRunner`, built once) and hands them every chunk of its
 trials at once, so they run while the caller does something else: ``wobjcal validate`` checks
 the plan in its cell, predicts and runs the trials it vets in the cell meanwhile
@@ -43,7 +43,7 @@ def chunk_size(total: int, n_workers: int) -> int:
 
 
 class TrialPool:
-    """The trials of ``seeds`` on ``n_workers`` forked worker processes, started at once.
+    """The trials of ``seeds`` on ``n_workers`` worker processes, started at once.
 
     Args:
         setup: what every trial shares (pickled to each worker).

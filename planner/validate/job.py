@@ -53,12 +53,13 @@ from planner.program.build import measuring_program
 from planner.program.model import search_keys
 from planner.sim.budget import check_run_size, run_size, sensitivity_runs
 from planner.sim.montecarlo import simulate
+from planner.sim.pool import prepare_pool
 from planner.sim.report import ValidationReport
 from planner.sim.report_points import report_rows
 from planner.sim.rows import RowSpec
 from planner.sim.search_events import ProgramPose, program_search_hook
 from planner.sim.sensitivity import SensitivityTable, sensitivity
-from planner.sim.simulation_run import SimulationRun, start_simulation
+from planner.sim.simulation_run import SimulationRun, pool_workers, start_simulation
 
 __all__ = [
     "ValidationModels",
@@ -96,7 +97,7 @@ def validate_plan(
         seed: seed of the ``numpy.random.Generator``; default ``plan.validation.seed``. The
             same plan, trials and seed give the same report, whatever ``workers``.
         workers: worker processes (``None``: up to 2; 1 runs in this process, as the web UI
-            does so as not to fork a threaded server).
+            does so as not to start processes beside a server).
         progress: ``progress(done_trials, total_trials)``, called as trials finish.
         reach_trials: also vet every commanded search of the first ``reach_trials`` trials
             in the plan's cell (reachability, joint limits, collisions with the part where it
@@ -180,13 +181,24 @@ def _start(
 ) -> _Started:
     """The preflight, the setup and the start of the Monte Carlo run of ``plan`` on ``part``
     (the first ``vetted`` trials wait to be vetted in the cell)."""
+    n = plan.validation.trials if trials is None else int(trials)
+    _prepare_workers(n, protocol, vetted, workers)
     preflight(plan, models, part)
     setup = simulation_setup(plan, models, part, fmt)
     rows = report_rows(plan.validation.report, part, models.geometry, setup.xoffset)
-    n = plan.validation.trials if trials is None else int(trials)
     rng = np.random.default_rng(plan.validation.seed if seed is None else seed)
     run = start_simulation(setup, part, n, rng, vetted=vetted, protocol=protocol, workers=workers)
     return _Started(run, rows, _published(models))
+
+
+def _prepare_workers(
+    n_trials: int, protocol: tuple[int, int] | None, vetted: int, workers: int | None
+) -> None:
+    """Start the workers' fork server now when the run will use workers, so that its imports
+    overlap the preflight (:func:`planner.sim.pool.prepare_pool`)."""
+    n_seeds = n_trials + (0 if protocol is None else protocol[0] * protocol[1])
+    if pool_workers(n_seeds, vetted, workers) > 1:
+        prepare_pool()
 
 
 def _published(models: ValidationModels) -> Mapping[tuple[str, float], float] | None:
@@ -249,18 +261,18 @@ def _simulate(
     progress: ProgressCallback | None,
     protocol: tuple[int, int] | None,
     fmt: str | None,
-    **vetting: Any,
 ) -> ValidationReport:
     """The preflight and the Monte Carlo run of ``plan`` on ``part``."""
+    n = plan.validation.trials if trials is None else int(trials)
+    _prepare_workers(n, protocol, 0, workers)
     preflight(plan, models, part)
     setup = simulation_setup(plan, models, part, fmt)
     rows = report_rows(plan.validation.report, part, models.geometry, setup.xoffset)
     paper = _published(models)
-    n = plan.validation.trials if trials is None else int(trials)
     rng = np.random.default_rng(plan.validation.seed if seed is None else seed)
     return simulate(
         setup, part, rows, n, rng, protocol=protocol, paper=paper, workers=workers,
-        progress=progress, **vetting,
+        progress=progress,
     )  # fmt: skip
 
 

@@ -43,10 +43,11 @@ def _start_validation() -> tuple[subprocess.Popen[bytes], set[int]]:
     workers: set[int] = set()
     while time.monotonic() < deadline and len(workers) < 2:
         time.sleep(0.2)
-        workers = _children(proc.pid)
+        # the workers are the fork server's children (planner.sim.pool)
+        workers = {w for c in _children(proc.pid) for w in _children(c)}
         assert proc.poll() is None, proc.stderr.read() if proc.stderr else ""
     assert len(workers) >= 2, "the validation never started its workers"
-    return proc, workers
+    return proc, workers | _children(proc.pid)
 
 
 def _gone(pids: set[int], timeout_s: float = 120.0) -> bool:

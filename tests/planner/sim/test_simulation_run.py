@@ -4,8 +4,12 @@ With worker processes the prediction runs on a worker while this process runs th
 trials; its failure used to surface only after every vetted trial had run (minutes with
 ``--reach-trials`` in the hundreds). The trials are counted, not timed: the real trials are
 replaced by a counting stub (the run never reaches its report). The prediction fails where a
-real one does, in its run of the plan's program on the ideal part, patched before the pool
-forks its workers so that they fail with it.
+real one does, in its run of the plan's program on the ideal part, patched in this process.
+
+The pool's workers normally come from a fork server, which knows nothing of a patch made here;
+these tests fork this process instead, so that the workers carry the patch, and stub the
+workers' trials out, so that no worker casts a ray (a forked child's first ray batch can hang
+on a lock that Embree's threads in this process held: :mod:`planner.sim.pool`).
 """
 
 from __future__ import annotations
@@ -18,7 +22,9 @@ import trimesh
 
 from bench.box_plans import POINT_SENSOR, box_mesh, box_plans
 from calib.errors import InputError, ProbeFailedError
+from planner.sim import pool as pool_module
 from planner.sim import predict as predict_module
+from planner.sim import trial_pool as trial_pool_module
 from planner.sim.report_points import report_rows
 from planner.sim.rows import RowSpec
 from planner.sim.setup import SimulationSetup
@@ -49,6 +55,11 @@ def _prediction_raises(monkeypatch: pytest.MonkeyPatch, exc: Exception) -> None:
     monkeypatch.setattr(predict_module, "execute", execute)
 
 
+def _no_trials(*args: object) -> list[object]:
+    """A worker's set-up and chunks, stubbed: the workers only predict."""
+    return []
+
+
 def _start(
     monkeypatch: pytest.MonkeyPatch,
     calls: list[TrialSeed],
@@ -56,7 +67,7 @@ def _start(
     exc: Exception = NOT_SMOOTH,
 ) -> tuple[SimulationRun, list[RowSpec]]:
     """A started two-worker run whose prediction raises ``exc`` and whose trials only count
-    themselves into ``calls`` (in this process; the workers fork with their own copy)."""
+    themselves into ``calls`` (in this process; the forked workers run none)."""
     started: list[SimulationRun] = []
 
     def counted(self: TrialRunner, seed: TrialSeed, reach: object) -> None:
@@ -68,6 +79,9 @@ def _start(
 
     _prediction_raises(monkeypatch, exc)
     monkeypatch.setattr(TrialRunner, "run_trial", counted)
+    monkeypatch.setattr(pool_module, "start_method", lambda: "fork")
+    monkeypatch.setattr(trial_pool_module, "init_worker", _no_trials)
+    monkeypatch.setattr(trial_pool_module, "run_chunk_in_worker", _no_trials)
     setup, mesh, rows = _box()
     n_trials = MIN_POOL_TRIALS + VETTED
     run = start_simulation(

@@ -1,0 +1,64 @@
+"""A validation's workers come from a fork server, never from a fork of a process that has cast
+rays (:mod:`planner.sim.pool`).
+
+Embree runs on TBB threads that stay alive after a ray batch. A validation in a pytest worker
+that had cast rays before forked its workers while one of those threads held TBB's lock, and
+both workers waited for it for ever at their first ray batch (the suite hung at 97 %). The hang
+needs a fork at the wrong instant, so no test makes it happen at will: these check that no
+plain fork is made, and that a process that has cast rays gets its trials back.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from planner.sim.pool import start_method
+
+REPO = Path(__file__).resolve().parents[3]
+
+
+def test_workers_never_fork_this_process() -> None:
+    expected = "forkserver" if "forkserver" in mp.get_all_start_methods() else None
+    assert start_method() == expected
+    assert start_method() != "fork"
+
+
+@pytest.mark.slow
+def test_a_process_that_cast_rays_gets_its_trials_back() -> None:
+    """Rays in this process first (Embree's threads start), then a validation on two workers;
+    a timeout stands for the hang."""
+    script = textwrap.dedent(
+        """
+        import numpy as np
+        from bench.box_plans import POINT_SENSOR, box_mesh, box_plans
+        from planner.sim.raycast import MeshRayCaster
+        from planner.validate.job import validate_plan
+
+        if __name__ == "__main__":
+            mesh = box_mesh()
+            caster = MeshRayCaster(mesh)
+            rng = np.random.default_rng(0)
+            for _ in range(20):  # Embree's TBB threads busy until just before the pool opens
+                o = rng.uniform(-2.0, 2.0, (20000, 3))
+                caster.first_hits(o, -o / np.linalg.norm(o, axis=1, keepdims=True))
+            plan = box_plans(POINT_SENSOR)["three_two_one"]
+            report = validate_plan(plan, trials=120, seed=3, mesh=mesh, workers=2)
+            print(report.n_ok)
+        """
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", script],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=180,
+        check=False,
+    )
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.split()[-1] == "120"
