@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import shapely
 import trimesh
 from scipy.spatial.transform import Rotation
 
@@ -210,3 +211,26 @@ def test_a_flat_face_too_small_for_the_sensor_says_so() -> None:
     assert on_boss.reason == (
         "on a flat face of 100.0 mm^2, too small for the 18 mm sensor (its face covers 254 mm^2)"
     )
+
+
+@pytest.mark.parametrize(
+    ("width_m", "room_to_spare"),
+    [(0.020, True), (0.0182, False)],  # the 18 mm sensor: 18.36 mm with room, 18 mm at all
+)
+def test_a_strip_meshed_as_two_long_triangles_holds_the_sensor_on_its_centre_line(
+    width_m: float, room_to_spare: bool
+) -> None:
+    """No triangle centroid of a 200 mm strip meshed as two triangles lies on its centre line:
+    a 20 mm strip is found by a spot with room to spare, an 18.2 mm one only by the centre of
+    its largest inscribed circle (the cheap spot has no room there)."""
+    from planner.faces.footprint import DEFAULT_FOOTPRINT_RADIUS_M as r
+    from planner.faces.footprint import _roomiest_spot, _spot_with_room
+
+    strip = trimesh.creation.box(extents=(0.2, width_m, 0.010))
+    pf = find_planar_faces(strip, name="strip")
+    normals = sorted(tuple(np.round(f.normal, 6) + 0.0) for f in pf.faces)
+    assert normals == [(0.0, 0.0, -1.0), (0.0, 0.0, 1.0)]
+    outline = shapely.box(-0.1, -width_m / 2, 0.1, width_m / 2)
+    assert (_spot_with_room(outline, r) is not None) == room_to_spare
+    centre = _roomiest_spot(outline, r)
+    assert centre is not None and abs(centre[1]) < 0.02 * r
