@@ -30,6 +30,19 @@ CHROMIUM_ARGS = [
     "--no-first-run",
 ]
 VIEWPORT = {"width": 1100, "height": 720}
+#: The page's WebGL contexts without multisampling: the scene is drawn by SwiftShader on the
+#: CPU, and its 4x multisampling took about two thirds of that (the demo module: 36 of 39 s of
+#: Chromium's CPU in the rasteriser's threads, 16 s without it). Only edges are drawn
+#: differently, as on a GPU without multisampling.
+NO_MSAA_JS = """
+(() => {
+  const get = HTMLCanvasElement.prototype.getContext;
+  HTMLCanvasElement.prototype.getContext = function (kind, attrs) {
+    if (kind === "webgl2" || kind === "webgl") attrs = { ...(attrs || {}), antialias: false };
+    return get.call(this, kind, attrs);
+  };
+})();
+"""
 REPO = Path(__file__).resolve().parents[2]
 #: How long a test waits for a condition before it fails, s (generous: a loaded machine).
 TIMEOUT_S = 120.0
@@ -105,6 +118,7 @@ def start_ui(plan: Path | None, tmp_path: Path) -> WobjcalApp:
 def open_page(browser: Any, app: WobjcalApp) -> UiSession:
     """Open a page on ``app`` and wait until its canvas is there and it is connected."""
     page = browser.new_page(viewport=VIEWPORT, accept_downloads=True)
+    page.add_init_script(NO_MSAA_JS)
     page.set_default_timeout(TIMEOUT_S * 1000)  # every Playwright wait: generous under load
     url = f"http://127.0.0.1:{app.server.get_port()}/"
     page.goto(url)
