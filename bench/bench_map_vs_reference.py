@@ -33,7 +33,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-from bench.reference_tree import ROOT, run_header, run_in_tree
+from bench.reference_tree import ROOT, adopt_orphans, run_header, run_in_tree
 from bench.result_file import write_result
 
 RESULTS = ROOT / "bench" / "results"
@@ -120,6 +120,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--inner", type=int, default=3, help="timed maps per warm process")
     ap.add_argument("--out", type=Path, default=None, help="result file (default by --name)")
     args = ap.parse_args(argv)
+    adopt_orphans()  # a fork server's CPU counts too (bench.reference_tree.reap_orphans)
     ours, reference = args.ours.resolve(), args.reference.resolve()
     out_path = args.out or RESULTS / f"map_vs_{args.name}.json"
     result: dict[str, Any] = json.loads(out_path.read_text()) if out_path.exists() else {}

@@ -37,6 +37,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from bench.reference_tree import adopt_orphans, reap_orphans
 from bench.result_file import write_result
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -98,7 +99,9 @@ def run_command(tree: Path, plan: str, trials: int, seed: int) -> dict[str, Any]
     load0 = os.getloadavg()[0]
     cpu0, t0 = _children_cpu_s(), time.perf_counter()
     proc = subprocess.run(argv, cwd=tree, env=_env(tree), capture_output=True, text=True)
-    wall, cpu = time.perf_counter() - t0, _children_cpu_s() - cpu0
+    wall = time.perf_counter() - t0
+    reap_orphans()  # the fork server and its workers' CPU (adopt_orphans, in main)
+    cpu = _children_cpu_s() - cpu0
     return {
         "wall_s": round(wall, 3),
         "cpu_s": round(cpu, 3),
@@ -165,6 +168,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--no-warmup", action="store_true")
     args = ap.parse_args(argv)
+    adopt_orphans()  # a fork server's CPU counts too (bench.reference_tree.reap_orphans)
     reference = args.reference.resolve()
     where = {"ours": planner_file(ROOT), "reference": planner_file(reference)}
     if not where["ours"].startswith(str(ROOT)) or not where["reference"].startswith(str(reference)):
