@@ -86,6 +86,9 @@ def _die_with(parent: int) -> None:
     import threading
     import time
 
+    if os.name != "posix":  # (os.kill(pid, 0) would end the process on Windows)
+        return
+
     def alive() -> bool:
         try:
             os.kill(parent, 0)
