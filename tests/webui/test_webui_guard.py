@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import ast
 import logging
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
@@ -132,17 +132,6 @@ CONTROLS: dict[str, tuple[str, str, Any]] = {
     "CalibratePanel": ("upload", "calibrate", _UPLOAD),
     "LayoutPanel": ("suggest_button", "suggest", None),
 }
-
-
-@pytest.fixture(scope="module")
-def app(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
-    from webui.server import run
-    from webui.testing import box_plan, free_port
-
-    folder = tmp_path_factory.mktemp("guard")
-    a = run(box_plan(folder), port=free_port(), block=False, autosave_path=folder / "auto.json")
-    yield a
-    a.stop()
 
 
 def _failing(exc: Exception) -> Callable[..., None]:

@@ -2,23 +2,11 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
 import pytest
 from viser import _messages
 
 from webui.app import WobjcalApp
 from webui.files_panel import MAX_UPLOAD_BYTES
-from webui.server import run
-from webui.testing import box_plan, free_port
-
-
-@pytest.fixture(scope="module")
-def app(tmp_path_factory: pytest.TempPathFactory) -> Iterator[WobjcalApp]:
-    folder = tmp_path_factory.mktemp("guard")
-    a = run(box_plan(folder), port=free_port(), block=False, autosave_path=folder / "auto.json")
-    yield a
-    a.stop()
 
 
 def _send(app: WobjcalApp, message: object) -> None:

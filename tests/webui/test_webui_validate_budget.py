@@ -3,24 +3,12 @@ naming what it holds, before anything runs."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from typing import Any
 
 import pytest
 
 from calib.errors import InputError
 from calib.plan.file import PlanError
-
-
-@pytest.fixture(scope="module")
-def app(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
-    from webui.server import run
-    from webui.testing import box_plan, free_port
-
-    folder = tmp_path_factory.mktemp("budget")
-    a = run(box_plan(folder), port=free_port(), block=False, autosave_path=folder / "auto.json")
-    yield a
-    a.stop()
 
 
 def test_a_server_holding_most_of_the_budget_refuses_a_validation(
