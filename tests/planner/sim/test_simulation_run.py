@@ -14,7 +14,9 @@ on a lock that Embree's threads in this process held: :mod:`planner.sim.pool`).
 
 from __future__ import annotations
 
+import multiprocessing as mp
 from concurrent.futures import wait
+from multiprocessing.synchronize import Event
 
 import numpy as np
 import pytest
@@ -46,10 +48,15 @@ def _box() -> tuple[SimulationSetup, trimesh.Trimesh, list[RowSpec]]:
     return setup, mesh, report_rows(plan.validation.report, mesh, models.geometry, setup.xoffset)
 
 
-def _prediction_raises(monkeypatch: pytest.MonkeyPatch, exc: Exception) -> None:
-    """Make the prediction's run of the program on the ideal part raise ``exc``."""
+def _prediction_raises(
+    monkeypatch: pytest.MonkeyPatch, exc: Exception, gate: Event | None = None
+) -> None:
+    """Make the prediction's run of the program on the ideal part raise ``exc``, once ``gate``
+    is set (in whichever process runs it: a forked worker shares the event)."""
 
     def execute(*args: object, **kwargs: object) -> None:
+        if gate is not None and not gate.wait(60.0):
+            raise AssertionError("the test never let the prediction fail")
         raise exc
 
     monkeypatch.setattr(predict_module, "execute", execute)
@@ -67,17 +74,25 @@ def _start(
     exc: Exception = NOT_SMOOTH,
 ) -> tuple[SimulationRun, list[RowSpec]]:
     """A started two-worker run whose prediction raises ``exc`` and whose trials only count
-    themselves into ``calls`` (in this process; the forked workers run none)."""
+    themselves into ``calls`` (in this process; the forked workers run none).
+
+    With ``first_trial_waits`` the prediction fails only once the first vetted trial has
+    begun (a gate the trial opens), so the run meets the failure between two trials, never
+    before the first: the order is fixed, not left to how fast the worker starts."""
     started: list[SimulationRun] = []
+    gate = mp.get_context("fork").Event()
+    if not first_trial_waits:
+        gate.set()
 
     def counted(self: TrialRunner, seed: TrialSeed, reach: object) -> None:
         calls.append(seed)
         if first_trial_waits and len(calls) == 1 and started:
             pool = started[0].pool
             assert pool is not None and pool.prediction is not None
+            gate.set()
             wait([pool.prediction])  # the prediction fails while the vetted trials run
 
-    _prediction_raises(monkeypatch, exc)
+    _prediction_raises(monkeypatch, exc, gate)
     monkeypatch.setattr(TrialRunner, "run_trial", counted)
     monkeypatch.setattr(pool_module, "start_method", lambda: "fork")
     monkeypatch.setattr(trial_pool_module, "init_worker", _no_trials)
