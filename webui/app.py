@@ -119,6 +119,9 @@ class WobjcalApp:
         #: the latest cycle-time estimate (:meth:`update_cycle_time`)
         self.cycle_future: Future[CycleTime | None] | None = None
         self._lock = threading.RLock()
+        #: held through a whole change of cell (build, draw, recheck): two at once (an undo
+        #: clicked twice, an edit during an undo) drew each other's nodes away half-made
+        self._cell_lock = threading.RLock()
         self._cell_key: tuple[CellSpec, WorkObjectSpec] | None = None
         self._part: tuple[str, str | None, str] | None = None
         self.flags = RoleFlags()
@@ -156,8 +159,13 @@ class WobjcalApp:
     def load_cell(self, plan: Plan, plan_dir: Path) -> None:
         """Build the plan's cell on the worker and redraw the scene; raise if it fails.
 
-        On failure the previous cell, scene and plan stay as they were.
+        On failure the previous cell, scene and plan stay as they were. One cell loads at a
+        time: a second waits for the first to be built and drawn whole.
         """
+        with self._cell_lock:
+            self._load_cell(plan, plan_dir)
+
+    def _load_cell(self, plan: Plan, plan_dir: Path) -> None:
         self.heatmap.stop()
         with self.busy("loading the cell"):
             try:
@@ -207,8 +215,9 @@ class WobjcalApp:
     def replace_source(self, plan: Plan, label: str) -> None:
         """Make ``plan`` (another cell: part, robot, fixtures or their poses) the session's, in
         one undoable step; its cell is built first, and when that fails nothing changes."""
-        self.load_cell(plan, self.plan_dir)
-        self.state.update(lambda d: with_source(d, plan), label)
+        with self._cell_lock:  # no other cell change between the cell and its plan
+            self._load_cell(plan, self.plan_dir)
+            self.state.update(lambda d: with_source(d, plan), label)
 
     # ---- checks ---------------------------------------------------------------------------
     def check_of(self, point_id: str) -> PointCheck | None:
@@ -352,10 +361,15 @@ class WobjcalApp:
     def _show_change(self, change: Change[UiPlan]) -> None:
         source = change.doc.source
         if isinstance(source, Plan) and _cell_key(source) != self._cell_key:
-            try:  # e.g. undo of an upload: go back to the earlier cell
-                self.load_cell(source, self.plan_dir)
-            except Exception as exc:
-                self.notify("Cell not loaded", str(exc), error=True)
+            with self._cell_lock:
+                # e.g. undo of an upload: go back to the earlier cell; the latest plan's, when
+                # a later change came while another cell was loading (changes are not queued)
+                latest = self.state.doc.source
+                if isinstance(latest, Plan) and _cell_key(latest) != self._cell_key:
+                    try:
+                        self._load_cell(latest, self.plan_dir)
+                    except Exception as exc:
+                        self.notify("Cell not loaded", str(exc), error=True)
             self._redraw()
             self.selection.follow(change.doc, set())  # deleted points, highlights moved
             return
