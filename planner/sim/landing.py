@@ -182,20 +182,27 @@ RIM_RAYS = 8
 OTHER_SURFACE_TOL_M = 1e-3
 
 
+#: The rim's directions around the sensor axis (cosine and sine of each rim ray's angle).
+_RIM_ANGLES = np.linspace(0.0, 2.0 * np.pi, RIM_RAYS, endpoint=False)
+_RIM_COS, _RIM_SIN = np.cos(_RIM_ANGLES), np.sin(_RIM_ANGLES)
+
+
 def _face_rays(
     start_wobj: FloatArray, axis_wobj: FloatArray, standoff_m: float, radius_m: float
 ) -> FloatArray:
-    """``(1 + RIM_RAYS, 3)`` origins on the sensor's face (``standoff_m`` behind the TCP at
-    ``start_wobj``, along ``axis_wobj``): its centre and its rim."""
-    a = axis_wobj / np.linalg.norm(axis_wobj)
-    helper = np.eye(3)[int(np.argmin(np.abs(a)))]
+    """``(N, 1 + RIM_RAYS, 3)`` origins on the sensor's face of ``N`` searches (``standoff_m``
+    behind the TCP at ``start_wobj`` ``(N, 3)``, along ``axis_wobj`` ``(N, 3)``; wobj frame,
+    m): its centre and its rim (``radius_m``)."""
+    a = axis_wobj / np.linalg.norm(axis_wobj, axis=1, keepdims=True)
+    helper = np.eye(3)[np.argmin(np.abs(a), axis=1)]
     u = np.cross(a, helper)
-    u /= np.linalg.norm(u)
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
     v = np.cross(a, u)
-    ang = np.linspace(0.0, 2.0 * np.pi, RIM_RAYS, endpoint=False)
-    rim = radius_m * (np.cos(ang)[:, None] * u + np.sin(ang)[:, None] * v)
+    rim = radius_m * (
+        _RIM_COS[None, :, None] * u[:, None, :] + _RIM_SIN[None, :, None] * v[:, None, :]
+    )
     centre = start_wobj - standoff_m * a
-    return np.vstack([centre, centre + rim])
+    return np.concatenate([centre[:, None, :], centre[:, None, :] + rim], axis=1)
 
 
 def landing_risk(
@@ -237,8 +244,9 @@ def landing_risk(
     edge_offset = edge_offset_of(program.settings)
     runs: dict[str, list[tuple[int, bool, bool]]] = {}  # key -> (trial, miss, inside)
     landed: dict[str, list[tuple[int, FloatArray]]] = {}  # key -> (trial, wobj point)
-    # key -> (trial, ray origins (R, 3), direction (3,), distance to the own face), wobj
-    rays: dict[str, list[tuple[int, FloatArray, FloatArray, float]]] = {}
+    # key -> (trial, start (3,), sensor axis (3,), direction (3,), distance to the own face),
+    # wobj; the sensor face's rays are made from them per key, in one batch
+    rays: dict[str, list[tuple[int, FloatArray, FloatArray, FloatArray, float]]] = {}
     for trial in range(trials):
         T_true = T_base_wobj_nominal @ misplacement.sample(rng, pivot_wobj_m)
         rec = _Recorder(PlaneProbe(T_true, edge_offset), [])
@@ -256,9 +264,9 @@ def landing_risk(
             if judged and caster is not None and np.isfinite(travel):
                 R = T_wobj_base[:3, :3]
                 start = transform_points(T_wobj_base, np.asarray(cmd.start_m, float))
-                origins = _face_rays(start, R @ cmd.sensor_axis, standoff_m, footprint_radius_m)
+                axis = R @ np.asarray(cmd.sensor_axis, float)
                 d = R @ np.asarray(cmd.direction, float)
-                rays.setdefault(key, []).append((trial, origins, d, travel + standoff_m))
+                rays.setdefault(key, []).append((trial, start, axis, d, travel + standoff_m))
     bad_trials: set[int] = set()
     off_of: dict[str, int] = {}
     partly_of: dict[str, int] = {}
@@ -274,11 +282,13 @@ def landing_risk(
     other_of: dict[str, int] = {}
     if caster is not None:
         for key, items in rays.items():
-            o = np.concatenate([it[1] for it in items])
-            d = np.repeat(np.array([it[2] for it in items]), 1 + RIM_RAYS, axis=0)
+            starts = np.array([it[1] for it in items])
+            axes = np.array([it[2] for it in items])
+            o = _face_rays(starts, axes, standoff_m, footprint_radius_m).reshape(-1, 3)
+            d = np.repeat(np.array([it[3] for it in items]), 1 + RIM_RAYS, axis=0)
             dist, tri = caster.first_hits_ids(o, d)
             dist = dist.reshape(len(items), 1 + RIM_RAYS)
-            own = np.array([it[3] for it in items])
+            own = np.array([it[4] for it in items])
             hit_early = dist < own[:, None] - OTHER_SURFACE_TOL_M
             if triangle_face is not None:  # the point's own planar face is not another surface
                 face = face_of.get(keys.get(key, key), -1)
