@@ -18,7 +18,8 @@ Owns:
     - :mod:`planner.sim.montecarlo`: :func:`simulate` (any plan) and
       :func:`simulate_stator_ah` (A-H on a stator), many seeded trials on up to 2 processes;
       :mod:`planner.sim.simulation_run` (a run started on the workers, finished later) and
-      :mod:`planner.sim.trial_pool` (the worker processes);
+      :mod:`planner.sim.trial_pool` (the worker processes), :mod:`planner.sim.pool` (started
+      from a fork server) and :mod:`planner.sim.worker_preload` (what the server loads once);
     - :mod:`planner.sim.predict`: the intervals predicted from the procedure's linearisation;
     - :mod:`planner.sim.rows`, :mod:`planner.sim.report_points`, :mod:`planner.sim.summary`,
       :mod:`planner.sim.report`: what each row measures, the rows of a plan, the report built

@@ -130,3 +130,22 @@ def finish_hits(
         origins, directions, ids, *arrays, float(outside_m), float(same_m)
     )
     return out
+
+
+def load_kernel() -> None:
+    """Import numba and load (or compile) the kernel now, for the argument types a cast
+    passes (:class:`planner.sim.raycast.MeshRayCaster`), without casting a ray: a fork
+    server does it once for all its workers (:mod:`planner.sim.worker_preload`), which would
+    otherwise pay about 0.4 s each at their first cast. Embree is not touched (its threads
+    must not exist in a process that forks)."""
+    one = np.zeros((1, 3))
+    arrays = (
+        np.array([[0.0, 0.0, 1.0]]),  # normals (F, 3)
+        np.zeros(1),  # offsets (F,)
+        np.zeros(1, dtype=np.bool_),  # has_sharp (F,)
+        np.zeros((1, 3), dtype=np.bool_),  # sharp (F, 3)
+        np.zeros((1, 3, 3)),  # edge_normals (F, 3, 3)
+        np.zeros((1, 3)),  # edge_offsets (F, 3)
+        np.full((1, 3), -1, dtype=np.int64),  # neighbour (F, 3)
+    )
+    finish_hits(one, one, np.full(1, -1, dtype=np.int64), arrays, -1e-12, 1e-7)

@@ -26,7 +26,7 @@ from typing import Any
 __all__ = ["kill_pool", "open_pool", "start_method"]
 
 #: modules a fork server imports once, before it forks workers (what a trial needs)
-_FORKSERVER_PRELOAD = ["planner.sim.trial", "planner.sim.predict"]
+_FORKSERVER_PRELOAD = ["planner.sim.worker_preload"]
 
 
 def start_method() -> str | None:

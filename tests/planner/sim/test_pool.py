@@ -62,3 +62,31 @@ def test_a_process_that_cast_rays_gets_its_trials_back() -> None:
     )
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.split()[-1] == "120"
+
+
+def test_a_worker_finds_the_ray_kernel_loaded() -> None:
+    """The fork server loads numba and the float64 ray-cast kernel once (for the types a cast
+    passes: no second compile at the first cast), not every worker at its first cast."""
+    if start_method() != "forkserver":
+        pytest.skip("no fork server on this platform")
+    script = textwrap.dedent(
+        """
+        from planner.sim.pool import open_pool, prepare_pool
+        from tests.planner.sim.worker_probe import kernel_state, nothing
+
+        if __name__ == "__main__":
+            prepare_pool()
+            with open_pool(1, nothing, ()) as pool:
+                print(pool.submit(kernel_state).result(timeout=120))
+        """
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", script],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=180,
+        check=False,
+    )
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.split()[-2:] == ["True", "1"]
