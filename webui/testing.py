@@ -1,8 +1,11 @@
-"""Helpers for tests and benchmarks of the UI: a small box plan, free ports, screen projection."""
+"""Helpers for tests and benchmarks of the UI: a small box plan, free ports, screen projection,
+waiting for a condition."""
 
 from __future__ import annotations
 
 import socket
+import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -117,6 +120,16 @@ def box_plan(folder: Path, n_triangles: int | None = None, name: str = "box_plan
         procedure=ThreeTwoOne(),
     )
     return save_plan(plan, folder / f"{name}.json")
+
+
+def wait_until(pred: Callable[[], object], what: str, timeout_s: float = 120.0) -> None:
+    """Poll ``pred`` every 10 ms until it is truthy; ``AssertionError`` naming ``what`` after
+    ``timeout_s`` seconds (generous: a loaded machine)."""
+    deadline = time.monotonic() + timeout_s
+    while not pred():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out waiting for {what}")
+        time.sleep(0.01)
 
 
 def free_port() -> int:

@@ -9,7 +9,6 @@ and took the other's half-made nodes away), and the robot was not drawn.
 from __future__ import annotations
 
 import threading
-import time
 from collections.abc import Mapping
 from typing import Any
 
@@ -18,16 +17,9 @@ import pytest
 from calib.plan.file import Plan
 from webui.app import WobjcalApp
 from webui.cell_setup_edits import box_fixture, with_fixture
+from webui.testing import wait_until
 
 TIMEOUT_S = 120.0
-
-
-def _wait(pred: Any, what: str) -> None:
-    deadline = time.monotonic() + TIMEOUT_S
-    while not pred():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out waiting for {what}")
-        time.sleep(0.01)
 
 
 def _with_box(plan: Plan, name: str, y_mm: float) -> Plan:
@@ -72,4 +64,4 @@ def test_two_undos_at_once_leave_the_cell_of_the_latest_plan_drawn(
     assert drawn[-1] == [], f"the scene ends with the fixtures {drawn[-1]} of an undone plan"
     assert app.view.fixtures == {}
     assert "/fixtures/one" not in app.server.scene._handle_from_node_name
-    _wait(lambda: len(app.checks()) == len(app.state.doc.points), "the points checked again")
+    wait_until(lambda: len(app.checks()) == len(app.state.doc.points), "the points checked again")

@@ -5,28 +5,20 @@ slower recheck for the undone sensor must not overwrite them."""
 from __future__ import annotations
 
 import threading
-import time
 from typing import Any
 
 from webui.app import WobjcalApp
 from webui.cell_setup_edits import sensor_fields, with_sensor
+from webui.testing import wait_until
 
 TIMEOUT_S = 120.0
-
-
-def _wait(pred: Any, what: str) -> None:
-    deadline = time.monotonic() + TIMEOUT_S
-    while not pred():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out waiting for {what}")
-        time.sleep(0.01)
 
 
 def test_an_undo_during_a_sensor_recheck_keeps_the_earlier_sensors_checks(
     demo_app: WobjcalApp,
 ) -> None:
     app = demo_app
-    _wait(lambda: len(app.checks()) == len(app.state.doc.points), "the first checks")
+    wait_until(lambda: len(app.checks()) == len(app.state.doc.points), "the first checks")
     before = app.checks()
     sensor0 = app.state.doc.source.validation.sensor
     fields = sensor_fields(app.state.doc)
@@ -52,7 +44,7 @@ def test_an_undo_during_a_sensor_recheck_keeps_the_earlier_sensors_checks(
         assert entered.wait(TIMEOUT_S), "the recheck for the wide sensor did not start"
         undo = threading.Thread(target=app.state.undo)
         undo.start()
-        _wait(
+        wait_until(
             lambda: all(app.check_of(pid) is c for pid, c in before.items()),
             "the earlier sensor's checks back (undo)",
         )

@@ -23,6 +23,21 @@ from planner.sim.pool import start_method
 REPO = Path(__file__).resolve().parents[3]
 
 
+def _run(script: str) -> subprocess.CompletedProcess[str]:
+    """Run a Python ``script`` in a fresh process at the repository's root; it must exit 0
+    within 180 s (a timeout stands for a hang)."""
+    out = subprocess.run(
+        [sys.executable, "-c", script],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=180,
+        check=False,
+    )
+    assert out.returncode == 0, out.stderr[-2000:]
+    return out
+
+
 def test_workers_never_fork_this_process() -> None:
     expected = "forkserver" if "forkserver" in mp.get_all_start_methods() else None
     assert start_method() == expected
@@ -52,15 +67,7 @@ def test_a_process_that_cast_rays_gets_its_trials_back() -> None:
             print(report.n_ok)
         """
     )
-    out = subprocess.run(
-        [sys.executable, "-c", script],
-        cwd=REPO,
-        capture_output=True,
-        text=True,
-        timeout=180,
-        check=False,
-    )
-    assert out.returncode == 0, out.stderr[-2000:]
+    out = _run(script)
     assert out.stdout.split()[-1] == "120"
 
 
@@ -80,13 +87,5 @@ def test_a_worker_finds_the_ray_kernel_loaded() -> None:
                 print(pool.submit(kernel_state).result(timeout=120))
         """
     )
-    out = subprocess.run(
-        [sys.executable, "-c", script],
-        cwd=REPO,
-        capture_output=True,
-        text=True,
-        timeout=180,
-        check=False,
-    )
-    assert out.returncode == 0, out.stderr[-2000:]
+    out = _run(script)
     assert out.stdout.split()[-2:] == ["True", "1"]
