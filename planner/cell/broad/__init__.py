@@ -19,8 +19,8 @@ Modules:
   of the distance to a mesh's surface;
 - :mod:`~planner.cell.broad.link_geometry`: collision shapes of robot and tool links as PyBullet
   holds them, in URDF link frames;
-- :mod:`~planner.cell.broad.path_clearance`: the clearance verdict of a sampled path: its first
-  sample whose clearance query fails;
+- :mod:`~planner.cell.broad.path_clearance`: the clearance verdict of a sampled path (its first
+  sample whose clearance query fails) and its samples' clearances;
 - :mod:`~planner.cell.broad.slack_bounds`: upper bounds of probe candidates' slacks without Bullet:
   GJK on the exact shapes;
 - :mod:`~planner.cell.broad.sphere_tree`: sphere covers of link collision shapes, as binary sphere
@@ -29,7 +29,7 @@ Modules:
 
 from planner.cell.broad.broad_arrays import EnvArrays, PartMap
 from planner.cell.broad.broad_phase import BroadPhase, broad_phase_of
-from planner.cell.broad.path_clearance import first_failure, first_failures
+from planner.cell.broad.path_clearance import first_failure, first_failures, path_clearances
 from planner.cell.broad.slack_bounds import SlackBounds
 
 __all__ = [
@@ -40,4 +40,5 @@ __all__ = [
     "broad_phase_of",
     "first_failure",
     "first_failures",
+    "path_clearances",
 ]

@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 from calib.arguments import check_positive, check_shape, check_vector3
 from calib.errors import DegenerateGeometryError
 from calib.frames import invert_transform
-from planner.cell.broad import first_failure
+from planner.cell.broad import first_failure, path_clearances
 from planner.cell.probe.feasibility import (
     MARGINAL_LIMIT_RAD,
     limit_margin,
@@ -211,16 +211,15 @@ def _walk(
     q_path, fail_j, reason = follow_branch(
         cell, sol.q, sol.valid, sol.branch, T_flange, q_start, branch, jump
     )
-    min_cl = math.inf
+    skip = s[:fail_j] > skip_from
     if not exact_clearance:  # the verdict only: the first sample that fails, broad phase first
-        skip = s[:fail_j] > skip_from
         j, cl = first_failure(cell, q_path[:fail_j], T_flange[:fail_j], skip, margin)
         if cl is not None:
             fail_j, reason = j, cl.reason()
-        min_cl = math.nan
-    for j in range(fail_j if exact_clearance else 0):
-        cell.set_joint_positions(q_path[j])
-        cl = cell.clearance(margin, sensor_wobj_allowed=True, skip_wobj=s[j] > skip_from)
+        return path_verdict(s, q_path, fail_j, reason, rotation, branch, math.nan)
+    # every sample's clearance up to the first that fails (the broad phase clears most parts)
+    min_cl = math.inf
+    for j, cl in enumerate(path_clearances(cell, q_path[:fail_j], T_flange[:fail_j], skip, margin)):
         min_cl = min(min_cl, cl.clearance_m)
         if not cl.ok:
             fail_j, reason = j, cl.reason()

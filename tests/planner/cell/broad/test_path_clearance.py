@@ -1,5 +1,6 @@
-"""planner.cell.broad.path_clearance: the verdict of a sampled path, broad phase first, against the
-plain loop of whole clearance queries (the same failing sample, the same reason)."""
+"""planner.cell.broad.path_clearance: the verdict and the clearances of a sampled path, broad phase
+first, against the plain loop of whole clearance queries (the same failing sample, the same
+reason, the same clearance at every sample)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ import trimesh
 
 from calib.frames import make_transform
 from calib.probing import ProbePoint, SearchCommand, SearchSpec
-from planner.cell.broad.path_clearance import first_failure
+from planner.cell.broad.path_clearance import first_failure, path_clearances
 from planner.cell.cell import Cell
 
 BOX = 0.4
@@ -70,6 +71,36 @@ def test_configurations_near_the_part_fail_where_the_loop_fails(cell: Cell) -> N
             seen_fail += want is not None
             seen_pass += want is None
     assert seen_fail >= 10 and seen_pass >= 5  # both kinds of answer were compared
+
+
+def test_every_sample_has_the_clearance_of_the_whole_query(cell: Cell) -> None:
+    """The same jittered blocks: each sample's clearance, limiting pair and verdict are the
+    whole query's, bit for bit, up to and including the first that fails (none after it)."""
+    rng = np.random.default_rng(4)
+    base = cell.check_search(SearchCommand.from_point(TOP, cell.T_base_wobj)).q_path
+    seen_fail = seen_near = 0
+    with cell.saved_state():
+        for n in range(49):
+            if n == 48:  # the search itself: it passes, near the part all along
+                q, skip = base, np.zeros(len(base), dtype=bool)
+            else:
+                q = base[rng.integers(len(base), size=8)]
+                q = q + rng.normal(0.0, 0.02 + 0.3 * (n % 4) / 3, size=q.shape)
+                q = np.clip(q, cell.chain.lower, cell.chain.upper)
+                skip = rng.random(8) < 0.3
+            got = path_clearances(cell, q, cell.chain.fk(q), skip, 0.005)
+            want = []
+            for j in range(len(q)):
+                cell.set_joint_positions(q[j])
+                want.append(
+                    cell.clearance(0.005, sensor_wobj_allowed=True, skip_wobj=bool(skip[j]))
+                )
+                if not want[-1].ok:
+                    break
+            assert got == want
+            seen_fail += not want[-1].ok
+            seen_near += sum(w.pair is not None and w.ok for w in want)
+    assert seen_fail >= 10 and seen_near >= 5  # failures and passing near misses compared
 
 
 def test_searches_give_the_same_verdict_with_and_without_the_clearances(cell: Cell) -> None:
