@@ -220,7 +220,7 @@ def plan_landing_risk(
     from planner.check.simulatable import check_simulatable
     from planner.check.simulation_setup import prediction_setup
     from planner.faces.checks import check_plan_faces
-    from planner.faces.detection import NoPlanarFaceError, find_planar_faces
+    from planner.faces.detection import NoPlanarFaceError, find_planar_faces, mesh_digest
     from planner.sim.landing import landing_risk
 
     try:
@@ -231,15 +231,19 @@ def plan_landing_risk(
         )
     except (InputError, NoPlanarFaceError):
         return None
+    sensor = plan.validation.sensor
+    standoff, radius = float(sensor.standoff_m), float(sensor.footprint_radius_m)
     key = (
         setup.program,
         setup.T_base_wobj_nominal.tobytes(),
         setup.misplacement,
         setup.pivot_wobj_m.tobytes(),
-        id(mesh),
+        standoff,
+        radius,
+        digest := mesh_digest(mesh),
     )
     if key in _RISKS:
-        return _RISKS[key][1]
+        return _RISKS[key]
     probes = [rp.point for rp in setup.points]
     face_of = {
         p.id: int(c.face_id)
@@ -253,38 +257,38 @@ def plan_landing_risk(
         setup.pivot_wobj_m,
         _outlines(faces, r),
         face_of,
-        caster=_caster(mesh),
-        standoff_m=float(plan.validation.sensor.standoff_m),
-        footprint_radius_m=float(plan.validation.sensor.footprint_radius_m),
+        caster=_caster(mesh, digest),
+        standoff_m=standoff,
+        footprint_radius_m=radius,
         triangle_face=np.asarray(faces.face_id, dtype=np.int64),
     )
     if len(_RISKS) >= 32:
         _RISKS.pop(next(iter(_RISKS)))
-    _RISKS[key] = (mesh, risk)  # the mesh kept, so its id stays its own
+    _RISKS[key] = risk
     return risk
 
 
 #: Landing risks of recent programs on recent parts (the same plan is checked again after
-#: every export and edit): ``{(program, nominal pose, misplacement, pivot, id of the mesh):
-#: (mesh, risk)}``; the risk is seeded, so a cached one is the one computed again.
-_RISKS: dict[tuple[object, ...], tuple[object, LandingRisk]] = {}
+#: every export and edit, and each check without an open cell loads the part again):
+#: ``{(program, nominal pose, misplacement, pivot, sensor standoff and footprint radius, content
+#: hash of the mesh): risk}``; the risk is seeded, so a cached one is the one computed again.
+_RISKS: dict[tuple[object, ...], LandingRisk] = {}
 
 
-#: The ray casters of recent parts: ``{id of the mesh: (mesh, caster)}``.
-_CASTERS: dict[int, tuple[object, object]] = {}
+#: The ray casters of recent parts: ``{content hash of the mesh: caster}``.
+_CASTERS: dict[str, MeshRayCaster] = {}
 
 
-def _caster(mesh: trimesh.Trimesh) -> MeshRayCaster:
-    """The part's ray caster (kept for the next check of the same mesh)."""
+def _caster(mesh: trimesh.Trimesh, digest: str) -> MeshRayCaster:
+    """The ray caster of the part ``mesh`` whose :func:`~planner.faces.detection.mesh_digest`
+    is ``digest`` (kept for the next check of a mesh with the same content)."""
     from planner.sim.raycast import MeshRayCaster
 
-    if id(mesh) not in _CASTERS:
+    if digest not in _CASTERS:
         if len(_CASTERS) >= 4:
             _CASTERS.pop(next(iter(_CASTERS)))
-        _CASTERS[id(mesh)] = (mesh, MeshRayCaster(mesh))
-    out = _CASTERS[id(mesh)][1]
-    assert isinstance(out, MeshRayCaster)
-    return out
+        _CASTERS[digest] = MeshRayCaster(mesh)
+    return _CASTERS[digest]
 
 
 def _outlines(faces: PlanarFaces, radius_m: float) -> FaceOutlines:

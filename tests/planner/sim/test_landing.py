@@ -10,6 +10,7 @@ import msgspec
 import numpy as np
 import pytest
 
+from calib.models.proximity import ProximitySensor
 from calib.plan.file import Plan, PlanError, load_plan
 from calib.probing import ProbePoint, SearchSpec
 from planner.check.job import plan_landing_risk
@@ -67,6 +68,38 @@ def test_the_risk_is_what_the_validation_simulates_on_the_real_mesh() -> None:
     # the adaptive program aims them after A, B and C: on the teeth
     rapid = plan_landing_risk(plan, _mesh(plan), "rapid")
     assert rapid is not None and rapid.point_problems() == {}
+
+
+def test_a_kept_risk_is_of_the_same_sensor_and_the_same_part(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The landing risks kept between checks: a part loaded again (another mesh object, the
+    same content) gets the kept risk without running the program again; a wider sensor face on
+    the same mesh object (a UI edit of the sensor) gets its own, the one computed afresh."""
+    from planner.check import job
+    from planner.sim import landing
+
+    plan = load_plan(STATOR)
+    runs = []
+    real = landing.landing_risk
+    monkeypatch.setattr(landing, "landing_risk", lambda *a, **k: runs.append(1) or real(*a, **k))
+    monkeypatch.setattr(job, "_RISKS", {})
+    first = plan_landing_risk(plan, _mesh(plan))
+    again = plan_landing_risk(plan, _mesh(plan))
+    assert first is not None and again is first and len(runs) == 1
+    sensor = plan.validation.sensor
+    assert isinstance(sensor, ProximitySensor)
+    wide = msgspec.structs.replace(sensor, face_diameter_m=3 * sensor.face_diameter_m)
+    wider = msgspec.structs.replace(
+        plan, validation=msgspec.structs.replace(plan.validation, sensor=wide)
+    )
+    mesh = _mesh(plan)
+    kept = plan_landing_risk(wider, mesh)
+    job._RISKS.clear()
+    fresh = plan_landing_risk(wider, mesh)
+    assert kept is not None and fresh is not None and len(runs) == 3
+    assert kept.searches == fresh.searches
+    assert kept.failed > first.failed  # the wide face meets the teeth: a different answer
 
 
 def test_search_reach_names_every_problem_of_every_point_at_once() -> None:
