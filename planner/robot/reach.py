@@ -9,6 +9,7 @@ may be wrong: ``about_part``) or ``joint_limit``.
 
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -68,6 +69,29 @@ def reach_model(chain: KinematicChain, rng: np.random.Generator) -> ReachModel:
     tip = frames[:, -1] @ chain.T_last_tip
     reach = float(np.max(np.linalg.norm(tip[:, :3, 3] - frames[:, k, :3, 3], axis=1)))
     return ReachModel(zero[0, :3, 3].copy(), axis, zero[k, :3, 3].copy(), reach)
+
+
+def cell_reach_model(chain: KinematicChain) -> ReachModel:
+    """The :func:`reach_model` of ``chain`` with seed 0, as every cell computes it; kept per
+    chain content (joint types, axes, joint frames, tip, limits), so a cell opened again for
+    the same robot does not sample its 20,000 configurations again. Its arrays are read-only."""
+    h = hashlib.sha1(repr(chain.joint_types).encode())
+    for a in (chain.axes, chain.T_prev_joint, chain.T_last_tip, chain.lower, chain.upper):
+        h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
+    key = h.hexdigest()
+    model = _REACH.get(key)
+    if model is None:
+        model = reach_model(chain, np.random.default_rng(0))
+        for a in (model.axis_origin_m, model.axis, model.shoulder_m):
+            a.flags.writeable = False
+        if len(_REACH) >= 16:
+            _REACH.pop(next(iter(_REACH)))
+        _REACH[key] = model
+    return model
+
+
+#: :func:`cell_reach_model`'s models: ``{content hash of the chain: model}``.
+_REACH: dict[str, ReachModel] = {}
 
 
 def _out_of_reach(where: str) -> Reason:

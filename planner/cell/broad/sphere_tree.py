@@ -14,6 +14,7 @@ wholly outside one of its faces are dropped.
 
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass
 
@@ -181,11 +182,30 @@ def build_tree(centers: FloatArray, radii: FloatArray, tags: IntArray | None = N
 
 
 def link_tree(shapes: tuple[LinkShape, ...]) -> SphereTree | None:
-    """The sphere tree of a link's shapes; ``None`` when one of them cannot be covered."""
+    """The sphere tree of a link's shapes; ``None`` when one of them cannot be covered.
+
+    Kept per leaf content: every cell of the same robot and tool has the same trees, and
+    building one takes far longer than its leaves (the same arrays, read-only)."""
     if not shapes or any(s.kind == "unknown" for s in shapes):
         return None
     parts = [shape_leaves(s) for s in shapes]
-    centers = np.concatenate([c for c, _ in parts])
-    radii = np.concatenate([r for _, r in parts])
+    centers = np.ascontiguousarray(np.concatenate([c for c, _ in parts]), dtype=np.float64)
+    radii = np.ascontiguousarray(np.concatenate([r for _, r in parts]), dtype=np.float64)
     tags = np.concatenate([np.full(len(r), k, dtype=np.int64) for k, (_, r) in enumerate(parts)])
-    return build_tree(centers, radii, tags)
+    h = hashlib.sha1(centers.tobytes())
+    h.update(radii.tobytes())
+    h.update(tags.tobytes())
+    key = h.hexdigest()
+    tree = _TREES.get(key)
+    if tree is None:
+        tree = build_tree(centers, radii, tags)
+        for a in (tree.center, tree.radius, tree.child, tree.shape):
+            a.flags.writeable = False
+        if len(_TREES) >= 256:
+            _TREES.pop(next(iter(_TREES)))
+        _TREES[key] = tree
+    return tree
+
+
+#: :func:`link_tree`'s trees: ``{content hash of the leaves: tree}``.
+_TREES: dict[str, SphereTree] = {}

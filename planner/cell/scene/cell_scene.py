@@ -45,7 +45,7 @@ from planner.cell.scene.workobject import WorkObject, load_work_object
 from planner.errors import UnknownFrameError
 from planner.robot.kinematics.chain import KinematicChain
 from planner.robot.kinematics.solver import IKSolver, make_ik_solver
-from planner.robot.reach import ReachModel, reach_model
+from planner.robot.reach import ReachModel, cell_reach_model
 from planner.robot.urdf import load_urdf
 
 FloatArray = NDArray[np.float64]
@@ -237,7 +237,7 @@ class CellScene:
     def reach_model(self) -> ReachModel:
         """Shoulder and reach of the robot (computed once, seeded)."""
         if self._reach is None:
-            self._reach = reach_model(self.chain, np.random.default_rng(0))
+            self._reach = cell_reach_model(self.chain)
         return self._reach
 
     @property

@@ -13,7 +13,7 @@ from calib.frames import make_transform
 from planner.builtins import robot_urdf
 from planner.robot.kinematics.chain import KinematicChain
 from planner.robot.kinematics.solver import make_ik_solver
-from planner.robot.reach import opw_wrist_reason, reach_model
+from planner.robot.reach import cell_reach_model, opw_wrist_reason, reach_model
 
 # IRB 4400 figures (assets/robots/irb4400/README.md)
 A1, C1, C2, C3, A2, C4 = 0.200, 0.680, 0.890, 0.880, 0.150, 0.140
@@ -31,6 +31,25 @@ def test_reach_of_the_builtin_arm(chain: KinematicChain, rng) -> None:
     # flange fully stretched: upper arm + |(forearm + flange, offset)|, sampled just below it
     stretched = C2 + math.hypot(C3 + C4, A2)
     assert stretched - 0.05 < model.reach_m <= stretched + 1e-9
+
+
+def test_a_cell_reach_model_is_kept_per_chain_content(chain: KinematicChain) -> None:
+    """The cells' reach model is the seed-0 model; the same robot loaded again gets the kept
+    one; a robot with other limits gets its own."""
+    import dataclasses
+
+    kept = cell_reach_model(chain)
+    fresh = reach_model(chain, np.random.default_rng(0))
+    for name in ("axis_origin_m", "axis", "shoulder_m"):
+        assert np.array_equal(getattr(kept, name), getattr(fresh, name))
+    assert kept.reach_m == fresh.reach_m
+    assert cell_reach_model(KinematicChain.from_urdf(robot_urdf("builtin:irb4400"))) is kept
+    with pytest.raises(ValueError):  # read-only: a caller cannot change the kept model
+        kept.shoulder_m[0] = 0.0
+    short = dataclasses.replace(chain, upper=np.minimum(chain.upper, 0.3))
+    other = cell_reach_model(short)
+    assert other is not kept
+    assert other.reach_m == reach_model(short, np.random.default_rng(0)).reach_m != kept.reach_m
 
 
 def test_shoulder_turns_towards_the_target(chain: KinematicChain, rng) -> None:

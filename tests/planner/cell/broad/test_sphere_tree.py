@@ -76,6 +76,30 @@ def test_every_node_holds_its_leaves_and_leaves_name_their_shape(rng) -> None:
     assert single.child.tolist() == [-1] and single.radius.tolist() == [1.0]
 
 
+def test_a_link_tree_is_kept_per_leaf_content() -> None:
+    """The same shapes again (new objects) get the kept tree, equal to one built afresh and
+    read-only; shapes moved in the link get their own."""
+    import dataclasses
+
+    tree = link_tree(tuple(SHAPES))
+    again = link_tree(tuple(dataclasses.replace(s) for s in SHAPES))
+    assert again is tree and tree is not None
+    parts = [shape_leaves(s) for s in SHAPES]
+    tags = np.concatenate([np.full(len(r), k) for k, (_, r) in enumerate(parts)])
+    fresh = build_tree(
+        np.concatenate([c for c, _ in parts]), np.concatenate([r for _, r in parts]), tags
+    )
+    for name in ("center", "radius", "child", "shape"):
+        assert np.array_equal(getattr(tree, name), getattr(fresh, name))
+    with pytest.raises(ValueError):
+        tree.radius[0] = 0.0
+    T = SHAPES[0].T_link_shape.copy()
+    T[0, 3] += 0.1
+    moved = link_tree((dataclasses.replace(SHAPES[0], T_link_shape=T), *SHAPES[1:]))
+    assert moved is not None and moved is not tree
+    assert not np.array_equal(moved.center, tree.center)
+
+
 def test_unknown_shapes_get_no_tree() -> None:
     assert link_tree((LinkShape("unknown", np.eye(4)),)) is None
     assert link_tree(()) is None
