@@ -20,7 +20,8 @@ other job runs it and it sits below them), then side by side, importing none of 
 :mod:`planner.export_plan`, :mod:`planner.sweep` and :mod:`planner.demo` (the built-in demo);
 :mod:`planner.cli` is the ``wobjcal`` command over them all. :mod:`planner.builtins` lists the
 built-in robots, tools and parts; :mod:`planner.errors` the planner's errors;
-:mod:`planner.reasons` why a pose, a search or a move fails, with its kind.
+:mod:`planner.reasons` why a pose, a search or a move fails, with its kind; :mod:`planner.memo`
+the in-process memo of what is computed from a robot's or a part's content.
 """
 
 from calib._version import __version__

@@ -27,6 +27,7 @@ BELOW_JOBS = {
     "calib",
     "planner.errors",
     "planner.reasons",
+    "planner.memo",
     "planner.builtins",
     "planner.robot",
     "planner.parts",
@@ -39,14 +40,16 @@ BELOW_JOBS = {
     "planner.results",
     "planner.plan_cell",
 }
-#: What every package of ``planner`` may import: ``calib``, the errors and the reasons (why a
-#: pose, a search or a move fails, with its kind: ``planner.reasons``, which imports nothing).
-BASE = {"calib", "planner.errors", "planner.reasons"}
+#: What every package of ``planner`` may import: ``calib``, the errors, the reasons (why a
+#: pose, a search or a move fails, with its kind: ``planner.reasons``, which imports nothing)
+#: and the memo of values computed from content (``planner.memo``, which imports nothing).
+BASE = {"calib", "planner.errors", "planner.reasons", "planner.memo"}
 ALLOWED: dict[str, set[str]] = {
     "calib": set(),
     "planner": {"calib"},  # the version
     "planner.errors": {"calib"},
     "planner.reasons": set(),
+    "planner.memo": set(),
     "planner.builtins": BASE,
     "planner.robot": BASE | {"planner.builtins"},
     "planner.parts": BASE,
@@ -68,7 +71,7 @@ ALLOWED: dict[str, set[str]] = {
 SUBPACKAGES = (
     "robot", "cad", "cell", "faces", "program", "sim", "parts", "export", "results", "cli",
 )  # fmt: skip
-TOP_MODULES = ("errors", "reasons", "builtins", "plan_cell", "__main__")
+TOP_MODULES = ("errors", "reasons", "memo", "builtins", "plan_cell", "__main__")
 #: The one allowed upward import: ``wobjcal ui`` starts the web app, lazily, in one function.
 LAZY_UI = ("planner.cli.misc", "webui", "cmd_ui")
 #: At most this many modules directly in ``planner/`` (``__init__`` and ``__main__`` included).

@@ -58,6 +58,7 @@ from calib.tolerances import FACE_MAX_DEVIATION_M
 from planner.check.cycle import plan_cycle_time
 from planner.check.paths import ProgramPath, check_program_path, measured_starts_wobj
 from planner.check.results import ConfData, PlanCheck, PointCheck, Status
+from planner.memo import Memo
 from planner.plan_cell import nominal_T_base_wobj, open_cell
 from planner.program.build import measuring_program, plan_settings, safety_spec
 from planner.program.controllers import controller
@@ -242,8 +243,9 @@ def plan_landing_risk(
         radius,
         digest := mesh_digest(mesh),
     )
-    if key in _RISKS:
-        return _RISKS[key]
+    kept = _RISKS.get(key)
+    if kept is not None:
+        return kept
     probes = [rp.point for rp in setup.points]
     face_of = {
         p.id: int(c.face_id)
@@ -262,21 +264,18 @@ def plan_landing_risk(
         footprint_radius_m=radius,
         triangle_face=np.asarray(faces.face_id, dtype=np.int64),
     )
-    if len(_RISKS) >= 32:
-        _RISKS.pop(next(iter(_RISKS)))
-    _RISKS[key] = risk
-    return risk
+    return _RISKS.put(key, risk)
 
 
 #: Landing risks of recent programs on recent parts (the same plan is checked again after
 #: every export and edit, and each check without an open cell loads the part again):
 #: ``{(program, nominal pose, misplacement, pivot, sensor standoff and footprint radius, content
 #: hash of the mesh): risk}``; the risk is seeded, so a cached one is the one computed again.
-_RISKS: dict[tuple[object, ...], LandingRisk] = {}
+_RISKS: Memo[tuple[object, ...], LandingRisk] = Memo(32)
 
 
 #: The ray casters of recent parts: ``{content hash of the mesh: caster}``.
-_CASTERS: dict[str, MeshRayCaster] = {}
+_CASTERS: Memo[str, MeshRayCaster] = Memo(4)
 
 
 def _caster(mesh: trimesh.Trimesh, digest: str) -> MeshRayCaster:
@@ -284,11 +283,8 @@ def _caster(mesh: trimesh.Trimesh, digest: str) -> MeshRayCaster:
     is ``digest`` (kept for the next check of a mesh with the same content)."""
     from planner.sim.raycast import MeshRayCaster
 
-    if digest not in _CASTERS:
-        if len(_CASTERS) >= 4:
-            _CASTERS.pop(next(iter(_CASTERS)))
-        _CASTERS[digest] = MeshRayCaster(mesh)
-    return _CASTERS[digest]
+    caster = _CASTERS.get(digest)
+    return caster if caster is not None else _CASTERS.put(digest, MeshRayCaster(mesh))
 
 
 def _outlines(faces: PlanarFaces, radius_m: float) -> FaceOutlines:

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.frames import invert_transform
+from planner.memo import Memo
 from planner.reasons import Reason
 
 if TYPE_CHECKING:
@@ -84,14 +85,12 @@ def cell_reach_model(chain: KinematicChain) -> ReachModel:
         model = reach_model(chain, np.random.default_rng(0))
         for a in (model.axis_origin_m, model.axis, model.shoulder_m):
             a.flags.writeable = False
-        if len(_REACH) >= 16:
-            _REACH.pop(next(iter(_REACH)))
-        _REACH[key] = model
+        model = _REACH.put(key, model)
     return model
 
 
 #: :func:`cell_reach_model`'s models: ``{content hash of the chain: model}``.
-_REACH: dict[str, ReachModel] = {}
+_REACH: Memo[str, ReachModel] = Memo(16)
 
 
 def _out_of_reach(where: str) -> Reason:

@@ -23,6 +23,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from planner.cell.broad.link_geometry import LinkShape
+from planner.memo import Memo
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -201,11 +202,9 @@ def link_tree(shapes: tuple[LinkShape, ...]) -> SphereTree | None:
         tree = build_tree(centers, radii, tags)
         for a in (tree.center, tree.radius, tree.child, tree.shape):
             a.flags.writeable = False
-        if len(_TREES) >= 256:
-            _TREES.pop(next(iter(_TREES)))
-        _TREES[key] = tree
+        tree = _TREES.put(key, tree)
     return tree
 
 
 #: :func:`link_tree`'s trees: ``{content hash of the leaves: tree}``.
-_TREES: dict[str, SphereTree] = {}
+_TREES: Memo[str, SphereTree] = Memo(256)

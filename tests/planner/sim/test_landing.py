@@ -83,7 +83,7 @@ def test_a_kept_risk_is_of_the_same_sensor_and_the_same_part(
     runs = []
     real = landing.landing_risk
     monkeypatch.setattr(landing, "landing_risk", lambda *a, **k: runs.append(1) or real(*a, **k))
-    monkeypatch.setattr(job, "_RISKS", {})
+    job._RISKS.clear()
     first = plan_landing_risk(plan, _mesh(plan))
     again = plan_landing_risk(plan, _mesh(plan))
     assert first is not None and again is first and len(runs) == 1
