@@ -7,6 +7,7 @@ waits get the same through the page's default timeout).
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -43,6 +44,13 @@ NO_MSAA_JS = """
   };
 })();
 """
+#: The canvas drawn at half the page's pixel density (viser's ``fixedDpr`` setting: the scene
+#: at a quarter of the pixels, scaled up by the page) unless the docs' screenshots are being
+#: rewritten (WOBJCAL_UPDATE_SCREENSHOTS=1). SwiftShader draws every frame on the CPU, and the
+#: tests read the page's text and the scene's nodes, not its pixels: over the demo, setup and
+#: glance modules, Chromium's GPU process took 58-64 s of CPU at full density, 40-43 s at half.
+#: Clicks on the canvas go through its CSS box (:func:`click_world`), the same at any density.
+FIXED_DPR = "" if os.environ.get("WOBJCAL_UPDATE_SCREENSHOTS") == "1" else "?fixedDpr=0.5"
 REPO = Path(__file__).resolve().parents[2]
 #: How long a test waits for a condition before it fails, s (generous: a loaded machine).
 TIMEOUT_S = 120.0
@@ -120,7 +128,7 @@ def open_page(browser: Any, app: WobjcalApp) -> UiSession:
     page = browser.new_page(viewport=VIEWPORT, accept_downloads=True)
     page.add_init_script(NO_MSAA_JS)
     page.set_default_timeout(TIMEOUT_S * 1000)  # every Playwright wait: generous under load
-    url = f"http://127.0.0.1:{app.server.get_port()}/"
+    url = f"http://127.0.0.1:{app.server.get_port()}/{FIXED_DPR}"
     page.goto(url)
     page.locator("canvas").first.wait_for()
     session = UiSession(app, page, url)
@@ -207,7 +215,6 @@ DOCS_IMG = REPO / "docs" / "img"
 def save_screenshot(page: Any, name: str, tmp_path: Path) -> Path:
     """Screenshot the page (notifications hidden) into ``artifacts/<name>``, and into
     ``docs/img/<name>`` when WOBJCAL_UPDATE_SCREENSHOTS=1; returns this run's own file."""
-    import os
     import shutil
 
     from calib.atomic_io import write_bytes_atomic
