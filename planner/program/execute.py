@@ -87,7 +87,7 @@ class ProgramProbe:
             return self.probe(cmd)
         T = np.asarray(cmd.T_base_wobj_estimate, dtype=np.float64)
         plan_start = T[:3, :3] @ _plan_start_wobj(point) + T[:3, 3]
-        moved = not np.allclose(cmd.start_m, plan_start, rtol=0.0, atol=1e-9)
+        moved = not bool(np.all(np.abs(np.asarray(cmd.start_m) - plan_start) <= 1e-9))
         if moved and point.search.kind == "edge":  # an edge search from an earlier point
             measured = transform_points(invert_transform(T), np.asarray(cmd.start_m))
             searches = program_searches(point, T, self.safety, measured_start_wobj=measured)
