@@ -350,6 +350,21 @@ class WobjcalApp:
         self.cycle_future = fut
         return fut
 
+    def _load_latest_cell(self) -> None:
+        """Load the cell of the session's latest plan, again until it is the one shown (with
+        ``_cell_lock`` held). Changes are not queued: one that came while another cell was
+        loading was compared with the cell shown then, and may have loaded nothing (a redo
+        back to that cell while an undo's earlier cell was being built)."""
+        while True:
+            latest = self.state.doc.source
+            if not isinstance(latest, Plan) or _cell_key(latest) == self._cell_key:
+                return
+            try:
+                self._load_cell(latest, self.plan_dir)
+            except Exception as exc:  # the previous cell stays; said, not retried
+                self.notify("Cell not loaded", str(exc), error=True)
+                return
+
     def _on_change(self, change: Change[UiPlan]) -> None:
         """Every change of the plan: its rows first (checked, drawn, sent), then the layout's
         quality, on the layout panel's own thread (after the rows: it does not slow them)."""
@@ -361,17 +376,10 @@ class WobjcalApp:
     def _show_change(self, change: Change[UiPlan]) -> None:
         source = change.doc.source
         if isinstance(source, Plan) and _cell_key(source) != self._cell_key:
-            with self._cell_lock:
-                # e.g. undo of an upload: go back to the earlier cell; the latest plan's, when
-                # a later change came while another cell was loading (changes are not queued)
-                latest = self.state.doc.source
-                if isinstance(latest, Plan) and _cell_key(latest) != self._cell_key:
-                    try:
-                        self._load_cell(latest, self.plan_dir)
-                    except Exception as exc:
-                        self.notify("Cell not loaded", str(exc), error=True)
+            with self._cell_lock:  # e.g. undo of an upload: go back to the earlier cell
+                self._load_latest_cell()
             self._redraw()
-            self.selection.follow(change.doc, set())  # deleted points, highlights moved
+            self.selection.follow(self.state.doc, set())  # deleted points, highlights moved
             return
         before = {p.id: p for p in change.previous.points}
         changed = [p.id for p in change.doc.points if before.get(p.id) != p]

@@ -1,5 +1,6 @@
-"""Two changes of cell at once (an undo clicked twice, an edit during an undo's reload) load
-one after the other, and the scene ends with the cell of the plan the session holds.
+"""Two changes of cell at once (an undo clicked twice, an edit during an undo's reload, a redo
+while an undo's cell is being built) load one after the other, and the scene ends with the
+cell of the plan the session holds.
 
 Seen in a browser test: a fixture added while two undos were reloading their cells failed
 with "Cannot assign to 'visible' on a removed MeshHandle" (each reload drew the work object
@@ -64,4 +65,28 @@ def test_two_undos_at_once_leave_the_cell_of_the_latest_plan_drawn(
     assert drawn[-1] == [], f"the scene ends with the fixtures {drawn[-1]} of an undone plan"
     assert app.view.fixtures == {}
     assert "/fixtures/one" not in app.server.scene._handle_from_node_name
+    wait_until(lambda: len(app.checks()) == len(app.state.doc.points), "the points checked again")
+
+
+def test_a_redo_while_the_undos_cell_is_built_leaves_the_redone_cell_drawn(
+    app: WobjcalApp,
+) -> None:
+    """The redo's plan has the cell still shown while the undo's is being built: its change
+    looks like no change of cell, and the undo's reload, which read the plan before the redo,
+    must not be the last cell drawn (found by a reviewer: the scene kept the undone cell)."""
+    plan = app.state.doc.source
+    assert isinstance(plan, Plan) and plan.cell.fixtures == []
+    app.replace_source(_with_box(plan, "one", 2000.0), "add one")
+    assert sorted(app.view.fixtures) == ["one"]
+    gate = threading.Event()
+    app.worker.submit(lambda _: gate.wait(TIMEOUT_S))  # the undo's cell waits behind this
+    undo = threading.Thread(target=app.state.undo)
+    undo.start()
+    wait_until(lambda: "loading the cell" in app.busy.text, "the undo to start its cell")
+    app.state.redo()  # the cell shown is the redo's: nothing to load, as the change sees it
+    gate.set()
+    undo.join(TIMEOUT_S)
+    assert not undo.is_alive()
+    assert [f.name for f in app.state.doc.source.cell.fixtures] == ["one"]
+    assert sorted(app.view.fixtures) == ["one"], "the scene shows the cell of the undone plan"
     wait_until(lambda: len(app.checks()) == len(app.state.doc.points), "the points checked again")
