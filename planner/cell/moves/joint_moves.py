@@ -10,8 +10,9 @@ switch off: every via is a fine point).
 
 The move is sampled with at most :data:`MAX_STEP_RAD` between poses (and never fewer than
 ``min_steps`` poses); each pose's clearance is the cell's full query (robot, tool, work object,
-fixtures, self-collision with the ACL), so a thin obstacle between two samples can be missed:
-the sampling is the joint step, not a swept volume.
+fixtures, self-collision with the ACL; the parts the broad phase clears are not asked of Bullet:
+:func:`planner.cell.broad.first_failure`, the same first failing pose and reason), so a thin
+obstacle between two samples can be missed: the sampling is the joint step, not a swept volume.
 """
 
 from __future__ import annotations
@@ -25,6 +26,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from planner.cell.broad import first_failure
+from planner.cell.scene import DEFAULT_MARGIN_M
 from planner.reasons import Reason
 
 if TYPE_CHECKING:
@@ -100,14 +103,13 @@ def check_joint_move(
     b = np.asarray(q_to, dtype=np.float64).reshape(-1)
     steps = move_steps(a, b, min_steps)
     qs = a + np.linspace(0.0, 1.0, steps)[:, None] * (b - a)
-    T = cell.T_world_base @ np.asarray(cell.chain.fk(qs)) @ cell.T_flange_tcp(tcp)
-    with cell.saved_state():
-        for k, q in enumerate(qs):
-            cell.set_joint_positions(q)
-            c = cell.clearance()
-            if not c.ok:
-                where = c.reason(f"at {100 * k // (steps - 1)} %: ", kind="move")
-                return MoveCheck(T[:, :3, 3].copy(), where)
+    T_base_flange = np.asarray(cell.chain.fk(qs))
+    T = cell.T_world_base @ T_base_flange @ cell.T_flange_tcp(tcp)
+    with cell.saved_state():  # each pose's whole query, as a loop would ask, broad phase first
+        k, c = first_failure(cell, qs, T_base_flange, np.zeros(steps, dtype=bool), DEFAULT_MARGIN_M)
+    if c is not None:
+        where = c.reason(f"at {100 * k // (steps - 1)} %: ", kind="move")
+        return MoveCheck(T[:, :3, 3].copy(), where)
     return MoveCheck(T[:, :3, 3].copy())
 
 
