@@ -12,6 +12,7 @@ from __future__ import annotations
 import logging
 import signal
 import threading
+from collections.abc import Callable
 from pathlib import Path
 
 import viser
@@ -176,8 +177,13 @@ def run(
 EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
 
 
-def serve(app: WobjcalApp) -> int:
+def serve(app: WobjcalApp, announce: Callable[[], None] | None = None) -> int:
     """Serve until Ctrl-C or SIGTERM, then stop the app (server, worker, autosave lock).
+
+    Args:
+        app: the running app (:func:`run` with ``block=False``).
+        announce: called once the signals stop the app, before serving (the CLI prints the
+            address there): a Ctrl-C right after the address is read still stops the app.
 
     Returns:
         The exit code: 130 after Ctrl-C, 143 after SIGTERM.
@@ -188,6 +194,8 @@ def serve(app: WobjcalApp) -> int:
     if threading.current_thread() is threading.main_thread():
         previous = signal.signal(signal.SIGTERM, lambda *_: stop.set())
     try:
+        if announce is not None:
+            announce()
         while not stop.wait(0.5):
             pass
     except KeyboardInterrupt:

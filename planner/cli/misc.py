@@ -112,17 +112,20 @@ def cmd_ui(args: argparse.Namespace) -> int:
     from webui.server import run, serve  # the one place planner imports webui (viser), lazily
 
     app = run(plan, host=args.host, port=args.port, block=False, fresh=args.fresh)
-    bound = app.server.get_port()
-    err = stderr()
-    if args.port not in (0, bound):
-        err.print(f"port {args.port} is busy: serving on {bound}", markup=False)
-    err.print(
-        f"wobjcal UI on http://{args.host}:{bound} "
-        f"({plan or 'built-in demo ' + DEMO_PLAN.name}); Ctrl-C stops it",
-        markup=False,
-    )
-    if app.state.autosave_path is not None:
-        err.print(f"the session plan autosaves to {app.state.autosave_path}", markup=False)
-    if app.autosave_note:
-        err.print(app.autosave_note, markup=False)
-    return serve(app)  # 130 after Ctrl-C, 143 after SIGTERM (docs/cli.md)
+
+    def announce() -> None:  # inside serve: a Ctrl-C as soon as the address shows stops the app
+        bound = app.server.get_port()
+        err = stderr()
+        if args.port not in (0, bound):
+            err.print(f"port {args.port} is busy: serving on {bound}", markup=False)
+        err.print(
+            f"wobjcal UI on http://{args.host}:{bound} "
+            f"({plan or 'built-in demo ' + DEMO_PLAN.name}); Ctrl-C stops it",
+            markup=False,
+        )
+        if app.state.autosave_path is not None:
+            err.print(f"the session plan autosaves to {app.state.autosave_path}", markup=False)
+        if app.autosave_note:
+            err.print(app.autosave_note, markup=False)
+
+    return serve(app, announce)  # 130 after Ctrl-C, 143 after SIGTERM (docs/cli.md)

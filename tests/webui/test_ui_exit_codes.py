@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import os
 import queue
 import signal
 import subprocess
@@ -25,6 +26,7 @@ def test_ui_exit_code_after_a_signal(sig: signal.Signals, code: int, tmp_path: P
     proc = subprocess.Popen(
         [sys.executable, "-m", "planner", "ui", str(plan), "--port", "0", "--fresh"],
         cwd=REPO,
+        env={**os.environ, "PYTHONFAULTHANDLER": "1"},  # SIGABRT dumps every thread's stack
         stderr=subprocess.PIPE,
         stdout=subprocess.DEVNULL,
         text=True,
@@ -48,7 +50,15 @@ def test_ui_exit_code_after_a_signal(sig: signal.Signals, code: int, tmp_path: P
             except queue.Empty:
                 continue
         proc.send_signal(sig)
-        assert proc.wait(timeout=60) == code
+        try:
+            got = proc.wait(timeout=60)
+        except subprocess.TimeoutExpired:  # hung: say where every thread of it is
+            proc.send_signal(signal.SIGABRT)
+            proc.wait(timeout=30)
+            time.sleep(0.5)  # the reader thread drains the dump
+            dump = "".join(lines.queue)
+            raise AssertionError(f"no exit 60 s after {sig.name}; its threads:\n{dump}") from None
+        assert got == code, "".join(lines.queue)
     finally:
         if proc.poll() is None:
             proc.kill()

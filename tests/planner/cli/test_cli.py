@@ -251,8 +251,13 @@ def test_ui_passes_flags_to_webui(
         return SimpleNamespace(server=server, state=state, autosave_note="")
 
     monkeypatch.setattr(webui.server, "run", fake_run)
-    monkeypatch.setattr(webui.server, "serve", lambda app: 0)
+    def fake_serve(app, announce):  # type: ignore[no-untyped-def]
+        announce()  # the address is printed once serving
+        return 0
+
+    monkeypatch.setattr(webui.server, "serve", fake_serve)
     assert main(["ui", str(STATOR), "--host", "0.0.0.0", "--port", "8123"]) == 0
+    assert "wobjcal UI on http://0.0.0.0:8123" in capsys.readouterr().err
     assert main(["demo"]) == 0
     flags = {"block": False, "fresh": False}
     assert calls[0] == ((str(STATOR),), {"host": "0.0.0.0", "port": 8123, **flags})
