@@ -53,13 +53,33 @@ def test_ui_exit_code_after_a_signal(sig: signal.Signals, code: int, tmp_path: P
         try:
             got = proc.wait(timeout=60)
         except subprocess.TimeoutExpired:  # hung: say where every thread of it is
+            masks = _signal_masks(proc.pid)
             proc.send_signal(signal.SIGABRT)
             proc.wait(timeout=30)
             time.sleep(0.5)  # the reader thread drains the dump
             dump = "".join(lines.queue)
-            raise AssertionError(f"no exit 60 s after {sig.name}; its threads:\n{dump}") from None
+            raise AssertionError(
+                f"no exit 60 s after {sig.name}; signal masks {masks}; its threads:\n{dump}"
+            ) from None
         assert got == code, "".join(lines.queue)
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+def _signal_masks(pid: int) -> dict[str, str]:
+    """The ignored, caught and blocked signal masks (hex, bit ``n - 1`` for signal ``n``) of
+    process ``pid`` and of each of its threads, and this process's handler of SIGINT."""
+    out = {"test's SIGINT handler": repr(signal.getsignal(signal.SIGINT))}
+    try:
+        for task in sorted(Path(f"/proc/{pid}/task").iterdir()):
+            fields = dict(
+                line.split(":\t", 1)
+                for line in (task / "status").read_text().splitlines()
+                if line.startswith(("SigIgn", "SigCgt", "SigBlk", "Name"))
+            )
+            out[task.name] = " ".join(f"{k}={v}" for k, v in sorted(fields.items()))
+    except OSError as exc:
+        out["error"] = str(exc)
+    return out

@@ -121,7 +121,7 @@ def test_the_cli_prints_the_port_actually_bound(
 ) -> None:  # type: ignore[no-untyped-def]
     import webui.server
 
-    monkeypatch.setattr(webui.server, "serve", lambda app: (app.stop(), 0)[1])
+    monkeypatch.setattr(webui.server, "serve", lambda app, announce: (announce(), app.stop(), 0)[2])
     plan = box_plan(tmp_path)
     with socket.socket() as busy:
         busy.bind(("127.0.0.1", 0))
