@@ -17,14 +17,26 @@ import pytest
 REPO = Path(__file__).resolve().parents[2]
 
 
+#: Run ``sys.argv[1:]`` with SIGINT's default action (``exec`` keeps it; Python then makes it
+#: KeyboardInterrupt).
+_DEFAULT_SIGINT = (
+    "import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_DFL); "
+    "os.execv(sys.argv[1], sys.argv[1:])"
+)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize(("sig", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
 def test_ui_exit_code_after_a_signal(sig: signal.Signals, code: int, tmp_path: Path) -> None:
     from webui.testing import box_plan
 
     plan = box_plan(tmp_path / "plan")  # a small cell: the server is up in seconds
+    ui = [sys.executable, "-m", "planner", "ui", str(plan), "--port", "0", "--fresh"]
     proc = subprocess.Popen(
-        [sys.executable, "-m", "planner", "ui", str(plan), "--port", "0", "--fresh"],
+        # started as from a terminal: a suite run as a background job ignores SIGINT, and a
+        # process inherits that (Python then leaves Ctrl-C ignored, as it should); the default
+        # is put back before the UI's interpreter starts
+        [sys.executable, "-c", _DEFAULT_SIGINT, *ui],
         cwd=REPO,
         env={**os.environ, "PYTHONFAULTHANDLER": "1"},  # SIGABRT dumps every thread's stack
         stderr=subprocess.PIPE,
