@@ -251,6 +251,7 @@ def test_ui_passes_flags_to_webui(
         return SimpleNamespace(server=server, state=state, autosave_note="")
 
     monkeypatch.setattr(webui.server, "run", fake_run)
+
     def fake_serve(app, announce):  # type: ignore[no-untyped-def]
         announce()  # the address is printed once serving
         return 0
