@@ -21,7 +21,7 @@ the secondary, one on the tertiary), and chosen points keep a minimum distance a
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -130,6 +130,7 @@ def select(
     max_passes: int = 10,
     available: NDArray[np.bool_] | None = None,
     background_m: FloatArray | None = None,
+    follows: Callable[[Sequence[int]], NDArray[np.bool_]] | None = None,
 ) -> Design:
     """Choose ``n`` candidate searches minimising :func:`criterion` (greedy, then exchange).
 
@@ -151,6 +152,12 @@ def select(
         available: ``(C,)`` candidates that may be chosen (default all).
         background_m: ``(B, 3)`` points whose mean error is added with a small weight
             (:data:`BACKGROUND_WEIGHT`), so every degree of freedom gets fixed.
+        follows: ``follows(chosen) -> (C,)``: the candidates that may be measured after
+            ``chosen`` (in the order chosen). With it the set is grown in measuring order, each
+            step among those, and an exchange puts a candidate in a search's place only when
+            it may follow the searches before that place and every later one may still follow
+            (the best candidate for the place; none when it breaks the order): ``chosen`` of
+            the result is a measuring order.
 
     Raises:
         ShapeError: inconsistent shapes, or a quota that does not add up to ``n``.
@@ -215,13 +222,23 @@ def select(
         take(int(c))
     score = criterion(cov, list(P), B)
     while len(chosen) < n:
-        c, new = _best_addition(cov, A, v, P, allowed(), B)
+        mask = allowed() if follows is None else allowed() & follows(tuple(chosen))
+        c, new = _best_addition(cov, A, v, P, mask, B)
         if c < 0:
             break
         take(c)
         score = new
     greedy = score
     swaps = 0
+
+    def keeps_order(i: int, c: int) -> bool:
+        """With ``follows``: every search after position ``i`` may still follow the ones
+        before it when ``c`` takes that position."""
+        if follows is None:
+            return True
+        new = [*chosen[:i], c, *chosen[i + 1 :]]
+        return all(follows(tuple(new[:j]))[new[j]] for j in range(i + 1, len(new)))
+
     for _ in range(max_passes):
         improved = False
         for i in range(len(chosen)):
@@ -234,9 +251,11 @@ def select(
             mask[out] = False
             if quota is not None:
                 mask &= g == key
+            if follows is not None:
+                mask &= follows(tuple(chosen[:i]))
             c, new = _best_addition(reduced, A, v, P, mask, B)
             left[key] -= 1
-            if c >= 0 and new < score * (1.0 - 1e-9):
+            if c >= 0 and new < score * (1.0 - 1e-9) and keeps_order(i, c):
                 chosen[i] = c
                 M = M_out + info(c)
                 cov = _inverse(M)

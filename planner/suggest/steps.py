@@ -292,6 +292,66 @@ def _select_feasible(ctx: Context, n: int, **kw: object) -> Design | None:
     return None
 
 
+def _select_in_order(ctx: Context, n: int, **kw: object) -> Design | None:
+    """The design of ``n`` points grown in measuring order: each point the one that helps
+    most among the candidates whose footprint stays on its face after the points before it
+    (:meth:`Sequencer.fits_many`), so a measuring order exists by construction.
+
+    The fallback of a best fit whose designs get stuck (:func:`_select_feasible`): a design
+    chosen for its information alone may hold no point that can be measured first (each is
+    grown by the whole misplacement), and banning its points then bans the faces' only
+    candidates. The footprints are tested in the layout of the previous try (first: the
+    design without the order); the result is ordered again in its own layout
+    (:meth:`Context.sequence`), and its search paths checked, before it is returned.
+    """
+    seq = ctx.sequencer
+    if seq is None:
+        return None
+    A, var = ctx.rows()
+    edge = ctx.pool.is_edge
+    approach = np.flatnonzero(~edge)
+    blocked = np.array([ctx.path_ok.get(i, True) is False for i in range(len(A))])
+    common: dict[str, object] = dict(
+        positions_m=ctx.pool.positions_m,
+        min_separation_m=max(2 * ctx.radius_m, 0.01),
+        scale_m=1.0,
+        background_m=ctx.corners,
+    )
+    first = select(A, var, n, ctx.poi, available=~blocked, **common, **kw)  # type: ignore[arg-type]
+    layout = list(first.chosen)
+    for _ in range(10):
+
+        def follows(chosen: tuple[int, ...], layout: list[int] = layout) -> NDArray[np.bool_]:
+            earlier = [i for i in chosen if not edge[i]]  # edge searches run last
+            ok = np.ones(len(A), dtype=bool)
+            ok[approach] = seq.fits_many([(int(i), earlier) for i in approach], layout)
+            return ok
+
+        d = select(
+            A,
+            var,
+            n,
+            ctx.poi,
+            available=~blocked,
+            follows=follows,
+            **common,
+            **kw,  # type: ignore[arg-type]
+        )
+        if len(d.chosen) < n or not np.isfinite(d.score):
+            return None
+        ordered = ctx.sequence(d.chosen, None)
+        if ordered.stuck:  # its own layout moved the pivot: grow it again in that layout
+            if sorted(d.chosen) == sorted(layout):
+                return None
+            layout = list(d.chosen)
+            continue
+        d = dataclasses.replace(d, chosen=ordered.order)
+        if ctx.paths_ok(d.chosen) and ctx.size_searches(d.chosen):
+            return d
+        blocked |= np.array([ctx.path_ok.get(i, True) is False for i in range(len(A))])
+    return None
+
+
 def best_fit_design(
     ctx: Context,
     target_m: float | None,
@@ -323,6 +383,8 @@ def best_fit_design(
         if best is not None:
             tries.append(_select_feasible(ctx, n, start=best.chosen, **extra))
             tries.append(_select_feasible(ctx, n, start=best.chosen, max_passes=0, **extra))
+        if all(d is None for d in tries):  # every design got stuck: grow one in order
+            tries.append(_select_in_order(ctx, n, **extra))
         found = [(ctx.worst(d.covariance), i, d) for i, d in enumerate(tries) if d is not None]
         # the searches are sized about the chosen points' centroid: size them for the one kept
         kept = next(

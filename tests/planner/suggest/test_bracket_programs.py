@@ -13,12 +13,11 @@ nominal frame), what the issue promises:
 - suggest gives a layout that validates within 1.25x of its prediction, or refuses saying
   what stops it.
 
-What does not hold today is marked ``xfail(strict=True)`` with the gap or the bug named: the
-nominal FANUC programs cannot measure the 20 mm end strips under a 20 mm bound (check says so,
-rightly); suggest's best fit for RAPID refuses a part it has a layout for. The hand-placed top
-points lie 25 mm in front of the upright: check names them (the sensor runs into the upright
-when the part lies towards them), as the validation's failures show. 200 trials, the plan's own
-seed: a half-width scatters by about 10 %.
+What does not hold today is marked ``xfail(strict=True)`` with the gap named: the nominal
+FANUC programs cannot measure the 20 mm end strips under a 20 mm bound (check says so,
+rightly). The hand-placed top points lie 25 mm in front of the upright: check names them (the
+sensor runs into the upright when the part lies towards them), as the validation's failures
+show. 200 trials, the plan's own seed: a half-width scatters by about 10 %.
 """
 
 from __future__ import annotations
@@ -309,18 +308,13 @@ def test_suggest_gives_a_layout_that_validates_or_says_what_stops_it(
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(
-    strict=True,
-    reason=(
-        "bug: planner/suggest/order.py Sequencer.order_progressive returns every chosen point "
-        "as stuck when none fits as the first (each grown by the whole 20 mm / 3 deg), and "
-        "planner/suggest/steps.py _select_feasible bans them and their neighbours for good, "
-        "the end faces' only candidates among them: 'no layout fixes all 6 degrees of "
-        "freedom', though the 3-2-1 suggestion's 6 points run as an adaptive best fit are "
-        "feasible and validate"
-    ),
-)
 def test_suggest_finds_a_best_fit_for_the_adaptive_program(runs: _Runs) -> None:
+    """A best-fit layout exists (the 3-2-1 suggestion's points run as a best fit), so suggest
+    gives one. Its designs chosen for information alone hold no point that can be measured
+    first under the whole 20 mm / 3 deg (each lies near an edge of its face): it grows a
+    design in measuring order instead of banning those points and their faces' candidates
+    (``test_suggest_gives_a_layout_that_validates_or_says_what_stops_it`` checks and validates
+    it)."""
     from planner.check.job import check_plan
 
     three = runs.suggest("three_two_one", "rapid")
