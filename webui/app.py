@@ -49,6 +49,8 @@ logger = logging.getLogger(__name__)
 
 #: A move that lands within this of where the point is changes nothing, m.
 MOVE_TOL_M = 1e-6
+#: How long a cell may take to load before the UI gives it up (the cell shown stays), s.
+CELL_LOAD_S = 300.0
 
 
 class WobjcalApp:
@@ -169,11 +171,11 @@ class WobjcalApp:
         self.heatmap.stop()
         with self.busy("loading the cell"):
             try:
-                self.worker.replace_resource(lambda: CellSession(plan, plan_dir)).result(300)
-            except TimeoutError:  # it has no message of its own
+                self.worker.replace_resource(lambda: CellSession(plan, plan_dir), CELL_LOAD_S)
+            except TimeoutError:  # it has no message of its own; the cell shown stays
                 raise InputError(
                     f"the cell of the plan ({len(plan.points)} points, work object "
-                    f"{plan.work_object.mesh}) did not load within 300 s"
+                    f"{plan.work_object.mesh}) did not load within {CELL_LOAD_S:.0f} s"
                 ) from None
         session = self.worker.call(lambda s: s)
         view = session.view

@@ -77,18 +77,40 @@ class CellWorker(Generic[C]):
             return job(self._resource, *args)
         return self.submit(job, *args).result(timeout)
 
-    def replace_resource(self, factory: Callable[[], C]) -> Future[None]:
-        """Close the current resource and create a new one with ``factory``, in the worker.
+    def replace_resource(self, factory: Callable[[], C], timeout: float | None = None) -> None:
+        """Create a new resource with ``factory`` in the worker, make it the worker's and close
+        the old one; wait up to ``timeout`` seconds (``None``: as long as it takes).
 
-        If ``factory`` raises, the old resource is kept and the future holds the exception.
+        If ``factory`` raises, the old resource is kept and the exception is raised here.
+
+        Raises:
+            TimeoutError: not done within ``timeout``. The old resource stays: a swap that has
+                not started is cancelled, and a resource that is still being built is closed
+                when it is done, never made the worker's (the caller has given it up).
         """
+        gate = threading.Lock()
+        state = {"abandoned": False, "installed": False}
 
         def swap(old: C | None) -> None:
             new = factory()
-            self._resource = new
+            with gate:
+                if state["abandoned"]:
+                    _close(new)
+                    return
+                self._resource = new
+                state["installed"] = True
             _close(old)
 
-        return self.submit(swap)
+        fut = self.submit(swap)
+        try:
+            fut.result(timeout)
+        except TimeoutError:
+            with gate:
+                if not state["installed"]:
+                    state["abandoned"] = True
+                    fut.cancel()
+                    raise
+            fut.result()  # made the worker's just as the wait ended: only the old one's close
 
     def close(self, timeout: float = 10.0) -> None:
         """Stop the worker after the queued jobs and close the resource."""

@@ -10,7 +10,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -311,39 +311,39 @@ def _select_in_order(ctx: Context, n: int, **kw: object) -> Design | None:
     edge = ctx.pool.is_edge
     approach = np.flatnonzero(~edge)
     blocked = np.array([ctx.path_ok.get(i, True) is False for i in range(len(A))])
-    common: dict[str, object] = dict(
-        positions_m=ctx.pool.positions_m,
-        min_separation_m=max(2 * ctx.radius_m, 0.01),
-        scale_m=1.0,
-        background_m=ctx.corners,
-    )
-    first = select(A, var, n, ctx.poi, available=~blocked, **common, **kw)  # type: ignore[arg-type]
-    layout = list(first.chosen)
-    for _ in range(10):
+    layout: list[int] = []
 
-        def follows(chosen: tuple[int, ...], layout: list[int] = layout) -> NDArray[np.bool_]:
-            earlier = [i for i in chosen if not edge[i]]  # edge searches run last
-            ok = np.ones(len(A), dtype=bool)
-            ok[approach] = seq.fits_many([(int(i), earlier) for i in approach], layout)
-            return ok
+    def follows(chosen: Sequence[int]) -> NDArray[np.bool_]:
+        earlier = [int(i) for i in chosen if not edge[i]]  # edge searches run last
+        ok = np.ones(len(A), dtype=bool)
+        ok[approach] = seq.fits_many([(int(i), earlier) for i in approach], layout)
+        return ok
 
-        d = select(
+    def design(in_order: bool) -> Design:
+        return select(
             A,
             var,
             n,
             ctx.poi,
+            positions_m=ctx.pool.positions_m,
             available=~blocked,
-            follows=follows,
-            **common,
+            min_separation_m=max(2 * ctx.radius_m, 0.01),
+            scale_m=1.0,
+            background_m=ctx.corners,
+            follows=follows if in_order else None,
             **kw,  # type: ignore[arg-type]
         )
+
+    layout[:] = design(in_order=False).chosen
+    for _ in range(10):
+        d = design(in_order=True)
         if len(d.chosen) < n or not np.isfinite(d.score):
             return None
         ordered = ctx.sequence(d.chosen, None)
         if ordered.stuck:  # its own layout moved the pivot: grow it again in that layout
             if sorted(d.chosen) == sorted(layout):
                 return None
-            layout = list(d.chosen)
+            layout[:] = d.chosen
             continue
         d = dataclasses.replace(d, chosen=ordered.order)
         if ctx.paths_ok(d.chosen) and ctx.size_searches(d.chosen):

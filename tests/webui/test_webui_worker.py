@@ -67,10 +67,52 @@ def test_replace_resource_keeps_old_on_failure() -> None:
         raise RuntimeError("broken urdf")
 
     with pytest.raises(RuntimeError):
-        w.replace_resource(bad).result(5)
+        w.replace_resource(bad, 5)
     assert w.call(lambda r: r) is old and not old.closed
-    w.replace_resource(_Res).result(5)
+    w.replace_resource(_Res, 5)
     assert w.call(lambda r: r) is not old and old.closed
+    w.close()
+
+
+def test_a_resource_given_up_while_it_is_built_is_never_the_workers() -> None:
+    """The caller stops waiting (a cell that takes too long to load): the old resource stays
+    the worker's, and the new one is closed when it is done, not swapped in behind the caller's
+    back (the UI would draw one cell and check in another)."""
+    w = CellWorker(_Res)
+    old = w.call(lambda r: r)
+    started, release = threading.Event(), threading.Event()
+    built: list[_Res] = []
+
+    def slow() -> _Res:
+        started.set()
+        release.wait(5)
+        built.append(_Res())
+        return built[-1]
+
+    with pytest.raises(TimeoutError):
+        w.replace_resource(slow, 0.2)
+    assert started.is_set()
+    release.set()
+    assert w.call(lambda r: r) is old and not old.closed  # runs after the abandoned swap
+    assert len(built) == 1 and built[0].closed
+    w.close()
+
+
+def test_a_swap_given_up_before_it_starts_is_not_run() -> None:
+    w = CellWorker(_Res)
+    old = w.call(lambda r: r)
+    gate = threading.Event()
+    w.submit(lambda _r: gate.wait(5))  # the worker is busy
+    calls: list[int] = []
+
+    def new() -> _Res:
+        calls.append(1)
+        return _Res()
+
+    with pytest.raises(TimeoutError):
+        w.replace_resource(new, 0.1)
+    gate.set()
+    assert w.call(lambda r: r) is old and calls == []
     w.close()
 
 
