@@ -342,6 +342,7 @@ def suggest_plan(
     # the most a point moves in its face when the part lies misplaced about its middle
     worst_shift = m.max_translation_m + m.max_angle_rad * float(np.linalg.norm(hi - lo))
     edge_start = r + 2.0 * worst_shift + 0.005
+    edge_note = ""
     if sensor.runs_edge_searches and _approaches_weak(pool):
         edges = edge_candidates(
             outlines, sorted(set(pool.face.tolist())), r, edge_start, worst_shift + FLOOR_M
@@ -350,6 +351,15 @@ def suggest_plan(
         for k, v in rej_e.items():
             rejected[k] = rejected.get(k, 0) + v
         pool = pool.joined(edges.subset(ok_e))
+        if not ok_e.any():
+            edge_note = (
+                f"; edge searches: {len(edges)} tracks, none feasible"
+                if len(edges)
+                else "; edge searches: none, as no straight square edge of these faces has a "
+                f"track {edge_start * 1e3:.0f} mm long that keeps the footprint on the face "
+                f"when moved {(worst_shift + FLOOR_M) * 1e3:.1f} mm by the misplacement (holes, "
+                "short or rounded edges)"
+            )
     if steered and bool(pool.is_edge.any()):  # its frame update takes approach searches only
         steered = False
     pivot = pool.positions_m.mean(axis=0)  # the probed region: the misplacement's pivot
@@ -385,6 +395,7 @@ def suggest_plan(
     )
     ctx = Context(cell, plan, pool, safety, rows_poi, z, r, corners, sequencer, tuple(old))
     ctx.edge_start_m, ctx.edge_overtravel_m = edge_start, 2.0 * worst_shift + 0.02
+    ctx.edge_note = edge_note
     if objective == "time":
         return _fastest_plan(
             ctx, plan, kind, target_m, max_points, at_m, level, fmt, t0, tried, len(cands),
@@ -775,6 +786,7 @@ def _no_layout(
         )
         + "): "
         + faces_text(tried, ctx.pool, ctx)
+        + ctx.edge_note
     )
     if set_aside:
         text += "; set aside after wobjcal check refused them: " + "; ".join(

@@ -81,6 +81,8 @@ class Context:
     #: edge searches: start inside the edge and travel past it, metres
     edge_start_m: float = 0.0
     edge_overtravel_m: float = 0.0
+    #: why no edge search is among the candidates, when they were looked for ("; edge ...")
+    edge_note: str = ""
     #: check the search paths of newly chosen candidates in the cell; ``False``: only the
     #: verdicts already cached count (what-if designs, e.g. at a smaller misplacement bound)
     check_paths: bool = True
@@ -221,6 +223,8 @@ def feasible_poses(
     where any of those passed."""
     ok = np.zeros(len(cands), dtype=bool)
     rejected: dict[str, int] = {}
+    if len(cands) == 0:  # e.g. no edge track that keeps the footprint on its face
+        return ok, rejected
     tcp = plan.cell.tool.tcp
     face_ids = sorted(set(cands.face.tolist()))
     first = np.concatenate([np.flatnonzero(cands.face == f)[:PROBE_FIRST] for f in face_ids])
