@@ -75,8 +75,10 @@ class ProcedureRun:
     Attributes:
         T_base_wobj: ``(4, 4)`` the calibrated work object in the robot base frame, metres.
         used_ids: the point ids the frame was computed from, in procedure order.
-        measured_m: ``{key: (3,)}`` every measurement the procedure took or used, base frame,
-            metres, by measurement key (see the module docstring).
+        measured_m: ``{key: (3,)}`` every measurement the procedure took or used, as
+            measured (an edge search's event with the sensor's edge offset still in it: the
+            procedure removes it when it fits), base frame, metres, by measurement key (see the
+            module docstring).
         probes: every search in the order run (empty for a frame estimated from recorded
             measurements).
         updates: the estimate after each update, in order (the last is ``T_base_wobj``; the

@@ -14,6 +14,7 @@ import numpy as np
 
 from calib.errors import PlanError
 from calib.estimators.best_fit import best_fit
+from calib.estimators.layout import search_constraint_set
 from calib.estimators.runners import run_best_fit
 from calib.limits import MAX_FIT_ITERATIONS
 from calib.paper.stator_layout import StatorLayout
@@ -135,11 +136,12 @@ class BestFitProcedure:
         left out; the fit refuses a set that no longer fixes all 6 degrees of freedom)."""
         cfg = settings if isinstance(settings, BestFit) else BestFit()
         pts = [rp.point for rp in self.assign(points) if rp.point.id in measured]
-        q = np.array([np.asarray(measured[p.id], dtype=float).reshape(-1, 3)[0] for p in pts])
-        q = edge_corrected(pts, q, T_base_wobj_nominal, edge_offset_of(cfg))
-        res = best_fit(pts, q, T_base_wobj_nominal, max_iterations=cfg.max_iterations, tol=cfg.tol)
+        raw = np.array([np.asarray(measured[p.id], dtype=float).reshape(-1, 3)[0] for p in pts])
+        q = edge_corrected(pts, raw, T_base_wobj_nominal, edge_offset_of(cfg))
+        cs = search_constraint_set(pts)  # an edge search: its edge coordinate only, as in run
+        res = best_fit(cs, q, T_base_wobj_nominal, max_iterations=cfg.max_iterations, tol=cfg.tol)
         ids = tuple(p.id for p in pts)
-        return ProcedureRun(res.T_base_wobj, ids, dict(zip(ids, q, strict=True)))
+        return ProcedureRun(res.T_base_wobj, ids, dict(zip(ids, raw, strict=True)))
 
     def adaptive_layout(self, points: Sequence[RolePoint]) -> StatorLayout | None:
         """``None``: programs run the searches in the nominal frame."""

@@ -119,11 +119,11 @@ class IterativeProcedure(BestFitProcedure):
         search counted by its edge coordinate only."""
         cfg = _settings(settings)
         pts = [rp.point for rp in self.assign(points) if rp.point.id in measured]
-        q = np.array([np.asarray(measured[p.id], dtype=float).reshape(-1, 3)[-1] for p in pts])
-        q = edge_corrected(pts, q, T_base_wobj_nominal, edge_offset_of(cfg))
+        raw = np.array([np.asarray(measured[p.id], dtype=float).reshape(-1, 3)[-1] for p in pts])
+        q = edge_corrected(pts, raw, T_base_wobj_nominal, edge_offset_of(cfg))
         res = best_fit(search_constraint_set(pts), q, T_base_wobj_nominal)
         ids = tuple(p.id for p in pts)
-        return ProcedureRun(res.T_base_wobj, ids, dict(zip(ids, q, strict=True)))
+        return ProcedureRun(res.T_base_wobj, ids, dict(zip(ids, raw, strict=True)))
 
 
 def run_iterative_fit(

@@ -213,10 +213,10 @@ class ThreeTwoOneProcedure:
         ordered = self.assign(points)
         layout = self.layout(ordered)
         ids = tuple(rp.point.id for rp in ordered)
-        q = np.array([np.asarray(measured[i], dtype=float).reshape(-1, 3)[0] for i in ids])
-        q = edge_corrected(layout.points, q, T_base_wobj_nominal, edge_offset_of(settings))
+        raw = np.array([np.asarray(measured[i], dtype=float).reshape(-1, 3)[0] for i in ids])
+        q = edge_corrected(layout.points, raw, T_base_wobj_nominal, edge_offset_of(settings))
         T = three_two_one(layout, q, T_base_wobj_nominal).T_base_wobj
-        return ProcedureRun(T, ids, dict(zip(ids, q, strict=True)))
+        return ProcedureRun(T, ids, dict(zip(ids, raw, strict=True)))
 
     def adaptive_layout(self, points: Sequence[RolePoint]) -> StatorLayout | None:
         """``None``: programs run the 3-2-1 searches in the nominal frame."""

@@ -249,9 +249,11 @@ def test_six_points_have_no_redundancy_and_say_so() -> None:
 
 
 def test_propagated_covariance_matches_best_fit_and_monte_carlo(rng: np.random.Generator) -> None:
-    """The covariance propagated through `estimate` equals best_fit's analytic one, and for the
-    A-H procedure it matches the scatter of 300 noisy replays within 20 %."""
+    """The covariance propagated through `estimate` equals best_fit's analytic one (F and H,
+    edge searches, counted by their edge coordinate only, as the procedure fits them), and for
+    the A-H procedure it matches the scatter of 300 noisy replays within 20 %."""
     from calib.estimators.best_fit import best_fit
+    from calib.estimators.layout import search_constraint_set
     from calib.procedures import procedure_kind
     from calib.procedures.uncertainty import propagated_covariance
 
@@ -262,7 +264,8 @@ def test_propagated_covariance_matches_best_fit_and_monte_carlo(rng: np.random.G
     sigma = 1e-4
     kind = procedure_kind("best_fit")
     cov = propagated_covariance(kind, points, exact, T_nom, None, sigma)
-    fit = best_fit([rp.point for rp in points], np.array([v[0] for v in exact.values()]), T_nom)
+    cs = search_constraint_set([rp.point for rp in points])
+    fit = best_fit(cs, np.array([exact[i][0] for i in cs.point_ids]), T_nom)
     np.testing.assert_allclose(cov, sigma**2 * fit.unit_covariance, rtol=1e-4, atol=1e-16)
 
     ah = procedure_kind("hultman2013")
