@@ -43,7 +43,7 @@ from webui.tab_robots import TabRobots, tab_robots_or_reason
 from webui.tab_selection import Selections
 from webui.tabs import AppTabs
 from webui.upload_guard import guard_uploads
-from webui.worker import CellWorker
+from webui.worker import CellWorker, ResourceTimeout
 
 logger = logging.getLogger(__name__)
 
@@ -172,7 +172,7 @@ class WobjcalApp:
         with self.busy("loading the cell"):
             try:
                 self.worker.replace_resource(lambda: CellSession(plan, plan_dir), CELL_LOAD_S)
-            except TimeoutError:  # it has no message of its own; the cell shown stays
+            except ResourceTimeout:  # it has no message of its own; the cell shown stays
                 raise InputError(
                     f"the cell of the plan ({len(plan.points)} points, work object "
                     f"{plan.work_object.mesh}) did not load within {CELL_LOAD_S:.0f} s"

@@ -28,6 +28,10 @@ class WorkerClosedError(RuntimeError):
     """A job was submitted to a worker that has been closed."""
 
 
+class ResourceTimeout(TimeoutError):
+    """:meth:`CellWorker.replace_resource` gave up waiting (the old resource stays)."""
+
+
 class CellWorker(Generic[C]):
     """A single thread that owns one resource (the cell) and runs jobs on it in order.
 
@@ -84,15 +88,24 @@ class CellWorker(Generic[C]):
         If ``factory`` raises, the old resource is kept and the exception is raised here.
 
         Raises:
-            TimeoutError: not done within ``timeout``. The old resource stays: a swap that has
-                not started is cancelled, and a resource that is still being built is closed
-                when it is done, never made the worker's (the caller has given it up).
+            ResourceTimeout: not done within ``timeout``. The old resource stays: a swap that
+                has not started is cancelled, and a resource that is still being built is
+                closed when it is done, never made the worker's (the caller has given it up;
+                an error of that build is logged).
+            RuntimeError: called from the worker thread (it would wait for itself).
         """
+        if threading.current_thread() is self._thread:
+            raise RuntimeError("replace_resource from the worker thread would wait for itself")
         gate = threading.Lock()
         state = {"abandoned": False, "installed": False}
 
         def swap(old: C | None) -> None:
-            new = factory()
+            try:
+                new = factory()
+            except BaseException:
+                if state["abandoned"]:  # nobody waits for this future any more
+                    logger.exception("building a resource given up on failed")
+                raise
             with gate:
                 if state["abandoned"]:
                     _close(new)
@@ -105,11 +118,13 @@ class CellWorker(Generic[C]):
         try:
             fut.result(timeout)
         except TimeoutError:
+            if fut.done():  # the factory's own TimeoutError: an error like any other
+                raise
             with gate:
                 if not state["installed"]:
                     state["abandoned"] = True
                     fut.cancel()
-                    raise
+                    raise ResourceTimeout(f"not done within {timeout} s") from None
             fut.result()  # made the worker's just as the wait ended: only the old one's close
 
     def close(self, timeout: float = 10.0) -> None:

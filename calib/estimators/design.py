@@ -157,7 +157,8 @@ def select(
             step among those, and an exchange puts a candidate in a search's place only when
             it may follow the searches before that place and every later one may still follow
             (the best candidate for the place; none when it breaks the order): ``chosen`` of
-            the result is a measuring order.
+            the result is a measuring order when the ``start`` searches are one (they are
+            taken as given, first).
 
     Raises:
         ShapeError: inconsistent shapes, or a quota that does not add up to ``n``.

@@ -344,9 +344,15 @@ def _select_in_order(ctx: Context, n: int, **kw: object) -> Design | None:
         if len(d.chosen) < n or not np.isfinite(d.score):
             return None
         ordered = ctx.sequence(d.chosen, None)
-        if ordered.stuck:  # its own layout moved the pivot: grow it again in that layout
-            if sorted(d.chosen) == sorted(layout):
+        if ordered.stuck and sorted(d.chosen) == sorted(layout):
+            # the layout it was grown in: the order it was grown in holds there (the
+            # sequencer's greedy order may miss it, a point after one other being grown more
+            # than a first point), with the edge searches last as the program runs them
+            grown = [i for i in d.chosen if not edge[i]] + [i for i in d.chosen if edge[i]]
+            if not all(follows(grown[:k])[i] for k, i in enumerate(grown)):
                 return None
+            ordered = dataclasses.replace(ordered, order=tuple(grown), stuck=())
+        if ordered.stuck:  # its own layout moved the pivot: grow it again in that layout
             layout[:] = d.chosen
             continue
         d = dataclasses.replace(d, chosen=ordered.order)

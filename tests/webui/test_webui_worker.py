@@ -7,7 +7,7 @@ import time
 
 import pytest
 
-from webui.worker import CellWorker, WorkerClosedError
+from webui.worker import CellWorker, ResourceTimeout, WorkerClosedError
 
 
 class _Res:
@@ -89,7 +89,7 @@ def test_a_resource_given_up_while_it_is_built_is_never_the_workers() -> None:
         built.append(_Res())
         return built[-1]
 
-    with pytest.raises(TimeoutError):
+    with pytest.raises(ResourceTimeout):
         w.replace_resource(slow, 0.2)
     assert started.is_set()
     release.set()
@@ -109,7 +109,7 @@ def test_a_swap_given_up_before_it_starts_is_not_run() -> None:
         calls.append(1)
         return _Res()
 
-    with pytest.raises(TimeoutError):
+    with pytest.raises(ResourceTimeout):
         w.replace_resource(new, 0.1)
     gate.set()
     assert w.call(lambda r: r) is old and calls == []
@@ -125,4 +125,22 @@ def test_long_job_does_not_block_submitters() -> None:
     assert time.perf_counter() - t0 < 1.0 and not quick.done()
     gate.set()
     assert fut.result(5) and quick.result(5) == 1
+    w.close()
+
+
+def test_a_factory_s_own_timeout_is_its_error_not_the_wait_s() -> None:
+    """A build that raises TimeoutError itself (a socket timeout while reading a file) is its
+    error, raised as it is at once; only the wait running out is a ResourceTimeout."""
+    w = CellWorker(_Res)
+    old = w.call(lambda r: r)
+
+    def times_out() -> _Res:
+        raise TimeoutError("reading the mesh timed out")
+
+    with pytest.raises(TimeoutError, match="reading the mesh") as err:
+        w.replace_resource(times_out, 5)
+    assert not isinstance(err.value, ResourceTimeout)
+    assert w.call(lambda r: r) is old
+    with pytest.raises(RuntimeError, match="wait for itself"):  # from the worker's own thread
+        w.call(lambda _r: w.replace_resource(_Res, 1))
     w.close()
