@@ -261,6 +261,26 @@ def fixed_rows(plan: Plan) -> tuple[FloatArray, FloatArray]:
     return A, np.full(len(A), var)
 
 
+def _design(
+    ctx: Context, A: FloatArray, var: FloatArray, n: int, available: NDArray[np.bool_], **kw: object
+) -> Design:
+    """:func:`calib.estimators.design.select` of ``n`` of the ``available`` candidates (rows
+    ``A``, variances ``var``) for the context's points of interest, footprint spacing and part
+    corners; ``kw`` are more of its arguments (quota, start, fixed rows, ``follows``)."""
+    return select(
+        A,
+        var,
+        n,
+        ctx.poi,
+        positions_m=ctx.pool.positions_m,
+        available=available,
+        min_separation_m=max(2 * ctx.radius_m, 0.01),
+        scale_m=1.0,
+        background_m=ctx.corners,
+        **kw,  # type: ignore[arg-type]
+    )
+
+
 def _select_feasible(ctx: Context, n: int, **kw: object) -> Design | None:
     """The design of ``n`` points whose search paths are all feasible (blocked ones dropped)."""
     A, var = ctx.rows()
@@ -269,18 +289,7 @@ def _select_feasible(ctx: Context, n: int, **kw: object) -> Design | None:
         blocked = np.array([ctx.path_ok.get(i, True) is False or i in stuck for i in range(len(A))])
         if kw.get("quota") is not None:  # a face design takes approach searches only
             blocked |= ctx.pool.is_edge
-        d = select(
-            A,
-            var,
-            n,
-            ctx.poi,
-            positions_m=ctx.pool.positions_m,
-            available=~blocked,
-            min_separation_m=max(2 * ctx.radius_m, 0.01),
-            scale_m=1.0,
-            background_m=ctx.corners,
-            **kw,  # type: ignore[arg-type]
-        )
+        d = _design(ctx, A, var, n, ~blocked, **kw)
         if len(d.chosen) < n or not np.isfinite(d.score):
             return None
         ordered = ctx.sequence(d.chosen, kw.get("quota"))  # type: ignore[arg-type]
@@ -324,19 +333,7 @@ def _select_in_order(ctx: Context, n: int, **kw: object) -> Design | None:
         return ok
 
     def design(in_order: bool) -> Design:
-        return select(
-            A,
-            var,
-            n,
-            ctx.poi,
-            positions_m=ctx.pool.positions_m,
-            available=~blocked,
-            min_separation_m=max(2 * ctx.radius_m, 0.01),
-            scale_m=1.0,
-            background_m=ctx.corners,
-            follows=follows if in_order else None,
-            **kw,  # type: ignore[arg-type]
-        )
+        return _design(ctx, A, var, n, ~blocked, follows=follows if in_order else None, **kw)
 
     layout[:] = design(in_order=False).chosen
     for _ in range(10):
