@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -69,6 +70,9 @@ class GrossErrorScreen:
     Attributes:
         sigma_m: expected noise of a measured point along its face normal, metres.
         k_sigma: a residual beyond ``k_sigma * sigma_m`` flags its point.
+        edge_rows: what an edge search's point counts for, as in the procedure's fit
+            (:attr:`calib.procedures.base.ProcedureKind.edge_rows`): ``"edge"``, only its edge
+            coordinate (a coordinate the program commanded is no measurement to screen).
         redundancy: constraints beyond the 6 degrees of freedom (0: nothing can be screened).
         residuals_m: ``{id: (r1[, r2])}`` least-squares point-to-face residuals, metres.
         flagged: the points with a residual beyond the limit, worst first.
@@ -146,6 +150,7 @@ def screen_measurements(
     T_base_wobj_nominal: ArrayLike,
     sigma_m: float,
     k_sigma: float = K_SIGMA,
+    edge_rows: Literal["both", "edge"] = "both",
 ) -> GrossErrorScreen:
     """Screen measured points for gross errors (see the module docstring).
 
@@ -164,7 +169,7 @@ def screen_measurements(
     k = check_positive(k_sigma, "k_sigma")
     pts = tuple(points)
     q = check_points(measured_base, "measured_base")
-    cs = constraint_set(pts, "measured points")
+    cs = constraint_set(pts, "measured points", edge_rows=edge_rows)
     redundancy = cs.n_constraints - 6
     report = analyze_layout(cs)
     if not report.observable:
@@ -183,7 +188,7 @@ def screen_measurements(
             "gross error in one point cannot be seen in the residuals"
         )
         return GrossErrorScreen(sigma, k, redundancy, residuals, (), (), (), fit, note)
-    loo = _leave_one_out(pts, q, T_base_wobj_nominal, sigma) if flagged else ()
+    loo = _leave_one_out(pts, q, T_base_wobj_nominal, sigma, edge_rows) if flagged else ()
     remeasure = tuple(x.point_id for x in loo if x.worst_m <= limit and x.left_out_m > limit)
     return GrossErrorScreen(sigma, k, redundancy, residuals, flagged, remeasure, loo, fit)
 
@@ -268,7 +273,9 @@ class Detectability:
         return f"{head}; add {self.add} point(s) to make it detectable, e.g. {each} {where} ({how})"
 
 
-def detectability(points: Sequence[ProbePoint]) -> Detectability:
+def detectability(
+    points: Sequence[ProbePoint], edge_rows: Literal["both", "edge"] = "both"
+) -> Detectability:
     """Which points' gross errors the screen can see, and how many points to add for all.
 
     A gross error in point ``i`` shows in the least-squares residuals by its redundancy number
@@ -279,11 +286,13 @@ def detectability(points: Sequence[ProbePoint]) -> Detectability:
     point, a point beside it), on the face that leaves the fewest unseen. Pure
     geometry: where the points really go is :mod:`planner.suggest`'s.
 
+    ``edge_rows``: what an edge search's point counts for (:func:`screen_measurements`).
+
     Raises:
         ShapeError, DegenerateGeometryError: bad points (see
             :func:`calib.estimators.layout.constraint_set`).
     """
-    cs = constraint_set(tuple(points), "points")
+    cs = constraint_set(tuple(points), "points", edge_rows=edge_rows)
     n = cs.n_constraints
     if not analyze_layout(cs).observable:
         return Detectability(n, n - 6, (), None)
@@ -374,13 +383,17 @@ def _by_point(fit: BestFitResult) -> dict[str, tuple[float, ...]]:
 
 
 def _leave_one_out(
-    points: tuple[ProbePoint, ...], q: FloatArray, T_nominal: ArrayLike, sigma: float
+    points: tuple[ProbePoint, ...],
+    q: FloatArray,
+    T_nominal: ArrayLike,
+    sigma: float,
+    edge_rows: Literal["both", "edge"] = "both",
 ) -> tuple[LeaveOneOut, ...]:
     """The fit without each point that leaves a redundant, observable layout."""
     out = []
     for j, left in enumerate(points):
         keep = [i for i in range(len(points)) if i != j]
-        sub = constraint_set([points[i] for i in keep], "measured points")
+        sub = constraint_set([points[i] for i in keep], "measured points", edge_rows=edge_rows)
         if sub.n_constraints - 6 < 1 or not analyze_layout(sub).observable:
             continue
         try:

@@ -14,7 +14,7 @@ import math
 from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Literal, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -140,6 +140,11 @@ class ProcedureKind(Protocol):
             for, display units, by ``(report row key, confidence percent)`` (the paper's Table
             1 for A-H), shown beside a validation of a built-in part with exact geometry;
             ``None``: none.
+        edge_rows: what an edge search's point counts for in this procedure's frame, and so in
+            the gross-error screen of its measurements
+            (:func:`calib.estimators.layout.constraint_set`): ``"edge"``, its edge coordinate
+            only (its coordinate across the face it slides over is the command's); ``"both"``,
+            also that coordinate (A-H and 3-2-1 put an edge point on its face by role).
     """
 
     method: str
@@ -151,6 +156,7 @@ class ProcedureKind(Protocol):
     design: LayoutDesign | None
     steering: Steering | None
     published: Mapping[tuple[str, float], float] | None
+    edge_rows: Literal["both", "edge"]
 
     def role_problem(self, roles: Sequence[str], complete: bool) -> str:
         """What is wrong with the points' roles (``""`` when fine); ``complete``: also require

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from types import MappingProxyType
+from typing import Literal
 
 import msgspec
 import numpy as np
@@ -88,6 +89,8 @@ class BestFitProcedure:
     #: for approach searches without a shared TCP error (a test checks it against the
     #: linearisation): the UI's live layout quality takes that fast path.
     least_squares = True
+    #: an edge search counts by its edge coordinate only (see :meth:`run`)
+    edge_rows: Literal["both", "edge"] = "edge"
 
     def role_problem(self, roles: Sequence[str], complete: bool) -> str:
         """See :meth:`ProcedureKind.role_problem`."""

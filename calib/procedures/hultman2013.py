@@ -11,6 +11,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from functools import lru_cache
 from types import MappingProxyType
+from typing import Literal
 
 import numpy as np
 
@@ -60,6 +61,8 @@ class Hultman2013Procedure:
     steering: Steering | None = None
     #: the paper's Table 1, beside a validation of a built-in stator
     published: Mapping[tuple[str, float], float] | None = PAPER_TABLE1
+    #: F and H stand on the side face and find its top edge (eq. 10-12)
+    edge_rows: Literal["both", "edge"] = "both"
 
     def role_problem(self, roles: Sequence[str], complete: bool) -> str:
         """See :meth:`ProcedureKind.role_problem`."""

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from types import MappingProxyType
+from typing import Literal
 
 import msgspec
 import numpy as np
@@ -164,6 +165,8 @@ class ThreeTwoOneProcedure:
     #: Six face constraints, solved exactly: its linearised covariance is the least-squares
     #: one of its searches (a test checks it against the linearisation to 1e-9).
     least_squares = True
+    #: an edge point stands on its role's face (see :mod:`calib.estimators.three_two_one`)
+    edge_rows: Literal["both", "edge"] = "both"
 
     def role_problem(self, roles: Sequence[str], complete: bool) -> str:
         """See :meth:`ProcedureKind.role_problem`."""

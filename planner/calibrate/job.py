@@ -31,6 +31,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, replace
+from typing import Literal
 
 import msgspec
 import numpy as np
@@ -182,11 +183,13 @@ def calibrate_plan(
     residuals, edge_res = point_residuals(plan, run.T_base_wobj, first)
     skipped = tuple(p.id for p in plan.points if p.id not in measured)
     sigma = expected_sigma_m(plan)
-    screen = screen_plan_measurements(plan, first, run.T_base_wobj, sigma, k_sigma)
+    # what the program that measured them measured (the plan's procedure's, whatever --method)
+    rows = procedure_kind(plan.method).edge_rows
+    screen = screen_plan_measurements(plan, first, run.T_base_wobj, sigma, k_sigma, rows)
     sequences = {pid: measured[pid] for pid in measured}
     cov = propagated_covariance(kind, points, sequences, T_nom, settings, sigma)
     problems = [*screen.messages(), *misplacement_problems(plan, run.T_base_wobj, screen)]
-    unseen = detectability([p.to_probe_point() for p in plan.points if p.id in first])
+    unseen = detectability([p.to_probe_point() for p in plan.points if p.id in first], rows)
     if unseen.unseen and (why := plan.fixed_points()):
         unseen = replace(unseen, fixed=why)
     # which points' gross errors the screen could not see, and how many points would show them
@@ -237,8 +240,11 @@ def screen_plan_measurements(
     T_base_wobj: FloatArray,
     sigma_m: float,
     k_sigma: float = K_SIGMA,
+    edge_rows: Literal["both", "edge"] = "both",
 ) -> GrossErrorScreen:
-    """Screen the first measurement of every measured point (see the module docstring).
+    """Screen the first measurement of every measured point (see the module docstring), an
+    edge search's point counting for what the program that took it measured (``edge_rows``:
+    the plan's procedure's, :attr:`calib.procedures.base.ProcedureKind.edge_rows`).
 
     Edge points are moved back by the plan's edge-event offset along their search direction
     (turned into the base frame by ``T_base_wobj``, then by the least-squares fit itself).
@@ -256,10 +262,12 @@ def screen_plan_measurements(
             rows.append(q)
         return np.array(rows, dtype=np.float64).reshape(-1, 3)
 
-    screen = screen_measurements(probes, corrected(T_base_wobj[:3, :3]), T_nom, sigma_m, k_sigma)
+    def screen_at(R: FloatArray) -> GrossErrorScreen:
+        return screen_measurements(probes, corrected(R), T_nom, sigma_m, k_sigma, edge_rows)
+
+    screen = screen_at(T_base_wobj[:3, :3])
     if offset and screen.fit is not None:
-        R_fit = screen.fit.T_base_wobj[:3, :3]
-        screen = screen_measurements(probes, corrected(R_fit), T_nom, sigma_m, k_sigma)
+        screen = screen_at(screen.fit.T_base_wobj[:3, :3])
     return screen
 
 

@@ -201,7 +201,8 @@ def plan_detectability(plan: Plan) -> Detectability | None:
     if not plan.points:
         return None
     try:
-        d = detectability([p.to_probe_point() for p in plan.points])
+        edge_rows = procedure_kind(plan.method).edge_rows
+        d = detectability([p.to_probe_point() for p in plan.points], edge_rows)
     except InputError:
         return None
     if d.add is None and not d.unseen:

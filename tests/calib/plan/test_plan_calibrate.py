@@ -300,3 +300,36 @@ def test_absurd_plan_position_is_refused_naming_the_path() -> None:
     doc["points"][2]["position_m"][1] = 1e308
     with pytest.raises(PlanError, match=r"points\[2\]\.position_m: 1e\+308 m is not a plausible"):
         plan_from_json(json.dumps(doc))
+
+
+@pytest.mark.slow
+def test_a_nominal_best_fit_with_edge_searches_is_trusted_when_exact(
+    rng: np.random.Generator,
+) -> None:
+    """The stator's points as a best fit run by its nominal program (every search in the
+    nominal frame): F's and H's recorded points lie on their commanded tracks, off the true
+    side face by up to a millimetre, which the fit does not count. Neither may the gross-error
+    screen: on an ideal part every calibration is exact and trusted (the screen once fitted
+    those commanded coordinates, flagged D and called 16 of 40 exact frames untrusted)."""
+    from calib.plane_probe import PlaneProbe
+    from calib.procedures import BestFit
+    from planner.program import measuring_program
+    from planner.program.execute import execute
+
+    stator = load_plan(STATOR)
+    plan = msgspec.structs.replace(
+        stator,
+        procedure=BestFit(edge_event_offset_m=0.0),
+        points=[msgspec.structs.replace(p, role="fit") for p in stator.points],
+    )
+    program = measuring_program(plan, None)
+    assert not program.adaptive and not program.steers_itself  # edge searches: nominal
+    T_nom = nominal_T_base_wobj(plan)
+    bound = plan.validation.misplacement
+    pivot = np.mean([p.position_m for p in plan.points], axis=0)
+    for _ in range(12):
+        T_true = T_nom @ bound.sample(rng, pivot)  # anywhere the plan's bound lets the part lie
+        run = execute(program, T_nom, PlaneProbe(T_true))
+        out = calibrate_plan(plan, Measurements.from_points_m(run.measured_m))
+        assert np.abs(motion_between(T_true, out.T_base_wobj)).max() < 1e-9
+        assert out.screen.flagged == () and out.problems == (), out.problems
