@@ -248,6 +248,31 @@ def test_procedure_entries_are_consistent() -> None:
             assert method in STEERED_METHODS
         else:
             assert update_groups(method, ["a"] * 6) == [] and method not in STEERED_METHODS
+        assert kind.edge_rows in ("both", "edge"), method
+
+
+@pytest.mark.parametrize("method", [m for m, k in PROCEDURES.items() if k.edge_rows == "edge"])
+def test_a_procedure_that_counts_edge_coordinates_only_ignores_the_track_height(
+    method: str,
+) -> None:
+    """``edge_rows == "edge"`` is what its ``estimate`` does: moving an edge search's recorded
+    point across the face it slides over (the commanded track height) changes no frame."""
+    from calib.frames import make_transform, transform_points
+    from calib.paper.stator_layout import example_stator_points
+    from calib.procedures import RolePoint
+
+    kind = PROCEDURES[method]
+    pts = list(example_stator_points().values())
+    T = make_transform(None, [1.0, 0.2, 0.5])
+    measured = {p.id: transform_points(T, p.position_m)[None] for p in pts}
+    edge = next(p for p in pts if p.search.kind == "edge")
+    moved = dict(measured)
+    moved[edge.id] = measured[edge.id] + 0.002 * np.asarray(edge.normal)  # T has no rotation
+    settings = kind.settings_type()
+    rp = [RolePoint("fit", p) for p in pts]
+    a = kind.estimate(rp, measured, T, settings).T_base_wobj
+    b = kind.estimate(rp, moved, T, settings).T_base_wobj
+    assert np.abs(a - b).max() < 1e-12, method
 
 
 # ---------------------------------------------------------------- paste lines
