@@ -352,14 +352,20 @@ def suggest_plan(
             rejected[k] = rejected.get(k, 0) + v
         pool = pool.joined(edges.subset(ok_e))
         if not ok_e.any():
+            shift_mm = (worst_shift + FLOOR_M) * 1e3
             edge_note = (
-                f"; edge searches: {len(edges)} tracks, none feasible"
+                f"; edge searches: {len(edges)} tracks, no feasible pose for any ("
+                + ", ".join(f"{k} {v}" for k, v in sorted(rej_e.items()))
+                + ")"
                 if len(edges)
                 else "; edge searches: none, as no straight square edge of these faces has a "
-                f"track {edge_start * 1e3:.0f} mm long that keeps the footprint on the face "
-                f"when moved {(worst_shift + FLOOR_M) * 1e3:.1f} mm by the misplacement (holes, "
-                "short or rounded edges)"
+                f"band clear of holes and other edges from {edge_start * 1e3 + shift_mm:.0f} mm "
+                f"inside it to the edge, {2 * shift_mm:.0f} mm wide (the track, moved "
+                f"{shift_mm:.1f} mm either way by the misplacement; short or rounded edges get "
+                "none)"
             )
+    elif _approaches_weak(pool):
+        edge_note = f"; edge searches: none, the {sensor.KIND} sensor runs none"
     if steered and bool(pool.is_edge.any()):  # its frame update takes approach searches only
         steered = False
     pivot = pool.positions_m.mean(axis=0)  # the probed region: the misplacement's pivot

@@ -72,4 +72,4 @@ def test_a_part_with_one_reachable_face_is_refused_in_one_message(
     assert "Traceback" not in err and not out.exists()
     assert "no layout fixes all 6 degrees of freedom" in err, err
     assert "normal +z" in err and "feasible poses" in err, err  # the one face it can reach
-    assert "edge searches: none" in err and "holes, short or rounded edges" in err, err
+    assert "edge searches: none" in err and "clear of holes and other edges" in err, err
