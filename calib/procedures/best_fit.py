@@ -13,7 +13,7 @@ from typing import Literal
 import msgspec
 import numpy as np
 
-from calib.errors import PlanError
+from calib.errors import PlanError, UnobservableError
 from calib.estimators.best_fit import best_fit
 from calib.estimators.layout import search_constraint_set
 from calib.estimators.runners import run_best_fit
@@ -142,7 +142,18 @@ class BestFitProcedure:
         raw = np.array([np.asarray(measured[p.id], dtype=float).reshape(-1, 3)[0] for p in pts])
         q = edge_corrected(pts, raw, T_base_wobj_nominal, edge_offset_of(cfg))
         cs = search_constraint_set(pts)  # an edge search: its edge coordinate only, as in run
-        res = best_fit(cs, q, T_base_wobj_nominal, max_iterations=cfg.max_iterations, tol=cfg.tol)
+        try:
+            res = best_fit(
+                cs, q, T_base_wobj_nominal, max_iterations=cfg.max_iterations, tol=cfg.tol
+            )
+        except UnobservableError as exc:
+            if not any(p.search.kind == "edge" for p in pts):
+                raise
+            raise UnobservableError(
+                f"{exc} (an edge search counts by its edge coordinate only: its height over "
+                "the face it slides over is the program's command)",
+                unconstrained=exc.unconstrained,
+            ) from None
         ids = tuple(p.id for p in pts)
         return ProcedureRun(res.T_base_wobj, ids, dict(zip(ids, raw, strict=True)))
 

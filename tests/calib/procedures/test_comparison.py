@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from calib.estimators.layout import constraint_set, search_constraint_set
-from calib.frames import make_transform, matrix_from_rotvec, motion_between
+from calib.frames import make_transform, matrix_from_rotvec, motion_between, transform_points
 from calib.paper.stator_layout import example_stator_points
 from calib.plane_probe import PlaneProbe
 from calib.probing import SearchCommand
@@ -89,3 +89,17 @@ def test_a_frame_estimated_from_recorded_points_keeps_them_as_measured(kind: obj
     # the fed fit takes the offset along the final estimate's axes, the procedure along the
     # nominal ones it commanded in: second order, 6 mm x (1 - cos 0.02 rad) = 1.2 um
     assert np.abs(motion_between(run.T_base_wobj, fed.T_base_wobj)).max() < 5e-6
+
+
+def test_a_layout_fixed_only_by_track_heights_is_refused_saying_why() -> None:
+    """A, B, C with F and H: five degrees of freedom once F's and H's heights over the side
+    face (their commanded tracks) do not count; the refusal names the free turn and says why
+    the edge searches do not fix it."""
+    from calib.errors import UnobservableError
+    from calib.procedures import BestFit
+
+    pts = [p for k, p in AH.items() if k in "ABCFH"]
+    measured = {p.id: transform_points(T_NOM, p.position_m)[None] for p in pts}
+    with pytest.raises(UnobservableError, match="rotation about") as err:
+        BEST_FIT.estimate([RolePoint("fit", p) for p in pts], measured, T_NOM, BestFit())
+    assert "an edge search counts by its edge coordinate only" in str(err.value)
