@@ -7,7 +7,9 @@ screens the measurements against the noise the plan expects:
 1. all measured points are fitted by least squares (:func:`calib.estimators.best_fit.best_fit`,
    started from the nominal frame), whatever the procedure, because only a fit of every point
    spreads a gross error over the residuals where it can be seen (the A-H procedure, for
-   instance, puts C, D, F and H exactly on their faces by construction);
+   instance, puts C, D, F and H exactly on their faces by construction); an edge search's
+   point counts as the procedure counts it (``edge_rows``: its edge coordinate only where the
+   program commands the track's height, which is no measurement to screen);
 2. a point is *flagged* when one of its point-to-face residuals exceeds ``k_sigma * sigma_m``;
 3. with redundant points (more constraints than the 6 degrees of freedom), every point is left
    out in turn (leave-one-out): the point whose removal lets all the others fit within the limit
