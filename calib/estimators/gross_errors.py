@@ -72,9 +72,6 @@ class GrossErrorScreen:
     Attributes:
         sigma_m: expected noise of a measured point along its face normal, metres.
         k_sigma: a residual beyond ``k_sigma * sigma_m`` flags its point.
-        edge_rows: what an edge search's point counts for, as in the procedure's fit
-            (:attr:`calib.procedures.base.ProcedureKind.edge_rows`): ``"edge"``, only its edge
-            coordinate (a coordinate the program commanded is no measurement to screen).
         redundancy: constraints beyond the 6 degrees of freedom (0: nothing can be screened).
         residuals_m: ``{id: (r1[, r2])}`` least-squares point-to-face residuals, metres.
         flagged: the points with a residual beyond the limit, worst first.
@@ -163,6 +160,9 @@ def screen_measurements(
         T_base_wobj_nominal: ``(4, 4)`` the nominal frame the fits start from.
         sigma_m: expected noise of one measured point along its face normal, metres (> 0).
         k_sigma: a residual beyond ``k_sigma * sigma_m`` flags its point.
+        edge_rows: what an edge search's point counts for, as in the procedure's fit
+            (:attr:`calib.procedures.base.ProcedureKind.edge_rows`): ``"edge"``, only its edge
+            coordinate (a coordinate the program commanded is no measurement to screen).
 
     Raises:
         ShapeError, NonFiniteError: malformed measurements (the argument is named).

@@ -353,10 +353,10 @@ def suggest_plan(
         pool = pool.joined(edges.subset(ok_e))
         if not ok_e.any():
             shift_mm = (worst_shift + FLOOR_M) * 1e3
+            why = ", ".join(f"{k} {v}" for k, v in sorted(rej_e.items()))
             edge_note = (
-                f"; edge searches: {len(edges)} tracks, no feasible pose for any ("
-                + ", ".join(f"{k} {v}" for k, v in sorted(rej_e.items()))
-                + ")"
+                f"; edge searches: {len(edges)} tracks, no feasible pose for any"
+                + (f" ({why})" if why else "")
                 if len(edges)
                 else "; edge searches: none, as no straight square edge of these faces has a "
                 f"band clear of holes and other edges from {edge_start * 1e3 + shift_mm:.0f} mm "
