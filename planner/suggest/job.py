@@ -343,7 +343,8 @@ def suggest_plan(
     worst_shift = m.max_translation_m + m.max_angle_rad * float(np.linalg.norm(hi - lo))
     edge_start = r + 2.0 * worst_shift + 0.005
     edge_note = ""
-    if sensor.runs_edge_searches and _approaches_weak(pool):
+    weak = _approaches_weak(pool)
+    if sensor.runs_edge_searches and weak:
         edges = edge_candidates(
             outlines, sorted(set(pool.face.tolist())), r, edge_start, worst_shift + FLOOR_M
         )
@@ -364,7 +365,7 @@ def suggest_plan(
                 f"{shift_mm:.1f} mm either way by the misplacement; short or rounded edges get "
                 "none)"
             )
-    elif _approaches_weak(pool):
+    elif weak:
         edge_note = f"; edge searches: none, the {sensor.KIND} sensor runs none"
     if steered and bool(pool.is_edge.any()):  # its frame update takes approach searches only
         steered = False

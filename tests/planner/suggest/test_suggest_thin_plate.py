@@ -29,19 +29,9 @@ PART = "base_interface_AP214.STEP"
 
 
 @pytest.fixture
-def plate_plan(tmp_path: Path) -> Path:
+def plate_plan(reference_dir: Path, tmp_path: Path) -> Path:
     """The shipped plate plan with the STEP plate as its work object, on the pedestal."""
-    from tests.conftest import REFERENCE
-
-    source = REFERENCE / "cad" / PART
-    if not source.is_file():
-        import os
-
-        message = f"reference CAD part not found at {source}"
-        if os.environ.get("CI", "").lower() in ("1", "true", "yes"):
-            pytest.fail(f"{message} (required under CI)")
-        pytest.skip(message)
-    shutil.copy(source, tmp_path / PART)
+    shutil.copy(reference_dir / "cad" / PART, tmp_path / PART)
     rep = msgspec.structs.replace
     plan = load_plan(TEMPLATE)
     work_object = rep(
