@@ -17,7 +17,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from planner.sim.report_points import surface_samples
-from planner.sim.rows import point_errors
+from planner.sim.rows import error_motion, point_errors
 
 FloatArray = NDArray[np.float64]
 
@@ -58,8 +58,9 @@ def error_quantiles(delta: FloatArray, points_wobj: FloatArray, level_percent: f
     out = np.full(len(P), np.nan)
     if len(d) == 0:
         return out
+    motion = error_motion(d)
     for i in range(0, len(P), 500):
-        length = np.linalg.norm(point_errors(d, P[i : i + 500]), axis=2)  # (n, m)
+        length = np.linalg.norm(point_errors(d, P[i : i + 500], motion), axis=2)  # (n, m)
         out[i : i + 500] = np.quantile(length, level_percent / 100.0, axis=0)
     return out
 

@@ -157,6 +157,11 @@ class MeshRayCaster:
             tri_out[r] = more_tri
         return out, tri_out
 
+    def triangle_arrays(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``(normals (F, 3), offsets (F,), corners (F, 3, 3))`` of every triangle, mesh frame,
+        m, float64 and C-contiguous (the caster's own arrays: read them, do not write)."""
+        return self._normals, self._offsets, self._triangles
+
     def triangle_normal(self, triangle: int | NDArray[np.int64]) -> FloatArray:
         """``(3,)`` (or ``(K, 3)``) unit normal of a triangle (or triangles), mesh frame."""
         return np.array(self._normals[triangle], dtype=np.float64)

@@ -106,10 +106,27 @@ def _unsigned(errors: FloatArray, components: str) -> FloatArray:
 CHUNK_SAMPLES = 500_000
 
 
-def point_errors(delta: FloatArray, p_wobj: FloatArray) -> FloatArray:
-    """Errors ``(n, M, 3)`` of wobj points ``(M, 3)`` under frame errors ``(n, 6)`` (exact)."""
+#: ``(R - I, t)`` of frame errors: ``(n, 3, 3)`` and ``(n, 3)`` (:func:`error_motion`).
+ErrorMotion = tuple[FloatArray, FloatArray]
+
+
+def error_motion(delta: FloatArray) -> ErrorMotion:
+    """``(R - I, t)`` of the motions ``T_true_est = small_motion(delta)`` of frame errors
+    ``(n, 6)`` (m, rad): what :func:`point_errors` applies, computed once for many points.
+    ``R - I`` is exact (the diagonal of ``R`` is near 1), so a point's error ``(R - I) p + t``
+    keeps its precision where ``R p + t - p`` would cancel."""
     T = small_motion(delta)  # T_true_est, (n, 4, 4)
-    return np.einsum("nij,mj->nmi", T[:, :3, :3], p_wobj) + T[:, None, :3, 3] - p_wobj
+    return T[:, :3, :3] - np.eye(3), T[:, :3, 3].copy()
+
+
+def point_errors(
+    delta: FloatArray, p_wobj: FloatArray, motion: ErrorMotion | None = None
+) -> FloatArray:
+    """Errors ``(n, M, 3)`` of wobj points ``(M, 3)`` under frame errors ``(n, 6)`` (exact):
+    ``(R - I) p + t`` of each trial's error motion (``motion``: :func:`error_motion` of
+    ``delta`` when the caller has it), metres."""
+    R_minus_I, t = error_motion(delta) if motion is None else motion
+    return np.matmul(p_wobj, R_minus_I.transpose(0, 2, 1)) + t[:, None, :]
 
 
 def samples_and_bias(
@@ -136,9 +153,10 @@ def samples_and_bias(
     samples = np.empty((n, m))
     means = np.empty((m, 3))
     step = max(1, CHUNK_SAMPLES // max(n, 1))  # a few points at a time: bounded transients
+    motion = error_motion(delta) if point_err is None and m else None
     for i in range(0, m, step):
         j = min(i + step, m)
-        e = point_errors(delta, pts[i:j]) if point_err is None else point_err[:, i:j]
+        e = point_errors(delta, pts[i:j], motion) if point_err is None else point_err[:, i:j]
         if spec.offset_m is not None:
             e = e - spec.offset_m[i:j]
         means[i:j] = e.mean(axis=0)

@@ -119,59 +119,23 @@ def sweep_contact(
     Each triangle is met at its face (the tangent point inside it), an edge or a corner,
     whichever comes first; the normal points from the contact to the ball's centre. The
     triangle is returned when the contact is on its face, else ``-1`` (an edge or corner).
-    All triangles are solved at once.
+    All triangles are solved in one compiled loop (:mod:`planner.sim.sweep_kernel`).
     """
-    tri = np.asarray(triangles, dtype=np.int64)
-    n = caster.triangle_normal(tri)  # (K, 3)
-    v = caster.triangle_vertices(tri)  # (K, 3, 3)
-    cos = n @ a
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t_face = (n @ centre0 - caster.triangle_offset(tri) - r) / -cos
-    facing = cos < -1e-12
-    t_face = np.where(facing, t_face, np.inf)
-    q = centre0 + np.where(facing, t_face, 0.0)[:, None] * a - r * n  # no inf * 0
-    edges = v[:, [1, 2, 0]] - v  # (K, 3, 3): v1 - v0, v2 - v1, v0 - v2
-    inside = facing & np.all(
-        np.einsum("kij,kj->ki", np.cross(edges, q[:, None, :] - v), n) >= -1e-12, axis=1
-    )
-    t_face = np.where(inside, t_face, np.inf)
-    # edges: the distance from the moving centre to each edge's line reaches r
-    length = np.linalg.norm(edges, axis=2)
-    e = edges / length[..., None]
-    u = centre0 - v  # (K, 3, 3)
-    u_perp = u - np.sum(u * e, axis=2, keepdims=True) * e
-    a_perp = a - (e @ a)[..., None] * e
-    t_edge = _first_roots(
-        np.sum(a_perp * a_perp, axis=2),
-        np.sum(u_perp * a_perp, axis=2),
-        np.sum(u_perp * u_perp, axis=2) - r * r,
-    )
-    finite = np.isfinite(t_edge)
-    s = np.sum((centre0 + np.where(finite, t_edge, 0.0)[..., None] * a - v) * e, axis=2)
-    t_edge = np.where(finite & (s >= 0.0) & (s <= length), t_edge, np.inf)
-    # corners: the distance from the moving centre to each corner reaches r
-    t_corner = _first_roots(np.ones(u.shape[:2]), u @ a, np.sum(u * u, axis=2) - r * r)
-    best = [float(np.min(t_face)), float(np.min(t_edge)), float(np.min(t_corner))]
-    kind = int(np.argmin(best))
-    travel = best[kind]
-    if not np.isfinite(travel):
-        return math.inf, -a, -1
-    centre = centre0 + travel * a
-    if kind == 0:
-        k = int(np.argmin(t_face))
-        return travel, n[k].copy(), int(tri[k])
-    if kind == 1:
-        ke, ie = (int(x) for x in np.unravel_index(int(np.argmin(t_edge)), t_edge.shape))
-        foot = v[ke, ie] + s[ke, ie] * e[ke, ie]
+    from planner.sim.sweep_kernel import CORNER, EDGE, NONE, first_contact  # numba: when used
+
+    tri = np.ascontiguousarray(triangles, dtype=np.int64)
+    start = np.ascontiguousarray(centre0, dtype=np.float64)
+    axis = np.ascontiguousarray(a, dtype=np.float64)
+    normals, offsets, vertices = caster.triangle_arrays()
+    kind, travel, k, i, s = first_contact(normals, offsets, vertices, tri, start, axis, float(r))
+    if kind == NONE:
+        return math.inf, -axis, -1
+    if kind not in (EDGE, CORNER):  # the face
+        return travel, caster.triangle_normal(int(tri[k])), int(tri[k])
+    v = caster.triangle_vertices(int(tri[k]))
+    centre = start + travel * axis
+    if kind == EDGE:
+        e = v[(i + 1) % 3] - v[i]
+        foot = v[i] + s * (e / np.linalg.norm(e))
         return travel, (centre - foot) / r, -1
-    kc, ic = (int(x) for x in np.unravel_index(int(np.argmin(t_corner)), t_corner.shape))
-    return travel, (centre - v[kc, ic]) / r, -1
-
-
-def _first_roots(A: FloatArray, half_b: FloatArray, c: FloatArray) -> FloatArray:
-    """Smaller roots of ``A t^2 + 2 half_b t + c = 0`` (``inf`` where none or ``A`` is 0)."""
-    disc = half_b * half_b - A * c
-    ok = (A > 1e-18) & (disc >= 0.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        root = (-half_b - np.sqrt(np.where(ok, disc, 0.0))) / np.where(ok, A, 1.0)
-    return np.where(ok, root, np.inf)
+    return travel, (centre - v[i]) / r, -1

@@ -1,7 +1,9 @@
 """What a validation's fork server (:mod:`planner.sim.pool`) loads once, before it forks
-its workers: the trial and prediction code, and the compiled float64 step of a ray cast
-(numba and the kernel's machine code, :func:`planner.sim.hit_kernel.load_kernel`), which each
-worker otherwise loaded at its first cast (about 0.4 s a worker).
+its workers: the trial and prediction code, and the compiled kernels a trial runs (numba and
+the kernels' machine code): the float64 step of a ray cast
+(:func:`planner.sim.hit_kernel.load_kernel`), which each worker otherwise loaded at its first
+cast (about 0.4 s a worker), the touch probe's sweep (:mod:`planner.sim.sweep_kernel`) and the
+steered updates' Gauss-Newton loop (:mod:`calib.estimators.min_norm_kernel`).
 
 numba's cache directory is left as a worker would find it (this imports nothing of the cell
 package, which points it at wobjcal's); no ray is cast (Embree's threads must not exist in a
@@ -10,9 +12,12 @@ process that forks).
 
 from __future__ import annotations
 
-from planner.sim import predict, trial
+from calib.estimators import min_norm_kernel
+from planner.sim import predict, sweep_kernel, trial
 from planner.sim.hit_kernel import load_kernel
 
 __all__ = ["predict", "trial"]
 
 load_kernel()
+sweep_kernel.load_kernel()
+min_norm_kernel.load_kernel()
