@@ -46,6 +46,7 @@ from calib.errors import DegenerateGeometryError, ShapeError
 FloatArray = NDArray[np.float64]
 
 _LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
+_EYE3 = np.eye(3)
 
 #: Below this |cos(beta)| the Tait-Bryan decomposition is at gimbal lock and gamma is set to 0.
 GIMBAL_LOCK_COS = 1e-9
@@ -65,6 +66,8 @@ def check_transform(value: ArrayLike, name: str = "T", tol: float = 1e-6) -> Flo
         DegenerateGeometryError: the rotation part is not orthonormal with determinant +1.
     """
     T = as_float_array(value, name)
+    if T.shape == (4, 4):  # one transform (per search and update): in plain floats
+        return _check_one_transform(T, name, tol)
     if T.ndim < 2 or T.shape[-2:] != (4, 4):
         raise ShapeError(f"{name} must be a (4, 4) homogeneous transform, got shape {T.shape}")
     check_finite(T, name)
@@ -78,6 +81,26 @@ def check_transform(value: ArrayLike, name: str = "T", tol: float = 1e-6) -> Flo
             f"{name} rotation part is not orthonormal (max |R^T R - I| = {ortho:.3g})"
         )
     if R.size and np.any(np.linalg.det(R) < 0):
+        raise DegenerateGeometryError(f"{name} rotation part is a reflection (det < 0)")
+    return T
+
+
+def _check_one_transform(T: FloatArray, name: str, tol: float) -> FloatArray:
+    """:func:`check_transform` of one ``(4, 4)`` array: the same tests and messages, without
+    the batch's numpy passes (about 4 us instead of 18: it runs per search and per update)."""
+    if not np.isfinite(T).all():
+        check_finite(T, name)  # raises, naming the first bad entry
+    w0, w1, w2, w3 = T[3].tolist()
+    if not (abs(w0) <= tol and abs(w1) <= tol and abs(w2) <= tol and abs(w3 - 1.0) <= tol + 1e-5):
+        raise ShapeError(f"{name} last row must be (0, 0, 0, 1)")
+    R = T[:3, :3]
+    ortho = float(np.abs(R.T @ R - _EYE3).max())
+    if ortho > tol:
+        raise DegenerateGeometryError(
+            f"{name} rotation part is not orthonormal (max |R^T R - I| = {ortho:.3g})"
+        )
+    (a0, a1, a2), (b0, b1, b2), (c0, c1, c2) = R.tolist()
+    if a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0) < 0.0:
         raise DegenerateGeometryError(f"{name} rotation part is a reflection (det < 0)")
     return T
 

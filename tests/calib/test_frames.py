@@ -100,6 +100,36 @@ def test_check_transform_errors() -> None:
         frames.check_transform("not a matrix", "T")
 
 
+def _bad_transforms() -> list[np.ndarray]:
+    """One of each kind of bad transform, and some that pass at the tolerance's edge."""
+    out = []
+    for i, j, v in [(0, 0, np.nan), (1, 3, np.inf), (3, 0, 2e-6), (3, 3, 1.0 + 2e-5), (0, 1, 2e-6)]:
+        T = np.eye(4)
+        T[i, j] = v
+        out.append(T)
+    out.append(np.diag([1.0, 1.0, -1.0, 1.0]))  # a reflection
+    out.append(np.diag([-1.0, -1.0, 1.0, 1.0]))  # a half turn: fine
+    edge = np.eye(4)
+    edge[3, 3] = 1.0 + 5e-6  # within tol + 1e-5
+    out.append(edge)
+    return out
+
+
+@pytest.mark.parametrize("k", range(8))
+def test_one_transform_is_judged_as_a_batch_of_one_is(k: int) -> None:
+    """The single-transform path gives the batch's verdict and message for each case."""
+    T = _bad_transforms()[k]
+
+    def verdict(value: np.ndarray) -> str:
+        try:
+            frames.check_transform(value, "T")
+        except ValueError as exc:  # (the index of a bad entry has the batch's axis too)
+            return f"{type(exc).__name__}: {str(exc).split(' (first at index')[0]}"
+        return "ok"
+
+    assert verdict(T) == verdict(T[None])
+
+
 def test_import_calib_is_pure() -> None:
     import subprocess
     import sys
