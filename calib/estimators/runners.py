@@ -21,7 +21,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from calib.arguments import check_finite, check_vector3
+from calib.arguments import check_vector3
 from calib.errors import ProbeFailedError, ShapeError
 from calib.estimators.best_fit import BestFitResult, best_fit
 from calib.estimators.layout import (
@@ -29,6 +29,8 @@ from calib.estimators.layout import (
     ConstraintSet,
     constraint_jacobian,
     constraint_set,
+    cross_rows,
+    small_motion_matrix,
 )
 from calib.estimators.observability import require_observable
 from calib.estimators.three_two_one import ThreeTwoOneLayout, ThreeTwoOneResult, three_two_one
@@ -96,8 +98,7 @@ def min_norm_update(
     0.04 mm disagreement turned the plate's estimate by 40 degrees and commanded the next
     search 63 m away; the plate's mesh is float32, so "the same coordinate" differs by 0.1 um
     and the relative threshold is :data:`FIXED_RCOND`, not machine precision). The step is the
-    min-norm solution in the nominally fixed motions only, each iteration's step
-    ``-V pinv(J V) r`` (compiled: :mod:`calib.estimators.min_norm_kernel`).
+    min-norm solution in the nominally fixed motions only.
 
     Args:
         cs: constraints of the points measured so far.
@@ -108,29 +109,23 @@ def min_norm_update(
         iterations: Gauss-Newton iterations (the step is min-norm in each).
         basis: ``(6, r)`` :func:`fixed_motions` of ``cs`` about ``pivot_m`` and ``scale_m``
             when the caller has it already (it depends on the nominal layout only).
-
-    Raises:
-        ShapeError, DegenerateGeometryError: ``T_base_wobj`` is not a rigid transform.
-        NonFiniteError: a measurement or the estimate holds NaN or infinity.
     """
-    from calib.estimators.min_norm_kernel import gauss_newton  # numba: imported when used
-
-    T = check_transform(T_base_wobj, "T_base_wobj")
-    q = check_finite(np.asarray(measured_base, dtype=np.float64)[cs.point_index], "measured")
+    T = check_transform(T_base_wobj, "T_base_wobj").copy()
+    q = np.asarray(measured_base, dtype=np.float64)[cs.point_index]
     c = cs.centroid_m if pivot_m is None else pivot_m
     L = cs.scale_m if scale_m is None else scale_m
     V = fixed_motions(cs, c, L) if basis is None else basis
-    out: FloatArray = gauss_newton(
-        np.ascontiguousarray(T),
-        np.ascontiguousarray(q),
-        np.ascontiguousarray(cs.normals, dtype=np.float64),
-        np.ascontiguousarray(cs.nominal_m, dtype=np.float64),
-        np.ascontiguousarray(c, dtype=np.float64),
-        float(L),
-        np.ascontiguousarray(V, dtype=np.float64),
-        int(iterations),
-    )
-    return out
+    for _ in range(iterations):
+        x = (q - T[:3, 3]) @ T[:3, :3]
+        r = np.einsum("ij,ij->i", cs.normals, x - cs.nominal_m)
+        J = constraint_jacobian(cs.normals, x - c)
+        J[:, 3:] /= L
+        step = -V @ (np.linalg.pinv(J @ V, rcond=1e-9) @ r)
+        w = step[3:] / L
+        T = T @ small_motion_matrix(np.concatenate([step[:3] - cross_rows(w, c), w]))
+        if float(np.max(np.abs(step))) < 1e-9:  # 1 nm: the estimate only steers the next search
+            break
+    return T
 
 
 def fixed_motions(cs: ConstraintSet, pivot_m: FloatArray, scale_m: float) -> FloatArray:

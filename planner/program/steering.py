@@ -9,7 +9,8 @@ last search the update uses every point: with a layout that fixes all six degree
 is the least-squares best fit (a 3-2-1's six constraints: its exact solution), the frame the
 program leaves on the controller and the one ``wobjcal calibrate`` computes from its results.
 
-The executor (:func:`planner.program.execute.execute`) runs :func:`steer`; a robot-language
+The executor (:func:`planner.program.execute.execute`) runs :func:`steer` (that update,
+compiled: :mod:`planner.program.update_kernel`); a robot-language
 writer writes the same iteration with the basis of each update (:func:`update_basis`) as
 constants, so the two compute one estimate (the RAPID interpreter test holds them to 1e-6 mm).
 Only approach searches are steered this way: an edge search's point counts only by its edge
@@ -19,13 +20,16 @@ coordinate, which the writers do not yet carry.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 from numpy.typing import NDArray
 
-from calib.estimators.layout import ConstraintSet, constraint_set
-from calib.estimators.runners import fixed_motions, min_norm_update
+from calib.errors import NonFiniteError
+from calib.estimators.layout import constraint_set
+from calib.estimators.runners import fixed_motions
+from calib.frames import check_transform
 from calib.probing import ProbePoint
 from calib.procedures import PROCEDURES, procedure_kind
 from planner.program.model import MeasuringProgram
@@ -74,13 +78,36 @@ def update_basis(points: Sequence[ProbePoint], pivot_m: FloatArray, scale_m: flo
     return fixed_motions(constraint_set(points), np.asarray(pivot_m, float), float(scale_m))
 
 
+@dataclass(frozen=True)
+class _UpdateLayout:
+    """What an update from some points fits (nominal: computed once), as the compiled loop
+    takes it: float64, C-contiguous.
+
+    Attributes:
+        rows: ``(M,)`` the point of each constraint row.
+        normals: ``(M, 3)`` unit face normals, wobj frame.
+        nominal_m: ``(M, 3)`` nominal points, wobj frame, m.
+        basis: ``(6, r)`` the scaled motions the nominal points fix (:func:`update_basis`).
+    """
+
+    rows: NDArray[np.intp]
+    normals: FloatArray
+    nominal_m: FloatArray
+    basis: FloatArray
+
+
 @lru_cache(maxsize=1024)
 def _update_layout(
     points: tuple[ProbePoint, ...], pivot_m: tuple[float, ...], scale_m: float
-) -> tuple[ConstraintSet, FloatArray]:
+) -> _UpdateLayout:
     """The constraints of ``points`` and their update basis (nominal: computed once)."""
     cs = constraint_set(points)
-    return cs, fixed_motions(cs, np.asarray(pivot_m, float), float(scale_m))
+    V = fixed_motions(cs, np.asarray(pivot_m, float), float(scale_m))
+
+    def c(a: FloatArray) -> FloatArray:
+        return np.ascontiguousarray(a, dtype=np.float64)
+
+    return _UpdateLayout(np.asarray(cs.point_index), c(cs.normals), c(cs.nominal_m), c(V))
 
 
 def steer(
@@ -91,13 +118,36 @@ def steer(
     scale_m: float,
 ) -> FloatArray:
     """``(4, 4)`` the estimate after an update from ``points`` (their last measurements in
-    ``measured_base``, base frame, metres), starting at ``T_base_wobj``."""
+    ``measured_base``, base frame, metres), starting at ``T_base_wobj``: the frame
+    :func:`~calib.estimators.runners.min_norm_update` computes, compiled
+    (:mod:`planner.program.update_kernel`).
+
+    Raises:
+        NonFiniteError: a measurement is NaN or infinite, or the update diverged.
+        ShapeError, DegenerateGeometryError: ``T_base_wobj`` is not a rigid transform.
+    """
+    from planner.program.update_kernel import gauss_newton  # numba: imported when used
+
     pivot = tuple(float(v) for v in np.asarray(pivot_m, float))
-    cs, V = _update_layout(tuple(points), pivot, float(scale_m))
-    q = np.array([measured_base[p.id] for p in points], dtype=np.float64)
-    return min_norm_update(
-        cs, q, T_base_wobj, np.asarray(pivot), float(scale_m), ITERATIONS, basis=V
+    L = float(scale_m)
+    lay = _update_layout(tuple(points), pivot, L)
+    T = check_transform(T_base_wobj, "T_base_wobj")
+    q = np.array([measured_base[p.id] for p in points], dtype=np.float64)[lay.rows]
+    if not (np.isfinite(q).all() and np.isfinite(pivot).all() and np.isfinite(L)):
+        raise NonFiniteError("a steered update: a measurement or the pivot is NaN or infinite")
+    out: FloatArray = gauss_newton(
+        np.ascontiguousarray(T),
+        q,
+        lay.normals,
+        lay.nominal_m,
+        np.array(pivot),
+        L,
+        lay.basis,
+        ITERATIONS,
     )
+    if not np.isfinite(out).all():
+        raise NonFiniteError("a steered update did not converge to a finite frame")
+    return out
 
 
 def update_bases(program: MeasuringProgram) -> list[tuple[int, FloatArray]]:

@@ -112,9 +112,8 @@ ErrorMotion = tuple[FloatArray, FloatArray]
 
 def error_motion(delta: FloatArray) -> ErrorMotion:
     """``(R - I, t)`` of the motions ``T_true_est = small_motion(delta)`` of frame errors
-    ``(n, 6)`` (m, rad): what :func:`point_errors` applies, computed once for many points.
-    ``R - I`` is exact (the diagonal of ``R`` is near 1), so a point's error ``(R - I) p + t``
-    keeps its precision where ``R p + t - p`` would cancel."""
+    ``(n, 6)`` (m, rad): what :func:`point_errors` applies, computed once for many points (a
+    point's error ``(R - I) p + t``: one matmul, no ``R p - p`` of two near-equal arrays)."""
     T = small_motion(delta)  # T_true_est, (n, 4, 4)
     return T[:, :3, :3] - np.eye(3), T[:, :3, 3].copy()
 

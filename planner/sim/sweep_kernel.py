@@ -4,8 +4,9 @@
 their first hit, where the stylus ball moving along its approach first touches each of them:
 at its face (the tangent point inside the triangle), at one of its edges or at a corner. Written
 with numpy it spent about 0.25 ms a search on a dozen passes over ``(K, 3, 3)`` arrays of a
-handful of triangles; this loop does it in a few microseconds, with the same formulas in the
-same order (``tests/planner/sim/test_sweep_kernel.py`` holds it to the numpy version).
+handful of triangles; this loop does it in a few microseconds, with the same formulas (the
+same contacts; travels within about 2e-14 m: ``tests/planner/sim/test_sweep_kernel.py`` holds
+it to the numpy version).
 
 numba takes its cache directory when this module is imported, which
 :func:`~planner.sim.touch.sweep_contact` does at its first call, and compiles the kernel (or
@@ -22,8 +23,9 @@ import numpy as np
 
 #: A face counts as facing the motion when ``n . a`` is below minus this.
 FACING_COS = 1e-12
-#: How far outside an edge (m, along the face) the tangent point may lie and count as inside.
-INSIDE_TOL_M = 1e-12
+#: How far outside an edge the tangent point may lie and count as inside, as ``(e x w) . n``
+#: (the edge's length times the point's distance inside it: m^2).
+INSIDE_TOL_M2 = 1e-12
 #: A quadratic's leading coefficient below this has no root (the motion parallel to an edge).
 MIN_LEADING = 1e-18
 
@@ -88,7 +90,7 @@ def first_contact(
                 e0, e1, e2 = v[j, 0] - v[i, 0], v[j, 1] - v[i, 1], v[j, 2] - v[i, 2]
                 w0, w1, w2 = q0 - v[i, 0], q1 - v[i, 1], q2 - v[i, 2]
                 x0, x1, x2 = e1 * w2 - e2 * w1, e2 * w0 - e0 * w2, e0 * w1 - e1 * w0
-                if (x0 * n0 + x1 * n1) + x2 * n2 < -INSIDE_TOL_M:
+                if (x0 * n0 + x1 * n1) + x2 * n2 < -INSIDE_TOL_M2:
                     inside = False
             if inside and tf < best_f:
                 best_f, kf = tf, k
@@ -135,6 +137,7 @@ def load_kernel() -> None:
     :func:`~planner.sim.touch.sweep_contact` passes: a fork server does it once for all its
     workers (:mod:`planner.sim.worker_preload`)."""
     tri = np.array([[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]])
+    tri.setflags(write=False)  # as the caster's corners (trimesh's cached, read-only array)
     first_contact(
         np.zeros((1, 3)),
         np.zeros(1),

@@ -121,7 +121,7 @@ def sweep_contact(
     triangle is returned when the contact is on its face, else ``-1`` (an edge or corner).
     All triangles are solved in one compiled loop (:mod:`planner.sim.sweep_kernel`).
     """
-    from planner.sim.sweep_kernel import CORNER, EDGE, NONE, first_contact  # numba: when used
+    from planner.sim.sweep_kernel import EDGE, FACE, NONE, first_contact  # numba: when used
 
     tri = np.ascontiguousarray(triangles, dtype=np.int64)
     start = np.ascontiguousarray(centre0, dtype=np.float64)
@@ -130,7 +130,7 @@ def sweep_contact(
     kind, travel, k, i, s = first_contact(normals, offsets, vertices, tri, start, axis, float(r))
     if kind == NONE:
         return math.inf, -axis, -1
-    if kind not in (EDGE, CORNER):  # the face
+    if kind == FACE:
         return travel, caster.triangle_normal(int(tri[k])), int(tri[k])
     v = caster.triangle_vertices(int(tri[k]))
     centre = start + travel * axis

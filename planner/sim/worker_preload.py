@@ -3,7 +3,7 @@ its workers: the trial and prediction code, and the compiled kernels a trial run
 the kernels' machine code): the float64 step of a ray cast
 (:func:`planner.sim.hit_kernel.load_kernel`), which each worker otherwise loaded at its first
 cast (about 0.4 s a worker), the touch probe's sweep (:mod:`planner.sim.sweep_kernel`) and the
-steered updates' Gauss-Newton loop (:mod:`calib.estimators.min_norm_kernel`).
+steered updates' Gauss-Newton loop (:mod:`planner.program.update_kernel`).
 
 numba's cache directory is left as a worker would find it (this imports nothing of the cell
 package, which points it at wobjcal's); no ray is cast (Embree's threads must not exist in a
@@ -12,7 +12,7 @@ process that forks).
 
 from __future__ import annotations
 
-from calib.estimators import min_norm_kernel
+from planner.program import update_kernel
 from planner.sim import predict, sweep_kernel, trial
 from planner.sim.hit_kernel import load_kernel
 
@@ -20,4 +20,4 @@ __all__ = ["predict", "trial"]
 
 load_kernel()
 sweep_kernel.load_kernel()
-min_norm_kernel.load_kernel()
+update_kernel.load_kernel()

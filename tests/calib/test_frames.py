@@ -115,10 +115,9 @@ def _bad_transforms() -> list[np.ndarray]:
     return out
 
 
-@pytest.mark.parametrize("k", range(8))
-def test_one_transform_is_judged_as_a_batch_of_one_is(k: int) -> None:
+@pytest.mark.parametrize("T", _bad_transforms())
+def test_one_transform_is_judged_as_a_batch_of_one_is(T: np.ndarray) -> None:
     """The single-transform path gives the batch's verdict and message for each case."""
-    T = _bad_transforms()[k]
 
     def verdict(value: np.ndarray) -> str:
         try:

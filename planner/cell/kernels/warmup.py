@@ -1,5 +1,4 @@
-"""Compile the broad phase's numba kernels (and the steered updates' loop,
-:mod:`calib.estimators.min_norm_kernel`) ahead of use and keep them in numba's cache.
+"""Compile the broad phase's numba kernels ahead of use and keep them in numba's cache.
 
 numba compiles a kernel the first time it is called (about 8 s of CPU for all of them, nearly
 all of it numba's own typing and lowering: LLVM's optimisation level changes it by < 5 %) and
@@ -105,13 +104,6 @@ def main(argv: list[str] | None = None) -> int:
         os.nice(10)  # the helper takes a spare core, never the check's
     cache_dir = configure()
     seconds = compile_kernels(reverse=args.reverse)
-    t0 = time.perf_counter()
-    # the steered updates' loop (check's landing risk, validate, suggest), imported only now:
-    # numba takes a kernel's cache directory when its module is imported
-    from calib.estimators import min_norm_kernel
-
-    min_norm_kernel.load_kernel()
-    seconds += time.perf_counter() - t0
     if cache_dir is not None:
         marker = marker_path(cache_dir)
         tmp = marker.with_suffix(f".{os.getpid()}.tmp")

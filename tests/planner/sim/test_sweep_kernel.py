@@ -138,3 +138,17 @@ def test_a_degenerate_triangle_is_met_at_its_corners_and_breaks_nothing() -> Non
     travel, normal, k = sweep_contact(caster, np.array([-0.002, -0.001, 0.1]), down, 0.003, tri)
     assert k == -1 and np.isfinite(normal).all()  # the sliver's corner, above the top face
     assert travel == pytest.approx(0.04 - np.sqrt(0.003**2 - 0.002**2 - 0.001**2), abs=1e-12)
+
+
+def test_the_preloaded_kernel_is_the_one_a_sweep_runs() -> None:
+    """A fork server's :func:`load_kernel` compiles (or loads) the version of the kernel for the
+    argument types a sweep passes (the caster's corners are read-only): a worker's first
+    sweep then compiles nothing."""
+    from planner.sim import sweep_kernel
+
+    sweep_kernel.load_kernel()
+    before = set(sweep_kernel.first_contact.signatures)
+    caster = MeshRayCaster(trimesh.creation.box(extents=(0.4, 0.4, 0.1)))
+    tri = np.arange(12, dtype=np.int64)
+    sweep_contact(caster, np.array([0.05, 0.02, 0.1]), np.array([0.0, 0.0, -1.0]), 0.003, tri)
+    assert set(sweep_kernel.first_contact.signatures) == before

@@ -1,21 +1,27 @@
-"""The Gauss-Newton loop of :func:`calib.estimators.runners.min_norm_update`, compiled (numba).
+"""The frame update of a steered program, compiled (numba): the loop
+:func:`calib.estimators.runners.min_norm_update` computes, for the simulation's hot path.
 
-Every steered program's update runs this loop: the simulated trials of ``wobjcal validate``
-(ten updates a trial for the plate's best fit), the landing risk of ``wobjcal check`` and
-the design of ``wobjcal suggest``. Written with numpy calls it spent about 0.4 ms an update in
-small-array overhead; compiled it takes about 30 us.
+Every steered program's update runs here (:func:`planner.program.steering.steer`): the simulated
+trials of ``wobjcal validate`` (ten updates a trial for the plate's best fit), the landing risk
+of ``wobjcal check`` and the design of ``wobjcal suggest``. Written with numpy calls, as
+``calib`` keeps it (pure numpy and scipy: the reference, and what ``wobjcal calibrate`` and
+the procedures' own runs use), it spends about 0.4 ms an update in small-array overhead; this
+loop takes about 30 us. The controller writers carry the same iteration in their languages
+(:mod:`planner.export.rapid_steer` and the others); all of them are held to ``calib``'s.
 
 The step of each iteration is the minimum-norm least-squares solution in the fixed motions
-``V``: ``step = -V pinv(J V) r``, with the pseudo-inverse's cut-off at ``RCOND`` of the largest
-singular value (``numpy.linalg.pinv(..., rcond=RCOND)``). The singular values come from a
-one-sided Jacobi SVD of the ``(M, r)`` matrix ``J V`` (``r <= 6``), written out here: it
-compiles in a third of the time numba's LAPACK binding takes and is at least as accurate. The
-frames agree with the numpy version to a few ulps (``tests/calib/estimators/
-test_min_norm_kernel.py`` holds the two together).
+``V``: ``step = -V pinv(J V) r``, with the pseudo-inverse's cut-off at :data:`RCOND` of the
+largest singular value (``numpy.linalg.pinv(..., rcond=RCOND)``). The singular values come from
+a one-sided Jacobi SVD of the ``(M, r)`` matrix ``J V`` (``r <= 6``), written out here: it
+compiles in a third of the time numba's LAPACK binding takes. Where the iteration converges the
+frames agree with ``calib``'s to about 1e-15 (``tests/planner/program/test_update_kernel.py``
+holds the two together over random layouts); where it does not (a misplacement far beyond the
+layout's reach), neither frame means anything and the two may differ.
 
 numba takes its cache directory when this module is imported, which
-:func:`calib.estimators.runners.min_norm_update` does at its first call (by then a planner
-process has pointed numba at wobjcal's cache, :mod:`planner.cell.kernels.kernel_cache`), and
+:func:`~planner.program.steering.steer` does at its first call (a process that has opened a
+cell has pointed numba at wobjcal's cache by then, :mod:`planner.cell.kernels.kernel_cache`; a
+validation's workers load it in their fork server, :mod:`planner.sim.worker_preload`), and
 compiles the kernel, or loads it from that cache, at its first call.
 """
 
@@ -33,20 +39,34 @@ RCOND = 1e-9
 #: An iteration whose step is below this (scaled motion, m) is the last: the estimate only
 #: steers the next search, 1 nm is far below any sensor.
 STEP_TOL_M = 1e-9
-#: Jacobi sweeps at most (a 6-column matrix converges in fewer than 10).
+#: Jacobi sweeps at most (random full-rank, rank-deficient and wide matrices of up to 6
+#: columns take at most 12: ``tests/planner/program/test_update_kernel.py``).
 MAX_SWEEPS = 60
 #: A pair of columns counts as orthogonal when ``|u_p . u_q| <= ORTHO_TOL |u_p| |u_q|``.
 ORTHO_TOL = 1e-15
+#: A column shorter than this part of the longest is left out of the rotations: its singular
+#: value is cut anyway (far below :data:`RCOND`), and rounding would keep rotating it (and
+#: another such column) until :data:`MAX_SWEEPS`.
+NULL_COLUMN = 1e-12
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def _min_norm_solve(A: Any, b: Any) -> Any:  # pragma: no cover - compiled
-    """``(r,)`` ``pinv(A, rcond=RCOND) @ b`` of an ``(M, r)`` matrix by one-sided Jacobi."""
+def min_norm_solve(A: Any, b: Any) -> tuple[Any, int]:  # pragma: no cover - compiled
+    """``((r,) pinv(A, rcond=RCOND) @ b, sweeps)`` of an ``(M, r)`` matrix and ``(M,)``
+    vector, by one-sided Jacobi (``sweeps``: how many it took, at most :data:`MAX_SWEEPS`)."""
     m, r = A.shape
     U = A.copy()
     W = np.eye(r)
+    sweeps = 0
     for _ in range(MAX_SWEEPS):
+        sweeps += 1
         rotated = False
+        longest = 0.0  # the longest column's squared norm
+        for k in range(r):
+            acc = 0.0
+            for i in range(m):
+                acc += U[i, k] * U[i, k]
+            longest = max(longest, acc)
         for p in range(r - 1):
             for q in range(p + 1, r):
                 alpha = 0.0
@@ -57,6 +77,8 @@ def _min_norm_solve(A: Any, b: Any) -> Any:  # pragma: no cover - compiled
                     beta += U[i, q] * U[i, q]
                     gamma += U[i, p] * U[i, q]
                 if abs(gamma) <= ORTHO_TOL * math.sqrt(alpha * beta):
+                    continue
+                if min(alpha, beta) <= NULL_COLUMN * NULL_COLUMN * longest:
                     continue
                 rotated = True
                 zeta = (beta - alpha) / (2.0 * gamma)
@@ -90,7 +112,7 @@ def _min_norm_solve(A: Any, b: Any) -> Any:  # pragma: no cover - compiled
             ub /= sv[k] * sv[k]  # U's columns are sigma_k u_k
             for j in range(r):
                 y[j] += W[j, k] * ub
-    return y
+    return y, sweeps
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -143,7 +165,7 @@ def gauss_newton(
                 for k in range(6):
                     acc += J[k] * V[k, j]
                 A[i, j] = acc
-        y = _min_norm_solve(A, res)
+        y, _ = min_norm_solve(A, res)
         step = np.empty(6)
         big = 0.0
         for k in range(6):
@@ -181,7 +203,7 @@ def gauss_newton(
 
 def load_kernel() -> None:
     """Load (or compile) the kernel now, for the argument types
-    :func:`~calib.estimators.runners.min_norm_update` passes: a fork server does it once for
-    all its workers (``planner.sim.worker_preload``)."""
+    :func:`~planner.program.steering.steer` passes: a fork server does it once for all its
+    workers (:mod:`planner.sim.worker_preload`)."""
     V = np.eye(6)[:, :3].copy()
     gauss_newton(np.eye(4), np.zeros((3, 3)), np.eye(3), np.zeros((3, 3)), np.zeros(3), 1.0, V, 1)
