@@ -104,6 +104,27 @@ class ConfidenceTable:
         return to_markdown(self, events_per_year)
 
 
+def _normal(x: FloatArray, lv: FloatArray) -> tuple[float, float, FloatArray]:
+    """``(mean, std (ddof 1), z (L,))`` of samples ``x`` at levels ``lv`` (fractions)."""
+    from scipy.special import ndtri  # lighter than scipy.stats (about 0.8 s to import)
+
+    z: FloatArray = ndtri(0.5 + lv / 2.0)
+    return float(x.mean()), float(x.std(ddof=1)), z
+
+
+def normal_half_widths(samples: FloatArray, levels: Sequence[float]) -> list[float]:
+    """The normal intervals' half-widths ``z * std`` of :func:`confidence_intervals` (the same
+    numbers, SI), without its checks and its empirical quantiles (a partition of every
+    sample: most of its time on a report row's millions of samples).
+
+    Args:
+        samples: ``(N,)`` finite sampled errors in SI units, ``N >= 2`` (the caller checks).
+        levels: confidence levels as fractions in (0, 1).
+    """
+    _, std, z = _normal(samples, np.asarray(levels, dtype=np.float64))
+    return [float(zi * std) for zi in z]
+
+
 def confidence_intervals(
     samples: ArrayLike,
     quantity: str,
@@ -130,10 +151,7 @@ def confidence_intervals(
     lv = np.asarray(levels, dtype=np.float64)
     if lv.ndim != 1 or np.any(~np.isfinite(lv)) or np.any((lv <= 0) | (lv >= 1)):
         raise ShapeError(f"levels must be fractions in (0, 1), got {list(levels)}")
-    mean, std = float(x.mean()), float(x.std(ddof=1))
-    from scipy.special import ndtri  # lighter than scipy.stats (about 0.8 s to import)
-
-    z = ndtri(0.5 + lv / 2.0)
+    mean, std, z = _normal(x, lv)
     emp = np.quantile(np.abs(x - mean), lv)
     rows = tuple(
         ConfidenceRow(

@@ -91,7 +91,7 @@ def measure(errors: FloatArray, components: str) -> FloatArray:
         return errors[..., _AXIS[components]]
     axes = [_AXIS[c] for c in components]
     sign_axis = 0 if components == "xyz" else next(i for i in range(3) if i not in axes)
-    length = np.linalg.norm(errors[..., axes], axis=-1)
+    length = np.linalg.norm(errors if components == "xyz" else errors[..., axes], axis=-1)
     return np.where(errors[..., sign_axis] >= 0.0, length, -length)
 
 

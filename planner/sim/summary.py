@@ -15,12 +15,11 @@ import dataclasses
 from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
-from calib.stats import confidence_intervals
+from calib.stats import normal_half_widths
 from planner.reasons import Reason
 from planner.sim.predict import Prediction
 from planner.sim.report import FailureCount, IntervalRow, PointOutcome, ValidationReport
@@ -95,12 +94,12 @@ def failure_counts(results: list[TrialResult]) -> tuple[FailureCount, ...]:
     )
 
 
-def _half_widths(samples: FloatArray, unit: str, levels: tuple[float, ...]) -> list[float]:
+def _half_widths(samples: FloatArray, levels: tuple[float, ...]) -> list[float]:
+    """The normal half-widths (SI) of a row's samples at ``levels`` (percent); NaN when there
+    are fewer than two or one is not finite."""
     if len(samples) < 2 or not np.all(np.isfinite(samples)):
         return [float("nan")] * len(levels)
-    si: Literal["m", "rad"] = "rad" if unit == "deg" else "m"
-    table = confidence_intervals(samples, "row", si, [lv / 100.0 for lv in levels])
-    return [r.half_width for r in table.rows]
+    return normal_half_widths(samples, [lv / 100.0 for lv in levels])
 
 
 @dataclass(frozen=True)
@@ -147,10 +146,8 @@ def build_rows(
             sigma = extra[1] if extra is not None else predicted_sigma(spec, inp.cov)
             proto = [nan] * len(levels)
             if inp.protocol_delta is not None and extra is None and len(inp.protocol_delta) >= 2:
-                proto = _half_widths(
-                    samples_and_bias(spec, inp.protocol_delta)[0], spec.unit, levels
-                )
-            per.append((_half_widths(s, spec.unit, levels), list(z * sigma), bias, proto))
+                proto = _half_widths(samples_and_bias(spec, inp.protocol_delta)[0], levels)
+            per.append((_half_widths(s, levels), list(z * sigma), bias, proto))
         for i, level in enumerate(spec.levels_percent):
             (hp, pp, bp, qp), (hf, pf, bf, qf) = per
             rows.append(

@@ -121,3 +121,14 @@ def test_bad_input_raises_named_errors() -> None:
         confidence_intervals([1.0, 2.0], "x").row("y", 0.99)
     with pytest.raises(ShapeError, match="T_base_wobj_est"):
         point_errors_wobj(np.eye(4), np.eye(3), EPSILON)
+
+
+def test_normal_half_widths_are_the_tables_half_widths() -> None:
+    """The report's rows take :func:`normal_half_widths` (no empirical quantiles): the same
+    numbers as the table's normal intervals, to the bit."""
+    from calib.stats import confidence_intervals, normal_half_widths
+
+    x = np.random.default_rng(4).normal(0.0, 2e-4, 10_001)
+    levels = [0.5, 0.955, 0.9999]
+    want = [r.half_width for r in confidence_intervals(x, "q", "m", levels).rows]
+    assert normal_half_widths(x, levels) == want
