@@ -33,6 +33,7 @@ pre-travel, qualification and ball-radius compensation; probe makers' datasheets
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 from typing import ClassVar
 
 import numpy as np
@@ -143,8 +144,7 @@ class TouchProbe(Strict, frozen=True, kw_only=True, tag="touch", tag_field="kind
         """
         a = np.asarray(axis, dtype=np.float64)
         u, v = face_frame(a)
-        disk = sunflower_disk(self.n_rays - 1, self.radius_m * (1.0 - 1e-9))
-        h = np.sqrt(np.maximum(self.radius_m**2 - np.sum(disk**2, axis=1), 0.0))
+        disk, h = _ball_front(self.n_rays, self.radius_m)
         pts = disk[:, :1] * u + disk[:, 1:] * v + h[:, None] * a
         return np.vstack([self.radius_m * a, pts])
 
@@ -178,3 +178,14 @@ class TouchProbe(Strict, frozen=True, kw_only=True, tag="touch", tag_field="kind
         if self.trigger_repeatability_sigma_m == 0.0:
             return 0.0
         return float(rng.normal(0.0, self.trigger_repeatability_sigma_m))
+
+
+@lru_cache(maxsize=16)
+def _ball_front(n_rays: int, radius_m: float) -> tuple[FloatArray, FloatArray]:
+    """``(disk (n_rays - 1, 2), height (n_rays - 1,))`` of :meth:`TouchProbe.front_points_m`:
+    the equal-area disk over the ball's silhouette and each point's height on the ball's front
+    half, m (depend on the ball only; shared, read-only)."""
+    disk = sunflower_disk(n_rays - 1, radius_m * (1.0 - 1e-9))
+    h = np.sqrt(np.maximum(radius_m**2 - np.sum(disk**2, axis=1), 0.0))
+    h.setflags(write=False)
+    return disk, h
