@@ -88,26 +88,35 @@ class _UpdateLayout:
         normals: ``(M, 3)`` unit face normals, wobj frame.
         nominal_m: ``(M, 3)`` nominal points, wobj frame, m.
         basis: ``(6, r)`` the scaled motions the nominal points fix (:func:`update_basis`).
+        pivot_m: ``(3,)`` the point rotations are taken about, wobj frame, m.
     """
 
     rows: NDArray[np.intp]
     normals: FloatArray
     nominal_m: FloatArray
     basis: FloatArray
+    pivot_m: FloatArray
 
 
 @lru_cache(maxsize=1024)
 def _update_layout(
     points: tuple[ProbePoint, ...], pivot_m: tuple[float, ...], scale_m: float
 ) -> _UpdateLayout:
-    """The constraints of ``points`` and their update basis (nominal: computed once)."""
+    """The constraints of ``points`` and their update basis (nominal: computed once).
+
+    Raises:
+        NonFiniteError: the pivot or the scale is NaN or infinite.
+    """
+    pivot = np.asarray(pivot_m, dtype=np.float64)
+    if not (np.isfinite(pivot).all() and np.isfinite(scale_m)):
+        raise NonFiniteError("a steered update: the pivot or the scale is NaN or infinite")
     cs = constraint_set(points)
-    V = fixed_motions(cs, np.asarray(pivot_m, float), float(scale_m))
+    V = fixed_motions(cs, pivot, float(scale_m))
 
     def c(a: FloatArray) -> FloatArray:
         return np.ascontiguousarray(a, dtype=np.float64)
 
-    return _UpdateLayout(np.asarray(cs.point_index), c(cs.normals), c(cs.nominal_m), c(V))
+    return _UpdateLayout(np.asarray(cs.point_index), c(cs.normals), c(cs.nominal_m), c(V), pivot)
 
 
 def steer(
@@ -123,7 +132,8 @@ def steer(
     (:mod:`planner.program.update_kernel`).
 
     Raises:
-        NonFiniteError: a measurement is NaN or infinite, or the update diverged.
+        NonFiniteError: a measurement, the pivot or the scale is NaN or infinite, or the update
+            diverged.
         ShapeError, DegenerateGeometryError: ``T_base_wobj`` is not a rigid transform.
     """
     from planner.program.update_kernel import gauss_newton  # numba: imported when used
@@ -133,14 +143,14 @@ def steer(
     lay = _update_layout(tuple(points), pivot, L)
     T = check_transform(T_base_wobj, "T_base_wobj")
     q = np.array([measured_base[p.id] for p in points], dtype=np.float64)[lay.rows]
-    if not (np.isfinite(q).all() and np.isfinite(pivot).all() and np.isfinite(L)):
-        raise NonFiniteError("a steered update: a measurement or the pivot is NaN or infinite")
+    if not np.isfinite(q).all():
+        raise NonFiniteError("a steered update: a measurement is NaN or infinite")
     out: FloatArray = gauss_newton(
         np.ascontiguousarray(T),
         q,
         lay.normals,
         lay.nominal_m,
-        np.array(pivot),
+        lay.pivot_m,
         L,
         lay.basis,
         ITERATIONS,
