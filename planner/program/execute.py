@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from calib.errors import ProbeFailedError
-from calib.frames import invert_transform, transform_points
+from calib.frames import check_transform, invert_transform, transform_points
 from calib.probing import Probe, ProbePoint, ProbeResult, SearchCommand
 from calib.procedures import ProcedureRun, RolePoint, procedure_kind
 from planner.program.model import (
@@ -75,11 +75,6 @@ class ProgramProbe:
         self._keys = search_keys(self.points)
         self._by_id = {rp.point.id: rp.point for rp in self.points}
 
-    def _searches(self, point: ProbePoint, T: FloatArray) -> tuple[SearchCommand, ...]:
-        """The program's searches of ``point`` in the estimate ``T`` (built once in the wobj
-        frame, then moved: a rigid motion of every point and direction of them)."""
-        return tuple(_moved(c, T) for c in _searches_in_wobj(point, self.safety))
-
     def __call__(self, cmd: SearchCommand) -> ProbeResult:
         """Run ``cmd`` as the program does; the result is that of its last (recorded) search."""
         point = self._by_id.get(self._keys.get(cmd.point_id, ""))
@@ -92,10 +87,16 @@ class ProgramProbe:
             measured = transform_points(invert_transform(T), np.asarray(cmd.start_m))
             searches = program_searches(point, T, self.safety, measured_start_wobj=measured)
             return self.probe(replace(searches[1].command, point_id=cmd.point_id))
-        first, *rest = self._searches(point, T)
+        return self.run_point(point, cmd.point_id, T)
+
+    def run_point(self, point: ProbePoint, key: str, T: FloatArray) -> ProbeResult:
+        """Run the program's searches of ``point`` (search key ``key``) from its safe start in
+        the estimate ``T`` ``(4, 4)`` (base frame, m): what :meth:`__call__` runs for a
+        command from the plan's start, and what a steered program runs at each search step."""
+        first, *rest = (_moved(c, T) for c in _searches_in_wobj(point, self.safety))
         if point.search.kind == "approach":
-            return self.probe(replace(first, point_id=cmd.point_id))
-        face = self.probe(replace(first, point_id=cmd.point_id + FACE_APPROACH))
+            return self.probe(replace(first, point_id=key))
+        face = self.probe(replace(first, point_id=key + FACE_APPROACH))
         if face.point_m is None:
             return ProbeResult(None, f"approach to the face: {face.reason}")
         edge = rest[0]
@@ -104,7 +105,7 @@ class ProgramProbe:
         run = float((end - start) @ edge.direction)
         if run <= 0.0:
             return ProbeResult(None, "the measured face point lies past the end of the edge search")
-        return self.probe(replace(edge, point_id=cmd.point_id, start_m=start, length_m=run))
+        return self.probe(replace(edge, point_id=key, start_m=start, length_m=run))
 
 
 @lru_cache(maxsize=4096)
@@ -174,23 +175,24 @@ def execute(
     return kind.estimate(list(points), measured, T_base_wobj_nominal, settings)
 
 
-def _run_steered(program: MeasuringProgram, T_base_wobj: FloatArray, probe: Probe) -> ProcedureRun:
+def _run_steered(
+    program: MeasuringProgram, T_base_wobj: FloatArray, probe: ProgramProbe
+) -> ProcedureRun:
     """A program that steers itself: each search in the estimate so far, each update
     (:func:`planner.program.steering.steer`) from the points it names; the frame is the last
     update's."""
     assert program.pivot_m is not None  # set with every update that fits points
     by_id = {rp.point.id: rp.point for rp in program.points}
-    pivot = np.asarray(program.pivot_m, dtype=np.float64)
-    T = np.asarray(T_base_wobj, dtype=np.float64).copy()
+    pivot = program.pivot_m
+    T = check_transform(T_base_wobj, "T_base_wobj").copy()  # each update's result is one too
     measured: dict[str, FloatArray] = {}
     for step in program.steps:
-        if isinstance(step, SearchStep) and step.recorded:
-            cmd = SearchCommand.from_point(by_id[step.point_id], T)
-            res = probe(replace(cmd, point_id=step.key))
+        if isinstance(step, SearchStep) and step.recorded:  # from the plan's start, in T
+            res = probe.run_point(by_id[step.point_id], step.key, T)
             if res.point_m is None:
                 raise ProbeFailedError(step.key, res.reason or "no reason given")
             measured[step.point_id] = np.asarray(res.point_m, dtype=np.float64)
         elif isinstance(step, UpdateStep) and step.uses:
             pts = [by_id[i] for i in step.uses]
-            T = steer(pts, measured, T, pivot, program.scale_m)
+            T = steer(pts, measured, T, pivot, program.scale_m, checked=True)
     return ProcedureRun(T, tuple(measured), measured)

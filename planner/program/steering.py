@@ -123,13 +123,16 @@ def steer(
     points: Sequence[ProbePoint],
     measured_base: Mapping[str, FloatArray],
     T_base_wobj: FloatArray,
-    pivot_m: FloatArray,
+    pivot_m: FloatArray | tuple[float, ...],
     scale_m: float,
+    *,
+    checked: bool = False,
 ) -> FloatArray:
     """``(4, 4)`` the estimate after an update from ``points`` (their last measurements in
     ``measured_base``, base frame, metres), starting at ``T_base_wobj``: the frame
     :func:`~calib.estimators.runners.min_norm_update` computes, compiled
-    (:mod:`planner.program.update_kernel`).
+    (:mod:`planner.program.update_kernel`). ``checked``: ``T_base_wobj`` is known to be a
+    rigid transform (checked by the caller, or an earlier update's result), not checked again.
 
     Raises:
         NonFiniteError: a measurement, the pivot or the scale is NaN or infinite, or the update
@@ -138,10 +141,11 @@ def steer(
     """
     from planner.program.update_kernel import gauss_newton  # numba: imported when used
 
-    pivot = tuple(float(v) for v in np.asarray(pivot_m, float))
+    given = pivot_m if isinstance(pivot_m, tuple) else np.asarray(pivot_m, float).tolist()
+    pivot = tuple(float(v) for v in given)
     L = float(scale_m)
     lay = _update_layout(tuple(points), pivot, L)
-    T = check_transform(T_base_wobj, "T_base_wobj")
+    T = T_base_wobj if checked else check_transform(T_base_wobj, "T_base_wobj")
     q = np.array([measured_base[p.id] for p in points], dtype=np.float64)[lay.rows]
     if not np.isfinite(q).all():
         raise NonFiniteError("a steered update: a measurement is NaN or infinite")

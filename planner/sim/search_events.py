@@ -20,6 +20,7 @@ from __future__ import annotations
 import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -327,10 +328,14 @@ class FaceLookup:
         want = self.intended.get(point_id, -1)
         if want < 0 or len(triangles) == 0:
             return None, 0.0
-        tri = np.asarray(triangles, dtype=np.int64)
-        face = np.where(tri >= 0, self.triangle_face[np.maximum(tri, 0)], -1)
-        off = face != want
-        frac = float(np.mean(off))
+        off = self._face_of[np.asarray(triangles, dtype=np.int64)] != want
+        frac = np.count_nonzero(off) / len(off)  # np.mean's value, without its overhead
         if bool(off[0]):
             return LANDED_OFF_FACE, frac
         return (PARTLY_OFF_FACE, frac) if frac > 0.0 else (None, 0.0)
+
+    @cached_property
+    def _face_of(self) -> NDArray[np.int64]:
+        """``(F + 1,)`` :attr:`triangle_face` with ``-1`` appended: indexed by a hit's
+        triangle, ``-1`` (nothing hit) gives ``-1``."""
+        return np.append(np.asarray(self.triangle_face, dtype=np.int64), -1)

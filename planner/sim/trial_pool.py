@@ -13,6 +13,7 @@ not depend on which process ran which chunk, nor when.
 from __future__ import annotations
 
 import math
+import threading
 from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, Future, wait
 from typing import Any
@@ -53,7 +54,12 @@ class TrialPool:
         predict_setup: also predict the rows of this setup on a worker, before the trials
             (:func:`planner.sim.predict.predict_report`; :attr:`prediction`); None: not.
 
-    Close it with :meth:`results` (waits) or :meth:`cancel` (kills the workers at once).
+    The workers are started and handed their chunks on a thread of this process
+    (``wobjcal-pool-start``): starting one waits for the fork server's imports and for the
+    worker to read its setup, about half a second each, which the caller spends on its own
+    work meanwhile. An error there (e.g. a setup that does not pickle) is raised by
+    :attr:`prediction` and :meth:`results`. Close the pool with :meth:`results` (waits) or
+    :meth:`cancel` (kills the workers at once).
     """
 
     def __init__(
@@ -68,28 +74,54 @@ class TrialPool:
         chunks = [seeds[i : i + size] for i in range(0, len(seeds), size)]
         self.total = len(seeds)
         self._pool = open_pool(n_workers, init_worker, (setup, mesh))
+        self._futures: list[Future[list[TrialResult]]] = []
+        self._sizes: dict[int, int] = {}
+        self._prediction: Future[Prediction] | None = None
+        self._error: BaseException | None = None
+        self._starter = threading.Thread(
+            target=self._start, args=(chunks, predict_setup), name="wobjcal-pool-start"
+        )
+        self._starter.daemon = True
+        self._starter.start()
+
+    def _start(self, chunks: list[list[TrialSeed]], predict_setup: SimulationSetup | None) -> None:
+        """Hand the workers the prediction, then every chunk (on the starter thread)."""
         try:
-            #: the prediction computed on a worker (its error raised by ``result()``), or None
-            self.prediction: Future[Prediction] | None = (
-                None if predict_setup is None else self._pool.submit(predict_report, predict_setup)
-            )
-            self._futures: list[Future[list[TrialResult]]] = [
-                self._pool.submit(run_chunk_in_worker, c) for c in chunks
-            ]
-        except BaseException:
+            if predict_setup is not None:
+                self._prediction = self._pool.submit(predict_report, predict_setup)
+            futures = [self._pool.submit(run_chunk_in_worker, c) for c in chunks]
+        except BaseException as exc:  # raised in the caller's thread (_started)
+            self._error = exc
+            return
+        self._sizes = {id(f): len(c) for f, c in zip(futures, chunks, strict=True)}
+        self._futures = futures
+
+    def _started(self) -> None:
+        """Wait until every chunk is handed out; raise what went wrong there (the workers
+        killed first)."""
+        self._starter.join()
+        if self._error is not None:
             kill_pool(self._pool)
-            raise
-        self._sizes = {id(f): len(c) for f, c in zip(self._futures, chunks, strict=True)}
+            raise self._error
+
+    @property
+    def prediction(self) -> Future[Prediction] | None:
+        """The prediction computed on a worker (its error raised by ``result()``), or None
+        when none was asked for (waits until the workers are started)."""
+        self._started()
+        return self._prediction
 
     @property
     def done(self) -> int:
-        """Trials whose chunk has finished so far."""
-        return sum(self._sizes[id(f)] for f in self._futures if f.done())
+        """Trials whose chunk has finished so far (0 while the workers are starting)."""
+        futures = self._futures
+        return sum(self._sizes[id(f)] for f in futures if f.done())
 
     def results(self, progress: DoneCallback | None = None) -> list[TrialResult]:
         """Wait for every trial and return them in seed order; ``progress(done)`` as chunks
         finish. An error, Ctrl-C or SIGTERM kills the workers (nothing left running)."""
         try:
+            self._started()
             pending = set(self._futures)
             while pending:
                 finished, pending = wait(pending, return_when=FIRST_COMPLETED)
@@ -99,13 +131,15 @@ class TrialPool:
                     progress(self.done)
             out = [r for f in self._futures for r in f.result()]
         except BaseException:
-            kill_pool(self._pool)
+            self.cancel()
             raise
         self._pool.shutdown(wait=True)
         return out
 
     def cancel(self) -> None:
-        """Kill the workers and drop their trials (no waiting)."""
+        """Kill the workers and drop their trials (no waiting for the trials; the workers
+        being started are started first, so that none is left running)."""
+        self._starter.join()
         kill_pool(self._pool)
 
 

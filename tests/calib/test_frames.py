@@ -81,6 +81,24 @@ def test_small_motion_round_trip(rng: np.random.Generator) -> None:
     )
 
 
+@pytest.mark.parametrize("angle", [0.0, 1e-12, 1e-7, 1e-3, 0.1, 1.0, 1.5, 1.5707, 2.0, 3.1])
+def test_motion_between_one_pair_is_scipys(angle: float, rng: np.random.Generator) -> None:
+    """One pair of transforms takes a plain-float path for rotations under 90 degrees: the
+    same rotation vector as scipy's (the batch path) within a few units in the last place,
+    at every size of rotation, and scipy's own above 90 degrees."""
+    for _ in range(200):
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        T_a = frames.random_transform(rng, 2.0, np.pi)
+        T_c = T_a @ frames.make_transform(
+            Rotation.from_rotvec(angle * axis).as_matrix(), rng.normal(0.0, 0.01, 3)
+        )
+        one = frames.motion_between(T_a, T_c)
+        batch = frames.motion_between(T_a[None], T_c[None])[0]  # scipy's Rotation
+        np.testing.assert_allclose(one, batch, rtol=1e-14, atol=1e-300)
+        np.testing.assert_allclose(np.linalg.norm(one[3:]), angle, rtol=1e-9, atol=1e-15)
+
+
 def test_check_transform_errors() -> None:
     with pytest.raises(ShapeError, match=r"T_base_wobj must be a \(4, 4\)"):
         frames.check_transform(np.eye(3), "T_base_wobj")

@@ -104,3 +104,42 @@ def test_a_failed_x_offset_run_leaves_the_row_to_the_other_trials(
     assert report.failures == {"x-offset PX1_11: why": 1} and report.n_ok == 50
     assert np.isfinite(report.rows[0].procedure)
     assert len(report.samples_procedure[XOFFSET_KEYS[1]]) == 49 * 6
+
+
+def test_rows_on_two_threads_are_the_rows_of_one(
+    rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``build_rows`` computes large reports on two threads: the same rows, samples and order
+    as one thread (frame, point, extra-error and protocol rows alike)."""
+    from planner.sim import summary
+    from planner.sim.summary import RowInputs, build_rows
+
+    specs = [
+        *frame_rows((95.5, 99.99)),
+        RowSpec("pts", "points", "mm", (95.5,), points_wobj=rng.normal(0, 0.3, (40, 3))),
+        RowSpec(
+            "yz", "plane", "mm", (99.99,), points_wobj=rng.normal(0, 0.3, (7, 3)), components="yz"
+        ),
+        RowSpec("extra", "x", "mm", (95.5,), points_wobj=np.zeros((3, 3)), components="x"),
+    ]
+    cov = np.diag(rng.uniform(1e-9, 1e-8, 6))
+    inputs = [
+        RowInputs(
+            rng.normal(0, 1e-4, (300, 6)),
+            cov,
+            {"extra": (rng.normal(0, 1e-4, (300, 3, 3)), 2e-4)},
+            rng.normal(0, 1e-4, (60, 6)),
+        )
+        for _ in range(2)
+    ]
+    monkeypatch.setattr(summary, "PARALLEL_SAMPLES", 10**12)
+    one = build_rows(specs, *inputs)
+    monkeypatch.setattr(summary, "PARALLEL_SAMPLES", 0)
+    two = build_rows(specs, *inputs)
+    assert [r.key for r in two[0]] == [r.key for r in one[0]]
+    for a, b in zip(one[0], two[0], strict=True):
+        assert repr(a) == repr(b)
+    for k in (1, 2):
+        assert one[k].keys() == two[k].keys()
+        for key in one[k]:
+            np.testing.assert_array_equal(one[k][key], two[k][key])
