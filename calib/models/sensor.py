@@ -49,11 +49,14 @@ def face_frame(axis: FloatArray) -> tuple[FloatArray, FloatArray]:
     close to ``e_x``) normalised, ``v = axis x u``. ``(u, v, axis)`` is the sensor's tool frame
     the simulation uses for a TCP calibration error.
     """
-    ax, ay, az = (float(c) for c in axis)
-    # u = axis x helper, helper = e_x unless the axis is close to it (then e_y)
+    ax, ay, az = (float(c) for c in np.asarray(axis, dtype=np.float64).tolist())
+    # u = axis x helper, helper = e_x unless the axis is close to it (then e_y); its length
+    # by numpy's dot (a plain sum can differ in the last bit, and a ray on a triangle's edge
+    # with it), the rest in floats
     u = np.array([0.0, az, -ay]) if abs(ax) < 0.9 else np.array([-az, 0.0, ax])
     u /= math.sqrt(float(u @ u))
-    v = np.array([ay * u[2] - az * u[1], az * u[0] - ax * u[2], ax * u[1] - ay * u[0]])
+    u0, u1, u2 = u.tolist()
+    v = np.array([ay * u2 - az * u1, az * u0 - ax * u2, ax * u1 - ay * u0])
     return u, v
 
 

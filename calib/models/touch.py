@@ -144,7 +144,9 @@ class TouchProbe(Strict, frozen=True, kw_only=True, tag="touch", tag_field="kind
         """
         a = np.asarray(axis, dtype=np.float64)
         u, v = face_frame(a)
-        return _ball_front_local(self.n_rays, self.radius_m) @ np.array([u, v, a])
+        disk, h = _ball_front(self.n_rays, self.radius_m)
+        pts = disk[:, :1] * u + disk[:, 1:] * v + h[:, None] * a
+        return np.vstack([self.radius_m * a, pts])
 
     # ------------------------------------------------------------------ pre-travel
     def pretravel_error_m(self, contact_normal: FloatArray, axis: FloatArray) -> float:
@@ -160,7 +162,7 @@ class TouchProbe(Strict, frozen=True, kw_only=True, tag="touch", tag_field="kind
         """
         a = np.asarray(axis, dtype=np.float64)
         f = -np.asarray(contact_normal, dtype=np.float64)  # the push on the ball, into the probe
-        cos_psi = float(np.clip(f @ a, -1.0, 1.0))
+        cos_psi = min(max(float(f @ a), -1.0), 1.0)
         sin2 = max(0.0, 1.0 - cos_psi * cos_psi)
         if sin2 == 0.0:
             return 0.0
@@ -176,17 +178,6 @@ class TouchProbe(Strict, frozen=True, kw_only=True, tag="touch", tag_field="kind
         if self.trigger_repeatability_sigma_m == 0.0:
             return 0.0
         return float(rng.normal(0.0, self.trigger_repeatability_sigma_m))
-
-
-@lru_cache(maxsize=16)
-def _ball_front_local(n_rays: int, radius_m: float) -> FloatArray:
-    """``(n_rays, 3)`` :meth:`TouchProbe.front_points_m` in the probe's face frame ``(u, v,
-    axis)``: the pole ``(0, 0, r)``, then the disk's points at their heights (shared,
-    read-only)."""
-    disk, h = _ball_front(n_rays, radius_m)
-    out = np.vstack([[0.0, 0.0, radius_m], np.column_stack([disk, h])])
-    out.setflags(write=False)
-    return out
 
 
 @lru_cache(maxsize=16)

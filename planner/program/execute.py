@@ -93,19 +93,19 @@ class ProgramProbe:
         """Run the program's searches of ``point`` (search key ``key``) from its safe start in
         the estimate ``T`` ``(4, 4)`` (base frame, m): what :meth:`__call__` runs for a
         command from the plan's start, and what a steered program runs at each search step."""
-        first, *rest = (_moved(c, T) for c in _searches_in_wobj(point, self.safety))
+        built = _searches_in_wobj(point, self.safety)
         if point.search.kind == "approach":
-            return self.probe(replace(first, point_id=key))
-        face = self.probe(replace(first, point_id=key + FACE_APPROACH))
+            return self.probe(_moved(built[0], T, key))
+        face = self.probe(_moved(built[0], T, key + FACE_APPROACH))
         if face.point_m is None:
             return ProbeResult(None, f"approach to the face: {face.reason}")
-        edge = rest[0]
+        edge = _moved(built[1], T, key)
         start = np.asarray(face.point_m, dtype=np.float64)
         end = edge.start_m + edge.length_m * edge.direction
         run = float((end - start) @ edge.direction)
         if run <= 0.0:
             return ProbeResult(None, "the measured face point lies past the end of the edge search")
-        return self.probe(replace(edge, point_id=key, start_m=start, length_m=run))
+        return self.probe(replace(edge, start_m=start, length_m=run))
 
 
 @lru_cache(maxsize=4096)
@@ -120,13 +120,14 @@ def _plan_start_wobj(point: ProbePoint) -> FloatArray:
     return SearchCommand.from_point(point, np.eye(4)).start_m
 
 
-def _moved(cmd: SearchCommand, T: FloatArray) -> SearchCommand:
-    """``cmd`` (built in the frame ``I``) as built in the frame ``T``: every point and
-    direction moved by ``T``, and ``T`` its estimate."""
+def _moved(cmd: SearchCommand, T: FloatArray, point_id: str) -> SearchCommand:
+    """``cmd`` (built in the frame ``I``) as built in the frame ``T``, named ``point_id``:
+    every point and direction moved by ``T`` (each by its own product: one product of all
+    five can differ in the last bit), and ``T`` its estimate."""
     R, t = T[:3, :3], T[:3, 3]
     stop = None if cmd.stop_normal is None else R @ cmd.stop_normal
     return SearchCommand(
-        point_id=cmd.point_id,
+        point_id=point_id,
         kind=cmd.kind,
         start_m=R @ cmd.start_m + t,
         direction=R @ cmd.direction,

@@ -135,10 +135,8 @@ class MeshRayCaster:
         """
         o = np.ascontiguousarray(origins, dtype=np.float64)
         d = np.ascontiguousarray(directions, dtype=np.float64)
-        out = np.full(len(o), np.inf)
-        tri_out = np.full(len(o), -1, dtype=np.int64)
         if len(o) == 0:
-            return out, tri_out
+            return np.full(0, np.inf), np.full(0, -1, dtype=np.int64)
         if self._scene is not None:
             ids = self._scene.run(o.astype(np.float32), d.astype(np.float32))
         else:  # pragma: no cover

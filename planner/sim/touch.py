@@ -73,7 +73,9 @@ class SimulatedTouchProbe(SimulatedSensor):
         centre0 = R @ (tcp0 - r * axis) + t  # part frame from here on
         a = R @ axis
         origins = centre0 + self.sensor.front_points_m(a)
-        dist, tri = self.caster.first_hits_ids(origins, np.broadcast_to(a, origins.shape))
+        along = np.empty_like(origins)
+        along[:] = a
+        dist, tri = self.caster.first_hits_ids(origins, along)
         length = float(cmd.length_m)
         if np.any(dist <= 0.0):
             return self._fail(cmd, BALL_INSIDE)
