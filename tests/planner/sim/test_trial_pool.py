@@ -1,0 +1,101 @@
+"""The trial pool starts its workers on a thread of its own (:mod:`planner.sim.trial_pool`):
+the caller goes on at once, gets the trials back in seed order, and gets an error of the start
+raised where it waits, with nothing left running.
+
+The executor is a stand-in that runs each call on submit (no process is started), so the tests
+see the pool's own logic: when it submits, what it raises, what it kills.
+"""
+
+from __future__ import annotations
+
+import pickle
+import threading
+from collections.abc import Callable
+from concurrent.futures import Future
+from typing import Any
+
+import pytest
+
+from planner.sim import trial_pool as trial_pool_module
+from planner.sim.trial_pool import TrialPool
+
+
+class _Executor:
+    """Runs each submitted call at once, after ``gate`` opens; ``fail`` makes a submit raise."""
+
+    def __init__(self, gate: threading.Event, fail: BaseException | None = None) -> None:
+        self.gate, self.fail = gate, fail
+        self.submitted = 0
+        self.killed = self.shut = False
+
+    def submit(self, fn: Callable[..., Any], *args: Any) -> Future[Any]:
+        assert self.gate.wait(30.0), "the test never opened the gate"
+        if self.fail is not None:
+            raise self.fail
+        self.submitted += 1
+        f: Future[Any] = Future()
+        f.set_result(fn(*args))
+        return f
+
+    def shutdown(self, wait: bool = True) -> None:
+        self.shut = True
+
+
+def _pool(monkeypatch: pytest.MonkeyPatch, executor: _Executor, n_seeds: int = 10) -> TrialPool:
+    monkeypatch.setattr(trial_pool_module, "open_pool", lambda *a: executor)
+    monkeypatch.setattr(trial_pool_module, "kill_pool", lambda p: setattr(p, "killed", True))
+    monkeypatch.setattr(trial_pool_module, "run_chunk_in_worker", lambda seeds: list(seeds))
+    monkeypatch.setattr(trial_pool_module, "predict_report", lambda setup: ("predicted", setup))
+    return TrialPool(
+        "setup",  # type: ignore[arg-type]
+        None,  # type: ignore[arg-type]
+        list(range(n_seeds)),  # type: ignore[arg-type]
+        2,
+        predict_setup="nominal",  # type: ignore[arg-type]
+    )
+
+
+def test_the_caller_goes_on_while_the_workers_start(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The pool returns before any chunk is handed out (the workers' start blocks here until
+    the gate opens); meanwhile no trial counts as done; then every trial comes back in seed
+    order and the prediction with them."""
+    gate = threading.Event()
+    executor = _Executor(gate)
+    pool = _pool(monkeypatch, executor, n_seeds=25)
+    assert executor.submitted == 0 and pool.done == 0
+    gate.set()
+    prediction = pool.prediction
+    assert prediction is not None and prediction.result() == ("predicted", "nominal")
+    seen: list[int] = []
+    assert pool.results(seen.append) == list(range(25))
+    assert executor.submitted == 1 + len(range(0, 25, 2)) and executor.shut
+    assert seen[-1] == 25 and not executor.killed
+
+
+@pytest.mark.parametrize("ask", ["results", "prediction"])
+def test_an_error_starting_the_workers_is_raised_where_the_caller_waits(
+    monkeypatch: pytest.MonkeyPatch, ask: str
+) -> None:
+    """A setup that does not pickle fails on the start thread; the caller gets that error
+    (not a hang, not a silent empty run) and the workers are killed."""
+    gate = threading.Event()
+    gate.set()
+    executor = _Executor(gate, pickle.PicklingError("cannot pickle 'generator' object"))
+    pool = _pool(monkeypatch, executor)
+    with pytest.raises(pickle.PicklingError, match="cannot pickle"):
+        pool.results() if ask == "results" else pool.prediction
+    assert executor.killed
+
+
+def test_cancel_while_the_workers_start_leaves_none_running(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Cancelling (Ctrl-C, an error of the caller) while the start thread is still handing out
+    chunks waits for it, then kills the workers: none is started after the kill."""
+    gate = threading.Event()
+    executor = _Executor(gate)
+    pool = _pool(monkeypatch, executor)
+    threading.Timer(0.2, gate.set).start()
+    pool.cancel()
+    assert executor.killed and executor.submitted == 1 + 10  # 10 chunks of 1 trial
+    assert not pool._starter.is_alive()
