@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Literal
 
 import numpy as np
@@ -137,16 +138,11 @@ class SearchCommand:
     def from_point(cls, point: ProbePoint, T_base_wobj: ArrayLike) -> SearchCommand:
         """Build the command for ``point`` given the current estimate ``T_base_wobj``."""
         T = np.asarray(T_base_wobj, dtype=np.float64)
-        p = np.asarray(point.position_m, float)
-        n = np.asarray(point.normal, float)
         s = point.search
-        if s.kind == "approach":
-            start_w, dir_w, stop_w = p + s.start_offset_m * n, -n, n
-        else:
-            d = np.asarray(s.edge_direction, float)
-            start_w, dir_w = p - s.start_offset_m * d, d
-            stop_w = d if point.edge_normal is None else np.asarray(point.edge_normal, float)
         if T.shape != (4, 4):  # a batch of frames: the general transforms
+            p = np.asarray(point.position_m, float)
+            n = np.asarray(point.normal, float)
+            start_w, dir_w, stop_w = _wobj_vectors(point)
             return cls(
                 point_id=point.id,
                 kind=s.kind,
@@ -161,8 +157,12 @@ class SearchCommand:
         # one frame (every search of a procedure run): the four directions and two points
         # in one product each, a few microseconds instead of six einsum calls
         R, t = T[:3, :3], T[:3, 3]
-        dirs = np.array([dir_w, -n, stop_w]) @ R.T
-        pts = np.array([start_w, p]) @ R.T + t
+        try:
+            dirs_w, pts_w = _wobj_rows(point)
+        except TypeError:  # a point built with lists or arrays (not hashable): not cached
+            dirs_w, pts_w = _wobj_rows.__wrapped__(point)
+        dirs = dirs_w @ R.T
+        pts = pts_w @ R.T + t
         return cls(
             point_id=point.id,
             kind=s.kind,
@@ -174,6 +174,32 @@ class SearchCommand:
             nominal_m=pts[1],
             stop_normal=dirs[2],
         )
+
+
+def _wobj_vectors(point: ProbePoint) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """``(start, direction, stop normal)`` of ``point``'s search in the wobj frame (m)."""
+    p = np.asarray(point.position_m, float)
+    n = np.asarray(point.normal, float)
+    s = point.search
+    if s.kind == "approach":
+        return p + s.start_offset_m * n, -n, n
+    d = np.asarray(s.edge_direction, float)
+    stop_w = d if point.edge_normal is None else np.asarray(point.edge_normal, float)
+    return p - s.start_offset_m * d, d, stop_w
+
+
+@lru_cache(maxsize=4096)
+def _wobj_rows(point: ProbePoint) -> tuple[FloatArray, FloatArray]:
+    """``(directions (3, 3), points (2, 3))`` :meth:`SearchCommand.from_point` moves into the
+    base frame: the search direction, the sensor axis and the stop normal; the start and the
+    nominal point (wobj frame, m; computed once per point, read-only)."""
+    start_w, dir_w, stop_w = _wobj_vectors(point)
+    n = np.asarray(point.normal, float)
+    dirs = np.array([dir_w, -n, stop_w])
+    pts = np.array([start_w, np.asarray(point.position_m, float)])
+    dirs.setflags(write=False)
+    pts.setflags(write=False)
+    return dirs, pts
 
 
 @dataclass(frozen=True)
