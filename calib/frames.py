@@ -267,7 +267,7 @@ def motion_between(T_a_b: ArrayLike, T_a_c: ArrayLike) -> FloatArray:
     Useful for errors of an estimated frame against the truth, in the truth's own axes.
     """
     T_b_c = invert_transform(T_a_b) @ np.asarray(T_a_c, dtype=np.float64)
-    if T_b_c.shape == (4, 4):  # one pair (two a simulated trial): a small rotation in floats
+    if T_b_c.shape == (4, 4):  # one pair (a simulated trial asks for two): in plain floats
         rv = _small_rotvec(T_b_c[:3, :3].tolist())
         if rv is not None:
             return np.array([*T_b_c[:3, 3].tolist(), *rv])
@@ -277,11 +277,14 @@ def motion_between(T_a_b: ArrayLike, T_a_c: ArrayLike) -> FloatArray:
 def _small_rotvec(R: list[list[float]]) -> tuple[float, float, float] | None:
     """The rotation vector of one rotation matrix of less than 90 degrees (rad), from its
     antisymmetric part ``sin(angle) * axis`` and ``cos(angle) = (trace - 1) / 2``, in plain
-    floats (about 2 us against scipy's 45); ``None`` for larger rotations (left to scipy).
-    Within a few units in the last place of :func:`rotvec_from_matrix` (tested)."""
+    floats (about 2 us against scipy's 45); ``None`` for larger rotations and for a matrix
+    that is no rotation (its trace above 3, NaN): left to scipy, which orthogonalises or
+    refuses it. Within a few units in the last place of :func:`rotvec_from_matrix` (tested):
+    a threshold on a motion's size (an iterative procedure's convergence test) can move by
+    that much, no more."""
     (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R
     c = 0.5 * (r00 + r11 + r22 - 1.0)
-    if not c > 0.0:  # 90 degrees or more, or NaN: scipy's general path
+    if not 0.0 < c <= 1.0 + 1e-9:  # 90 degrees or more, no rotation, NaN: scipy's path
         return None
     x, y, z = 0.5 * (r21 - r12), 0.5 * (r02 - r20), 0.5 * (r10 - r01)
     s = math.sqrt(x * x + y * y + z * z)

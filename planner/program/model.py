@@ -232,14 +232,22 @@ def search_keys(points: Sequence[RolePoint]) -> dict[str, str]:
     The plan id itself; a role held by exactly one point (the A-H procedure names its
     searches by role); either with ``"2"`` appended (its retakes ``"C2"``, ``"D2"``); and
     either with :data:`FACE_APPROACH` appended (an edge point's approach to its face).
+
+    A plan id always names its own point, and a point's first search its own: the ids are
+    taken first, then the roles, then the face approaches, then the retakes (``"T12"`` is
+    point T12, never a retake of T1; ``"T12@face"`` is T12's face approach).
     """
     out: dict[str, str] = {}
     roles = [rp.role for rp in points]
-    for rp in points:
-        names = [rp.point.id] + ([rp.role] if roles.count(rp.role) == 1 else [])
-        for name in names:
-            for suffix in ("", "2", FACE_APPROACH, "2" + FACE_APPROACH):
-                out.setdefault(f"{name}{suffix}", rp.point.id)
+    names = [
+        (rp.point.id, [rp.point.id] + ([rp.role] if roles.count(rp.role) == 1 else []))
+        for rp in points
+    ]
+    for suffix in ("", FACE_APPROACH, "2", "2" + FACE_APPROACH):  # first takes before retakes
+        for k in (0, 1):  # the ids, then the roles
+            for pid, own in names:
+                if k < len(own):
+                    out.setdefault(f"{own[k]}{suffix}", pid)
     return out
 
 

@@ -14,7 +14,9 @@ trial of 54 searches, 0.7 kB a trial of 10; rounded up):
 - :data:`SEARCH_BYTES` per search of a trial (its id, and its event when it landed partly off);
 - :data:`SAMPLE_BYTES` per main trial and report point (two samples kept, 8 bytes each), and
   :data:`ROW_BYTES` per main trial and point of the largest row (the transients of the row
-  being made: its quantiles sort a copy, its error vectors come a few points at a time);
+  being made: its error vectors come a few points at a time; the spread of each of its two
+  samples takes a copy of it, 8 bytes, and both are taken at once on a large report,
+  :func:`planner.sim.summary.build_rows`);
 - :data:`XOFFSET_BYTES` per main trial and slot hole of an x-offset run (its x error, and the
   error vectors of the x-offset rows).
 

@@ -25,6 +25,7 @@ import logging
 import os
 import time
 from collections.abc import Callable, Mapping
+from concurrent.futures import Future
 from dataclasses import dataclass
 from typing import Any
 
@@ -35,7 +36,7 @@ from calib.errors import ShapeError
 from calib.limits import MAX_PROTOCOL_TRIALS
 from calib.plan.models import MAX_TRIALS
 from planner.sim.error_map import error_map
-from planner.sim.predict import predict_report
+from planner.sim.predict import Prediction, predict_report
 from planner.sim.report import ValidationReport
 from planner.sim.rows import RowSpec
 from planner.sim.search_events import ReachabilityHook, cell_search_hook
@@ -129,7 +130,7 @@ class SimulationRun:
             report(0 if self.pool is None else self.pool.done)
 
         pool = self.pool
-        pending = None if pool is None else pool.prediction  # computed on a worker meanwhile
+        pending: Future[Prediction] | None = None  # computed on a worker meanwhile
 
         def prediction_failed() -> None:
             # a plan that cannot work fails at once, not after the vetted trials
@@ -137,6 +138,8 @@ class SimulationRun:
                 pending.result()  # its error, raised here
 
         try:
+            # waits for the workers' start (a Ctrl-C there cancels the run like any other)
+            pending = None if pool is None else pool.prediction
             if pending is None:
                 prediction = predict_report(self.nominal_setup)  # a plan that cannot work
             results: list[TrialResult] = []

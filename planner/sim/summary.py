@@ -122,8 +122,10 @@ class RowInputs:
     protocol_delta: FloatArray | None = None
 
 
-#: Samples (trials x points, both estimators) above which :func:`build_rows` computes the
-#: rows on two threads: numpy's loops over a row's millions of samples release the GIL.
+#: Samples (trials, the protocol's included, x points, both estimators, all rows) above which
+#: :func:`build_rows` computes the rows on two threads: numpy's loops over a row's millions of
+#: samples release the GIL. The two threads make the procedure's and the best fit's share of a
+#: row at once: their transients together stay within ``planner.sim.budget.ROW_BYTES``.
 PARALLEL_SAMPLES = 2_000_000
 
 #: What one estimator gives a row: its samples, half-widths, predicted half-widths, bias and

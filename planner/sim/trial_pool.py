@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 import threading
 from collections.abc import Callable
-from concurrent.futures import FIRST_COMPLETED, Future, wait
+from concurrent.futures import FIRST_COMPLETED, CancelledError, Future, wait
 from typing import Any
 
 import trimesh
@@ -78,6 +78,8 @@ class TrialPool:
         self._sizes: dict[int, int] = {}
         self._prediction: Future[Prediction] | None = None
         self._error: BaseException | None = None
+        self._stop = threading.Event()  # cancel(): hand out nothing more
+        self._started_all = threading.Event()  # the start thread has returned
         self._starter = threading.Thread(
             target=self._start, args=(chunks, predict_setup), name="wobjcal-pool-start"
         )
@@ -85,23 +87,35 @@ class TrialPool:
         self._starter.start()
 
     def _start(self, chunks: list[list[TrialSeed]], predict_setup: SimulationSetup | None) -> None:
-        """Hand the workers the prediction, then every chunk (on the starter thread)."""
+        """Hand the workers the prediction, then every chunk (on the starter thread), until
+        :meth:`cancel` says stop."""
         try:
+            calls: list[tuple[Callable[..., Any], Any]] = [(run_chunk_in_worker, c) for c in chunks]
             if predict_setup is not None:
-                self._prediction = self._pool.submit(predict_report, predict_setup)
-            futures = [self._pool.submit(run_chunk_in_worker, c) for c in chunks]
+                calls.insert(0, (predict_report, predict_setup))
+            futures: list[Future[Any]] = []
+            for fn, arg in calls:
+                if self._stop.is_set():
+                    self._error = CancelledError("the trial pool was cancelled")
+                    return
+                futures.append(self._pool.submit(fn, arg))
+            if predict_setup is not None:
+                self._prediction = futures.pop(0)
+            self._sizes = {id(f): len(c) for f, c in zip(futures, chunks, strict=True)}
+            self._futures = futures
         except BaseException as exc:  # raised in the caller's thread (_started)
             self._error = exc
-            return
-        self._sizes = {id(f): len(c) for f, c in zip(futures, chunks, strict=True)}
-        self._futures = futures
+        finally:
+            self._started_all.set()
 
     def _started(self) -> None:
         """Wait until every chunk is handed out; raise what went wrong there (the workers
-        killed first)."""
-        self._starter.join()
+        killed first). Waits on an event, not on the thread: a Ctrl-C in ``Thread.join``
+        marks a running thread as ended (Python 3.11), and :meth:`cancel` must not believe
+        it."""
+        self._started_all.wait()
         if self._error is not None:
-            kill_pool(self._pool)
+            self.cancel()
             raise self._error
 
     @property
@@ -137,10 +151,15 @@ class TrialPool:
         return out
 
     def cancel(self) -> None:
-        """Kill the workers and drop their trials (no waiting for the trials; the workers
-        being started are started first, so that none is left running)."""
-        self._starter.join()
-        kill_pool(self._pool)
+        """Kill the workers and drop their trials (no waiting for the trials). The start
+        thread is told to stop; a worker it is starting meanwhile is killed once it returns
+        (a second Ctrl-C while waiting for that still kills what is there)."""
+        self._stop.set()
+        try:
+            kill_pool(self._pool)  # the workers started so far; a later submit fails
+            self._started_all.wait()
+        finally:
+            kill_pool(self._pool)  # the worker that was being started, if any
 
 
 def run_all(

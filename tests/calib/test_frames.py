@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -97,6 +99,19 @@ def test_motion_between_one_pair_is_scipys(angle: float, rng: np.random.Generato
         batch = frames.motion_between(T_a[None], T_c[None])[0]  # scipy's Rotation
         np.testing.assert_allclose(one, batch, rtol=1e-14, atol=1e-300)
         np.testing.assert_allclose(np.linalg.norm(one[3:]), angle, rtol=1e-9, atol=1e-15)
+
+
+def test_motion_between_leaves_a_matrix_that_is_no_rotation_to_scipy() -> None:
+    """A scaled "rotation" (trace above 3) is not read by the plain-float path: scipy's
+    answer (or its refusal), as for a batch."""
+    T = np.diag([2.0, 2.0, -0.5, 1.0])
+    try:
+        want = frames.motion_between(np.eye(4)[None], T[None])[0]
+    except ValueError as exc:
+        with pytest.raises(ValueError, match=re.escape(str(exc))):
+            frames.motion_between(np.eye(4), T)
+    else:
+        np.testing.assert_array_equal(frames.motion_between(np.eye(4), T), want)
 
 
 def test_check_transform_errors() -> None:

@@ -308,3 +308,28 @@ def test_suggest_writes_whole_searches_from_a_steered_plan() -> None:
     res = suggest_plan(start, PLATE.parent, max_points=6)
     assert not res.plan.steered_searches
     assert "search_sizing" not in plan_to_json(res.plan)
+
+
+def test_a_plan_id_that_reads_like_a_retake_names_its_own_point() -> None:
+    """The shipped plate with T4 renamed T12: ``T12`` is that point's key, not a retake of T1
+    (the keys once sent T12's searches to T1, and no trial calibrated), and every trial
+    calibrates with the same frames as under the old name."""
+    from calib.probing import ProbePoint
+    from calib.procedures import RolePoint
+    from planner.program.model import search_keys
+    from planner.validate.job import validate_plan
+
+    keys = search_keys(
+        [RolePoint("fit", ProbePoint(i, (0.0, 0.0, 0.0), (0.0, 0.0, 1.0))) for i in ("T1", "T12")]
+    )
+    assert keys["T12"] == "T12" and keys["T12@face"] == "T12" and keys["T1"] == "T1"
+    plan = load_plan(PLATE)
+    text = plan_to_json(plan)
+    renamed = plan_from_json(text.replace('"T4"', '"T12"'))
+    assert "T12" in [p.id for p in renamed.points]
+    reports = [
+        validate_plan(p, trials=6, seed=2, workers=1, plan_dir=PLATE.parent)
+        for p in (plan, renamed)
+    ]
+    assert [r.n_ok for r in reports] == [6, 6]
+    np.testing.assert_array_equal(reports[1].delta_best_fit, reports[0].delta_best_fit)

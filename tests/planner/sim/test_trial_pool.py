@@ -9,9 +9,10 @@ see the pool's own logic: when it submits, what it raises, what it kills.
 from __future__ import annotations
 
 import pickle
+import signal
 import threading
 from collections.abc import Callable
-from concurrent.futures import Future
+from concurrent.futures import CancelledError, Future
 from typing import Any
 
 import pytest
@@ -27,6 +28,7 @@ class _Executor:
         self.gate, self.fail = gate, fail
         self.submitted = 0
         self.killed = self.shut = False
+        self.kills: list[int] = []
 
     def submit(self, fn: Callable[..., Any], *args: Any) -> Future[Any]:
         assert self.gate.wait(30.0), "the test never opened the gate"
@@ -42,8 +44,12 @@ class _Executor:
 
 
 def _pool(monkeypatch: pytest.MonkeyPatch, executor: _Executor, n_seeds: int = 10) -> TrialPool:
+    def kill(pool: _Executor) -> None:
+        pool.killed = True
+        pool.kills.append(pool.submitted)  # how many calls were handed out at each kill
+
     monkeypatch.setattr(trial_pool_module, "open_pool", lambda *a: executor)
-    monkeypatch.setattr(trial_pool_module, "kill_pool", lambda p: setattr(p, "killed", True))
+    monkeypatch.setattr(trial_pool_module, "kill_pool", kill)
     monkeypatch.setattr(trial_pool_module, "run_chunk_in_worker", lambda seeds: list(seeds))
     monkeypatch.setattr(trial_pool_module, "predict_report", lambda setup: ("predicted", setup))
     return TrialPool(
@@ -90,12 +96,46 @@ def test_an_error_starting_the_workers_is_raised_where_the_caller_waits(
 def test_cancel_while_the_workers_start_leaves_none_running(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    """Cancelling (Ctrl-C, an error of the caller) while the start thread is still handing out
-    chunks waits for it, then kills the workers: none is started after the kill."""
+    """Cancelling (an error of the caller) while the start thread is handing out chunks: the
+    call in progress ends, nothing more is handed out, and the workers are killed after it."""
     gate = threading.Event()
     executor = _Executor(gate)
     pool = _pool(monkeypatch, executor)
     threading.Timer(0.2, gate.set).start()
     pool.cancel()
-    assert executor.killed and executor.submitted == 1 + 10  # 10 chunks of 1 trial
+    assert executor.submitted == 1 and executor.kills[-1] == 1
+    assert not pool._starter.is_alive()
+    with pytest.raises(CancelledError):
+        pool.results()
+
+
+class _Interrupt(BaseException):
+    """A Ctrl-C of this test's own (SIGUSR1), so that a stray one cannot stop pytest."""
+
+
+def test_ctrl_c_while_waiting_for_the_start_leaves_none_running(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A signal that interrupts the caller while it waits for the start (``results``): the
+    caller gets the interrupt, the start stops after the call in progress, and the workers
+    are killed after that call (``Thread.join`` interrupted this way once let the kill run
+    before the start had stopped)."""
+
+    def interrupt(signum: int, frame: object) -> None:
+        raise _Interrupt
+
+    previous = signal.signal(signal.SIGUSR1, interrupt)
+    try:
+        gate = threading.Event()
+        executor = _Executor(gate)
+        pool = _pool(monkeypatch, executor)
+        main = threading.main_thread().ident
+        assert main is not None
+        threading.Timer(0.2, signal.pthread_kill, (main, signal.SIGUSR1)).start()
+        threading.Timer(0.5, gate.set).start()
+        with pytest.raises(_Interrupt):
+            pool.results()
+    finally:
+        signal.signal(signal.SIGUSR1, previous)
+    assert executor.submitted == 1 and executor.kills[-1] == 1
     assert not pool._starter.is_alive()
