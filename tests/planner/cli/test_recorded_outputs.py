@@ -2,7 +2,8 @@
 
 ``tests/data/golden/`` holds what ``wobjcal check --json``, every ``wobjcal export`` format and
 ``wobjcal validate --trials 50 --seed 1 --json`` printed for ``assets/plans/stator_section_ah.json``
-before ``planner/`` was regrouped into subpackages. A refactor must reproduce them: text equal
+before ``planner/`` was regrouped into subpackages (and the plate's steered plans' validations,
+recorded at faf8398). A refactor must reproduce them: text equal
 outside numbers, numbers equal to 1e-9. To record them anew after an intended change of
 behaviour, run this file with ``WOBJCAL_UPDATE_GOLDEN=1`` and say why in the commit.
 """
@@ -138,6 +139,18 @@ def test_validate_json_unchanged(tmp_path: Path) -> None:
     argv = ["validate", PLAN, "--trials", "50", "--seed", "1", "--json", str(out)]
     assert main(argv) == 0
     _record_or_compare(GOLDEN / "validate.json", out.read_text())
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("plan", ["plate_holes_best_fit", "plate_holes_321"])
+def test_validate_json_of_a_steered_plate_unchanged(plan: str, tmp_path: Path) -> None:
+    """The plate's steered programs (best fit, 3-2-1: touch probe, updates between searches),
+    which the A-H stator does not run: recorded at faf8398, before issue 24's changes to the
+    steered run, the touch probe and the frames."""
+    out = tmp_path / "validate.json"
+    argv = ["validate", f"assets/plans/{plan}.json", "--trials", "50", "--seed", "1"]
+    assert main([*argv, "--json", str(out)]) == 0
+    _record_or_compare(GOLDEN / f"validate_{plan}.json", out.read_text())
 
 
 def test_comparison_catches_a_changed_number() -> None:
