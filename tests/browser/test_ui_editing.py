@@ -146,7 +146,9 @@ def test_the_3_point_frame_is_drawn_as_a_triad_while_picked(ui: UiSession, tmp_p
     x = (panel.picked[1] - panel.picked[0]) / np.linalg.norm(panel.picked[1] - panel.picked[0])
     np.testing.assert_allclose(T[:3, 0], x, atol=1e-9)
     np.testing.assert_allclose(T[:3, 2], [0.0, 0.0, 1.0], atol=1e-9)  # out of the top face
-    np.testing.assert_allclose(triad.position, transform_points(T_WORLD_WOBJ_BOX, T[:3, 3]))
+    # viser lists a frame's handle before it sets its pose (another thread): wait for the pose
+    want = transform_points(T_WORLD_WOBJ_BOX, T[:3, 3])
+    wait_for(lambda: np.allclose(triad.position, want, rtol=1e-7, atol=0.0), what="its pose")
     wait_for(lambda: "green (+y) side" in page.inner_text("body"), what="the hint")
     page.get_by_text("green (+y) side").scroll_into_view_if_needed()
     save_screenshot(page, "frame_triad.png", tmp_path)
