@@ -38,11 +38,21 @@ def points_by_role(points: Sequence[RolePoint]) -> dict[str, ProbePoint]:
     """``{role: point}`` of an A-H layout (each point keeps its plan id).
 
     Raises:
-        PlanError: a role of A-H is missing or used twice.
+        PlanError: a role of A-H is missing or used twice, or a point's id is a name the
+            procedure gives another point's search (its role, or a retake ``C2``, ``D2``).
     """
     problem = HULTMAN2013.role_problem([rp.role for rp in points], complete=True)
     if problem:
         raise PlanError(f"hultman2013: {problem}")
+    taken = {rp.role: (rp.role, f"role {rp.role}") for rp in points}
+    taken |= {"C2": ("C", "the retake of C"), "D2": ("D", "the retake of D")}
+    for rp in points:
+        role, what = taken.get(rp.point.id, (rp.role, ""))
+        if role != rp.role:  # (C's id C2 is harmless: both of its names find it)
+            raise PlanError(
+                f"hultman2013: point {rp.point.id!r} (role {rp.role}): its id is what the "
+                f"procedure calls its search of {what}; give it another id (e.g. its role)"
+            )
     return {rp.role: rp.point for rp in points}
 
 

@@ -6,6 +6,7 @@ the true frame; estimated again from the measurements it took, it gives the same
 
 from __future__ import annotations
 
+import re
 import typing
 
 import numpy as np
@@ -72,3 +73,27 @@ def test_role_checks_name_the_problem(method: str) -> None:
 def test_only_hultman_runs_adaptively_in_programs() -> None:
     adaptive = {m for m, k in PROCEDURES.items() if k.adaptive_layout(role_points(m))}
     assert adaptive == {"hultman2013"}
+
+
+@pytest.mark.parametrize(
+    ("renamed", "message"),
+    [
+        ({"A": "B", "B": "A"}, "point 'B' (role A): its id is what the procedure calls its search"),
+        ({"E": "C2"}, "point 'C2' (role E): its id is what the procedure calls its search of the"),
+    ],
+)
+def test_an_ah_point_id_that_names_another_search_is_refused(
+    renamed: dict[str, str], message: str
+) -> None:
+    """A-H commands its searches by role (and C2, D2 for the retakes), and a program finds the
+    point by that name: a point whose id is another point's role, or a retake's name, would
+    have its searches measured at the wrong point. Refused with one message naming it."""
+    import dataclasses
+
+    pts = [
+        RolePoint(rp.role, dataclasses.replace(rp.point, id=renamed.get(rp.role, rp.role)))
+        for rp in role_points("hultman2013")
+    ]
+    with pytest.raises(PlanError, match=re.escape(message)):
+        PROCEDURES["hultman2013"].assign(pts)
+    assert PROCEDURES["hultman2013"].assign(role_points("hultman2013"))  # ids = roles: fine
