@@ -277,9 +277,10 @@ def motion_between(T_a_b: ArrayLike, T_a_c: ArrayLike) -> FloatArray:
 def _small_rotvec(R: list[list[float]]) -> tuple[float, float, float] | None:
     """The rotation vector of one rotation matrix of less than 90 degrees (rad), from its
     antisymmetric part ``sin(angle) * axis`` and ``cos(angle) = (trace - 1) / 2``, in plain
-    floats (about 2 us against scipy's 45); ``None`` for larger rotations and for a matrix
-    that is no rotation (its trace above 3, NaN): left to scipy, which orthogonalises or
-    refuses it. Within a few units in the last place of :func:`rotvec_from_matrix` (tested):
+    floats (about 2 us against scipy's 45); ``None`` for larger rotations, a trace above 3
+    and NaN: left to scipy, which orthogonalises or refuses it. A scaled rotation with a
+    trace below 3 is read as a rotation (no orthonormality test: trials pass rigid frames).
+    Within a few units in the last place of :func:`rotvec_from_matrix` (tested):
     a threshold on a motion's size (an iterative procedure's convergence test) can move by
     that much, no more."""
     (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R

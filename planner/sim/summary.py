@@ -124,8 +124,8 @@ class RowInputs:
 
 #: Samples (trials, the protocol's included, x points, both estimators, all rows) above which
 #: :func:`build_rows` computes the rows on two threads: numpy's loops over a row's millions of
-#: samples release the GIL. The two threads make the procedure's and the best fit's share of a
-#: row at once: their transients together stay within ``planner.sim.budget.ROW_BYTES``.
+#: samples release the GIL. At most two shares are made at once, each no larger than the
+#: largest row's: their transients together stay within ``planner.sim.budget.ROW_BYTES``.
 PARALLEL_SAMPLES = 2_000_000
 
 #: What one estimator gives a row: its samples, half-widths, predicted half-widths, bias and

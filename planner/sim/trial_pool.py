@@ -155,11 +155,15 @@ class TrialPool:
         thread is told to stop; a worker it is starting meanwhile is killed once it returns
         (a second Ctrl-C while waiting for that still kills what is there)."""
         self._stop.set()
+        # the executor forgets its processes at shutdown (the first kill): keep them here
+        procs: dict[int, Any] | None = getattr(self._pool, "_processes", None)  # (even empty)
         try:
             kill_pool(self._pool)  # the workers started so far; a later submit fails
             self._started_all.wait()
         finally:
-            kill_pool(self._pool)  # the worker that was being started, if any
+            kill_pool(self._pool)
+            for proc in list((procs or {}).values()):  # the one being started, if any
+                proc.kill()
 
 
 def run_all(

@@ -29,6 +29,7 @@ class _Executor:
         self.submitted = 0
         self.killed = self.shut = False
         self.kills: list[int] = []
+        self.open_on_kill = False  # the gate opens at the first kill
 
     def submit(self, fn: Callable[..., Any], *args: Any) -> Future[Any]:
         assert self.gate.wait(30.0), "the test never opened the gate"
@@ -47,6 +48,8 @@ def _pool(monkeypatch: pytest.MonkeyPatch, executor: _Executor, n_seeds: int = 1
     def kill(pool: _Executor) -> None:
         pool.killed = True
         pool.kills.append(pool.submitted)  # how many calls were handed out at each kill
+        if pool.open_on_kill:
+            pool.gate.set()
 
     monkeypatch.setattr(trial_pool_module, "open_pool", lambda *a: executor)
     monkeypatch.setattr(trial_pool_module, "kill_pool", kill)
@@ -128,13 +131,15 @@ def test_ctrl_c_while_waiting_for_the_start_leaves_none_running(
     try:
         gate = threading.Event()
         executor = _Executor(gate)
+        executor.open_on_kill = True  # the start is held up until the interrupt's cancel
         pool = _pool(monkeypatch, executor)
         main = threading.main_thread().ident
         assert main is not None
-        threading.Timer(0.2, signal.pthread_kill, (main, signal.SIGUSR1)).start()
-        threading.Timer(0.5, gate.set).start()
+        timer = threading.Timer(0.2, signal.pthread_kill, (main, signal.SIGUSR1))
+        timer.start()
         with pytest.raises(_Interrupt):
             pool.results()
+        timer.join()
     finally:
         signal.signal(signal.SIGUSR1, previous)
     assert executor.submitted == 1 and executor.kills[-1] == 1
