@@ -344,7 +344,14 @@ def plan_quality(
         quality = layout_quality(setup, poi_rows(plan.validation.report, mesh))
         return replace(quality, program=setup.program.name), ""
     except (InputError, ProbeFailedError) as exc:
-        return None, f"{plan.method}: {exc}"
+        return None, _named(plan.method, exc)
+
+
+def _named(method: str, exc: Exception) -> str:
+    """``exc``'s message under the procedure's name, once (the procedure's own errors, e.g.
+    :func:`calib.procedures.hultman2013.points_by_role`'s, already carry it)."""
+    text = str(exc)
+    return text if text.startswith(f"{method}: ") else f"{method}: {text}"
 
 
 def layout_problem(plan: Plan, fmt: str | None = None) -> str:
@@ -373,7 +380,7 @@ def layout_problem(plan: Plan, fmt: str | None = None) -> str:
         probe = PlaneProbe(T, edge_offset_of(program.settings), within_length=True)
         T_est = execute(program, T, probe).T_base_wobj
     except (InputError, ProbeFailedError) as exc:
-        return f"{plan.method}: {exc}"
+        return _named(plan.method, exc)
     positions = np.array([p.position_m for p in plan.points], dtype=np.float64)
     off = np.linalg.norm(
         transform_points(T_est, positions) - transform_points(T, positions), axis=1

@@ -62,6 +62,17 @@ def test_an_a_h_layout_off_its_assumptions_is_named() -> None:
     assert layout_problem(_moved(plan, "A", (a[0], a[1], a[2] + 2e-4))) == ""
 
 
+def test_an_a_h_point_named_after_another_role_is_named_once() -> None:
+    """A and B's ids swapped against their roles: the procedure's own message, under its name
+    once (the procedure's errors carry the name already)."""
+    plan = load_plan(STATOR)
+    ids = {"A": "B", "B": "A"}
+    swapped = [msgspec.structs.replace(p, id=ids.get(p.id, p.id)) for p in plan.points]
+    problem = layout_problem(msgspec.structs.replace(plan, points=swapped))
+    assert problem.startswith("hultman2013: point 'B' (role A): its id is what"), problem
+    assert problem.count("hultman2013") == 1, problem
+
+
 @pytest.mark.slow
 def test_check_reports_the_layout_problem_and_fails(tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
     plan = load_plan(SMALL)
