@@ -201,8 +201,9 @@ def bracket_plans(
 ) -> dict[str, Plan]:
     """The 3-2-1 and best-fit plans on the bracket, written with its mesh into ``folder``.
 
-    Made as a user makes them: the shipped plate plan loaded as the template, its work
-    object, sensor, misplacement, points and procedure replaced (``msgspec.structs.replace``);
+    Made as a user makes them: the shipped plate plan loaded as the template (without its
+    plate mesh, which ``../shared/reference`` holds: it is replaced), its work object, sensor,
+    misplacement, points and procedure replaced (``msgspec.structs.replace``);
     with ``vias``, the via points ``wobjcal check --add-vias`` adds where a joint move between
     points collides (:func:`planner.check.vias.plan_with_vias`: the check names those moves and
     says to); saved beside the mesh and loaded back (digest checked).
@@ -213,7 +214,7 @@ def bracket_plans(
     """
     rep = msgspec.structs.replace
     mesh = write_bracket(folder, wall_m, max_edge_m=max_edge_m)
-    template = load_plan(TEMPLATE)
+    template = load_plan(TEMPLATE, check_files=False)  # its plate mesh is replaced
     work_object = rep(
         template.work_object,
         mesh=mesh.name,

@@ -357,6 +357,7 @@ def test_mutated_controller_files_calibrate_or_are_refused(case: tuple[str, str,
         assert_handled(run, f"calibrate --from {fmt} with {name}: {done}")
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 def test_the_unmutated_inputs_pass() -> None:
     """The generator's bases are valid: a mutant's refusal is the mutation's doing."""

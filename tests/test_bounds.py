@@ -165,6 +165,7 @@ def test_a_run_that_would_not_fit_in_memory_is_refused_before_any_work(
     assert "MiB of results until the report" in capsys.readouterr().err
 
 
+@pytest.mark.reference
 def test_the_part_leaves_its_share_of_the_budget() -> None:
     """Before: a 786,432-triangle part and 200 trials took `validate` to 2.3 GB; the results
     now get what the part leaves of the 2 GB."""

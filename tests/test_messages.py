@@ -272,6 +272,7 @@ def test_check_json_and_the_calibrate_note_say_it(tmp_path: Path) -> None:
     assert "no redundancy" in note and "add 3 point(s) to make it detectable" in note
 
 
+@pytest.mark.reference
 def test_the_ui_layout_panel_says_it() -> None:
     from webui.layout_panel import redundancy_markdown
     from webui.plan_adapter import ui_plan_from_plan

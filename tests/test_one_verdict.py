@@ -36,6 +36,9 @@ from planner.reasons import Reason
 from planner.sim.search_events import ProgramPose, program_search_hook
 from planner.validate.job import validate_plan
 
+#: every test here runs a shipped plate plan, whose mesh is in ../shared/reference
+pytestmark = pytest.mark.reference
+
 PLANS = Path(__file__).resolve().parents[1] / "assets" / "plans"
 BASES = ("plate_holes_best_fit.json", "plate_holes_321.json", "stator_section_ah.json")
 

@@ -68,6 +68,7 @@ def export_json(out: str) -> list[str]:
 
 
 # ---- devices, FIFOs and symbolic links to them are written in place --------------------------
+@pytest.mark.reference
 def test_export_to_a_full_device_exits_2_and_the_node_stays(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -84,6 +85,7 @@ def test_export_to_a_full_device_exits_2_and_the_node_stays(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["full", "link.json"]
 
 
+@pytest.mark.reference
 def test_export_to_a_null_device_succeeds_and_the_node_stays(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -116,6 +118,7 @@ def test_every_file_output_writes_a_device_or_fifo_in_place(tmp_path: Path) -> N
     assert stat.S_ISFIFO(fifo.lstat().st_mode)
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 def test_dev_stdout_redirected_to_a_file_gets_the_output(tmp_path: Path) -> None:
     """``export -o /dev/stdout >> out.txt``. Before: out.txt stayed empty (or was replaced)
@@ -131,6 +134,7 @@ def test_dev_stdout_redirected_to_a_file_gets_the_output(tmp_path: Path) -> None
 
 
 # ---- a failed write names the file and is exit 2 ------------------------------------------------
+@pytest.mark.reference
 def test_a_full_disk_under_a_regular_file_names_the_file(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -186,6 +190,7 @@ def test_schema_into_a_full_device_exits_2_naming_standard_output(tmp_path: Path
     ],
     ids=["calibrate", "check"],
 )
+@pytest.mark.reference
 def test_json_into_a_full_stdout_exits_2(
     argv: list[str],
     tmp_path: Path,

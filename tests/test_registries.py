@@ -112,6 +112,7 @@ def _ui_download() -> None:
         "ui download",
     ],
 )
+@pytest.mark.reference
 def test_an_unknown_name_gets_the_one_error(ask: Callable[[], object], error: type) -> None:
     with pytest.raises(error) as info:
         ask()
@@ -177,6 +178,7 @@ def _plan_of(method: str) -> Plan:
     pytest.fail(f"no plan to validate {method} with: ship one in assets/plans")
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 @pytest.mark.parametrize("method", list(PROCEDURES))
 def test_every_procedure_validates(method: str) -> None:
@@ -213,6 +215,7 @@ def plate_cell():  # type: ignore[no-untyped-def]
         yield plan, cell
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 @pytest.mark.parametrize("method", list(DESIGNED))
 def test_every_designed_procedure_is_suggested(method: str, plate_cell) -> None:  # type: ignore[no-untyped-def]

@@ -228,6 +228,7 @@ def test_a_plan_from_before_the_touch_probe_loads_its_proximity_sensor() -> None
     assert json.loads(plan_to_json(plan))["validation"]["sensor"]["kind"] == "proximity"
 
 
+@pytest.mark.reference
 def test_plan_files_are_written_without_negative_zeros() -> None:
     """A zero the arithmetic signed (``-0.0``) is written ``0.0``: the same plan gives the same
     file whichever code path made it (the digest already ignored the sign)."""

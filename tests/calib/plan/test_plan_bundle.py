@@ -260,6 +260,7 @@ def test_save_plan_bundle_writes_the_archive(tmp_path: Path, ur5_plan: tuple[Pla
     assert out.read_bytes() == plan_bundle(plan, plan_dir, "cell_plan")
 
 
+@pytest.mark.reference
 def test_file_refs_and_rebased_plan(tmp_path: Path) -> None:
     plan = load_plan(PLATE_PLAN)
     assert file_refs(plan) == [("work_object.mesh", plan.work_object.mesh)]  # built-ins left out

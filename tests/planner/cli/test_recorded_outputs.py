@@ -141,6 +141,7 @@ def test_validate_json_unchanged(tmp_path: Path) -> None:
     _record_or_compare(GOLDEN / "validate.json", out.read_text())
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 @pytest.mark.parametrize("plan", ["plate_holes_best_fit", "plate_holes_321"])
 def test_validate_json_of_a_steered_plate_unchanged(plan: str, tmp_path: Path) -> None:

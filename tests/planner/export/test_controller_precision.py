@@ -180,6 +180,7 @@ def krl_stray(name: str, seed: int) -> Stray:
         pytest.param("stator_section_ah.json", 3, marks=pytest.mark.slow),
     ],
 )
+@pytest.mark.reference
 def test_single_precision_keeps_the_frame_within_the_limit(
     name: str, seed: int, record_property: Any
 ) -> None:

@@ -28,6 +28,9 @@ from planner.export import FORMATS, export_file_stem, export_files
 from planner.export.job import CheckStatus, ToolData, build_job
 from planner.export.text import file_stem
 
+#: every test here runs a shipped plate plan, whose mesh is in ../shared/reference
+pytestmark = pytest.mark.reference
+
 PLANS = Path(__file__).resolve().parents[3] / "assets" / "plans"
 NAME = "plate refused 1"
 #: The points check refuses, per format: the adaptive programs P1 and S1; the nominal FANUC

@@ -142,6 +142,7 @@ def edge_slack(
     return slack_m, slack_rad
 
 
+@pytest.mark.reference
 @pytest.mark.parametrize(("name", "seed"), CASES)
 def test_the_tp_program_replays_a_validate_trial(name: str, seed: int) -> None:
     plan, setup, probe, _T_true = _trial(PLANS / name, "fanuc", seed)
@@ -161,6 +162,7 @@ def test_the_tp_program_replays_a_validate_trial(name: str, seed: int) -> None:
     assert_replays_trial(plan, setup, job, tp.recorded_base_m(n), run)
 
 
+@pytest.mark.reference
 def test_the_interpreter_runs_skip_motions_as_the_controller() -> None:
     """The oracle's own semantics: a skip motion whose input switches on the way stops there
     and records it; one that sees no change reaches its target and jumps to its label (code 1;

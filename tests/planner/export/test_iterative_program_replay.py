@@ -38,6 +38,9 @@ from tests.planner.validate.test_program_trial_replay import PLANS, _search_call
 from tests.rapid_interp import Machine, _vec
 from tests.urscript_interp import UrMachine
 
+#: every test here runs a shipped plate plan, whose mesh is in ../shared/reference
+pytestmark = pytest.mark.reference
+
 PLATE_FIT = PLANS / "plate_holes_best_fit.json"
 #: The trial's seed (misplacement and noise).
 SEED = 6

@@ -79,6 +79,7 @@ def failing_at(search: SearchFn, k: int, answer: str = "ERR_WHLSEARCH") -> Searc
     ("name", "seed"),
     [("plate_holes_best_fit.json", 1), ("plate_holes_321.json", 2), ("stator_section_ah.json", 3)],
 )
+@pytest.mark.reference
 def test_the_adaptive_krl_program_replays_a_validate_trial(name: str, seed: int) -> None:
     plan, setup, probe, T_true = _trial(PLANS / name, "krl", seed)
     program = setup.program
@@ -161,6 +162,7 @@ def _rows(m: KrlMachine, name: str) -> list[list[Any]]:
 
 
 # ------------------------------------------------------------------ the ideal part
+@pytest.mark.reference
 @pytest.mark.parametrize("seed", range(3))
 @pytest.mark.parametrize("path", [STATOR, PLATE_321, PLANS / "plate_holes_best_fit.json"])
 def test_on_an_ideal_part_the_program_is_the_executed_program(path: Path, seed: int) -> None:
@@ -271,6 +273,7 @@ def test_a_failed_search_stops_the_a_h_program_keeping_what_was_measured(k: int)
     assert retreat.end_m is not None and np.abs(retreat.end_m - safe).max() < 1e-9
 
 
+@pytest.mark.reference
 @pytest.mark.parametrize("k", [1, 3, 4, 6])
 def test_a_failed_search_stops_the_steered_program(k: int) -> None:
     """The 3-2-1 plate: P1 P2 P3 | S1 S2 | T1; the k-th fails: no update after it, the frame

@@ -397,6 +397,7 @@ def _with_arms(job: ExportJob) -> ExportJob:
     return replace(job, targets=targets)
 
 
+@pytest.mark.reference
 @pytest.mark.parametrize("path", PLANS, ids=[p.stem for p in PLANS])
 def test_tool_offset_and_status_turn_change_nothing_measured(path: Path) -> None:
     """A sensor TCP away from the flange and targets with S and T: the same searches and
@@ -418,6 +419,7 @@ def test_tool_offset_and_status_turn_change_nothing_measured(path: Path) -> None
     assert (hit.type, hit.f["S"], hit.f["T"]) == ("E6POS", 2, 42)
 
 
+@pytest.mark.reference
 @pytest.mark.parametrize("adaptive", [False, True], ids=["nominal", "adaptive"])
 def test_a_nominal_frame_away_from_the_base_and_turned_sensors(adaptive: bool) -> None:
     """A random nominal frame, sensor orientations and tool: the program's base and targets
@@ -668,6 +670,7 @@ def test_the_search_routines_resume_as_krl_allows() -> None:
         assert np.abs(s.end_m[:3, 3] - s.target_m[:3, 3]).max() > 1e-3  # stopped on the way
 
 
+@pytest.mark.reference
 def test_negative_edge_directions_are_written_in_parentheses() -> None:
     """``fDot*(-0.5)``, never ``fDot*-0.5`` (a sign right after ``*``, which KRL may refuse)."""
     plan = with_edges(load_plan(PLATE))
@@ -741,6 +744,7 @@ def assert_legal_names(files: dict[str, str]) -> list[str]:
         ),
     ],
 )
+@pytest.mark.reference
 def test_names_are_legal_krl(change: Callable[[Plan], Plan], names: list[str]) -> None:
     """Point ids differing only in case get different KRL names (KRL is case-insensitive);
     ids over 17 characters (``x<id>_start``, ``x<id>_probe``) and plan names whose words join
@@ -759,6 +763,7 @@ def test_names_are_legal_krl(change: Callable[[Plan], Plan], names: list[str]) -
     )
 
 
+@pytest.mark.reference
 def test_random_long_ids_and_names_make_legal_krl() -> None:
     """Point ids of up to 32 characters (the plan's limit) differing in case or only after
     their 17th character, with vias, and a long plan name: the module compiles, runs and

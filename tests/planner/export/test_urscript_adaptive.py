@@ -258,6 +258,7 @@ def test_call_computes_a_function_and_refuses_one_that_moves() -> None:
     "variant",
     ["plate_holes_best_fit.json", "plate_holes_321.json", "stator", "stator_from_measured"],
 )
+@pytest.mark.reference
 def test_every_global_a_function_assigns_is_declared_global(variant: str) -> None:
     """The URScript manual binds a name a function assigns, without ``global`` or ``local``, to
     the global of that name when there is one (the interpreter does so); read strictly, a

@@ -76,6 +76,7 @@ def _job(plan: Any, T_nom: np.ndarray) -> ExportJob:
     return build_job(plan, T_nom, ToolData(T_flange_tcp=np.eye(4)))
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 @pytest.mark.parametrize(("name", "seed"), CASES)
 def test_the_urscript_program_replays_a_validate_trial(name: str, seed: int) -> None:
@@ -129,6 +130,7 @@ def failing(search: Any, which: int) -> Any:
      ("plate_holes_best_fit.json", 4, "T4")],
     ids=["ah-approach", "ah-edge-search", "best-fit"],
 )  # fmt: skip
+@pytest.mark.reference
 def test_a_failed_search_stops_the_program_with_what_was_measured(
     name: str, which: int, failed: str
 ) -> None:

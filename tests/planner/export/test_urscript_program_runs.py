@@ -498,6 +498,7 @@ def spun_rotations(plan: Plan, rng: np.random.Generator) -> dict[str, np.ndarray
 
 
 # ------------------------------------------------------------------ the shipped plans
+@pytest.mark.reference
 @pytest.mark.parametrize("seed", range(4))
 @pytest.mark.parametrize("path", PLANS, ids=[p.stem for p in PLANS])
 def test_shipped_plan_runs_to_the_end_and_measures_each_point_exactly(
@@ -525,6 +526,7 @@ def test_shipped_plan_runs_to_the_end_and_measures_each_point_exactly(
     assert np.abs(machine.motions[-1].end_T - safe_starts[-1]).max() < 1e-9  # type: ignore[operator]
 
 
+@pytest.mark.reference
 @pytest.mark.parametrize("path", PLANS, ids=[p.stem for p in PLANS])
 def test_nominal_part_gives_the_plan_points(path: Path) -> None:
     """On the part at its nominal pose every ``meas_<ID>`` is the plan's point (base frame):

@@ -185,6 +185,7 @@ def test_the_stator_program_takes_minutes_as_in_the_paper(
     assert out["cycle_time"]["searches"] == sum(r["searches"] for r in rows)
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 def test_the_plate_program_takes_seconds(plate: tuple[Plan, PlanCheck]) -> None:
     _, check = plate
@@ -194,6 +195,7 @@ def test_the_plate_program_takes_seconds(plate: tuple[Plan, PlanCheck]) -> None:
     assert 5.0 < c.total_s < 120.0
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 def test_every_program_header_says_its_cycle_time(plate: tuple[Plan, PlanCheck]) -> None:
     plan, check = plate
@@ -225,6 +227,7 @@ def _comment_text(program: str, comment: str) -> str:
     return " ".join(m.group(1).strip() for m in found if m)
 
 
+@pytest.mark.reference
 def test_the_linear_speed_is_what_every_program_commands() -> None:
     """The model's speed of the moves that are no search, against the exported texts."""
     plan = load_plan(PLANS / "plate_holes_321.json")
@@ -272,6 +275,7 @@ def _with_cycle(cycle: object) -> str:
     return json.dumps(raw)
 
 
+@pytest.mark.reference
 def test_the_cycle_fields_round_trip_and_keep_old_digests() -> None:
     plan = load_plan(PLANS / "plate_holes_321.json")
     assert "cycle" not in json.loads(plan_to_json(plan))["validation"]  # left out unset
@@ -299,6 +303,7 @@ def test_the_cycle_fields_round_trip_and_keep_old_digests() -> None:
         ({"settle": 0.2}, "validation.cycle.settle: unknown field"),
     ],
 )
+@pytest.mark.reference
 def test_a_bad_cycle_value_gives_one_clear_error(cycle: object, message: str) -> None:
     with pytest.raises(PlanError) as err:
         plan_from_json(_with_cycle(cycle))
@@ -306,6 +311,7 @@ def test_a_bad_cycle_value_gives_one_clear_error(cycle: object, message: str) ->
     assert str(err.value).count("validation.cycle") == 1
 
 
+@pytest.mark.reference
 def test_the_ui_status_says_the_cycle_time(plate: tuple[Plan, PlanCheck]) -> None:
     """The Points tab's status table ends with the check's estimate (the same program)."""
     from webui.server import run
@@ -369,6 +375,7 @@ def test_each_controllers_joint_moves_are_timed_as_its_program_commands_them() -
     assert joint_move_time(a, wrist, rapid) == pytest.approx(1.2 / math.radians(50), rel=1e-9)
 
 
+@pytest.mark.reference
 def test_the_programs_command_the_joint_speeds_the_model_times() -> None:
     """The exporters write their joint-move speeds from the same registry the model reads."""
     from planner.export.fanuc_text import JOINT_PCT

@@ -34,6 +34,7 @@ PLATE_FIT = PLANS / "plate_holes_best_fit.json"
 PLATE_321 = PLANS / "plate_holes_321.json"
 
 
+@pytest.mark.reference
 def test_a_plan_and_a_controller_give_one_named_program() -> None:
     stator, fit, three = load_plan(STATOR), load_plan(PLATE_FIT), load_plan(PLATE_321)
     assert measuring_program(stator, "rapid").name == "RAPID, adaptive A-H"
@@ -108,6 +109,7 @@ def _planes_probe(plan: Plan, T_true: np.ndarray, log: list[SearchCommand]):  # 
     return probe
 
 
+@pytest.mark.reference
 @pytest.mark.parametrize("path", [PLATE_FIT, PLATE_321])
 @pytest.mark.parametrize("seed", range(3))
 def test_a_nominal_program_searches_from_the_exported_safe_starts(path: Path, seed: int) -> None:
@@ -176,6 +178,7 @@ def test_the_adaptive_rapid_program_measures_what_the_executed_program_measures(
     assert log == [s.key for s in prog.searches]
 
 
+@pytest.mark.reference
 def test_a_validate_trial_executes_the_program_of_the_chosen_controller() -> None:
     from planner.validate.job import validate_plan
 
@@ -201,6 +204,7 @@ def _world_probe(world):  # type: ignore[no-untyped-def]
     return probe
 
 
+@pytest.mark.reference
 @pytest.mark.parametrize("path", [PLATE_FIT, PLATE_321])
 @pytest.mark.parametrize("seed", range(3))
 def test_the_adaptive_rapid_fit_programs_compute_what_the_executor_computes(

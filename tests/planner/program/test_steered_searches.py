@@ -115,6 +115,7 @@ def _worst_gaps(plan: Plan, trials: int, seed: int) -> tuple[float, float]:
     return least, most
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 @pytest.mark.parametrize("proximity", [False, True], ids=["touch", "proximity"])
 def test_steered_searches_start_outside_and_end_past_every_misplaced_face(proximity: bool) -> None:
@@ -137,6 +138,7 @@ def test_steered_searches_start_outside_and_end_past_every_misplaced_face(proxim
     assert len(shorter) >= 5, steered
 
 
+@pytest.mark.reference
 def test_the_gap_test_finds_bounds_that_are_too_small() -> None:
     """Negative control: the same run with every steered bound cut to a fifth finds a search
     that starts too near or ends short: the test above can fail."""
@@ -165,6 +167,7 @@ def test_the_gap_test_finds_bounds_that_are_too_small() -> None:
     assert least < safety.sensing_distance_m or most >= 0.0
 
 
+@pytest.mark.reference
 def test_bounds_are_the_whole_misplacement_before_the_first_update_and_never_more() -> None:
     plan = _hard_plate()
     safety = safety_spec(plan)
@@ -217,6 +220,7 @@ def test_search_sizing_round_trips_and_an_older_plan_keeps_its_bytes() -> None:
     assert "steered" in str(err.value) and "whole" in str(err.value)
 
 
+@pytest.mark.reference
 def test_steered_plan_keeps_the_floors_and_the_first_point_whole() -> None:
     plan = _hard_plate(tight=False)
     safety = safety_spec(plan)
@@ -230,6 +234,7 @@ def test_steered_plan_keeps_the_floors_and_the_first_point_whole() -> None:
         assert p.search.overtravel_m >= safety.overtravel_m(p.position_m, p.id) - 1e-12
 
 
+@pytest.mark.reference
 def test_a_program_that_cannot_steer_refuses_a_steered_plan() -> None:
     plan = _hard_plate(tight=False)
     assert measuring_program(plan, "rapid").steers_itself
@@ -241,6 +246,7 @@ def test_a_program_that_cannot_steer_refuses_a_steered_plan() -> None:
         measuring_program(ah, "rapid")
 
 
+@pytest.mark.reference
 def test_export_writes_the_steered_starts_and_refuses_fanuc() -> None:
     plan = _hard_plate(tight=False)
     whole = msgspec.structs.replace(plan, search_sizing="whole")
@@ -259,6 +265,7 @@ def test_export_writes_the_steered_starts_and_refuses_fanuc() -> None:
     assert "search_sizing steered" in job.safety.describe()
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 def test_validate_runs_the_tight_steered_program_without_a_failed_search() -> None:
     """The same tight program simulated on the plate's mesh with the touch probe and the robot's
@@ -272,6 +279,7 @@ def test_validate_runs_the_tight_steered_program_without_a_failed_search() -> No
     assert "adaptive" in report.program
 
 
+@pytest.mark.reference
 def test_steering_shortens_nothing_when_the_floors_hold_every_search() -> None:
     """The shipped plate's misplacement (3 mm, 1 deg) needs less than the floors everywhere:
     a suggestion's whole searches and its steered ones are the same (so suggest offers no
@@ -298,6 +306,7 @@ def test_steering_shortens_nothing_when_the_floors_hold_every_search() -> None:
     assert sum(a[0] < b[0] - 1e-3 for a, b in pairs) >= 5
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 def test_suggest_writes_whole_searches_from_a_steered_plan() -> None:
     """``--objective accuracy`` writes searches for the whole misplacement, and says so: a plan
@@ -310,6 +319,7 @@ def test_suggest_writes_whole_searches_from_a_steered_plan() -> None:
     assert "search_sizing" not in plan_to_json(res.plan)
 
 
+@pytest.mark.reference
 def test_a_plan_id_that_reads_like_a_retake_names_its_own_point() -> None:
     """The shipped plate with T4 renamed T12: ``T12`` is that point's key, not a retake of T1
     (the keys once sent T12's searches to T1, and no trial calibrated), and every trial

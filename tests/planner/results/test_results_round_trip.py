@@ -68,6 +68,7 @@ def _job(plan: Plan, T_nom: np.ndarray):  # type: ignore[no-untyped-def]
 @pytest.mark.parametrize(
     ("name", "seed"), [("plate_holes_best_fit.json", 1), ("stator_section_ah.json", 3)]
 )
+@pytest.mark.reference
 def test_the_rapid_json_gives_the_frame_the_controller_computed(
     tmp_path: Path, name: str, seed: int
 ) -> None:
@@ -99,6 +100,7 @@ def test_the_rapid_json_gives_the_frame_the_controller_computed(
 @pytest.mark.parametrize(
     ("name", "seed"), [("plate_holes_321.json", 2), ("stator_section_ah.json", 3)]
 )
+@pytest.mark.reference
 def test_the_krl_dat_gives_the_frame_the_controller_computed(
     tmp_path: Path, name: str, seed: int
 ) -> None:
@@ -125,6 +127,7 @@ def test_the_krl_dat_gives_the_frame_the_controller_computed(
     _close(T, base_m(m), tol_m, tol_rad)
 
 
+@pytest.mark.reference
 def test_a_krl_dat_of_a_stopped_run_names_what_was_not_measured(tmp_path: Path) -> None:
     plan, setup, probe, _ = _trial(PLANS / "plate_holes_321.json", "krl", 2)
     files = export_files(_job(plan, setup.T_base_wobj_nominal), "krl")
@@ -147,6 +150,7 @@ def test_a_krl_dat_of_a_stopped_run_names_what_was_not_measured(tmp_path: Path) 
     assert any("nResult = 2" in n and ids[2] in n for n in res.notes)
 
 
+@pytest.mark.reference
 def test_a_krl_dat_copied_before_the_run_is_refused(tmp_path: Path) -> None:
     plan = load_plan(PLANS / "plate_holes_321.json")
     files = export_files(_job(plan, np.eye(4)), "krl")
@@ -156,6 +160,7 @@ def test_a_krl_dat_copied_before_the_run_is_refused(tmp_path: Path) -> None:
         read_results(plan, [dat])
 
 
+@pytest.mark.reference
 def test_a_krl_dat_of_another_plan_is_refused(tmp_path: Path) -> None:
     plan = load_plan(PLANS / "plate_holes_321.json")
     other = load_plan(PLANS / "plate_holes_best_fit.json")
@@ -165,6 +170,7 @@ def test_a_krl_dat_of_another_plan_is_refused(tmp_path: Path) -> None:
         read_results(plan, [dat])
 
 
+@pytest.mark.reference
 def test_a_measured_slot_without_its_point_is_named(tmp_path: Path) -> None:
     plan = load_plan(PLANS / "plate_holes_321.json")
     text = export_files(_job(plan, np.eye(4)), "krl")[".dat"]
@@ -186,6 +192,7 @@ def test_a_measured_slot_without_its_point_is_named(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("name", "seed"), [("plate_holes_best_fit.json", 1), ("stator_section_ah.json", 3)]
 )
+@pytest.mark.reference
 def test_the_ur_log_gives_the_frame_the_controller_computed(
     tmp_path: Path, name: str, seed: int
 ) -> None:
@@ -216,6 +223,7 @@ def test_the_ur_log_gives_the_frame_the_controller_computed(
     _close(T, m.frame("wobj"), tol_m, tol_rad)
 
 
+@pytest.mark.reference
 def test_a_ur_log_cut_before_the_end_is_refused(tmp_path: Path) -> None:
     plan = load_plan(PLANS / "plate_holes_321.json")
     digest = plan_digest(plan)
@@ -236,6 +244,7 @@ def test_a_ur_log_cut_before_the_end_is_refused(tmp_path: Path) -> None:
 
 
 # ------------------------------------------------------------------ FANUC
+@pytest.mark.reference
 def test_the_fanuc_register_backups_give_the_trials_frame(tmp_path: Path) -> None:
     plan, setup, probe, _ = _trial(PLANS / "plate_holes_321.json", "fanuc", 2)
     T_nom = setup.T_base_wobj_nominal
@@ -260,6 +269,7 @@ def test_the_fanuc_register_backups_give_the_trials_frame(tmp_path: Path) -> Non
     _close(T, run.T_base_wobj, 5e-6, 1e-5)
 
 
+@pytest.mark.reference
 def test_fanuc_registers_of_another_frame_or_a_failed_point_are_named(tmp_path: Path) -> None:
     plan, setup, probe, _ = _trial(PLANS / "plate_holes_321.json", "fanuc", 2)
     T_nom = setup.T_base_wobj_nominal
@@ -288,6 +298,7 @@ def test_fanuc_registers_of_another_frame_or_a_failed_point_are_named(tmp_path: 
 
 
 # ------------------------------------------------------------------ any
+@pytest.mark.reference
 def test_a_file_of_no_controller_is_named(tmp_path: Path) -> None:
     plan = load_plan(PLANS / "plate_holes_321.json")
     f = tmp_path / "notes.txt"

@@ -16,6 +16,9 @@ from calib.plan.file import load_plan
 from planner.cli.main import main
 from planner.plan_cell import nominal_T_base_wobj
 
+#: every test here runs a shipped plate plan, whose mesh is in ../shared/reference
+pytestmark = pytest.mark.reference
+
 ROOT = Path(__file__).resolve().parents[3]
 DATA = ROOT / "tests" / "data" / "results"
 PLAN = str(ROOT / "assets" / "plans" / "plate_holes_321.json")

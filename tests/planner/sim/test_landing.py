@@ -27,6 +27,7 @@ def _mesh(plan: Plan):  # type: ignore[no-untyped-def]
     return work_object_mesh(plan, PLANS, check_simulatable(plan))
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 def test_a_nominal_program_on_narrow_faces_is_flagged_the_adaptive_one_is_not() -> None:
     """The plate's 3-2-1: its secondary and tertiary points sit on 12.7 mm side faces. Measured
@@ -102,6 +103,7 @@ def test_a_kept_risk_is_of_the_same_sensor_and_the_same_part(
     assert kept.failed > first.failed  # the wide face meets the teeth: a different answer
 
 
+@pytest.mark.reference
 def test_search_reach_names_every_problem_of_every_point_at_once() -> None:
     plan = load_plan(PLATE_321)
     safety = safety_spec(plan)
@@ -120,6 +122,7 @@ def test_search_reach_names_every_problem_of_every_point_at_once() -> None:
     assert "2.0 mm past it" in b
 
 
+@pytest.mark.reference
 @pytest.mark.parametrize("overtravel_mm", [1.0, 3.9, 4.2, 20.0])
 def test_check_and_validate_refuse_the_same_short_searches(overtravel_mm: float) -> None:
     """One rule: a search too short for the misplacement fails check's reach and validate's

@@ -24,6 +24,9 @@ from planner.check.results import PlanCheck
 from planner.reasons import Reason
 from planner.suggest import SuggestError, suggest_plan
 
+#: every test here runs a shipped plate plan, whose mesh is in ../shared/reference
+pytestmark = pytest.mark.reference
+
 PLANS = Path(__file__).resolve().parents[3] / "assets" / "plans"
 
 

@@ -45,6 +45,7 @@ def test_placement_is_a_function_of_seed_and_index() -> None:
     assert len({p.base_dx_mm for p in a}) == 50  # drawn, not constant
 
 
+@pytest.mark.reference
 def test_placed_plan_moves_base_part_and_fixtures_rigidly() -> None:
     plan = load_plan(PLATE)
     where = Placement(0, 100.0, -50.0, 90.0, 10.0, 20.0, 30.0, 45.0)
@@ -69,6 +70,7 @@ def test_parse_range(text: str, expected: tuple[float, float]) -> None:
     assert parse_range(text, "base_dx_mm") == expected
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 def test_serial_and_distributed_rows_are_the_same(serial_dir: Path, tmp_path: Path) -> None:
     result = run_sweep(PLATE, tmp_path, samples=N, seed=3, workers=2)
@@ -84,6 +86,7 @@ def test_serial_and_distributed_rows_are_the_same(serial_dir: Path, tmp_path: Pa
     assert all(float(r[COLUMNS.index("cycle_s")]) > 0 for r in rows.values())
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 def test_resume_runs_only_the_missing_placements(
     serial_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
@@ -110,6 +113,7 @@ def test_resume_runs_only_the_missing_placements(
     assert ran == []
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 def test_other_arguments_are_refused_naming_them(serial_dir: Path, tmp_path: Path) -> None:
     out = tmp_path / "other"
@@ -128,6 +132,7 @@ def test_other_arguments_are_refused_naming_them(serial_dir: Path, tmp_path: Pat
         run_sweep(PLATE, out, samples=N, seed=3, workers=0)
 
 
+@pytest.mark.reference
 def test_cli_refuses_another_sweep_with_exit_2(
     serial_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -174,6 +179,7 @@ def test_bad_flags_exit_2_with_one_clear_error(
     assert not (tmp_path / "x").exists()  # nothing written
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 def test_part_out_of_reach_is_a_row_with_its_reason(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
@@ -189,6 +195,7 @@ def test_part_out_of_reach_is_a_row_with_its_reason(
     assert side["ranges"]["part_dx_mm"] == [5000.0, 5000.0] and side["samples"] == 1
 
 
+@pytest.mark.reference
 def test_a_check_that_raises_becomes_an_error_row(monkeypatch: pytest.MonkeyPatch) -> None:
     def refuse(*args: object, **kwargs: object) -> None:
         raise InputError("work object: 2 triangles\nout of the cell")
@@ -201,6 +208,7 @@ def test_a_check_that_raises_becomes_an_error_row(monkeypatch: pytest.MonkeyPatc
     assert row.points_total == len(load_plan(PLATE).points) and math.isnan(row.accuracy_mm)
 
 
+@pytest.mark.reference
 @pytest.mark.slow
 def test_a_running_scheduler_runs_the_same_rows(
     serial_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]

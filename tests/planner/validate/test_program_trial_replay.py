@@ -97,6 +97,7 @@ def _search_callback(probe: Any) -> Any:
     ("name", "seed"),
     [("plate_holes_best_fit.json", 1), ("plate_holes_321.json", 2), ("stator_section_ah.json", 3)],
 )
+@pytest.mark.reference
 def test_the_rapid_module_replays_a_validate_trial(name: str, seed: int) -> None:
     plan, setup, probe, _T_true = _trial(PLANS / name, "rapid", seed)
     T_nom = setup.T_base_wobj_nominal
@@ -125,6 +126,7 @@ def test_the_rapid_module_replays_a_validate_trial(name: str, seed: int) -> None
     assert np.arccos(np.clip((np.trace(dR) - 1.0) / 2.0, -1.0, 1.0)) < tol_rad
 
 
+@pytest.mark.reference
 @pytest.mark.parametrize("name", ["plate_holes_best_fit.json", "plate_holes_321.json"])
 def test_the_krl_program_replays_a_validate_trial(name: str) -> None:
     """The nominal KRL program, its searches answered by the simulated sensor of a trial of the
