@@ -11,6 +11,8 @@ import numpy as np
 import pytest
 from hypothesis import settings
 
+from tests.reference_data import PLATE_MESH, REFERENCE
+
 # Deterministic property tests: the same examples on every run and machine (no flaky CI).
 settings.register_profile("wobjcal", derandomize=True, deadline=None, print_blob=True)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "wobjcal"))
@@ -22,7 +24,6 @@ os.environ.setdefault("WOBJCAL_BACKGROUND_COMPILE", "0")
 
 REPO = Path(__file__).resolve().parent.parent
 ASSETS = REPO / "assets"
-REFERENCE = REPO.parent / "shared" / "reference"
 
 
 @pytest.fixture
@@ -51,14 +52,12 @@ def reference_dir() -> Path:
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Tests marked ``reference`` read ``../shared/reference`` without the fixture (the shipped
-    plate plans name its ``parts/plate_holes.STL`` as their mesh): skipped, as the fixture's
-    users are, where it is absent; under CI they run and fail, naming the missing file."""
-    if REFERENCE.is_dir() or _under_ci():
+    """Tests (or cases) marked ``reference`` run a shipped plate plan, whose mesh is
+    :data:`~tests.reference_data.PLATE_MESH`: skipped, as the ``reference_dir`` fixture's users
+    are, where that file is absent; under CI they run and fail, naming the missing file."""
+    if PLATE_MESH.is_file() or _under_ci():
         return
-    skip = pytest.mark.skip(
-        reason=f"reference data not found at {REFERENCE} (the shipped plate plans' mesh)"
-    )
+    skip = pytest.mark.skip(reason=f"the shipped plate plans' mesh not found at {PLATE_MESH}")
     for item in items:
         if item.get_closest_marker("reference") is not None:
             item.add_marker(skip)

@@ -228,11 +228,10 @@ def test_a_plan_from_before_the_touch_probe_loads_its_proximity_sensor() -> None
     assert json.loads(plan_to_json(plan))["validation"]["sensor"]["kind"] == "proximity"
 
 
-@pytest.mark.reference
 def test_plan_files_are_written_without_negative_zeros() -> None:
     """A zero the arithmetic signed (``-0.0``) is written ``0.0``: the same plan gives the same
     file whichever code path made it (the digest already ignored the sign)."""
-    plan = load_plan(SCHEMA_FILE.parent / "plans" / "plate_holes_321.json")
+    plan = load_plan(SCHEMA_FILE.parent / "plans" / "plate_holes_321.json", check_files=False)
     p = plan.points[0]
     signed = msgspec.structs.replace(p, position_m=(-0.0, p.position_m[1], p.position_m[2]))
     again = msgspec.structs.replace(plan, points=[signed, *plan.points[1:]])

@@ -43,6 +43,7 @@ from tests.krl_interp import KrlMachine
 from tests.planner.validate.test_program_trial_replay import _search_callback
 from tests.planner.validate.test_program_trial_replay import _trial as replay_trial
 from tests.rapid_interp import Machine, _vec
+from tests.reference_data import plate_case
 
 PLANS = Path(__file__).resolve().parents[3] / "assets" / "plans"
 #: The issue's limit: the float32 frame within this of the float64 frame at the part's
@@ -175,12 +176,11 @@ def krl_stray(name: str, seed: int) -> Stray:
 @pytest.mark.parametrize(
     ("name", "seed"),
     [
-        ("plate_holes_best_fit.json", 1),
-        ("plate_holes_321.json", 2),
+        plate_case("plate_holes_best_fit.json", 1),
+        plate_case("plate_holes_321.json", 2),
         pytest.param("stator_section_ah.json", 3, marks=pytest.mark.slow),
     ],
 )
-@pytest.mark.reference
 def test_single_precision_keeps_the_frame_within_the_limit(
     name: str, seed: int, record_property: Any
 ) -> None:

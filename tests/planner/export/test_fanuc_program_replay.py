@@ -43,10 +43,11 @@ from tests.fanuc_interp import AT_START, TPError, TPMachine
 from tests.planner.export.test_export_fanuc import with_arms
 from tests.planner.export.test_urscript_adaptive_replay import angle_rad
 from tests.planner.validate.test_program_trial_replay import PLANS, TOL_M, _search_callback, _trial
+from tests.reference_data import plate_case
 
 CASES = [
-    ("plate_holes_best_fit.json", 1),
-    ("plate_holes_321.json", 2),
+    plate_case("plate_holes_best_fit.json", 1),
+    plate_case("plate_holes_321.json", 2),
     ("stator_section_ah.json", 3),
 ]
 #: Agreement of the frame of the recorded points with the trial's: m, rad.
@@ -142,7 +143,6 @@ def edge_slack(
     return slack_m, slack_rad
 
 
-@pytest.mark.reference
 @pytest.mark.parametrize(("name", "seed"), CASES)
 def test_the_tp_program_replays_a_validate_trial(name: str, seed: int) -> None:
     plan, setup, probe, _T_true = _trial(PLANS / name, "fanuc", seed)

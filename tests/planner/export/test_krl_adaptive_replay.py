@@ -54,6 +54,7 @@ from tests.planner.validate.test_program_trial_replay import (
     _search_callback,
     _trial,
 )
+from tests.reference_data import plate_case
 
 PLANS = Path(__file__).resolve().parents[3] / "assets" / "plans"
 STATOR = PLANS / "stator_section_ah.json"
@@ -77,9 +78,12 @@ def failing_at(search: SearchFn, k: int, answer: str = "ERR_WHLSEARCH") -> Searc
 @pytest.mark.slow
 @pytest.mark.parametrize(
     ("name", "seed"),
-    [("plate_holes_best_fit.json", 1), ("plate_holes_321.json", 2), ("stator_section_ah.json", 3)],
+    [
+        plate_case("plate_holes_best_fit.json", 1),
+        plate_case("plate_holes_321.json", 2),
+        ("stator_section_ah.json", 3),
+    ],
 )
-@pytest.mark.reference
 def test_the_adaptive_krl_program_replays_a_validate_trial(name: str, seed: int) -> None:
     plan, setup, probe, T_true = _trial(PLANS / name, "krl", seed)
     program = setup.program
@@ -162,9 +166,10 @@ def _rows(m: KrlMachine, name: str) -> list[list[Any]]:
 
 
 # ------------------------------------------------------------------ the ideal part
-@pytest.mark.reference
 @pytest.mark.parametrize("seed", range(3))
-@pytest.mark.parametrize("path", [STATOR, PLATE_321, PLANS / "plate_holes_best_fit.json"])
+@pytest.mark.parametrize(
+    "path", [STATOR, plate_case(PLATE_321), plate_case(PLANS / "plate_holes_best_fit.json")]
+)
 def test_on_an_ideal_part_the_program_is_the_executed_program(path: Path, seed: int) -> None:
     """Noise-free, the part at the full misplacement: every search the program commands is the
     one the executed program commands (start and end to 1e-6 mm), so the points and frame are

@@ -64,7 +64,6 @@ def as_saved(dat: str) -> str:
     return "\n".join(out)
 
 
-@pytest.mark.reference
 @pytest.mark.slow
 @pytest.mark.parametrize("case", list(CASES))
 def test_the_program_parses(case: str) -> None:
@@ -73,7 +72,6 @@ def test_the_program_parses(case: str) -> None:
     assert krl_errors(files[".dat"]) == [], case
 
 
-@pytest.mark.reference
 @pytest.mark.slow
 def test_a_program_of_90_points_parses() -> None:
     """2,770 lines of ``.src`` and 4,250 of ``.dat``: about 4 s."""
@@ -82,7 +80,6 @@ def test_a_program_of_90_points_parses() -> None:
     assert krl_errors(files[".dat"]) == []
 
 
-@pytest.mark.reference
 @pytest.mark.parametrize("case", ["stator A-H (shipped)", "plate best fit with vias (shipped)"])
 def test_the_data_list_as_the_controller_saves_it_parses(case: str) -> None:
     dat = _files(CASES[case]())[".dat"]

@@ -61,9 +61,15 @@ from planner.program import execute
 from tests.box_part import BOX_HI, BOX_LO, BoxProbe, distance_to_box
 from tests.krl_interp import KrlError, KrlMachine, SearchFn
 from tests.planner.export.test_export_rapid_adaptive import full_misplacement, rapid_search
+from tests.reference_data import plate_case
 
 REPO = Path(__file__).resolve().parents[3]
 PLANS = sorted((REPO / "assets" / "plans").glob("*.json"))
+#: :data:`PLANS` as cases, the plate's marked ``reference`` (their mesh is in ``../shared``).
+PLAN_CASES = [
+    plate_case(p, id=p.stem) if p.stem.startswith("plate") else pytest.param(p, id=p.stem)
+    for p in PLANS
+]
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
 PLATE = REPO / "assets" / "plans" / "plate_holes_321.json"
 PLATE_BEST_FIT = REPO / "assets" / "plans" / "plate_holes_best_fit.json"
@@ -397,8 +403,7 @@ def _with_arms(job: ExportJob) -> ExportJob:
     return replace(job, targets=targets)
 
 
-@pytest.mark.reference
-@pytest.mark.parametrize("path", PLANS, ids=[p.stem for p in PLANS])
+@pytest.mark.parametrize("path", PLAN_CASES)
 def test_tool_offset_and_status_turn_change_nothing_measured(path: Path) -> None:
     """A sensor TCP away from the flange and targets with S and T: the same searches and
     points, ``$TOOL`` the tool, and the status and turn reach ``$POS_INT``."""
@@ -419,7 +424,6 @@ def test_tool_offset_and_status_turn_change_nothing_measured(path: Path) -> None
     assert (hit.type, hit.f["S"], hit.f["T"]) == ("E6POS", 2, 42)
 
 
-@pytest.mark.reference
 @pytest.mark.parametrize("adaptive", [False, True], ids=["nominal", "adaptive"])
 def test_a_nominal_frame_away_from_the_base_and_turned_sensors(adaptive: bool) -> None:
     """A random nominal frame, sensor orientations and tool: the program's base and targets
@@ -427,7 +431,8 @@ def test_a_nominal_frame_away_from_the_base_and_turned_sensors(adaptive: bool) -
     the nominal program (edge searches) as computed here, the adaptive 3-2-1 (its frame updates
     with ``INV_POS`` and ``:``) as executed."""
     rng = np.random.default_rng(11)
-    plan = load_plan(PLATE) if adaptive else with_edges(load_plan(PLATE))
+    plate = load_plan(PLATE, check_files=False)  # the program is written from the plan alone
+    plan = plate if adaptive else with_edges(plate)
     T_nom = random_transform(rng, 2.0, np.pi)
     T_true = T_nom @ full_misplacement(plan, rng)
     rotations = {
@@ -670,10 +675,9 @@ def test_the_search_routines_resume_as_krl_allows() -> None:
         assert np.abs(s.end_m[:3, 3] - s.target_m[:3, 3]).max() > 1e-3  # stopped on the way
 
 
-@pytest.mark.reference
 def test_negative_edge_directions_are_written_in_parentheses() -> None:
     """``fDot*(-0.5)``, never ``fDot*-0.5`` (a sign right after ``*``, which KRL may refuse)."""
-    plan = with_edges(load_plan(PLATE))
+    plan = with_edges(load_plan(PLATE, check_files=False))
     job = build_job(plan, nominal_T_base_wobj(plan), ToolData(T_flange_tcp=np.eye(4)))
     src = export_files(job, "krl")[".src"]
     assert "*(-" in src and not re.search(r"\*\s*-", src)
@@ -744,13 +748,12 @@ def assert_legal_names(files: dict[str, str]) -> list[str]:
         ),
     ],
 )
-@pytest.mark.reference
 def test_names_are_legal_krl(change: Callable[[Plan], Plan], names: list[str]) -> None:
     """Point ids differing only in case get different KRL names (KRL is case-insensitive);
     ids over 17 characters (``x<id>_start``, ``x<id>_probe``) and plan names whose words join
     to over 17 characters (``Wobjcal<Words>``) are cut to KRL's 24 characters. The plan model
     accepts all of them; the (adaptive best fit) program compiles and measures as executed."""
-    plan = load_plan(PLATE_BEST_FIT)
+    plan = load_plan(PLATE_BEST_FIT, check_files=False)
     plan = change(msgspec.structs.replace(plan, points=plan.points[:3]))
     job = build_job(plan, nominal_T_base_wobj(plan), ToolData(T_flange_tcp=np.eye(4)))
     assert job.program("krl").adaptive
@@ -763,13 +766,12 @@ def test_names_are_legal_krl(change: Callable[[Plan], Plan], names: list[str]) -
     )
 
 
-@pytest.mark.reference
 def test_random_long_ids_and_names_make_legal_krl() -> None:
     """Point ids of up to 32 characters (the plan's limit) differing in case or only after
     their 17th character, with vias, and a long plan name: the module compiles, runs and
     measures every point as computed."""
     rng = np.random.default_rng(23)
-    plan = with_edges(load_plan(PLATE))
+    plan = with_edges(load_plan(PLATE, check_files=False))
     stem = "".join(rng.choice(list("abcXYZ_09"), 16))
     ids = [f"{stem}{k}" for k in range(3)] + [f"{stem}0".upper(), f"{stem}0".lower(), "S" * 32]
     plan = _renamed(plan, ids[: len(plan.points)])

@@ -30,21 +30,18 @@ def _errors(plan: Plan) -> list[str]:
     return rapid_errors(export_files(job, "rapid")[".mod"])
 
 
-@pytest.mark.reference
 @pytest.mark.slow
 @pytest.mark.parametrize("case", list(PLANS_MADE))
 def test_the_module_passes_rapidchecker(case: str) -> None:
     assert _errors(PLANS_MADE[case]()) == [], case
 
 
-@pytest.mark.reference
 @pytest.mark.slow
 def test_a_module_of_90_points_passes_rapidchecker() -> None:
     """2,950 lines: the tool takes about 45 s over it."""
     assert _errors(ninety()) == []
 
 
-@pytest.mark.reference
 @pytest.mark.slow
 def test_the_checker_sees_a_declaration_after_a_routine() -> None:
     """The layout error the tool found, put back by hand: it is reported."""

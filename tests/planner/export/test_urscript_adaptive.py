@@ -30,6 +30,7 @@ from tests.box_part import BoxProbe, distance_to_box
 from tests.planner.export.test_export_rapid_adaptive import full_misplacement, rapid_search
 from tests.planner.export.test_export_rapid_xoffset import affine_face
 from tests.planner.export.test_urscript_adaptive_replay import angle_rad
+from tests.reference_data import plate_case
 from tests.urscript_interp import (
     Pose,
     SearchFn,
@@ -256,9 +257,13 @@ def test_call_computes_a_function_and_refuses_one_that_moves() -> None:
 
 @pytest.mark.parametrize(
     "variant",
-    ["plate_holes_best_fit.json", "plate_holes_321.json", "stator", "stator_from_measured"],
+    [
+        plate_case("plate_holes_best_fit.json"),
+        plate_case("plate_holes_321.json"),
+        "stator",
+        "stator_from_measured",
+    ],
 )
-@pytest.mark.reference
 def test_every_global_a_function_assigns_is_declared_global(variant: str) -> None:
     """The URScript manual binds a name a function assigns, without ``global`` or ``local``, to
     the global of that name when there is one (the interpreter does so); read strictly, a

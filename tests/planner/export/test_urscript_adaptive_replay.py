@@ -34,11 +34,12 @@ from tests.planner.validate.test_program_trial_replay import (
     _search_callback,
     _trial,
 )
+from tests.reference_data import plate_case
 from tests.urscript_interp import UrMachine
 
 CASES = [
-    ("plate_holes_best_fit.json", 1),
-    ("plate_holes_321.json", 2),
+    plate_case("plate_holes_best_fit.json", 1),
+    plate_case("plate_holes_321.json", 2),
     ("stator_section_ah.json", 3),
 ]
 
@@ -76,7 +77,6 @@ def _job(plan: Any, T_nom: np.ndarray) -> ExportJob:
     return build_job(plan, T_nom, ToolData(T_flange_tcp=np.eye(4)))
 
 
-@pytest.mark.reference
 @pytest.mark.slow
 @pytest.mark.parametrize(("name", "seed"), CASES)
 def test_the_urscript_program_replays_a_validate_trial(name: str, seed: int) -> None:
@@ -127,10 +127,9 @@ def failing(search: Any, which: int) -> Any:
 @pytest.mark.parametrize(
     ("name", "which", "failed"),
     [("stator_section_ah.json", 3, "C"), ("stator_section_ah.json", 7, "F"),
-     ("plate_holes_best_fit.json", 4, "T4")],
+     plate_case("plate_holes_best_fit.json", 4, "T4")],
     ids=["ah-approach", "ah-edge-search", "best-fit"],
 )  # fmt: skip
-@pytest.mark.reference
 def test_a_failed_search_stops_the_program_with_what_was_measured(
     name: str, which: int, failed: str
 ) -> None:

@@ -58,6 +58,7 @@ from planner.program import execute
 from planner.program.model import FACE_APPROACH
 from tests.box_part import BoxProbe, distance_to_box
 from tests.planner.export.test_export_rapid_adaptive import full_misplacement, rapid_search
+from tests.reference_data import plate_case
 from tests.urscript_interp import (
     AT_START,
     Pose,
@@ -69,6 +70,11 @@ from tests.urscript_interp import (
 
 REPO = Path(__file__).resolve().parents[3]
 PLANS = sorted((REPO / "assets" / "plans").glob("*.json"))
+#: :data:`PLANS` as cases, the plate's marked ``reference`` (their mesh is in ``../shared``).
+PLAN_CASES = [
+    plate_case(p, id=p.stem) if p.stem.startswith("plate") else pytest.param(p, id=p.stem)
+    for p in PLANS
+]
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
 #: 1e-6 mm: the ideal probe and the interpreter are exact up to rounding.
 TOL_M = 1e-9
@@ -498,9 +504,8 @@ def spun_rotations(plan: Plan, rng: np.random.Generator) -> dict[str, np.ndarray
 
 
 # ------------------------------------------------------------------ the shipped plans
-@pytest.mark.reference
 @pytest.mark.parametrize("seed", range(4))
-@pytest.mark.parametrize("path", PLANS, ids=[p.stem for p in PLANS])
+@pytest.mark.parametrize("path", PLAN_CASES)
 def test_shipped_plan_runs_to_the_end_and_measures_each_point_exactly(
     path: Path, seed: int
 ) -> None:
@@ -526,8 +531,7 @@ def test_shipped_plan_runs_to_the_end_and_measures_each_point_exactly(
     assert np.abs(machine.motions[-1].end_T - safe_starts[-1]).max() < 1e-9  # type: ignore[operator]
 
 
-@pytest.mark.reference
-@pytest.mark.parametrize("path", PLANS, ids=[p.stem for p in PLANS])
+@pytest.mark.parametrize("path", PLAN_CASES)
 def test_nominal_part_gives_the_plan_points(path: Path) -> None:
     """On the part at its nominal pose every ``meas_<ID>`` is the plan's point (base frame):
     the reference itself checked against the plan (an adaptive program's every slot, the

@@ -44,6 +44,7 @@ from tests.planner.validate.test_program_trial_replay import (
     _vec,
 )
 from tests.rapid_interp import Machine
+from tests.reference_data import plate_case
 from tests.urscript_interp import UrMachine
 
 PLANS = Path(__file__).resolve().parents[3] / "assets" / "plans"
@@ -66,7 +67,7 @@ def _job(plan: Plan, T_nom: np.ndarray):  # type: ignore[no-untyped-def]
 # ------------------------------------------------------------------ RAPID
 @pytest.mark.slow
 @pytest.mark.parametrize(
-    ("name", "seed"), [("plate_holes_best_fit.json", 1), ("stator_section_ah.json", 3)]
+    ("name", "seed"), [plate_case("plate_holes_best_fit.json", 1), ("stator_section_ah.json", 3)]
 )
 @pytest.mark.reference
 def test_the_rapid_json_gives_the_frame_the_controller_computed(
@@ -98,7 +99,7 @@ def test_the_rapid_json_gives_the_frame_the_controller_computed(
 # ------------------------------------------------------------------ KRL
 @pytest.mark.slow
 @pytest.mark.parametrize(
-    ("name", "seed"), [("plate_holes_321.json", 2), ("stator_section_ah.json", 3)]
+    ("name", "seed"), [plate_case("plate_holes_321.json", 2), ("stator_section_ah.json", 3)]
 )
 @pytest.mark.reference
 def test_the_krl_dat_gives_the_frame_the_controller_computed(
@@ -190,7 +191,7 @@ def test_a_measured_slot_without_its_point_is_named(tmp_path: Path) -> None:
 # ------------------------------------------------------------------ URScript
 @pytest.mark.slow
 @pytest.mark.parametrize(
-    ("name", "seed"), [("plate_holes_best_fit.json", 1), ("stator_section_ah.json", 3)]
+    ("name", "seed"), [plate_case("plate_holes_best_fit.json", 1), ("stator_section_ah.json", 3)]
 )
 @pytest.mark.reference
 def test_the_ur_log_gives_the_frame_the_controller_computed(

@@ -30,6 +30,7 @@ from planner.sim.trial import TrialRunner
 from planner.validate.job import check_simulatable, simulation_setup, work_object_mesh
 from tests.krl_interp import KrlMachine
 from tests.rapid_interp import Machine, _vec
+from tests.reference_data import plate_case
 
 PLANS = Path(__file__).resolve().parents[3] / "assets" / "plans"
 #: Agreement of a recorded point, metres: the programs' written decimals (0.0001 mm).
@@ -95,9 +96,12 @@ def _search_callback(probe: Any) -> Any:
 @pytest.mark.slow
 @pytest.mark.parametrize(
     ("name", "seed"),
-    [("plate_holes_best_fit.json", 1), ("plate_holes_321.json", 2), ("stator_section_ah.json", 3)],
+    [
+        plate_case("plate_holes_best_fit.json", 1),
+        plate_case("plate_holes_321.json", 2),
+        ("stator_section_ah.json", 3),
+    ],
 )
-@pytest.mark.reference
 def test_the_rapid_module_replays_a_validate_trial(name: str, seed: int) -> None:
     plan, setup, probe, _T_true = _trial(PLANS / name, "rapid", seed)
     T_nom = setup.T_base_wobj_nominal
