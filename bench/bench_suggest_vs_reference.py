@@ -24,11 +24,11 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
-import statistics
 import tempfile
 from pathlib import Path
 from typing import Any
 
+from bench.interleaved import interleaved
 from bench.reference_tree import ROOT, adopt_orphans, run_header, run_in_tree
 from bench.result_file import write_result
 
@@ -37,7 +37,6 @@ CASES: dict[str, list[str]] = {
     "demo": ["assets/plans/stator_section_ah.json", "--target", "0.3"],
     "plate": ["assets/plans/plate_holes_best_fit.json", "--target", "0.07", "--max-points", "9"],
 }
-LOAD_KEYS = ("load_1min_before", "load_1min_after")
 
 
 def _points_key(plan: dict[str, Any]) -> list[Any]:
@@ -109,42 +108,16 @@ def compare(
     if warmup:  # fill both trees' caches, untimed
         run_case(reference, case, cache[reference], tmp)
         run_case(ours, case, cache[ours], tmp)
-    pairs: list[dict[str, Any]] = []
-    expected: dict[str, Any] | None = None
-    for k in range(repeats):
-        order = (ours, reference) if k % 2 == 0 else (reference, ours)
-        got = {tree: run_case(tree, case, cache[tree], tmp) for tree in order}
-        a, b = got[ours], got[reference]
-        expected = expected or b
-        pair = {
-            "first": "ours" if order[0] == ours else "reference",
-            "ours": a,
-            "reference": b,
-            "ratio": round(b["wall_s"] / a["wall_s"], 3),
-            "same_points": a["points_sha256"] == b["points_sha256"] == expected["points_sha256"]
-            and a["exit_code"] == b["exit_code"],
-            "same_file": a["file_sha256"] == b["file_sha256"],
-        }
-        pairs.append(pair)
-        print(
-            f"suggest {case} #{k + 1}: ours {a['wall_s']:.1f} s, reference {b['wall_s']:.1f} s,"
-            f" ratio {pair['ratio']:.2f}, same points {pair['same_points']} (load"
-            f" {min(a['load_1min_before'], b['load_1min_before']):.1f}-"
-            f"{max(a['load_1min_after'], b['load_1min_after']):.1f})",
-            flush=True,
-        )
-    ratios = [p["ratio"] for p in pairs]
-    loads = [p[s][key] for p in pairs for s in ("ours", "reference") for key in LOAD_KEYS]
-    return {
-        "args": CASES[case],
-        "pairs": pairs,
-        "ours_median_s": statistics.median(p["ours"]["wall_s"] for p in pairs),
-        "reference_median_s": statistics.median(p["reference"]["wall_s"] for p in pairs),
-        "ratio_median": statistics.median(ratios),
-        "ratio_range": [min(ratios), max(ratios)],
-        "load_range": [min(loads), max(loads)],
-        "same_points": all(p["same_points"] for p in pairs),
-    }
+
+    def run(tree: Path) -> dict[str, Any]:
+        return run_case(tree, case, cache[tree], tmp)
+
+    out = interleaved(
+        ours, reference, repeats, run, "points_sha256", "same_points", f"suggest {case}"
+    )
+    for pair in out["pairs"]:  # the whole file: recorded, not counted against the answers
+        pair["same_file"] = pair["ours"]["file_sha256"] == pair["reference"]["file_sha256"]
+    return {"args": CASES[case], **out}
 
 
 def main(argv: list[str] | None = None) -> int:
