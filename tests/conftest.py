@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Iterator
+import sys
+from collections.abc import Generator, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -11,7 +12,7 @@ import numpy as np
 import pytest
 from hypothesis import settings
 
-from tests.reference_data import PLATE_MESH, REFERENCE
+from tests.reference_data import PLATE_MESH, PLATE_OPENS, REFERENCE, watched
 
 # Deterministic property tests: the same examples on every run and machine (no flaky CI).
 settings.register_profile("wobjcal", derandomize=True, deadline=None, print_blob=True)
@@ -61,6 +62,18 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     for item in items:
         if item.get_closest_marker("reference") is not None:
             item.add_marker(skip)
+
+
+if PLATE_MESH.is_file():  # where tests can open it, an unmarked test that does fails
+    sys.addaudithook(PLATE_OPENS)
+
+    @pytest.hookimpl(wrapper=True)
+    def pytest_runtest_setup(item: pytest.Item) -> Generator[None, Any, Any]:
+        return (yield from watched(item))
+
+    @pytest.hookimpl(wrapper=True)
+    def pytest_runtest_call(item: pytest.Item) -> Generator[None, Any, Any]:
+        return (yield from watched(item))
 
 
 @pytest.fixture(scope="module")

@@ -5,11 +5,16 @@ The shipped plate plans (``assets/plans/plate_holes_*.json``) name
 ``../shared/reference/parts/plate_holes.STL`` as their mesh (trimesh's MIT-licensed plate; not
 copied into the project). A test that runs one is marked ``reference`` (a whole test, or only
 its plate cases with :func:`plate_case`); ``tests/conftest.py`` skips those where the mesh is
-absent, and lets them fail under CI.
+absent, and lets them fail under CI. Where the mesh is present (CI), :func:`watched` fails a
+test that opens it without that mark or the ``reference_dir`` fixture: such a test would fail,
+not skip, in a clone without ``../shared``.
 """
 
 from __future__ import annotations
 
+import os
+import threading
+from collections.abc import Generator
 from pathlib import Path
 from typing import Any
 
@@ -25,3 +30,48 @@ def plate_case(*values: Any, id: str | None = None, marks: Any = ()) -> Any:
     ``reference`` (besides ``marks``)."""
     extra = marks if isinstance(marks, (list, tuple)) else (marks,)
     return pytest.param(*values, id=id, marks=(pytest.mark.reference, *extra))
+
+
+class _PlateOpens:
+    """An audit hook (:func:`sys.addaudithook`) that notes an ``open`` of :data:`PLATE_MESH` by
+    the thread running the current test (other threads, e.g. a server's left from an earlier
+    test, are not counted). It never raises: an audit hook's exception would fail the open."""
+
+    def __init__(self) -> None:
+        self.thread: int | None = None
+        self.opened = False
+        self._real = os.path.realpath(PLATE_MESH)
+
+    def __call__(self, event: str, args: tuple[Any, ...]) -> None:
+        if event != "open" or self.thread != threading.get_ident() or self.opened:
+            return
+        try:
+            name = os.fsdecode(args[0])
+            if name.endswith(PLATE_MESH.name) and os.path.realpath(name) == self._real:
+                self.opened = True
+        except Exception:  # an fd, a path of another type: not the mesh by name
+            return
+
+
+PLATE_OPENS = _PlateOpens()
+
+
+def watched(item: pytest.Item) -> Generator[None, Any, Any]:
+    """The body of a ``pytest_runtest_setup``/``_call`` wrapper: fails ``item`` when it opened
+    :data:`PLATE_MESH` unmarked (see the module docstring)."""
+    PLATE_OPENS.thread, PLATE_OPENS.opened = threading.get_ident(), False
+    try:
+        result = yield
+    finally:
+        PLATE_OPENS.thread = None
+    allowed = item.get_closest_marker("reference") or "reference_dir" in getattr(
+        item, "fixturenames", ()
+    )
+    if PLATE_OPENS.opened and not allowed:
+        pytest.fail(
+            f"{item.nodeid} opens {PLATE_MESH} (a shipped plate plan's mesh) but is not marked "
+            "'reference': mark it (or its plate cases, tests.reference_data.plate_case), or load "
+            "the plan with check_files=False if it needs no mesh",
+            pytrace=False,
+        )
+    return result

@@ -247,6 +247,7 @@ def _write(folder: Path, name: str, text: str) -> Path:
 # --- plans --------------------------------------------------------------------------------
 
 
+@pytest.mark.reference  # without the plate mesh every case is refused for its absence
 @pytest.mark.slow
 @settings(max_examples=150, suppress_health_check=[HealthCheck.too_slow])
 @given(case=mutated_plans(), fmt=st.sampled_from(["json", "rapid", "krl", "urscript", "fanuc"]))
@@ -263,6 +264,7 @@ def test_a_mutated_plan_exports_or_is_refused_with_a_message(
             assert any(out.iterdir()) if out.is_dir() else out.is_file(), "exit 0, nothing written"
 
 
+@pytest.mark.reference  # without the plate mesh every case is refused for its absence
 @pytest.mark.slow
 @settings(max_examples=8, suppress_health_check=[HealthCheck.too_slow])
 @given(case=mutated_plans().filter(lambda c: c[0] != "stator_ah"))  # the plate's check: ~3 s
@@ -279,6 +281,7 @@ def test_a_mutated_plan_is_checked_or_refused_with_a_message(case: tuple[str, st
 MEASURED = json.loads((RESULTS / "wobjcal_measured.json").read_text())
 
 
+@pytest.mark.reference  # without the plate mesh every case is refused for its absence
 @pytest.mark.slow
 @settings(max_examples=120, suppress_health_check=[HealthCheck.too_slow])
 @given(case=mutated_documents(MEASURED))
@@ -343,6 +346,7 @@ def mutated_results(draw: Callable[[Any], Any]) -> tuple[str, str, str, str]:
     return fmt, name, mutant, done
 
 
+@pytest.mark.reference  # without the plate mesh every case is refused for its absence
 @pytest.mark.slow
 @settings(max_examples=60, suppress_health_check=[HealthCheck.too_slow])
 @given(case=mutated_results())

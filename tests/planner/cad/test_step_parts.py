@@ -191,7 +191,7 @@ _T_WORLD_WOBJ = Pose(position_m=(1.3279, -0.1039, 0.6374))
 
 def _box_plan(folder: Path, mesh: str, units: str, body: str | None, vias: bool) -> Path:
     rep = msgspec.structs.replace
-    template = load_plan(TEMPLATE)
+    template = load_plan(TEMPLATE, check_files=False)  # its plate mesh is replaced
     points = [
         PlanPoint(
             id=pid,

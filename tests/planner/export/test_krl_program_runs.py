@@ -364,7 +364,7 @@ def assert_on_own_face(plan: Plan, T_true: np.ndarray, measured: dict[int, np.nd
 # ------------------------------------------------------------------ tests
 @pytest.mark.parametrize("seed", range(2))
 @pytest.mark.parametrize("variant", sorted(VARIANTS))
-@pytest.mark.parametrize("path", PLANS, ids=[p.stem for p in PLANS])
+@pytest.mark.parametrize("path", PLAN_CASES)
 def test_exported_program_runs_and_measures_what_its_searches_find(
     path: Path, variant: str, seed: int
 ) -> None:

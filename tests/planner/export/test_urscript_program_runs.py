@@ -556,7 +556,7 @@ def test_nominal_part_gives_the_plan_points(path: Path) -> None:
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", range(2))
 @pytest.mark.parametrize("shape", sorted(SHAPES))
-@pytest.mark.parametrize("path", PLANS, ids=[p.stem for p in PLANS])
+@pytest.mark.parametrize("path", PLAN_CASES)
 def test_generated_variants_run_and_measure_exactly(path: Path, shape: str, seed: int) -> None:
     """Other procedures, one point, edge searches, no vias; and random speeds, offsets,
     overtravels (some searches then end before the part: code 1), tolerance, nominal frame,
