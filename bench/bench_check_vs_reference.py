@@ -36,6 +36,8 @@ def _statuses(stdout: str) -> str | None:
         report = json.loads(stdout)
     except json.JSONDecodeError:
         return None
+    if not isinstance(report, dict):
+        return None
     key = [report.get("feasible")] + [
         [p.get("id"), p.get("status"), p.get("pose_status"), p.get("path_feasible")]
         for p in report.get("points", [])

@@ -7,7 +7,9 @@ copied into the project). A test that runs one is marked ``reference`` (a whole 
 its plate cases with :func:`plate_case`); ``tests/conftest.py`` skips those where the mesh is
 absent, and lets them fail under CI. Where the mesh is present (CI), :func:`watched` fails a
 test that opens it without that mark or the ``reference_dir`` fixture: such a test would fail,
-not skip, in a clone without ``../shared``.
+not skip, in a clone without ``../shared``. It sees opens on the test's own thread, in setup
+and call; not those of other threads or of subprocesses (a CLI run in a child), and a module
+fixture's open is laid to the test that sets it up first.
 """
 
 from __future__ import annotations
@@ -41,15 +43,16 @@ class _PlateOpens:
         self.thread: int | None = None
         self.opened = False
         self._real = os.path.realpath(PLATE_MESH)
+        self._ident = threading.get_ident  # kept: module globals are gone at shutdown
 
     def __call__(self, event: str, args: tuple[Any, ...]) -> None:
-        if event != "open" or self.thread != threading.get_ident() or self.opened:
-            return
         try:
+            if event != "open" or self.opened or self.thread != self._ident():
+                return
             name = os.fsdecode(args[0])
             if name.endswith(PLATE_MESH.name) and os.path.realpath(name) == self._real:
                 self.opened = True
-        except Exception:  # an fd, a path of another type: not the mesh by name
+        except Exception:  # an fd, another type of path, an interpreter shutting down
             return
 
 
@@ -64,9 +67,10 @@ def watched(item: pytest.Item) -> Generator[None, Any, Any]:
         result = yield
     finally:
         PLATE_OPENS.thread = None
-    allowed = item.get_closest_marker("reference") or "reference_dir" in getattr(
-        item, "fixturenames", ()
-    )
+    # the fixtures asked for by name too (request.getfixturevalue): pytest's request knows them
+    request = getattr(item, "_request", None)
+    names = getattr(request, "fixturenames", None) or getattr(item, "fixturenames", ())
+    allowed = item.get_closest_marker("reference") or "reference_dir" in names
     if PLATE_OPENS.opened and not allowed:
         pytest.fail(
             f"{item.nodeid} opens {PLATE_MESH} (a shipped plate plan's mesh) but is not marked "

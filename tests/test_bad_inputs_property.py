@@ -30,6 +30,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from planner.cli.main import main
+from tests.reference_data import plate_case
 
 ROOT = Path(__file__).resolve().parents[1]
 PLANS = {
@@ -228,12 +229,18 @@ def _plan_bases() -> dict[str, dict[str, Any]]:
 
 BASE_PLANS = _plan_bases()
 PLAN_NAMES = sorted(BASE_PLANS)
+#: The bases on built-in parts, and the plate's, whose mesh is in ``../shared/reference``
+#: (without it every mutant of theirs is refused for the missing mesh: those cases skip).
+BASES = [
+    pytest.param([n for n in PLAN_NAMES if not n.startswith("plate")], id="built-in parts"),
+    plate_case([n for n in PLAN_NAMES if n.startswith("plate")], id="plate"),
+]
 
 
 @st.composite
-def mutated_plans(draw: Callable[[Any], Any]) -> tuple[str, str, str]:
-    """(base plan name, mutated plan text, what was done)."""
-    name = draw(st.sampled_from(PLAN_NAMES))
+def mutated_plans(draw: Callable[[Any], Any], names: list[str]) -> tuple[str, str, str]:
+    """(base plan name of ``names``, mutated plan text, what was done)."""
+    name = draw(st.sampled_from(names))
     text, done = draw(mutated_documents(BASE_PLANS[name]))
     return name, text, done
 
@@ -247,14 +254,14 @@ def _write(folder: Path, name: str, text: str) -> Path:
 # --- plans --------------------------------------------------------------------------------
 
 
-@pytest.mark.reference  # without the plate mesh every case is refused for its absence
 @pytest.mark.slow
-@settings(max_examples=150, suppress_health_check=[HealthCheck.too_slow])
-@given(case=mutated_plans(), fmt=st.sampled_from(["json", "rapid", "krl", "urscript", "fanuc"]))
+@pytest.mark.parametrize("names", BASES)
+@settings(max_examples=75, suppress_health_check=[HealthCheck.too_slow])
+@given(data=st.data(), fmt=st.sampled_from(["json", "rapid", "krl", "urscript", "fanuc"]))
 def test_a_mutated_plan_exports_or_is_refused_with_a_message(
-    case: tuple[str, str, str], fmt: str
+    names: list[str], data: st.DataObject, fmt: str
 ) -> None:
-    name, text, done = case
+    name, text, done = data.draw(mutated_plans(names))
     with tempfile.TemporaryDirectory() as tmp:
         plan = _write(Path(tmp), "plan.json", text)
         out = Path(tmp) / "out"
@@ -264,12 +271,14 @@ def test_a_mutated_plan_exports_or_is_refused_with_a_message(
             assert any(out.iterdir()) if out.is_dir() else out.is_file(), "exit 0, nothing written"
 
 
-@pytest.mark.reference  # without the plate mesh every case is refused for its absence
 @pytest.mark.slow
-@settings(max_examples=8, suppress_health_check=[HealthCheck.too_slow])
-@given(case=mutated_plans().filter(lambda c: c[0] != "stator_ah"))  # the plate's check: ~3 s
-def test_a_mutated_plan_is_checked_or_refused_with_a_message(case: tuple[str, str, str]) -> None:
-    name, text, done = case
+@pytest.mark.parametrize("names", BASES)
+@settings(max_examples=4, suppress_health_check=[HealthCheck.too_slow])
+@given(data=st.data())  # a check takes ~3 s; not the stator's A-H (its check is longer)
+def test_a_mutated_plan_is_checked_or_refused_with_a_message(
+    names: list[str], data: st.DataObject
+) -> None:
+    name, text, done = data.draw(mutated_plans([n for n in names if n != "stator_ah"]))
     with tempfile.TemporaryDirectory() as tmp:
         plan = _write(Path(tmp), "plan.json", text)
         run = run_cli(["check", str(plan), "--json"])

@@ -11,7 +11,9 @@ from bench.interleaved import interleaved
 OURS, REF = Path("/ours"), Path("/ref")
 
 
-def _runner(walls: dict[Path, list[float]], answers: dict[Path, list[str]]) -> Any:
+def _runner(
+    walls: dict[Path, list[float]], answers: dict[Path, list[str]], codes: tuple[int, ...] = ()
+) -> Any:
     order: list[Path] = []
 
     def run(tree: Path) -> dict[str, Any]:
@@ -19,7 +21,7 @@ def _runner(walls: dict[Path, list[float]], answers: dict[Path, list[str]]) -> A
         order.append(tree)
         return {
             "wall_s": walls[tree][k],
-            "exit_code": 0,
+            "exit_code": codes[k] if tree == OURS and codes else 0,
             "load_1min_before": 1.0 + k,
             "load_1min_after": 1.5 + k,
             "digest": answers[tree][k],
@@ -46,3 +48,9 @@ def test_an_answer_unlike_the_references_first_is_said() -> None:
     out = interleaved(OURS, REF, 2, run, "digest", "same_digest", "t")
     assert [p["same_digest"] for p in out["pairs"]] == [True, False]
     assert out["same_digest"] is False
+
+
+def test_the_same_answer_with_another_exit_code_is_not_the_same() -> None:
+    run, _ = _runner({OURS: [1.0, 1.0], REF: [1.0, 1.0]}, {OURS: ["a"] * 2, REF: ["a"] * 2}, (0, 1))
+    out = interleaved(OURS, REF, 2, run, "digest", "same_digest", "t")
+    assert [p["same_digest"] for p in out["pairs"]] == [True, False]
