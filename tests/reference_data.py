@@ -14,9 +14,10 @@ fixture's open is laid to the test that sets it up first.
 
 from __future__ import annotations
 
+import json
 import os
 import threading
-from collections.abc import Generator
+from collections.abc import Generator, Iterable
 from pathlib import Path
 from typing import Any
 
@@ -32,6 +33,17 @@ def plate_case(*values: Any, id: str | None = None, marks: Any = ()) -> Any:
     ``reference`` (besides ``marks``)."""
     extra = marks if isinstance(marks, (list, tuple)) else (marks,)
     return pytest.param(*values, id=id, marks=(pytest.mark.reference, *extra))
+
+
+def plan_cases(paths: Iterable[Path]) -> list[Any]:
+    """Plan files as ``parametrize`` cases (id: the file's stem), those whose mesh is the
+    plate's (:data:`PLATE_MESH`, by the plan's ``work_object.mesh``) marked ``reference``."""
+    out = []
+    for path in paths:
+        mesh = str(json.loads(path.read_text()).get("work_object", {}).get("mesh", ""))
+        case = plate_case if Path(mesh).name == PLATE_MESH.name else pytest.param
+        out.append(case(path, id=path.stem))
+    return out
 
 
 class _PlateOpens:

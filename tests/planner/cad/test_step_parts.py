@@ -41,7 +41,7 @@ INCH = 0.0254
 @pytest.fixture(scope="module")
 def cad_dir() -> Path:
     """``../shared/reference/cad``; skips (fails under CI) where it is absent."""
-    from tests.conftest import REFERENCE
+    from tests.reference_data import REFERENCE
 
     folder = REFERENCE / "cad"
     if not folder.is_dir():

@@ -61,15 +61,12 @@ from planner.program import execute
 from tests.box_part import BOX_HI, BOX_LO, BoxProbe, distance_to_box
 from tests.krl_interp import KrlError, KrlMachine, SearchFn
 from tests.planner.export.test_export_rapid_adaptive import full_misplacement, rapid_search
-from tests.reference_data import plate_case
+from tests.reference_data import plan_cases
 
 REPO = Path(__file__).resolve().parents[3]
 PLANS = sorted((REPO / "assets" / "plans").glob("*.json"))
 #: :data:`PLANS` as cases, the plate's marked ``reference`` (their mesh is in ``../shared``).
-PLAN_CASES = [
-    plate_case(p, id=p.stem) if p.stem.startswith("plate") else pytest.param(p, id=p.stem)
-    for p in PLANS
-]
+PLAN_CASES = plan_cases(PLANS)
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
 PLATE = REPO / "assets" / "plans" / "plate_holes_321.json"
 PLATE_BEST_FIT = REPO / "assets" / "plans" / "plate_holes_best_fit.json"

@@ -58,7 +58,7 @@ from planner.program import execute
 from planner.program.model import FACE_APPROACH
 from tests.box_part import BoxProbe, distance_to_box
 from tests.planner.export.test_export_rapid_adaptive import full_misplacement, rapid_search
-from tests.reference_data import plate_case
+from tests.reference_data import plan_cases
 from tests.urscript_interp import (
     AT_START,
     Pose,
@@ -71,10 +71,7 @@ from tests.urscript_interp import (
 REPO = Path(__file__).resolve().parents[3]
 PLANS = sorted((REPO / "assets" / "plans").glob("*.json"))
 #: :data:`PLANS` as cases, the plate's marked ``reference`` (their mesh is in ``../shared``).
-PLAN_CASES = [
-    plate_case(p, id=p.stem) if p.stem.startswith("plate") else pytest.param(p, id=p.stem)
-    for p in PLANS
-]
+PLAN_CASES = plan_cases(PLANS)
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
 #: 1e-6 mm: the ideal probe and the interpreter are exact up to rounding.
 TOL_M = 1e-9
