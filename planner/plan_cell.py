@@ -21,6 +21,7 @@ from calib.plan.file import Plan, resolve_ref
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
     from planner.cell.scene import WorkObject
+    from planner.robot.controller_base import ControllerBase
 
 FloatArray = NDArray[np.float64]
 
@@ -168,6 +169,28 @@ def open_cell(plan: Plan, plan_dir: Path) -> Cell:
     return cell
 
 
+def plan_controller_base(plan: Plan, plan_dir: Path) -> ControllerBase:
+    """The robot controller's base frame for the plan's robot
+    (:func:`planner.robot.controller_base.controller_base`): the frame the exported programs, the
+    lines to paste and the controllers' results measure from.
+
+    Raises:
+        URDFError: the robot file cannot be read (named in the message).
+    """
+    from planner.robot.controller_base import controller_base
+    from planner.robot.urdf import load_urdf
+
+    model = load_urdf(plan_robot_urdf(plan, plan_dir), check_meshes=False)
+    return controller_base(model, plan.cell.robot.base_link)
+
+
+def controller_T_base_wobj(plan: Plan, plan_dir: Path) -> FloatArray:
+    """``(4, 4)`` the nominal work object in the controller's base frame
+    (:func:`plan_controller_base`), m: what the exported programs declare."""
+    T_base_controller = plan_controller_base(plan, plan_dir).T_base_controller
+    return invert_transform(T_base_controller) @ nominal_T_base_wobj(plan)
+
+
 def controller_T_flange_tool(plan: Plan, plan_dir: Path) -> FloatArray:
     """``(4, 4)`` the tool's root frame in the robot controller's flange frame, m.
 
@@ -223,9 +246,11 @@ def tool_data(plan: Plan, plan_dir: Path) -> tuple[Any, str]:
 
 __all__ = [
     "T_base_world",
+    "controller_T_base_wobj",
     "default_cell_note",
     "nominal_T_base_wobj",
     "open_cell",
+    "plan_controller_base",
     "plan_robot_urdf",
     "plan_work_object",
     "resolved_refs",

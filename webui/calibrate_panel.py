@@ -17,6 +17,7 @@ from calib.errors import InputError
 from calib.frames import motion_between
 from calib.plan.measurements import measurements_from_json
 from planner.calibrate.job import CalibrationOutput, calibrate_plan
+from planner.plan_cell import plan_controller_base
 from webui.files_panel import check_upload
 from webui.panel import Panel
 from webui.plan_adapter import plan_from_ui
@@ -58,7 +59,10 @@ class CalibratePanel(Panel):
             raise InputError(f"{name}: not UTF-8 text, so not a measurements file") from None
         measurements = measurements_from_json(text, source=name)
         plan = plan_from_ui(self._app.state.doc)
-        out = calibrate_plan(plan, measurements)
+        # base-frame measurements are the controller's: its base frame, which may not be the
+        # robot's base link (a UR arm's is turned 180 deg about z)
+        base = plan_controller_base(plan, self._app.plan_dir)
+        out = calibrate_plan(plan, measurements, T_base_controller=base.T_base_controller)
         self.last_output = out
         delta = motion_between(out.T_base_wobj_nominal, out.T_base_wobj)
         rows = [f"**{out.method}** with {len(out.used_ids)} points", ""]

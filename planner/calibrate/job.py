@@ -30,7 +30,7 @@ lines to paste unless ``--force``, and the UI does not draw the frame as calibra
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import msgspec
@@ -68,16 +68,28 @@ class MeasuredPoints(Mapping[str, FloatArray]):
     Args:
         measurements: the measurements file's content.
         T_base_world: ``(4, 4)`` the world frame in the base frame (for world-frame files).
+        T_base_controller: ``(4, 4)`` the robot controller's base frame in the base frame
+            (:mod:`planner.robot.controller_base`): a ``base``-frame file holds what the
+            controller measured, in its own base frame. ``None``: the same frame.
     """
 
-    def __init__(self, measurements: Measurements, T_base_world: FloatArray) -> None:
+    def __init__(
+        self,
+        measurements: Measurements,
+        T_base_world: FloatArray,
+        T_base_controller: FloatArray | None = None,
+    ) -> None:
         self._m = measurements
         self._T = T_base_world
+        self._T_bc = T_base_controller if measurements.frame == "base" else None
         self._cache: dict[str, FloatArray] = {}
 
     def __getitem__(self, point_id: str) -> FloatArray:
         if point_id not in self._cache:
-            self._cache[point_id] = self._m.sequence_m(point_id, self._T)  # raises, named
+            pts = self._m.sequence_m(point_id, self._T)  # raises, named
+            if self._T_bc is not None:
+                pts = transform_points(self._T_bc, pts)
+            self._cache[point_id] = pts
         return self._cache[point_id]
 
     def __iter__(self) -> Iterator[str]:
@@ -109,6 +121,8 @@ class CalibrationOutput:
             ``(dx, dy, dz, rx, ry, rz)`` in the calibrated frame's axes (m^2, m rad, rad^2).
         problems: why the frame must not be used as it is (empty when ``trusted``).
         notes: what the user should know that does not stop the result (e.g. no redundancy).
+        T_base_controller: ``(4, 4)`` the controller's base frame in the robot base frame
+            (identity: the same frame).
     """
 
     method: str
@@ -122,6 +136,13 @@ class CalibrationOutput:
     covariance: FloatArray | None = None
     problems: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
+    T_base_controller: FloatArray = field(default_factory=lambda: np.eye(4))
+
+    @property
+    def T_controller_wobj(self) -> FloatArray:
+        """``(4, 4)`` the calibrated work object in the controller's base frame, m: what the
+        lines to paste give the controller."""
+        return invert_transform(self.T_base_controller) @ self.T_base_wobj
 
     @property
     def trusted(self) -> bool:
@@ -138,7 +159,11 @@ class CalibrationOutput:
 
 
 def calibrate_plan(
-    plan: Plan, measurements: Measurements, method: str | None = None, k_sigma: float = K_SIGMA
+    plan: Plan,
+    measurements: Measurements,
+    method: str | None = None,
+    k_sigma: float = K_SIGMA,
+    T_base_controller: FloatArray | None = None,
 ) -> CalibrationOutput:
     """Compute ``T_base_wobj`` from measured points and screen it (see the module docstring).
 
@@ -147,6 +172,11 @@ def calibrate_plan(
         measurements: the measured points (base or world frame, m or mm).
         method: a procedure of :data:`calib.procedures.PROCEDURES`; default: the plan's.
         k_sigma: a residual beyond ``k_sigma`` times the expected noise flags its point.
+        T_base_controller: ``(4, 4)`` the controller's base frame in the robot base frame
+            (:func:`planner.plan_cell.plan_controller_base`), which ``base``-frame
+            measurements are in; ``None``: the robot base frame itself. The result stays in
+            the robot base frame (:attr:`CalibrationOutput.T_controller_wobj`: the
+            controller's).
 
     Raises:
         InputError: unknown method, a measured id the plan does not have, missing
@@ -176,7 +206,8 @@ def calibrate_plan(
         )
     )
     T_nom = nominal_T_base_wobj(plan)
-    measured = MeasuredPoints(measurements, T_base_world(plan))
+    T_bc = np.eye(4) if T_base_controller is None else np.asarray(T_base_controller, float)
+    measured = MeasuredPoints(measurements, T_base_world(plan), T_bc)
     points = plan.role_points()
     run = kind.estimate(points, measured, T_nom, settings)
     first = {pid: measured[pid][0] for pid in measured}
@@ -206,6 +237,7 @@ def calibrate_plan(
         cov,
         tuple(problems),
         tuple(notes),
+        T_bc,
     )
 
 

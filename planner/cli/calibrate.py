@@ -12,11 +12,17 @@ import numpy as np
 from rich.table import Table
 
 from calib.estimators.gross_errors import K_SIGMA
-from calib.frames import motion_between, quat_wxyz_from_matrix, tait_bryan_zyx_from_matrix
+from calib.frames import (
+    invert_transform,
+    motion_between,
+    quat_wxyz_from_matrix,
+    tait_bryan_zyx_from_matrix,
+)
 from calib.procedures import METHODS
 from planner.calibrate.job import CalibrationOutput, calibrate_plan
 from planner.cli.common import print_json, read_plan, stdout
 from planner.export import FORMATS
+from planner.plan_cell import nominal_T_base_wobj, plan_controller_base
 from planner.results import KINDS, read_results
 
 
@@ -159,20 +165,27 @@ def result_json(out: CalibrationOutput, with_frame: bool = True) -> dict[str, An
         }
     if with_frame:
         data["T_base_wobj"] = T.tolist()
+        T = out.T_controller_wobj  # what the controller is given: its own base frame
+        data["T_controller_wobj"] = T.tolist()
         data["origin_m"] = T[:3, 3].tolist()
         data["tait_bryan_zyx_deg"] = np.degrees(tait_bryan_zyx_from_matrix(T[:3, :3])).tolist()
         data["quat_wxyz"] = quat_wxyz_from_matrix(T[:3, :3]).tolist()
     return data
 
 
-def _print_text(out: CalibrationOutput, paste: bool, fmt: str | None = None) -> None:
+def _print_text(
+    out: CalibrationOutput, paste: bool, fmt: str | None = None, controller_base: str | None = None
+) -> None:
     con = stdout()
-    T = out.T_base_wobj
+    T = out.T_controller_wobj  # the robot base frame, or the controller's where they differ
     o = T[:3, 3] * 1e3
     a, b, c = np.degrees(tait_bryan_zyx_from_matrix(T[:3, :3]))
     q = quat_wxyz_from_matrix(T[:3, :3])
-    delta = motion_between(out.T_base_wobj_nominal, T)
-    con.print(f"[bold]T_base_wobj[/] by {out.method} from {', '.join(out.used_ids)}")
+    delta = motion_between(out.T_base_wobj_nominal, out.T_base_wobj)
+    name = "T_base_wobj" if controller_base is None else "T_controller_wobj"
+    con.print(f"[bold]{name}[/] by {out.method} from {', '.join(out.used_ids)}")
+    if controller_base is not None:
+        con.print(f"  ({controller_base})", markup=False)
     if out.skipped_ids:
         con.print(f"[yellow]not measured, left out: {', '.join(out.skipped_ids)}[/]")
     con.print(f"  origin       x {o[0]:.3f}  y {o[1]:.3f}  z {o[2]:.3f} mm")
@@ -203,7 +216,7 @@ def _print_text(out: CalibrationOutput, paste: bool, fmt: str | None = None) -> 
     if not out.trusted:
         con.print("[red]NOT TRUSTED (printed because of --force):[/]")
     for f in FORMATS.values() if fmt is None else (FORMATS[fmt],):
-        lines = f.paste_lines(T)
+        lines = f.paste_lines(out.T_controller_wobj)
         con.print(f"{f.vendor} {f.label} ({lines.where}):", markup=False)
         for line in lines.lines:
             con.print(f"  {line}", markup=False)
@@ -211,11 +224,16 @@ def _print_text(out: CalibrationOutput, paste: bool, fmt: str | None = None) -> 
 
 def cmd_calibrate(args: argparse.Namespace) -> int:
     """Compute and print the calibrated frame."""
-    plan, _ = read_plan(args.plan)
-    results = read_results(plan, args.results, args.source_kind)
+    plan, plan_dir = read_plan(args.plan)
+    base = plan_controller_base(plan, plan_dir)
+    T_controller_wobj = invert_transform(base.T_base_controller) @ nominal_T_base_wobj(plan)
+    results = read_results(plan, args.results, args.source_kind, T_controller_wobj)
     for note in results.notes:
         print(f"wobjcal calibrate: note: {note}", file=sys.stderr)
-    out = calibrate_plan(plan, results.measurements, args.method, k_sigma=args.k_sigma)
+    out = calibrate_plan(
+        plan, results.measurements, args.method, k_sigma=args.k_sigma,
+        T_base_controller=base.T_base_controller,
+    )  # fmt: skip
     paste = out.trusted or args.force
     for note in out.notes:
         note = note.replace("wobjcal suggest PLAN ", f"wobjcal suggest {args.plan} ")
@@ -225,5 +243,5 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     if args.json:
         print_json(result_json(out, with_frame=paste))
     else:
-        _print_text(out, paste, args.format)
+        _print_text(out, paste, args.format, None if base.is_identity else base.describe())
     return 0 if paste else 1

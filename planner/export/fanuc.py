@@ -235,7 +235,7 @@ def export_fanuc(job: ExportJob) -> dict[str, str]:
     name = program_name(job.name)
     prog = _Program()
     _header(prog, job, name)
-    prog.set_register(PR_UFRAME, job.T_base_wobj)
+    prog.set_register(PR_UFRAME, job.T_controller_wobj)
     prog.set_register(PR_UTOOL, job.tool.T_flange_tcp)
     prog.add(f"UFRAME[{UFRAME_NO}]=PR[{PR_UFRAME}]")
     prog.add(f"UTOOL[{UTOOL_NO}]=PR[{PR_UTOOL}]")

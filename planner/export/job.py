@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from calib.errors import InputError
-from calib.frames import check_transform, make_transform
+from calib.frames import check_transform, invert_transform, make_transform
 from calib.plan.file import Plan, plan_digest
 from calib.probing import SearchCommand
 from planner.export.text import module_name
@@ -197,7 +197,8 @@ class ExportJob:
         name: identifier-safe program/module name, e.g. ``"WobjcalStatorSectionAh"``.
         plan_name: the plan's name (for comments).
         method: the plan's procedure.
-        T_base_wobj: ``(4, 4)`` nominal work-object frame in the robot base frame, m.
+        T_base_wobj: ``(4, 4)`` nominal work-object frame in the robot base frame (the
+            chain's base link, as the cell has it), m.
         tool: the sensor tool.
         targets: one :class:`TargetPair` per point, in plan order.
         sensor_input: name of the sensor's digital input (RAPID signal, KRL/UR input number).
@@ -216,6 +217,11 @@ class ExportJob:
         cycle_times: the estimated cycle time of each controller's program, by controller
             name (:mod:`planner.check.cycle`; from the check's poses, so only with a check):
             every header says it (:func:`cycle_header`).
+        T_base_controller: ``(4, 4)`` the controller's base frame in the robot base frame
+            (:mod:`planner.robot.controller_base`; identity: the same frame). The writers
+            declare the work object in the controller's frame, :attr:`T_controller_wobj`.
+        controller_base: which frame that is, one sentence for the headers (``""``: the robot
+            base frame itself, nothing to say).
     """
 
     name: str
@@ -232,6 +238,14 @@ class ExportJob:
     plan_digest: str = ""
     check: CheckStatus = field(default_factory=CheckStatus)
     cycle_times: Mapping[str, CycleTime] = field(default_factory=dict)
+    T_base_controller: FloatArray = field(default_factory=lambda: np.eye(4))
+    controller_base: str = ""
+
+    @property
+    def T_controller_wobj(self) -> FloatArray:
+        """``(4, 4)`` the nominal work object in the controller's base frame, m: what every
+        program declares (``wobjdata``, ``BASE_DATA``, ``wobj``, ``PR[1]``)."""
+        return invert_transform(self.T_base_controller) @ self.T_base_wobj
 
     def program(self, fmt: str) -> MeasuringProgram:
         """The measuring program the controller ``fmt`` runs for this job's plan.
@@ -273,6 +287,8 @@ def build_job(
     confdata: Mapping[str, ConfData] | None = None,
     sensor_input: str = "diSensor",
     check: CheckStatus | None = None,
+    T_base_controller: ArrayLike | None = None,
+    controller_base: str = "",
 ) -> ExportJob:
     """The export job of ``plan``.
 
@@ -286,8 +302,16 @@ def build_job(
         sensor_input: name of the sensor input.
         check: what ``wobjcal check`` said about the program (``None``: built without a
             check).
+        T_base_controller: ``(4, 4)`` the controller's base frame in the robot base frame
+            (``None``: the same frame).
+        controller_base: which frame that is, for the headers (``""``: nothing to say).
     """
     T = check_transform(T_base_wobj, "T_base_wobj")
+    T_bc = (
+        np.eye(4)
+        if T_base_controller is None
+        else check_transform(T_base_controller, "T_base_controller")
+    )
     rotations = rotations_wobj or {}
     confs = confdata or {}
     safety = safety_spec(plan)
@@ -341,6 +365,8 @@ def build_job(
         program_errors=errors,
         plan_digest=plan_digest(plan),
         check=check or CheckStatus(),
+        T_base_controller=T_bc,
+        controller_base=controller_base,
     )
 
 
@@ -354,6 +380,11 @@ def check_header(job: ExportJob, fmt: str) -> str:
     """What was checked, as the header of the controller ``fmt``'s program says it: ``CHECKED:
     ...`` when ``wobjcal check`` passed this program in the plan's cell, else ``NOT CHECKED:
     ...`` naming why (built without a check; or the points and problems check refuses)."""
+    frame = f" Coordinates: {job.controller_base}." if job.controller_base else ""
+    return _check_text(job, fmt) + frame
+
+
+def _check_text(job: ExportJob, fmt: str) -> str:
     status = job.check
     c = CONTROLLERS[fmt]
     if status.passed:

@@ -174,7 +174,7 @@ def _dat(job: ExportJob, names: list[str], program: MeasuringProgram) -> str:
         *comment_lines(comment_text(check_header(job, "krl")), "; "),
         *comment_lines(comment_text(cycle_header(job, "krl")), "; "),
         f"SIGNAL diSensor $IN[{SENSOR_IN}]",
-        f"DECL FRAME xBaseNominal={frame_text(job.T_base_wobj)}",
+        f"DECL FRAME xBaseNominal={frame_text(job.T_controller_wobj)}",
         f"DECL FRAME xToolSensor={frame_text(tool.T_flange_tcp)}",
         f"DECL LOAD ldSensor={{M {fmt(tool.mass_kg, 3)},CM {{X {fmt(cog[0] * 1e3, 3)},"
         f"Y {fmt(cog[1] * 1e3, 3)},Z {fmt(cog[2] * 1e3, 3)},A 0,B 0,C 0}},J {{X 0,Y 0,Z 0}}}}",

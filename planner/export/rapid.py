@@ -96,7 +96,7 @@ def _declarations(job: ExportJob, names: list[str]) -> list[str]:
     ids = ",".join(_string(pid) for pid, _ in slots)
     retake = ",".join("TRUE" if r else "FALSE" for _, r in slots)
     empty = ",".join(['""'] * n)
-    nominal = wobjdata_text(job.T_base_wobj)
+    nominal = wobjdata_text(job.T_controller_wobj)
     lines = [
         f"    PERS tooldata tSensor:=[TRUE,{pose_text(tool.T_flange_tcp)},"
         f"[{fmt(tool.mass_kg, 3)},[{cog}],[1,0,0,0],0,0,0]];",

@@ -54,7 +54,7 @@ def preamble(job: ExportJob, header: list[str], wobj_comment: str) -> list[str]:
         f"  SENSOR_IN = {SENSOR_IN}  # standard digital input of the proximity sensor",
         f"  set_tcp({pose_text(tool.T_flange_tcp)})",
         f"  set_payload({fmt(tool.mass_kg, 3)}, [{', '.join(fmt(c, 6) for c in tool.cog_m)}])",
-        f"  wobj = {pose_text(job.T_base_wobj)}  # {wobj_comment}",
+        f"  wobj = {pose_text(job.T_controller_wobj)}  # {wobj_comment}",
         "  # the log's results lines start here (`wobjcal calibrate` reads the last run)",
         f'  textmsg("{LOG_MARK} start {job.plan_digest or "unknown"}")',
     ]

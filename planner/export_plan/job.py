@@ -31,7 +31,7 @@ from calib.plan.file import Plan
 from planner.check.job import ConfData, PlanCheck, check_plan, layout_problem
 from planner.export import export_files
 from planner.export.job import TARGET_KINDS, ArmPose, CheckStatus, ExportJob, build_job
-from planner.plan_cell import nominal_T_base_wobj, open_cell, tool_data
+from planner.plan_cell import nominal_T_base_wobj, open_cell, plan_controller_base, tool_data
 
 if TYPE_CHECKING:
     from planner.cell.cell import Cell
@@ -104,7 +104,14 @@ def export_job_for(
             notes.append(f"no feasible pose for {no_pose}: default orientation, no confdata")
         if blocked:
             notes.append(f"points {blocked} are not feasible (see 'wobjcal check')")
-    job = build_job(plan, T_nom, tool, rotations, confs, check=check_status(check))
+    base = plan_controller_base(plan, plan_dir)
+    if not base.is_identity:
+        notes.append(base.describe())
+    job = build_job(
+        plan, T_nom, tool, rotations, confs, check=check_status(check),
+        T_base_controller=base.T_base_controller,
+        controller_base="" if base.is_identity else base.describe(),
+    )  # fmt: skip
     return job, tuple(notes)
 
 

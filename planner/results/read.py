@@ -7,6 +7,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Final
 
+import numpy as np
+from numpy.typing import NDArray
+
 from calib.plan.file import Plan, plan_digest
 from calib.plan.measurements import Measurements, measurements_from_json
 from calib.reading import MiB, read_bytes_capped
@@ -16,6 +19,8 @@ from planner.results.fanuc_va import fanuc_readings, parse_numreg, parse_posreg
 from planner.results.krl_dat import SlotReadings, krl_readings, parse_krl_dat
 from planner.results.layout import krl_slots, plan_order
 from planner.results.urscript_log import MARK, parse_urscript_log
+
+FloatArray = NDArray[np.float64]
 
 #: The controllers whose results can be read (``--from``).
 KINDS: Final = ("rapid", "krl", "urscript", "fanuc")
@@ -132,14 +137,26 @@ def _digest_note(found: str | None, plan: Plan, source: str) -> list[str]:
     return []
 
 
-def read_results(plan: Plan, paths: list[str | Path], kind: str | None = None) -> ControllerResults:
+def read_results(
+    plan: Plan,
+    paths: list[str | Path],
+    kind: str | None = None,
+    T_controller_wobj: FloatArray | None = None,
+) -> ControllerResults:
     """Read the results of ``plan``'s program on a controller.
+
+    The points come in the controller's base frame (``frame: base``), as the controller
+    measured them; :func:`planner.calibrate.job.calibrate_plan` takes them to the robot base.
 
     Args:
         plan: the plan the program was exported from.
         paths: the results file(s): one, or for FANUC ``POSREG.VA`` and ``NUMREG.VA`` (or
             the folder holding them).
         kind: the controller (:data:`KINDS`), or ``None`` to detect it from the contents.
+        T_controller_wobj: ``(4, 4)`` the nominal work object in the controller's base frame
+            as the program declares it (:func:`planner.plan_cell.controller_T_base_wobj`;
+            FANUC's ``PR[1]`` is checked against it and the user-frame points taken to the
+            base with it); ``None``: the plan's nominal work object in the robot base.
 
     Raises:
         ResultsError: a file of the wrong kind, malformed or partial, or another plan's
@@ -185,10 +202,11 @@ def read_results(plan: Plan, paths: list[str | Path], kind: str | None = None) -
         )
         m = _measurements(run.readings, "m", f"URScript log {Path(name).name}")
         return ControllerResults(kind, m, said + run.readings.notes, sources)
-    return _read_fanuc(plan, texts)
+    T_uframe = nominal_T_base_wobj(plan) if T_controller_wobj is None else T_controller_wobj
+    return _read_fanuc(plan, texts, T_uframe)
 
 
-def _read_fanuc(plan: Plan, texts: dict[str, str]) -> ControllerResults:
+def _read_fanuc(plan: Plan, texts: dict[str, str], T_uframe: FloatArray) -> ControllerResults:
     pos = [n for n, t in texts.items() if "[*POSREG*]$POSREG" in t]
     num = [n for n, t in texts.items() if "[*NUMREG*]$NUMREG" in t]
     if len(pos) != 1 or len(num) != 1 or len(texts) != 2:
@@ -198,9 +216,7 @@ def _read_fanuc(plan: Plan, texts: dict[str, str]) -> ControllerResults:
         )
     regs = parse_posreg(texts[pos[0]], pos[0])
     codes = parse_numreg(texts[num[0]], num[0])
-    readings = fanuc_readings(
-        regs, codes, plan_order(plan), nominal_T_base_wobj(plan), (pos[0], num[0])
-    )
+    readings = fanuc_readings(regs, codes, plan_order(plan), T_uframe, (pos[0], num[0]))
     notes = [
         "FANUC register backups carry no plan digest: checked instead that PR[1] holds the "
         "plan's nominal work object"
