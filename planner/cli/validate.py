@@ -179,7 +179,7 @@ def report_json(report: ValidationReport) -> dict[str, Any]:
     its ``pair``, ``search``: :mod:`planner.reasons`): ``failed_reasons`` of each search and
     ``failure_reasons`` of the trials.
     """
-    from planner.sim.report import failed_by_words
+    from planner.sim.report import failed_by_words, reach_warning
 
     return {
         "program": {"name": report.program, "steps": list(report.program_steps)},
@@ -188,6 +188,9 @@ def report_json(report: ValidationReport) -> dict[str, Any]:
         "sensor": report.sensor,
         "n_trials": report.n_trials,
         "n_ok": report.n_ok,
+        "reach_checked": report.reach_checked,
+        "reach_failed": report.reach_failed,
+        "reach_warning": reach_warning(report),
         "elapsed_s": report.elapsed_s,
         "protocol": report.protocol,
         "noise_m": {k: _num(v) for k, v in report.noise.items()},

@@ -135,6 +135,9 @@ class ValidationReport:
         workers: worker processes used.
         reach_checked: how many trials (the first ones) also vetted every commanded search for
             reachability and collisions in the cell; 0 when no cell was given.
+        reach_failed: how many of those failed (for any reason): the others cannot fail on
+            reach or collisions, so with ``reach_checked < n_trials`` their share is the better
+            estimate of the runs that fail (:meth:`reach_warning`).
         method: the procedure's method.
         sensor: the sensor kind.
         outcomes: per-search outcomes, in the order the searches were first run.
@@ -167,6 +170,7 @@ class ValidationReport:
     elapsed_s: float
     workers: int
     reach_checked: int = 0
+    reach_failed: int = 0
     method: str = "hultman2013"
     sensor: str = "proximity"
     outcomes: tuple[PointOutcome, ...] = ()
@@ -242,6 +246,26 @@ def failed_by_words(failed: dict[Reason, int]) -> dict[str, int]:
     return dict(sorted(out.items()))
 
 
+def reach_warning(report: ValidationReport) -> str:
+    """``""``, or the warning a report needs when trials checked in the cell failed but most
+    trials were not checked there: "calibrated: N" then counts trials that could not fail on
+    reach or collisions, and overstates how many real runs succeed."""
+    n, k = report.reach_checked, report.reach_failed
+    if k == 0 or n >= report.n_trials:
+        return ""
+    from scipy.stats import beta
+
+    lo = float(beta.ppf(0.025, k, n - k + 1))
+    hi = float(beta.ppf(0.975, k + 1, n - k)) if k < n else 1.0
+    return (
+        f"ONLY {n} OF {report.n_trials} TRIALS WERE CHECKED IN THE CELL, AND {k} OF THEM FAILED "
+        f"({k / n:.0%}; 95 % interval {lo:.0%} to {hi:.0%}): the {report.n_trials - n} "
+        "unchecked trials could not fail on reach or collisions, so 'calibrated' above "
+        "overstates how many runs succeed; validate with --reach-trials "
+        f"{report.n_trials} for the figure"
+    )
+
+
 def report_markdown(report: ValidationReport) -> str:
     """The report's rows, per-point outcomes, failures and notes."""
     protocol = bool(report.protocol)
@@ -262,6 +286,7 @@ def report_markdown(report: ValidationReport) -> str:
         f"Procedure: {report.method}, sensor: {report.sensor}. Trials: {report.n_trials}, "
         f"calibrated: {report.n_ok}, time: {report.elapsed_s:.2f} s on {report.workers} "
         "worker(s)" + (f"; paper protocol: {report.protocol}" if protocol else ""),
+        *([warning] if (warning := reach_warning(report)) else []),
         "",
         "| " + " | ".join(head) + " |",
         "|" + "---|" * len(head),

@@ -273,6 +273,7 @@ def build_report(
         elapsed_s=elapsed,
         workers=n_workers,
         reach_checked=n_reach,
+        reach_failed=int((~ok[:n_reach]).sum()),
         method=setup.method,
         program=setup.program.describe()[0],
         program_steps=tuple(setup.program.describe()[1:]),

@@ -48,6 +48,10 @@ ADDED = {
     # issue 23: validate's failed searches and trials with their kinds beside their words
     "failed_reasons",
     "failure_reasons",
+    # the trials checked in the cell and how many of them failed (helper-55's D2)
+    "reach_checked",
+    "reach_failed",
+    "reach_warning",
 }
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")

@@ -144,3 +144,27 @@ def test_a_procedure_that_got_no_frame_has_no_kind_in_the_json() -> None:
             "text": label,
         }
     ]
+
+
+def test_failures_among_the_trials_checked_in_the_cell_are_not_diluted_by_the_others() -> None:
+    """helper-55 (D2): 396 of 400 'calibrated' while 4 of the 20 trials checked in the cell had
+    failed; the 380 others could not fail on reach or collisions. The report says so, with an
+    exact (Clopper-Pearson) interval, scipy's binomtest the reference."""
+    from scipy.stats import binomtest
+
+    from planner.sim.report import reach_warning
+
+    report = _report(failures={}, reach_checked=20, reach_failed=4)
+    report = ValidationReport(**{**report.__dict__, "n_trials": 400, "n_ok": 396})
+    text = reach_warning(report)
+    ci = binomtest(4, 20).proportion_ci(0.95, method="exact")
+    assert f"AND 4 OF THEM FAILED (20%; 95 % interval {ci.low:.0%} to {ci.high:.0%})" in text
+    assert "--reach-trials 400" in text
+    assert text in report_markdown(report).splitlines()[1:3]
+    data = report_json(report)
+    assert (data["reach_checked"], data["reach_failed"], data["reach_warning"]) == (20, 4, text)
+    # nothing to say: every trial checked, or none of the checked failed
+    for kw in ({"reach_checked": 400, "reach_failed": 4}, {"reach_checked": 20}):
+        quiet = ValidationReport(**{**report.__dict__, "reach_failed": 0, **kw})
+        assert reach_warning(quiet) == ""
+        assert "CHECKED IN THE CELL" not in report_markdown(quiet)
