@@ -61,7 +61,7 @@ from numpy.typing import NDArray
 
 from calib.errors import InputError
 from calib.estimators.design import Design
-from calib.estimators.layout import search_constraint_set
+from calib.estimators.layout import COINCIDENT_TOL_M, search_constraint_set
 from calib.plan.bundle import rebased_plan
 from calib.plan.file import Plan, PlanError, PlanPoint
 from calib.plan.report_spec import PointOfInterest
@@ -367,6 +367,12 @@ def suggest_plan(
             )
     elif weak:
         edge_note = f"; edge searches: none, the {sensor.KIND} sensor runs none"
+    if add and plan.points:  # a candidate where a kept point is: the layout refuses the pair
+        kept = np.array([p.position_m for p in plan.points], dtype=np.float64)
+        gap = np.linalg.norm(pool.positions_m[:, None, :] - kept[None, :, :], axis=-1)
+        pool = pool.subset(gap.min(axis=1) >= COINCIDENT_TOL_M)
+        if len(pool) == 0:
+            raise SuggestError("every feasible candidate lies on a point the plan has already")
     if steered and bool(pool.is_edge.any()):  # its frame update takes approach searches only
         steered = False
     pivot = pool.positions_m.mean(axis=0)  # the probed region: the misplacement's pivot
