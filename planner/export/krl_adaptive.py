@@ -108,8 +108,9 @@ def ah_header() -> str:
     return (
         "ADAPTIVE: the A-H procedure of Hultman & Leijon (2013); "
         f"{WOBJ} (and $BASE) is updated after every step, so each search runs in the "
-        f"work-object frame estimated so far. At the end (nResult 1) {WOBJ} is the calibrated "
-        "work object (the frame `wobjcal calibrate` computes from xMeas)."
+        f"work-object frame estimated so far. At the end (nResult 1) {WOBJ} holds the frame "
+        "`wobjcal calibrate` computes from xMeas, NOT YET SCREENED for gross errors: use it "
+        "only once `wobjcal calibrate` trusts it."
     )
 
 

@@ -43,8 +43,9 @@ def steer_header(program: MeasuringProgram) -> str:
         "smallest motion that puts the points measured so far on their faces "
         "(planner.program.steering: best fit: after every point; 3-2-1: after the primary, "
         "the secondary and the tertiary points), so each search runs in the work-object frame "
-        f"estimated so far. At the end (nResult 1) {WOBJ} is the calibrated work object, the "
-        f"{program.method_label} frame `wobjcal calibrate` computes from xMeas."
+        f"estimated so far. At the end (nResult 1) {WOBJ} holds the {program.method_label} "
+        "frame `wobjcal calibrate` computes from xMeas, NOT YET SCREENED for gross errors: "
+        "use it only once `wobjcal calibrate` trusts it."
     )
 
 

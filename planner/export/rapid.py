@@ -274,7 +274,8 @@ def _steered_header() -> list[str]:
     return [
         f"    ! ADAPTIVE: {WOBJ}.uframe is updated after the points its steps name (the smallest",
         "    ! motion that puts them on their faces), so each search runs in the work-object",
-        f"    ! frame estimated so far. At the end {WOBJ} is the calibrated work object.",
+        f"    ! frame estimated so far. At the end {WOBJ} holds the measured frame, NOT YET",
+        "    ! SCREENED for gross errors: use it once `wobjcal calibrate` trusts it.",
     ]
 
 

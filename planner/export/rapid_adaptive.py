@@ -47,7 +47,8 @@ def adaptive_header() -> list[str]:
     return [
         f"    ! ADAPTIVE: the A-H procedure of Hultman & Leijon (2013); {WOBJ}.uframe is updated",
         "    ! after every step, so each search runs in the work-object frame estimated so far.",
-        f"    ! At the end {WOBJ} is the calibrated work object (same as `wobjcal calibrate`).",
+        f"    ! At the end {WOBJ} holds the frame `wobjcal calibrate` computes, NOT YET SCREENED",
+        "    ! for gross errors: use it once `wobjcal calibrate` on the recorded points trusts it.",
     ]
 
 
@@ -167,7 +168,7 @@ def adaptive_main(job: ExportJob, names: list[str]) -> list[str]:
         f"{ind}! 9: D{' retaken' if a.settings.retake_c_d else ''}, x origin",
         *(probe("D", d2) if a.settings.retake_c_d else []),
         f"{ind}ShiftOrigin [1,0,0],measured{{{d2}}},nFaceX;",
-        f'{ind}TPWrite "wobjcal: A-H done, {WOBJ} is the calibrated work object";',
+        f'{ind}TPWrite "wobjcal: A-H done, {WOBJ} not screened: run wobjcal calibrate";',
     ]
     if a.settings.xoffset is not None:
         lines += [

@@ -206,5 +206,5 @@ def steer_main(job: ExportJob, program: MeasuringProgram, names: list[str]) -> l
             r = V.shape[1]
             lines.append(f"{ind}Steer {k},{off},{r};")
             off += 6 * r
-    lines.append(f'{ind}TPWrite "wobjcal: done, {WOBJ} is the calibrated work object";')
+    lines.append(f'{ind}TPWrite "wobjcal: done, {WOBJ} not screened: run wobjcal calibrate";')
     return lines

@@ -269,7 +269,7 @@ def adaptive_main(job: ExportJob, program: MeasuringProgram) -> list[str]:
                 st.done = True
     if not all(st.done for st in stages):
         raise ValueError(f"{program.name}: the program ends before the procedure's last update")
-    lines.append('  textmsg("wobjcal: A-H done, wobj is the calibrated work object: ", wobj)')
+    lines.append('  textmsg("wobjcal: A-H done, wobj (not screened, see calibrate): ", wobj)')
     lines += xoffset_main(job)
     return lines
 
@@ -284,9 +284,9 @@ def export_adaptive(job: ExportJob, program: MeasuringProgram) -> str:
         "10; y from C; rotation from A, B, D, E; x from E; rotation from H, F, D; z from H; "
         + ("y from C and x from D retaken" if s.retake_c_d else "y from C and x from D")
         + f"; edge-event offset {s.edge_offset_m * 1000.0:g} mm removed from F and H), so each "
-        "search is commanded in the work-object frame estimated so far. At the end wobj is "
-        "the calibrated work object, the frame `wobjcal calibrate` computes from the same "
-        "points."
+        "search is commanded in the work-object frame estimated so far. At the end wobj "
+        "holds the frame `wobjcal calibrate` computes from the same points, NOT YET SCREENED "
+        "for gross errors: use it only once `wobjcal calibrate` trusts it."
         + (
             " Then the x-offset run (eq. 13-14) in the calibrated frame fills mx_w; "
             "slot_target(slot, layer, standoff) gives the target at a slot hole."

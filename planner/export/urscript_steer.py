@@ -233,7 +233,7 @@ def steer_main(job: ExportJob, program: MeasuringProgram) -> list[str]:
             r = V.shape[1]
             lines.append(f"  steer({k}, {off}, {r})")
             off += 6 * r
-    lines.append('  textmsg("wobjcal: done, wobj is the calibrated work object: ", wobj)')
+    lines.append('  textmsg("wobjcal: done, wobj (not screened: run wobjcal calibrate): ", wobj)')
     return lines
 
 
@@ -246,8 +246,9 @@ def export_steered(job: ExportJob, program: MeasuringProgram) -> str:
         f"below {STEP_TOL_M * 1000.0:g} mm; rotations about the layout's centroid st_pivot "
         "scaled by its RMS size st_scale; the step restricted to the motions the nominal "
         "points fix, st_basis), so each search is commanded in the frame estimated so far. "
-        "After the last point wobj is the calibrated work object, the frame `wobjcal "
-        "calibrate` computes from the same points. A failed search stops the program (halt); "
+        "After the last point wobj holds the frame `wobjcal calibrate` computes from the same "
+        "points, NOT YET SCREENED for gross errors: use it only once `wobjcal calibrate` "
+        "trusts it. A failed search stops the program (halt); "
         "the points measured before it stay in measured and meas_<ID>."
     )
     return adaptive_program(

@@ -31,7 +31,7 @@ CODES = {
 #: How an adaptive program ended, by ``nResult``.
 RESULTS = {
     0: "it was still running or was stopped by the operator",
-    1: "it ended with the calibrated work object in BASE_DATA[10]",
+    1: "it ended with the measured frame (not screened yet) in BASE_DATA[10]",
     2: "a search failed and stopped it",
     3: "the points measured define no frame",
     4: "an x-offset search found nothing (the frame was calibrated)",

@@ -11,7 +11,8 @@ MODULE WobjcalStatorSectionAh
     ! Probes each point with the proximity sensor on digital input diSensor.
     ! ADAPTIVE: the A-H procedure of Hultman & Leijon (2013); wobjCal.uframe is updated
     ! after every step, so each search runs in the work-object frame estimated so far.
-    ! At the end wobjCal is the calibrated work object (same as `wobjcal calibrate`).
+    ! At the end wobjCal holds the frame `wobjcal calibrate` computes, NOT YET SCREENED
+    ! for gross errors: use it once `wobjcal calibrate` on the recorded points trusts it.
     ! SAFE FOR: part misplaced up to 20.0 mm and 3.00 deg about [-3.8, -252.0, -84.8] mm
     ! (wobj), sensing distance 8.0 mm. Every search starts outside the nominal surface by at
     ! least the largest misplacement of its face plus the sensing distance (the plan's start
@@ -290,7 +291,7 @@ MODULE WobjcalStatorSectionAh
         Probe_pD 10;
         Require 10;
         ShiftOrigin [1,0,0],measured{10},nFaceX;
-        TPWrite "wobjcal: A-H done, wobjCal is the calibrated work object";
+        TPWrite "wobjcal: A-H done, wobjCal not screened: run wobjcal calibrate";
         ! 10: the x-offset run over every second tooth at two slot-hole levels, in the
         !     calibrated frame, and the x-offset matrix (eq. 13-14)
         XOffsetRun;
