@@ -83,6 +83,7 @@ class RepairReport:
         n_vertices: vertex count after repair.
         n_faces: face count after repair.
         warnings: human-readable warnings (also logged).
+        units_declared: the unit is the one a CAD file declares (not the plan's, not guessed).
     """
 
     source: str
@@ -100,12 +101,19 @@ class RepairReport:
     warnings: tuple[str, ...] = ()
     extents_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     units_note: str = ""
+    units_declared: bool = False
 
     @property
     def size_text(self) -> str:
         """The part's size and units in words, e.g. ``"0.203 x 0.305 x 0.013 m (file in mm)"``."""
         dims = " x ".join(f"{v:.3g}" for v in self.extents_m)
-        how = "detected" if self.units_detected else "given"
+        how = (
+            "declared in the file"
+            if self.units_declared
+            else "detected"
+            if self.units_detected
+            else "given"
+        )
         return f"{dims} m (file units {self.units!r}, {how})"
 
 
@@ -324,6 +332,7 @@ def load_work_object(
         source=src,
         units=units,
         units_detected=detected,
+        units_declared=cad is not None and cad.file_unit is not None,
         scale=scale,
         merged_vertices=merged,
         removed_degenerate_faces=degenerate,

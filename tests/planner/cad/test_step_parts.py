@@ -59,6 +59,8 @@ def test_unit_comes_from_the_file_and_gives_the_real_size(cad_dir: Path) -> None
     plate = load_work_object(cad_dir / "base_interface_AP214.STEP")
     assert plate.report.units == "in" and not plate.report.units_detected
     assert "declared in the file" in plate.report.units_note
+    # every reason about the part says so too, not "given" (helper-55, D10)
+    assert plate.report.size_text.endswith("m (file units 'in', declared in the file)")
     # 23.598 x 25.144 x 0.1875 in, read from the file: 0.6 m, not 600 m
     np.testing.assert_allclose(plate.mesh.extents, [0.59941, 0.63866, 0.0047625], atol=2e-5)
     box = load_work_object(cad_dir / "box_sides.STEP", body="all")
