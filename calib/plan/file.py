@@ -368,11 +368,27 @@ def plan_digest(plan: Plan) -> str:
     """The plan's digest: the first 16 hex digits of the sha256 of its canonical JSON, with
     every ``-0.0`` taken as ``0.0`` (the same plan gives the same digest whatever wrote it).
 
+    Where the plan's files lie does not count (a file reference is taken as ``"file"``, a
+    ``builtin:`` one as it is; the robot's package path not at all): a plan moved to another
+    folder or downloaded with its files in a ZIP (:mod:`calib.plan.bundle`: its paths
+    rewritten, a file renamed where two share a name) is the same plan, and calibrates the
+    results of the program exported before; the ``sha256`` fields pin the files' contents.
+
     Program headers carry it and ``wobjcal calibrate`` compares it with the plan it is given,
     so results measured with another plan's program are named, not used.
     """
+    data = msgspec.to_builtins(plan)
+    cell = data.get("cell", {})
+    refs = [(cell.get("robot", {}), "urdf"), (cell.get("tool", {}), "name")]
+    refs += [(f, "mesh") for f in cell.get("fixtures", [])]
+    refs.append((data.get("work_object", {}), "mesh"))
+    for holder, key in refs:
+        ref = holder.get(key)
+        if isinstance(ref, str) and not ref.startswith("builtin:"):
+            holder[key] = "file"
+    cell.get("robot", {}).pop("package_path", None)
     text = json.dumps(
-        unsigned_zeros(msgspec.to_builtins(plan)),
+        unsigned_zeros(data),
         sort_keys=True,
         separators=(",", ":"),
         ensure_ascii=False,

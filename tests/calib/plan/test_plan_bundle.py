@@ -297,3 +297,22 @@ def test_check_gives_the_same_statuses_unpacked(tmp_path: Path, reference_dir: P
     after = check_plan(unpacked, folder)
     assert statuses(after) == statuses(before)
     assert after.error == before.error and after.part_units == before.part_units
+
+
+def test_a_bundled_or_moved_plan_keeps_its_digest(
+    tmp_path: Path, ur5_plan: tuple[Plan, Path]
+) -> None:
+    """helper-56 (D7): the plan in the UI's ZIP had another digest than the programs exported
+    from it (its paths rewritten), so calibrate refused their results. Where the files lie is
+    not the plan; its points are."""
+    from calib.plan.file import plan_digest
+
+    plan, plan_dir = ur5_plan
+    unpacked, _ = _unpack(plan_bundle(plan, plan_dir, "ur5"), tmp_path / "elsewhere", "ur5")
+    assert unpacked.cell.fixtures[1].mesh == "files/fixtures/block-2.stl"  # renamed too
+    moved = rebased_plan(plan, plan_dir, tmp_path / "other")
+    assert plan_digest(unpacked) == plan_digest(plan) == plan_digest(moved)
+    p0 = plan.points[0]
+    shifted = msgspec.structs.replace(p0, position_m=(p0.position_m[0] + 1e-4, *p0.position_m[1:]))
+    other = msgspec.structs.replace(plan, points=[shifted, *plan.points[1:]])
+    assert plan_digest(other) != plan_digest(plan)  # a point moved 0.1 mm: another plan
