@@ -126,6 +126,7 @@ class WobjcalApp:
         self._cell_lock = threading.RLock()
         self._cell_key: tuple[CellSpec, WorkObjectSpec] | None = None
         self._part: tuple[str, str | None, str] | None = None
+        self._robot_key: tuple[object, ...] | None = None
         self.flags = RoleFlags()
         #: Handlers of scene clicks by mode (``"place"``: click-to-place); a panel may set
         #: :attr:`click_mode` to its own (e.g. picking the points of a 3-point frame).
@@ -192,10 +193,15 @@ class WobjcalApp:
             self._cycle_memo.clear()
         self.scene.draw_work_object(view.wobj_mesh, view.T_world_wobj)
         self.scene.draw_fixtures(view.fixtures)
-        if self.robot is not None:
+        robot_key = _robot_key(view)
+        if self.robot is not None and robot_key == self._robot_key:
+            pass  # the same robot, base and tool (the part or a fixture changed): each tab's
+            # robot stays drawn where it is, jogged or taught, with the Teach tab's fields
+        elif self.robot is not None:
             self.robot.remove()
             self.robot = None
-        if view.robot_urdf is not None:
+        self._robot_key = robot_key
+        if self.robot is None and view.robot_urdf is not None:
             self.robot, why = tab_robots_or_reason(self.server, view, self.robot_display)
             if self.robot is not None:  # tabs that connected while it was being built
                 for client in list(self.server.get_clients().values()):
@@ -590,6 +596,30 @@ class WobjcalApp:
 def _cell_key(plan: Plan) -> tuple[CellSpec, WorkObjectSpec]:
     """What decides the cell: when it changes, the cell is rebuilt."""
     return (plan.cell, plan.work_object)
+
+
+def _file_key(path: Path | None) -> tuple[str, int, int] | None:
+    if path is None:
+        return None
+    try:
+        st = path.stat()
+    except OSError:
+        return (str(path), -1, -1)
+    return (str(path), st.st_mtime_ns, st.st_size)
+
+
+def _robot_key(view: CellView) -> tuple[object, ...]:
+    """What decides how the robot and its tool are drawn: the robot's and the tool's files
+    (path, time, size), the base pose, the tool's mount and mesh. The same key after a cell
+    change (the part or a fixture moved): the tabs' robots are kept, at their poses."""
+    mesh = view.tool_mesh
+    return (
+        _file_key(view.robot_urdf),
+        _file_key(view.tool_urdf),
+        np.asarray(view.T_world_base, dtype=np.float64).tobytes(),
+        np.asarray(view.T_flange_tool, dtype=np.float64).tobytes(),
+        None if mesh is None else (mesh.vertices.tobytes(), mesh.faces.tobytes()),
+    )
 
 
 def _part_key(plan: Plan) -> tuple[str, str | None, str]:

@@ -272,3 +272,34 @@ def test_typing_a_points_position_moves_it_in_one_undo_step(demo: UiSession) -> 
     open_tab(page, "Points")
     page.get_by_role("button", name="Undo", exact=True).click()
     wait_for(lambda: app.state.doc is before, what="the plan before the entry: one undo step")
+
+
+def test_moving_the_part_keeps_the_jogged_robot_where_it_stands(demo: UiSession) -> None:
+    """helper-56 (D1): after a jog, moving the part rebuilt the robot: the fields went back to
+    0, the arm stayed drawn at the jogged pose and the tool at the home pose's flange. The same
+    robot, base and tool are kept now, each tab's robot where it stands."""
+    app, page = demo.app, demo.page
+    panel, robot = app.teach_panel, app.robot
+    assert robot is not None
+    open_tab(page, "Teach")
+    j2 = _input_of(page, panel.sliders[1])
+    want = 20.0
+
+    def jog() -> None:
+        j2.fill(f"{want}")
+        j2.press("Tab")
+
+    act_until(jog, lambda: abs(np.degrees(panel.q[1]) - want) < 1e-3, what="J2 jogged")
+    q_jogged = panel.q.copy()
+    open_tab(page, "Cell")
+    T0 = pose_of(app.state.doc.source, WORK_OBJECT)
+    page.get_by_role("button", name="Snap part onto fixture").click()
+    wait_for(lambda: not np.allclose(pose_of(app.state.doc.source, WORK_OBJECT), T0), what="snap")
+    wait_for(lambda: len(app.checks()) == 8, what="the points checked in the moved cell")
+    assert app.robot is robot, "the same robot drawing, not rebuilt"
+    np.testing.assert_allclose(robot.q_of(demo.client().client_id), q_jogged)
+    open_tab(page, "Teach")
+    j2 = _input_of(page, app.teach_panel.sliders[1])  # the sliders are built anew
+    wait_for(lambda: float(j2.input_value()) == want, what="the page's J2 field at the jog")
+    app.state.undo()
+    wait_for(lambda: np.allclose(app.view.T_world_wobj, T0, atol=1e-12), what="undo")
