@@ -222,6 +222,8 @@ class ExportJob:
             declare the work object in the controller's frame, :attr:`T_controller_wobj`.
         controller_base: which frame that is, one sentence for the headers (``""``: the robot
             base frame itself, nothing to say).
+        sensor_kind: the plan's sensor (``"proximity"``, ``"touch"``), as the headers name it
+            (:attr:`sensor_words`).
     """
 
     name: str
@@ -240,6 +242,12 @@ class ExportJob:
     cycle_times: Mapping[str, CycleTime] = field(default_factory=dict)
     T_base_controller: FloatArray = field(default_factory=lambda: np.eye(4))
     controller_base: str = ""
+    sensor_kind: str = "proximity"
+
+    @property
+    def sensor_words(self) -> str:
+        """The sensor in words for the program headers, e.g. ``"proximity sensor"``."""
+        return "touch probe" if self.sensor_kind == "touch" else f"{self.sensor_kind} sensor"
 
     @property
     def T_controller_wobj(self) -> FloatArray:
@@ -367,6 +375,7 @@ def build_job(
         check=check or CheckStatus(),
         T_base_controller=T_bc,
         controller_base=controller_base,
+        sensor_kind=str(type(plan.validation.sensor).KIND),
     )
 
 

@@ -241,7 +241,7 @@ def _src(job: ExportJob, names: list[str], program: MeasuringProgram) -> str:
         f"({digest_text(job)}, procedure {comment_text(job.method)}).",
         *comment_lines(comment_text(check_header(job, "krl"))),
         *comment_lines(comment_text(cycle_header(job, "krl"))),
-        "  ; Probes each point with the proximity sensor on diSensor; see the .dat file.",
+        f"  ; Probes each point with the {job.sensor_words} on diSensor; see the .dat file.",
         _status_note(job),
     ]
     if program.adaptive:

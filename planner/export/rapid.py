@@ -174,7 +174,7 @@ def export_rapid(job: ExportJob) -> str:
         *_comment(comment_text(check_header(job, "rapid"))),
         *_comment(comment_text(cycle_header(job, "rapid"))),
         f"    ! PROGRAM: {comment_text(program.name)}.",
-        "    ! Probes each point with the proximity sensor on digital input diSensor.",
+        f"    ! Probes each point with the {job.sensor_words} on digital input diSensor.",
         *(
             adaptive_header()
             if a is not None

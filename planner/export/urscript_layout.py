@@ -51,7 +51,7 @@ def preamble(job: ExportJob, header: list[str], wobj_comment: str) -> list[str]:
         *("  # " + line for line in textwrap.wrap(comment_text(cycle_header(job, "urscript")), 88)),
         "  # Units m and rad; poses p[x, y, z, rx, ry, rz] with rotation vectors.",
         *header,
-        f"  SENSOR_IN = {SENSOR_IN}  # standard digital input of the proximity sensor",
+        f"  SENSOR_IN = {SENSOR_IN}  # standard digital input of the {job.sensor_words}",
         f"  set_tcp({pose_text(tool.T_flange_tcp)})",
         f"  set_payload({fmt(tool.mass_kg, 3)}, [{', '.join(fmt(c, 6) for c in tool.cog_m)}])",
         f"  wobj = {pose_text(job.T_controller_wobj)}  # {wobj_comment}",
