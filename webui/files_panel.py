@@ -144,6 +144,9 @@ class FilesPanel(Panel):
             lambda ev: self.guard(ev, self.download_anyway, ev.client, title="Not exported")
         )
         app.state.subscribe(lambda change: self._clear_refusal())
+        # the list of points off the part is of the plan it was made for: another plan (an
+        # upload, undo, an edit) gets it anew, so it never names points the plan does not have
+        app.state.subscribe(lambda change: self._list_off_surface() if self.off else None)
 
     def _export_callback(self, fmt: str) -> Any:
         def callback(event: Any) -> None:

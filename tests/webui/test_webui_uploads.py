@@ -66,6 +66,26 @@ def test_a_part_waits_for_its_units_with_its_size_shown(
     np.testing.assert_allclose(app.view.wobj_mesh.extents, [0.6, 0.4, 0.3], atol=1e-9)
 
 
+def test_the_points_off_the_part_are_of_the_plan_shown(
+    app: WobjcalApp, reference_dir: Path
+) -> None:
+    """helper-56 (D4): after a new part listed A-H off its surface, loading another plan kept
+    the list (and "Project them" said no points were off): the list follows the plan."""
+    files = app.files_panel
+    data = (reference_dir / "parts" / "plate_holes.STL").read_bytes()
+    files.units.value = "mm"
+    files.stage_mesh("plate_holes.STL", data)
+    files.accept_mesh()
+    assert files.off and "Points off the new part's surface:" in files.off_md.content
+    other = box_plan(app.plan_dir, name="other_plan")  # its mesh beside the app's plan
+    files.upload_plan(other.name, other.read_bytes())
+    assert files.off == {} and files.off_md.content == "" and not files.project_off.visible
+    app.state.undo()  # the plan
+    app.state.undo()  # the new part
+    assert files.off == {} and files.off_md.content == ""
+    np.testing.assert_allclose(app.view.wobj_mesh.extents, [0.6, 0.4, 0.3], atol=1e-9)
+
+
 def test_a_bad_part_is_refused_naming_the_users_file(app: WobjcalApp) -> None:
     before = app.state.doc
     with pytest.raises(InputError, match=r"broken_part\.stl") as info:
