@@ -97,6 +97,11 @@ class WobjcalApp:
         self.picker: SurfacePicker | None = None
         self.robot: TabRobots | None = None  # one drawing per tab, each at its own pose
         self._checks: dict[str, tuple[ProbePoint, PointCheck]] = {}
+        #: the moves between the points (:meth:`update_via_moves`): per point, its check as
+        #: :attr:`_checks` holds it and that check with its moves checked (shown instead while
+        #: the point's check is that one)
+        self._via: dict[str, tuple[PointCheck, PointCheck]] = {}
+        self.via_future: Future[None] | None = None
         # per point, bumped by every change that drops its check: a recheck started before the
         # change (say, for a sensor an undo has taken back) must not store its result after
         self._check_gen: dict[str, int] = {}
@@ -187,6 +192,7 @@ class WobjcalApp:
             self.view, self.picker = view, picker
             self._cell_key = _cell_key(plan)
             self._checks.clear()
+            self._via.clear()
             self._checked_in.clear()
             self._cell_gen += 1
             self._check_memo.clear()
@@ -229,15 +235,61 @@ class WobjcalApp:
 
     # ---- checks ---------------------------------------------------------------------------
     def check_of(self, point_id: str) -> PointCheck | None:
-        """The latest check of a point, or ``None`` while it is being computed."""
+        """The latest check of a point, or ``None`` while it is being computed; with the moves
+        into it checked once :meth:`update_via_moves` has (as ``wobjcal check`` has them)."""
         with self._lock:
             entry = self._checks.get(point_id)
-        return None if entry is None else entry[1]
+            return None if entry is None else self._with_moves(point_id, entry[1])
 
     def checks(self) -> dict[str, PointCheck]:
-        """The latest check of every point that has one."""
+        """The latest check of every point that has one (moves included, :meth:`check_of`)."""
         with self._lock:
-            return {pid: c for pid, (_, c) in self._checks.items()}
+            return {pid: self._with_moves(pid, c) for pid, (_, c) in self._checks.items()}
+
+    def _with_moves(self, point_id: str, check: PointCheck) -> PointCheck:
+        via = self._via.get(point_id)
+        return via[1] if via is not None and via[0] is check else check
+
+    def update_via_moves(self) -> Future[None]:
+        """Check the moves between the points (joint moves through each point's vias, from
+        every point a program probes before it) once every point of the plan as edited has
+        its check, on the cell worker; then the table and the markers show a point whose moves
+        fail as ``wobjcal check`` and the export do: infeasible, with its ``vias:`` cause. A
+        single point's check leaves them out (they depend on the other points)."""
+        done: Future[None] = Future()
+        done.set_result(None)
+        doc = self.state.doc
+        plan = plan_as_edited(doc)
+        with self._lock:
+            raw = {pid: c for pid, (_, c) in self._checks.items()}
+            gen = self._cell_gen
+        if plan is None or any(p.id not in raw for p in plan.points):
+            return done  # a later check of the missing points asks again
+        checks = [raw[p.id] for p in plan.points]
+        fut = self.worker.submit(lambda s: None if s is None else s.via_moves(plan, checks))
+
+        def show(f: Future[tuple[PointCheck, ...] | None]) -> None:
+            try:
+                moved = f.result()
+            except Exception:  # the rows keep the points' own checks
+                logger.exception("checking the moves between the points failed")
+                return
+            if moved is None or self.state.doc is not doc or gen != self._cell_gen:
+                return  # a later edit's (or cell's) moves follow
+            with self._lock:
+                before = {pid: self._with_moves(pid, c) for pid, c in raw.items()}
+                self._via = {c.point_id: (c, m) for c, m in zip(checks, moved, strict=True)}
+                changed = [pid for pid in raw if self._with_moves(pid, raw[pid]) is not before[pid]]
+            if changed:
+                self.points_panel.refresh()
+                self.scene.draw_points(
+                    doc, self.checks(), None, only=changed, flags=self.flags.by_point
+                )
+                self.server.flush()
+
+        fut.add_done_callback(show)
+        self.via_future = fut
+        return fut
 
     def recheck(
         self, point_ids: tuple[str, ...] | list[str], doc: UiPlan | None = None
@@ -296,6 +348,7 @@ class WobjcalApp:
         self.scene.draw_points(doc, self.checks(), None, only=point_ids, flags=self.flags.by_point)
         self.server.flush()
         self.update_cycle_time()  # after the rows: a click or undo does not wait for it
+        self.update_via_moves()  # and the moves between the points, once all are checked
 
     def _sorted_checks(self) -> tuple[tuple[str, PointCheck], ...]:
         """The latest checks, by point id (what a cycle-time estimate is made from)."""

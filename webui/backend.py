@@ -21,7 +21,7 @@ from planner.cell.cell import Cell
 from planner.cell.moves import MoveCheck, ViaPath, check_joint_move, check_via_path
 from planner.cell.scene import RayHit, first_hit, load_work_object
 from planner.check.cycle import plan_cycle_time
-from planner.check.job import PointCheck, check_points
+from planner.check.job import PointCheck, check_points, check_via_moves
 from planner.plan_cell import open_cell, plan_robot_urdf
 from planner.program.cycle_time import CycleTime
 from planner.robot.kinematics.chain import KinematicChain
@@ -174,6 +174,14 @@ class CellSession:
             return plan_cycle_time(plan, checks, self.cell)
         except InputError:  # not a refusal to tell anyone: no program yet means no cycle time
             return None  # (the status table shows why the points or the plan fall short)
+
+    def via_moves(self, plan: Plan, checks: list[PointCheck]) -> tuple[PointCheck, ...]:
+        """``checks`` (of all of ``plan``'s points, in plan order) with the moves between the
+        points checked: :func:`planner.check.job.check_via_moves`, as ``wobjcal check`` and
+        the export check them (unchanged without a cell)."""
+        if self.cell is None:
+            return tuple(checks)
+        return check_via_moves(self.cell, plan, checks)
 
     # ---- jogging ---------------------------------------------------------------------------
     def T_world_tcp(self, q: ArrayLike, tcp: str) -> NDArray[np.float64]:

@@ -83,6 +83,10 @@ def first_cause(check: PointCheck | None, flag: str) -> str:
     passes (``""``: nothing to say)."""
     found = causes(check)
     if check is not None and check.status == "infeasible" and found:
+        # what makes it infeasible first: a pose that is only marginal (a joint near its
+        # limit) comes after the search path, face, moves or landing that fail
+        if check.pose_status != "infeasible" and check.pose_cause is not None and len(found) > 1:
+            found = [r for r in found if r is not check.pose_cause] or found
         return short_cause(found[0])
     if flag:
         return shorten(flag)

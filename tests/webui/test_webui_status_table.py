@@ -111,3 +111,15 @@ def test_details_give_every_cause_the_note_once_and_the_point() -> None:
     assert "- clearance 12.3 mm (link\\_6 – table)" in lines
     assert "- at (0.0, 0.0, 0.0) mm, normal (0.000, 0.000, 1.000), wobj frame" in lines
     assert "- approach search: start 30.0 mm, overtravel 20.0 mm" in lines
+
+
+def test_an_infeasible_rows_first_cause_is_what_fails_not_a_marginal_pose() -> None:
+    """helper-56 (D6): C's row read "joint 5 near its upper limit" (a marginal pose) while its
+    search path is what fails."""
+    from dataclasses import replace
+
+    near = Reason("joint_limit", "joint 5 near its upper limit (joint_5, 3.9 deg to go)")
+    check = replace(_check("P1", "infeasible", near, PATH), pose_status="marginal")
+    assert first_cause(check, "") == short_cause(PATH.worded("search path: "))
+    # a pose that fails by itself stays first
+    assert first_cause(_check("P1", "infeasible", REACH, PATH), "") == short_cause(REACH)
