@@ -198,6 +198,8 @@ class WobjcalApp:
             self._check_memo.clear()
             self._cycle_memo.clear()
         self.scene.draw_work_object(view.wobj_mesh, view.T_world_wobj)
+        for layer in ("quality", "error"):  # painted again below for the new part, if ticked
+            self.scene.color_work_object(None, layer=layer)
         self.scene.draw_fixtures(view.fixtures)
         robot_key = _robot_key(view)
         if self.robot is not None and robot_key == self._robot_key:
@@ -225,6 +227,10 @@ class WobjcalApp:
         self.recheck(self.state.doc.ids, with_source(self.state.doc, plan))
         self.teach_panel.after_checks(force=True)  # vias and moves in the new cell
         self.layout_panel.refresh()
+        try:  # the last report's error, on the part as it is now (when ticked)
+            self.validate_panel.paint_error()
+        except Exception:  # colours only: the cell is loaded whatever they do
+            logger.exception("painting the validation's error on the new part failed")
 
     def replace_source(self, plan: Plan, label: str) -> None:
         """Make ``plan`` (another cell: part, robot, fixtures or their poses) the session's, in

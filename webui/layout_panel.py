@@ -312,7 +312,7 @@ class LayoutPanel(Panel):
         view, q = self._app.view, self.last
         if not self.show_map.value or view is None or q is None or q.rating == "unobservable":
             if self._painted:  # leave another panel's colours alone
-                self._app.scene.color_work_object(None)
+                self._app.scene.color_work_object(None, layer="quality")
                 scene.remove_by_name("/wobj/poi")
                 self._painted = False
             return
@@ -320,7 +320,9 @@ class LayoutPanel(Panel):
         level = q.poi[0].levels_percent[0] if q.poi else 95.5
         r = error_radius(np.asarray(view.wobj_mesh.vertices), q.covariance, level)
         lo, hi = float(r.min()), float(r.max())
-        self._app.scene.color_work_object(heat_rgb(1.0 - (r - lo) / max(hi - lo, 1e-12)))
+        self._app.scene.color_work_object(
+            heat_rgb(1.0 - (r - lo) / max(hi - lo, 1e-12)), layer="quality"
+        )
         for i, p in enumerate(q.poi):
             scene.add_icosphere(
                 f"/wobj/poi/{i}",

@@ -40,6 +40,14 @@ STATUS_MEANING: dict[str, str] = {
     "pending": "being checked",
 }
 WOBJ_RGB = (170, 185, 200)
+#: The colour overlays of the work object (:meth:`Scene.color_work_object`), by layer: the scene
+#: node and how far it lies out of the surface, m (the validation's error over the layout's
+#: predicted error over the reachability heat map; clicks still hit the part's own mesh).
+OVERLAYS: dict[str, tuple[str, float]] = {
+    "reach": ("/wobj/heat_mesh", 0.0005),
+    "quality": ("/wobj/quality_mesh", 0.00075),
+    "error": ("/wobj/error_mesh", 0.001),
+}
 SELECTED_RGB = (60, 120, 255)
 MARKER_RADIUS_M = 0.008
 
@@ -95,15 +103,22 @@ class PlanScene:
         self._wobj_mesh: trimesh.Trimesh | None = None
 
     def color_work_object(
-        self, vertex_rgb: ArrayLike | None, mesh: trimesh.Trimesh | None = None
+        self,
+        vertex_rgb: ArrayLike | None,
+        mesh: trimesh.Trimesh | None = None,
+        layer: str = "reach",
     ) -> None:
         """Overlay the work object with per-vertex colours (``(V, 3)`` uint8), or remove it.
 
         ``mesh``: a refined copy of the work object (wobj frame) the colours belong to;
-        default the work object itself.
+        default the work object itself. ``layer``: whose colours (:data:`OVERLAYS`: the
+        reachability heat map, the layout's predicted error, the validation's simulated
+        error); each is an overlay of its own, a hair further out than the one before, so one
+        panel's colours never remove another's and the later layer shows while both are on.
         """
+        name, lift_m = OVERLAYS[layer]
         if vertex_rgb is None or self._wobj_mesh is None:
-            self._scene.remove_by_name("/wobj/heat_mesh")
+            self._scene.remove_by_name(name)
             return
         colored = (self._wobj_mesh if mesh is None else mesh).copy()
         rgb = np.asarray(vertex_rgb, dtype=np.uint8)
@@ -111,8 +126,8 @@ class PlanScene:
             colored, vertex_colors=np.hstack([rgb, np.full((len(rgb), 1), 255, np.uint8)])
         )
         # a hair above the surface so the colours win the depth test; clicks still hit the mesh
-        colored.vertices = colored.vertices + 0.0005 * colored.vertex_normals
-        self._scene.add_mesh_trimesh("/wobj/heat_mesh", colored)
+        colored.vertices = colored.vertices + lift_m * colored.vertex_normals
+        self._scene.add_mesh_trimesh(name, colored)
 
     def draw_work_object(self, mesh: trimesh.Trimesh, T_world_wobj: ArrayLike) -> viser.MeshHandle:
         """Draw the work object (wobj frame mesh) and the nominal WOCS axes at ``T_world_wobj``."""

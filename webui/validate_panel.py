@@ -213,14 +213,14 @@ class ValidatePanel(Panel):
         view = self._app.view
         report = self.last_report
         if not self.show_error.value or view is None or report is None:
-            self._app.scene.color_work_object(None)
+            self._app.scene.color_work_object(None, layer="error")
             self.error_md.content = ""
             return False
         colours = validation.error_colours(report, view.wobj_mesh)
         if colours is None:
             return False
         rgb, lo, hi = colours
-        self._app.scene.color_work_object(rgb)
+        self._app.scene.color_work_object(rgb, layer="error")
         level = report.error_map.level_percent if report.error_map else 95.5
         self.error_md.content = (
             f"{level:g} % of calibrations place each point within: green {lo * 1e3:.2f} mm "

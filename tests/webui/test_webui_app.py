@@ -159,6 +159,18 @@ def test_heat_map_grows_in_chunks_and_colours_vertices(app: WobjcalApp) -> None:
     assert app.server.scene.get_handle_by_name("/wobj/heat_mesh") is not None
     assert "surface samples usable" in app.heatmap.summary
     app.place_at_ray(*_ray_to([0.0, 0.1, 0.0]), point_id="H1")  # clicks still work after
+    # helper-56 (D2): a validation that finished with "Show error on part" unticked cleared
+    # the heat map (one overlay for all): each panel's colours are a layer of their own now
+    panel = app.validate_panel
+    assert not panel.show_error.value and not panel.paint_error()
+    app.layout_panel.show_map.value = False
+    app.layout_panel._paint()
+    assert app.server.scene.get_handle_by_name("/wobj/heat_mesh") is not None
+    n = len(app.view.wobj_mesh.vertices)
+    app.scene.color_work_object(np.zeros((n, 3), np.uint8), layer="error")
+    app.scene.color_work_object(None, layer="error")
+    assert app.server.scene.get_handle_by_name("/wobj/error_mesh") is None
+    assert app.server.scene.get_handle_by_name("/wobj/heat_mesh") is not None
     app.heatmap.stop()
     assert app.server.scene.get_handle_by_name("/wobj/heat_mesh") is None
 

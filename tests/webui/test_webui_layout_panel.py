@@ -49,7 +49,7 @@ def test_quality_is_live_and_follows_an_edit(app: WobjcalApp) -> None:
 
 def test_error_map_paints_every_vertex(app: WobjcalApp, monkeypatch: pytest.MonkeyPatch) -> None:
     painted: list[Any] = []
-    monkeypatch.setattr(app.scene, "color_work_object", lambda rgb: painted.append(rgb))
+    monkeypatch.setattr(app.scene, "color_work_object", lambda rgb, **_kw: painted.append(rgb))
     panel = app.layout_panel
     panel.refresh().result(60)
     panel.show_map.value = True
