@@ -229,6 +229,8 @@ def _read(
     if not isinstance(mesh, trimesh.Trimesh):
         raise MeshError(f"mesh file {path} holds no triangle mesh (got {type(mesh).__name__})")
     if len(mesh.faces) == 0 and size > 0:
+        if path.suffix.lower() == ".stl" and (cut := _ascii_stl_cut_short(path)):
+            raise MeshError(f"mesh file {path}: {cut}")
         raise MeshError(
             f"mesh file {path}: no triangle could be read from its {size:,} bytes (corrupt, or "
             f"not a {path.suffix.lstrip('.').upper() or 'mesh'} file)"
@@ -236,6 +238,26 @@ def _read(
     if len(mesh.faces) > limit:
         raise _too_many(path, len(mesh.faces), limit)
     return mesh, str(path), None
+
+
+def _ascii_stl_cut_short(path: Path) -> str:
+    """Why an ASCII STL that gave no triangle is cut short (``""``: it does not look so): it
+    starts with ``solid`` and holds facets, but its last line is not ``endsolid`` (a file cut
+    in a copy or an upload; the reader then refuses the whole file)."""
+    with path.open("rb") as handle:
+        if not handle.read(256).lstrip().lower().startswith(b"solid"):
+            return ""
+        handle.seek(0)
+        text = handle.read().decode("ascii", errors="replace")
+    facets = text.count("endfacet")
+    lines = text.rstrip().splitlines()
+    if facets == 0 or (lines and lines[-1].strip().lower().startswith("endsolid")):
+        return ""
+    return (
+        f"an ASCII STL cut short: {facets:,} whole facets, then it ends without its "
+        f"'endsolid' line (last line {lines[-1].strip()[:40]!r}); the file is incomplete: "
+        "copy or export it again"
+    )
 
 
 def load_work_object(

@@ -136,6 +136,22 @@ def test_bad_meshes_name_the_file(tmp_path) -> None:
         load_work_object(trimesh.Trimesh())
 
 
+@pytest.mark.parametrize("cut", ["after a facet", "in a facet"])
+def test_an_ascii_stl_cut_short_is_named_so(tmp_path, cut: str) -> None:
+    """helper-55 (D11): an ASCII STL cut in a copy was 'no triangle could be read from its
+    58,692 bytes' although it held hundreds of facets."""
+    box = trimesh.creation.box([0.1, 0.2, 0.3])
+    text = trimesh.exchange.stl.export_stl_ascii(box)
+    end = [i for i in range(len(text)) if text.startswith("endfacet", i)][4] + len("endfacet\n")
+    path = tmp_path / "cut.stl"
+    path.write_text(text[:end] if cut == "after a facet" else text[: end + 30])
+    with pytest.raises(MeshError, match=r"cut\.stl: an ASCII STL cut short: 5 whole facets"):
+        load_work_object(path, units="m")
+    whole = tmp_path / "whole.stl"
+    whole.write_text(text)
+    assert len(load_work_object(whole, units="m").mesh.faces) == 12
+
+
 def cube_mesh() -> trimesh.Trimesh:
     """A 0.1 m cube: a built-in part factory for the registry test."""
     return trimesh.creation.box([0.1, 0.1, 0.1])
