@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from calib.errors import InputError
 from calib.plan.file import Plan
 from calib.registry import lookup
 from planner.export import FORMATS as EXPORT_FORMATS
@@ -58,6 +59,8 @@ def export_program(plan: Plan, fmt: str, plan_dir: Path, cell: Cell | None = Non
 
     name = lookup(FORMATS, fmt, "export format (download)")
     result = make(plan, plan_dir, name, cell=cell)
+    if not result.files:  # the controller has no program for the plan: nothing to force
+        raise InputError(f"no {fmt} program for this plan: {result.layout}")
     stem = EXPORT_FORMATS[name].file_stem(plan.name)
     out = tuple((f"{stem}{suffix}", text.encode("utf-8")) for suffix, text in result.files.items())
     if result.check is not None:

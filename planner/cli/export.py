@@ -101,7 +101,7 @@ def cmd_export(args: argparse.Namespace) -> int:
 
     result = export_program(plan, plan_dir, args.format, run_check=not args.no_check)
     refused = result.layout or (result.check is not None and not result.check.feasible)
-    if refused and not args.force:
+    if refused and (not args.force or not result.files):  # no program: --force has none
         err = stderr()
         if result.layout:
             err.print(f"error: layout: {result.layout}", markup=False)
@@ -113,7 +113,10 @@ def cmd_export(args: argparse.Namespace) -> int:
                     f"error: point {p.point_id} is not feasible: {p.reason or p.status}",
                     markup=False,
                 )
-        err.print("nothing written; fix the plan, or export anyway with --force")
+        if result.files:
+            err.print("nothing written; fix the plan, or export anyway with --force")
+        else:
+            err.print(f"nothing written: no {args.format} program for this plan; fix the plan")
         return 1
     if result.notes:
         stderr().print("note: " + "; ".join(result.notes), markup=False)

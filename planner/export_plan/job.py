@@ -44,7 +44,8 @@ class ProgramExport:
     """A robot program of a plan.
 
     Attributes:
-        files: ``{suffix: text}`` of the program, e.g. ``{".src": ..., ".dat": ...}``.
+        files: ``{suffix: text}`` of the program, e.g. ``{".src": ..., ".dat": ...}``; empty
+            when the controller has no program for the plan (``layout`` says why).
         notes: what the user should know (estimated tool load, points without a checked pose).
         check: the plan check the orientations came from, or ``None`` when not run.
         layout: why the plan's procedure refuses its points (e.g. an A-H plan without a
@@ -143,6 +144,8 @@ def export_program(
         job = with_cycle_times(job, plan, check, cell)
     if layout:
         notes = (*notes, f"layout: {layout}")
+    if fmt in job.program_errors:  # no such program for this plan: a refusal, as check's
+        return ProgramExport({}, notes, check, layout or job.program_errors[fmt])
     return ProgramExport(export_files(job, fmt), notes, check, layout)
 
 

@@ -267,6 +267,28 @@ def test_export_writes_the_steered_starts_and_refuses_fanuc() -> None:
 
 @pytest.mark.reference
 @pytest.mark.slow
+def test_the_cli_refuses_the_steered_plans_fanuc_program_as_check_does(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """helper-55 (D7): check said exit 1 (layout) and export exit 2 (bad input) for the same
+    refusal; export exits 1 now, --force or not (there is no TP program to force)."""
+    from planner.cli.main import main
+    from planner.suggest import moved_plan
+
+    path = tmp_path / "steered.json"
+    path.write_text(plan_to_json(moved_plan(_hard_plate(tight=False), PLATE.parent, tmp_path)))
+    out = tmp_path / "out.ls"
+    assert main(["check", str(path), "--format", "fanuc"]) == 1
+    for force in ([], ["--force"]):
+        capsys.readouterr()
+        assert main(["export", str(path), "--format", "fanuc", "-o", str(out), *force]) == 1
+        err = capsys.readouterr().err
+        assert 'search_sizing "steered"' in err and "no fanuc program for this plan" in err
+        assert not out.exists()
+
+
+@pytest.mark.reference
+@pytest.mark.slow
 def test_validate_runs_the_tight_steered_program_without_a_failed_search() -> None:
     """The same tight program simulated on the plate's mesh with the touch probe and the robot's
     noise (``wobjcal validate``): no search starts touching or runs short in any trial (X1 and
