@@ -10,8 +10,9 @@ orientations and configurations chosen by ``wobjcal check``.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
+import msgspec
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -287,6 +288,39 @@ def default_sensor_rotation(
     return np.column_stack([x, y, z])
 
 
+def _ah_in_controller_base(
+    spec: AdaptiveSpec,
+    T_base_controller: FloatArray,
+    programs: dict[str, MeasuringProgram],
+    errors: dict[str, str],
+) -> AdaptiveSpec | None:
+    """The A-H specifics as a controller computes them in its own base frame.
+
+    Eq. 11-12's P3 is the one step of the procedure that reads the base's axes: the side face
+    is taken to lean by ``beta1`` towards base +x. Every other step is built from the measured
+    points alone, and so is the same in any frame turned about z or shifted. A controller base
+    shifted only keeps ``beta1``; one turned 180 deg about z (a UR arm's Base) has the face
+    leaning towards its -x: ``-beta1`` there gives the same P3, hence the same searches.
+    Another turn: the adaptive A-H programs are refused (moved from ``programs`` to
+    ``errors``, which this changes), as their P3 would not be the one validate simulates.
+    """
+    R = np.asarray(T_base_controller, dtype=np.float64)[:3, :3]
+    if np.allclose(R, np.eye(4)[:3, :3], rtol=0.0, atol=1e-9):
+        return spec
+    if np.allclose(R, np.diag([-1.0, -1.0, 1.0]), rtol=0.0, atol=1e-9):
+        beta1 = -spec.settings.beta1_rad
+        return replace(spec, settings=msgspec.structs.replace(spec.settings, beta1_rad=beta1))
+    for name in [n for n, p in programs.items() if p.adaptive and not p.steers_itself]:
+        del programs[name]
+        errors[name] = (
+            "the adaptive A-H program computes P3 (eq. 11-12) from the side face's lean "
+            "towards the controller's base +x, and this controller's base frame is turned "
+            "from the robot's base link other than by 180 deg about z, so its searches would "
+            "not be the ones check and validate judge; use a best-fit or 3-2-1 procedure"
+        )
+    return None
+
+
 def build_job(
     plan: Plan,
     T_base_wobj: ArrayLike,
@@ -334,6 +368,8 @@ def build_job(
         spec = adaptive_spec(plan) if any(p.adaptive for p in programs.values()) else None
     except InputError:
         spec = None
+    if spec is not None:
+        spec = _ah_in_controller_base(spec, T_bc, programs, errors)
     targets = []
     for p in plan.points:
         cmd = SearchCommand.from_point(p.to_probe_point(), np.eye(4))
