@@ -14,6 +14,7 @@ from concurrent.futures import Future
 from pathlib import Path
 from typing import Any
 
+import msgspec
 import numpy as np
 import viser
 from numpy.typing import ArrayLike
@@ -101,7 +102,8 @@ class WobjcalApp:
         #: :attr:`_checks` holds it and that check with its moves checked (shown instead while
         #: the point's check is that one)
         self._via: dict[str, tuple[PointCheck, PointCheck]] = {}
-        self.via_future: Future[None] | None = None
+        self.via_future: Future[Any] | None = None
+        self._via_asked: tuple[object, ...] = ()
         # per point, bumped by every change that drops its check: a recheck started before the
         # change (say, for a sensor an undo has taken back) must not store its result after
         self._check_gen: dict[str, int] = {}
@@ -201,7 +203,7 @@ class WobjcalApp:
         for layer in ("quality", "error"):  # painted again below for the new part, if ticked
             self.scene.color_work_object(None, layer=layer)
         self.scene.draw_fixtures(view.fixtures)
-        robot_key = _robot_key(view)
+        robot_key = _robot_key(view, plan)
         if self.robot is not None and robot_key == self._robot_key:
             pass  # the same robot, base and tool (the part or a fixture changed): each tab's
             # robot stays drawn where it is, jogged or taught, with the Teach tab's fields
@@ -256,13 +258,13 @@ class WobjcalApp:
         via = self._via.get(point_id)
         return via[1] if via is not None and via[0] is check else check
 
-    def update_via_moves(self) -> Future[None]:
+    def update_via_moves(self) -> Future[Any]:
         """Check the moves between the points (joint moves through each point's vias, from
         every point a program probes before it) once every point of the plan as edited has
         its check, on the cell worker; then the table and the markers show a point whose moves
         fail as ``wobjcal check`` and the export do: infeasible, with its ``vias:`` cause. A
         single point's check leaves them out (they depend on the other points)."""
-        done: Future[None] = Future()
+        done: Future[Any] = Future()
         done.set_result(None)
         doc = self.state.doc
         plan = plan_as_edited(doc)
@@ -272,6 +274,10 @@ class WobjcalApp:
         if plan is None or any(p.id not in raw for p in plan.points):
             return done  # a later check of the missing points asks again
         checks = [raw[p.id] for p in plan.points]
+        key = (doc, gen, tuple(id(c) for c in checks))
+        if self.via_future is not None and self._via_asked == key:
+            return self.via_future  # the same plan, checks and cell: asked already
+        self._via_asked = key
         fut = self.worker.submit(lambda s: None if s is None else s.via_moves(plan, checks))
 
         def show(f: Future[tuple[PointCheck, ...] | None]) -> None:
@@ -286,11 +292,15 @@ class WobjcalApp:
                 before = {pid: self._with_moves(pid, c) for pid, c in raw.items()}
                 self._via = {c.point_id: (c, m) for c, m in zip(checks, moved, strict=True)}
                 changed = [pid for pid in raw if self._with_moves(pid, raw[pid]) is not before[pid]]
-            if changed:
+            if changed and self.state.doc is doc:  # only the points whose status changed,
+                # each drawn alone (no other marker touched, whatever another thread draws)
                 self.points_panel.refresh()
-                self.scene.draw_points(
-                    doc, self.checks(), None, only=changed, flags=self.flags.by_point
-                )
+                with self.server.atomic():
+                    for pid in changed:
+                        if pid in doc.ids:
+                            self.scene.draw_point(
+                                doc.get(pid), self.check_of(pid), False, pid in self.flags.by_point
+                            )
                 self.server.flush()
 
         fut.add_done_callback(show)
@@ -447,7 +457,9 @@ class WobjcalApp:
                 self._load_latest_cell()
             self._redraw()
             self.selection.follow(self.state.doc, set())  # deleted points, highlights moved
+            self.files_panel.refresh_off_surface(part_changed=True)
             return
+        self.files_panel.refresh_off_surface(part_changed=False)
         before = {p.id: p for p in change.previous.points}
         changed = [p.id for p in change.doc.points if before.get(p.id) != p]
         previous = change.previous.source
@@ -667,12 +679,15 @@ def _file_key(path: Path | None) -> tuple[str, int, int] | None:
     return (str(path), st.st_mtime_ns, st.st_size)
 
 
-def _robot_key(view: CellView) -> tuple[object, ...]:
-    """What decides how the robot and its tool are drawn: the robot's and the tool's files
-    (path, time, size), the base pose, the tool's mount and mesh. The same key after a cell
-    change (the part or a fixture moved): the tabs' robots are kept, at their poses."""
+def _robot_key(view: CellView, plan: Plan) -> tuple[object, ...]:
+    """What decides how the robot and its tool are drawn: the plan's robot and tool (file,
+    base and tip links, xacro arguments, package path, mount, TCP), their files (path, time,
+    size), the base pose, the tool's mount and mesh. The same key after a cell change (the
+    part or a fixture moved): the tabs' robots are kept, at their poses."""
     mesh = view.tool_mesh
+    specs = msgspec.json.encode((plan.cell.robot, plan.cell.tool))
     return (
+        specs,
         _file_key(view.robot_urdf),
         _file_key(view.tool_urdf),
         np.asarray(view.T_world_base, dtype=np.float64).tobytes(),

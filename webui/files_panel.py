@@ -144,9 +144,6 @@ class FilesPanel(Panel):
             lambda ev: self.guard(ev, self.download_anyway, ev.client, title="Not exported")
         )
         app.state.subscribe(lambda change: self._clear_refusal())
-        # the list of points off the part is of the plan it was made for: another plan (an
-        # upload, undo, an edit) gets it anew, so it never names points the plan does not have
-        app.state.subscribe(lambda change: self._list_off_surface() if self.off else None)
 
     def _export_callback(self, fmt: str) -> Any:
         def callback(event: Any) -> None:
@@ -301,6 +298,14 @@ class FilesPanel(Panel):
         """Use an uploaded mesh (in the chosen units) as the work object at once (scripts)."""
         self.stage_mesh(name, content)
         return self.accept_mesh()
+
+    def refresh_off_surface(self, part_changed: bool) -> None:
+        """After a change of the plan, once its cell is the one shown (the app calls it): the
+        points off the part listed again when the part changed (an undo or redo of a new part)
+        or when some were listed (another plan, an edit), so the list is always of the plan and
+        the part shown, never of the one before."""
+        if part_changed or self.off:
+            self._list_off_surface()
 
     def _list_off_surface(self) -> None:
         view = self._app.view

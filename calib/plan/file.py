@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import json
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 from typing import Any, Final, Literal, get_args
 
 import msgspec
@@ -364,27 +364,37 @@ def plan_to_json(plan: Plan) -> str:
     return canonical_json(plan)
 
 
+def _file_ref(ref: object) -> bool:
+    return isinstance(ref, str) and not ref.startswith("builtin:")
+
+
 def plan_digest(plan: Plan) -> str:
     """The plan's digest: the first 16 hex digits of the sha256 of its canonical JSON, with
     every ``-0.0`` taken as ``0.0`` (the same plan gives the same digest whatever wrote it).
 
-    Where the plan's files lie does not count (a file reference is taken as ``"file"``, a
-    ``builtin:`` one as it is; the robot's package path not at all): a plan moved to another
-    folder or downloaded with its files in a ZIP (:mod:`calib.plan.bundle`: its paths
-    rewritten, a file renamed where two share a name) is the same plan, and calibrates the
-    results of the program exported before; the ``sha256`` fields pin the files' contents.
+    Where the plan's files lie does not count: the robot's and the tool's files count by
+    their names (a robot file decides the controller's base frame: another robot is another
+    plan), the meshes not at all (their ``sha256`` fields pin their contents when given; a
+    ZIP renames a fixture's mesh whose name another has), ``builtin:`` references as they
+    are, the robot's package path not at all. So a plan moved to another folder or downloaded
+    with its files in a ZIP (:mod:`calib.plan.bundle`: its paths rewritten) is the same plan,
+    and calibrates the results of the program exported before. (Before 2026-11-29 the paths
+    counted: a program exported then from a plan with file references carries another digest;
+    export it again.)
 
     Program headers carry it and ``wobjcal calibrate`` compares it with the plan it is given,
     so results measured with another plan's program are named, not used.
     """
     data = msgspec.to_builtins(plan)
     cell = data.get("cell", {})
-    refs = [(cell.get("robot", {}), "urdf"), (cell.get("tool", {}), "name")]
-    refs += [(f, "mesh") for f in cell.get("fixtures", [])]
-    refs.append((data.get("work_object", {}), "mesh"))
-    for holder, key in refs:
-        ref = holder.get(key)
-        if isinstance(ref, str) and not ref.startswith("builtin:"):
+    named = [(cell.get("robot", {}), "urdf"), (cell.get("tool", {}), "name")]
+    meshes = [(f, "mesh") for f in cell.get("fixtures", [])]
+    meshes.append((data.get("work_object", {}), "mesh"))
+    for holder, key in named:
+        if _file_ref(ref := holder.get(key)):
+            holder[key] = PurePosixPath(str(ref).replace("\\", "/")).name
+    for holder, key in meshes:
+        if _file_ref(holder.get(key)):
             holder[key] = "file"
     cell.get("robot", {}).pop("package_path", None)
     text = json.dumps(

@@ -5,8 +5,10 @@ Example::
     {"schema": "wobjcal.measurements/1", "frame": "base", "units": "mm",
      "points": {"A": [1510.2, -402.7, 731.9], "B": [1511.0, 297.1, 732.4]}}
 
-``frame`` is ``base`` (the robot base, as read from a ``robtarget``/``pos`` in RAPID without a
-work object) or ``world`` (the cell frame; converted with the plan's ``T_world_base``).
+``frame`` is ``base`` (the robot controller's base, as read from a ``robtarget``/``pos`` in
+RAPID without a work object: on a robot whose URDF hangs a turned ROS-Industrial ``base`` link
+from its base link, a UR arm's Base, that frame; ``planner.robot.controller_base``) or
+``world`` (the cell frame; converted with the plan's ``T_world_base``).
 ``units`` is ``m`` or ``mm``. ``retakes`` optionally holds later measurements of the same point
 (the A-H procedure measures C and D twice), in the order they were taken. ``failed`` names points
 whose search failed on the robot, with the reason. Inside the code everything is metres.

@@ -135,9 +135,10 @@ class ValidationReport:
         workers: worker processes used.
         reach_checked: how many trials (the first ones) also vetted every commanded search for
             reachability and collisions in the cell; 0 when no cell was given.
-        reach_failed: how many of those failed (for any reason): the others cannot fail on
-            reach or collisions, so with ``reach_checked < n_trials`` their share is the better
-            estimate of the runs that fail (:meth:`reach_warning`).
+        reach_failed: how many of those failed for a reason only the cell shows (reach, a
+            joint limit, a singularity, a collision: :data:`planner.sim.summary.CELL_KINDS`):
+            the others cannot fail so, so with ``reach_checked < n_trials`` this share is the
+            better estimate of the runs that fail that way (:func:`reach_warning`).
         method: the procedure's method.
         sensor: the sensor kind.
         outcomes: per-search outcomes, in the order the searches were first run.
@@ -259,8 +260,9 @@ def reach_warning(report: ValidationReport) -> str:
     hi = float(beta.ppf(0.975, k + 1, n - k)) if k < n else 1.0
     return (
         f"ONLY {n} OF {report.n_trials} TRIALS WERE CHECKED IN THE CELL, AND {k} OF THEM FAILED "
-        f"({k / n:.0%}; 95 % interval {lo:.0%} to {hi:.0%}): the {report.n_trials - n} "
-        "unchecked trials could not fail on reach or collisions, so 'calibrated' above "
+        f"THERE ({k / n:.0%}; 95 % interval {lo:.0%} to {hi:.0%}; reach, limits or "
+        f"collisions): the {report.n_trials - n} unchecked trials could not fail so, so "
+        "'calibrated' above "
         "overstates how many runs succeed; validate with --reach-trials "
         f"{report.n_trials} for the figure"
     )

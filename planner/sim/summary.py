@@ -205,6 +205,17 @@ def build_rows(
     return tuple(rows), samples[0], samples[1]
 
 
+#: The kinds of a failure only the cell shows (reach, limits, collisions, moves): a trial not
+#: checked in the cell cannot fail so (:data:`planner.reasons.KINDS`).
+CELL_KINDS = frozenset({"reach", "joint_limit", "singularity", "collision", "move"})
+
+
+def _failed_in_cell(result: TrialResult) -> bool:
+    """The trial stopped at a search for a reason only the cell's check shows."""
+    f = result.failed_search
+    return f is not None and f.cause.kind in CELL_KINDS
+
+
 def build_report(
     setup: SimulationSetup,
     results: list[TrialResult],
@@ -273,7 +284,7 @@ def build_report(
         elapsed_s=elapsed,
         workers=n_workers,
         reach_checked=n_reach,
-        reach_failed=int((~ok[:n_reach]).sum()),
+        reach_failed=sum(_failed_in_cell(r) for r in results[:n_reach]),
         method=setup.method,
         program=setup.program.describe()[0],
         program_steps=tuple(setup.program.describe()[1:]),

@@ -80,9 +80,14 @@ def test_the_points_off_the_part_are_of_the_plan_shown(
     other = box_plan(app.plan_dir, name="other_plan")  # its mesh beside the app's plan
     files.upload_plan(other.name, other.read_bytes())
     assert files.off == {} and files.off_md.content == "" and not files.project_off.visible
-    app.state.undo()  # the plan
-    app.state.undo()  # the new part
+    app.state.undo()  # the plan: the plate again, its points off it listed again
+    assert set(files.off) == set(app.state.doc.ids) and files.project_off.visible
+    app.state.undo()  # the new part: the box, the points on it
     assert files.off == {} and files.off_md.content == ""
+    app.state.redo()  # the plate again (review, helper-57: the list was the box's here)
+    assert set(files.off) == set(app.state.doc.ids)
+    app.state.undo()
+    assert files.off == {}
     np.testing.assert_allclose(app.view.wobj_mesh.extents, [0.6, 0.4, 0.3], atol=1e-9)
 
 

@@ -316,3 +316,7 @@ def test_a_bundled_or_moved_plan_keeps_its_digest(
     shifted = msgspec.structs.replace(p0, position_m=(p0.position_m[0] + 1e-4, *p0.position_m[1:]))
     other = msgspec.structs.replace(plan, points=[shifted, *plan.points[1:]])
     assert plan_digest(other) != plan_digest(plan)  # a point moved 0.1 mm: another plan
+    # another robot file (its controller's base frame may be turned): another plan
+    robot = msgspec.structs.replace(plan.cell.robot, urdf="../robots/irb2400/irb2400.urdf")
+    swapped = msgspec.structs.replace(plan, cell=msgspec.structs.replace(plan.cell, robot=robot))
+    assert plan_digest(swapped) != plan_digest(plan)

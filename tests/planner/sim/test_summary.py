@@ -158,7 +158,7 @@ def test_failures_among_the_trials_checked_in_the_cell_are_not_diluted_by_the_ot
     report = ValidationReport(**{**report.__dict__, "n_trials": 400, "n_ok": 396})
     text = reach_warning(report)
     ci = binomtest(4, 20).proportion_ci(0.95, method="exact")
-    assert f"AND 4 OF THEM FAILED (20%; 95 % interval {ci.low:.0%} to {ci.high:.0%})" in text
+    assert f"AND 4 OF THEM FAILED THERE (20%; 95 % interval {ci.low:.0%} to {ci.high:.0%};" in text
     assert "--reach-trials 400" in text
     assert text in report_markdown(report).splitlines()[1:3]
     data = report_json(report)
@@ -168,3 +168,14 @@ def test_failures_among_the_trials_checked_in_the_cell_are_not_diluted_by_the_ot
         quiet = ValidationReport(**{**report.__dict__, "reach_failed": 0, **kw})
         assert reach_warning(quiet) == ""
         assert "CHECKED IN THE CELL" not in report_markdown(quiet)
+
+
+def test_only_failures_the_cell_shows_count_for_the_warning() -> None:
+    """A missed search fails checked and unchecked trials alike: it is not what the unchecked
+    trials could not show (review of the warning, helper-57)."""
+    from planner.sim.summary import _failed_in_cell
+
+    assert _failed_in_cell(_trial(SearchFailure("D", HIT)))
+    assert _failed_in_cell(_trial(SearchFailure("D", LIMIT)))
+    assert not _failed_in_cell(_trial(SearchFailure("D", MISSED)))
+    assert not _failed_in_cell(_trial())
