@@ -274,11 +274,20 @@ class WobjcalApp:
         if plan is None or any(p.id not in raw for p in plan.points):
             return done  # a later check of the missing points asks again
         checks = [raw[p.id] for p in plan.points]
-        key = (doc, gen, tuple(id(c) for c in checks))
-        if self.via_future is not None and self._via_asked == key:
-            return self.via_future  # the same plan, checks and cell: asked already
-        self._via_asked = key
-        fut = self.worker.submit(lambda s: None if s is None else s.via_moves(plan, checks))
+        key = (doc, gen, *checks)
+        with self._lock:  # the same plan, checks and cell asked and still queued: that one
+            pending = self.via_future
+            asked = self._via_asked
+            if (
+                pending is not None
+                and not pending.done()
+                and len(asked) == len(key)
+                and all(a is b for a, b in zip(asked[:1] + asked[2:], key[:1] + key[2:]))
+                and asked[1] == gen
+            ):
+                return pending
+            fut = self.worker.submit(lambda s: None if s is None else s.via_moves(plan, checks))
+            self._via_asked, self.via_future = key, fut
 
         def show(f: Future[tuple[PointCheck, ...] | None]) -> None:
             try:
@@ -304,7 +313,6 @@ class WobjcalApp:
                 self.server.flush()
 
         fut.add_done_callback(show)
-        self.via_future = fut
         return fut
 
     def recheck(
@@ -457,7 +465,9 @@ class WobjcalApp:
                 self._load_latest_cell()
             self._redraw()
             self.selection.follow(self.state.doc, set())  # deleted points, highlights moved
-            self.files_panel.refresh_off_surface(part_changed=True)
+            was = change.previous.source
+            new_part = not isinstance(was, Plan) or _part_key(was) != _part_key(source)
+            self.files_panel.refresh_off_surface(part_changed=new_part)
             return
         self.files_panel.refresh_off_surface(part_changed=False)
         before = {p.id: p for p in change.previous.points}

@@ -84,7 +84,9 @@ class Measurements(msgspec.Struct, frozen=True, forbid_unknown_fields=True, kw_o
         return _SCALE[self.units]
 
     def sequence_m(self, point_id: str, T_base_frame: ArrayLike | None = None) -> NDArray:
-        """All measurements of ``point_id`` in order, ``(k, 3)`` metres, base frame.
+        """All measurements of ``point_id`` in order, ``(k, 3)`` metres, in the ``base`` frame
+        (the controller's base for a ``base`` file; a ``world`` file turned into the robot's
+        base link with ``T_base_frame``).
 
         Args:
             point_id: the point id.

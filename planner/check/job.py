@@ -60,7 +60,13 @@ from planner.check.paths import ProgramPath, check_program_path, measured_starts
 from planner.check.results import ConfData, PlanCheck, PointCheck, Status
 from planner.memo import Memo
 from planner.plan_cell import nominal_T_base_wobj, open_cell
-from planner.program.build import measuring_program, plan_settings, safety_spec
+from planner.program.build import (
+    AH_TURNED_BASE,
+    ah_base_sign,
+    measuring_program,
+    plan_settings,
+    safety_spec,
+)
 from planner.program.controllers import controller
 from planner.program.execute import execute
 from planner.program.reach import search_problems
@@ -121,7 +127,9 @@ def check_plan(
     # a robot standing inside the part makes every point fail: the cause, said once, first
     error = "; ".join(e for e in (base_in_part(cell), error) if e)
     checks = check_via_moves(cell, plan, checks)
-    layout = layout_problem(plan, fmt)
+    layout = layout_problem(plan, fmt) or controller_base_problem(
+        plan, fmt, cell.controller_base.T_base_controller
+    )
     quality, note = None, ""
     landing = None
     if not layout and cell.work_object is not None:
@@ -352,6 +360,20 @@ def _named(method: str, exc: Exception) -> str:
     :func:`calib.procedures.hultman2013.points_by_role`'s, already carry it)."""
     text = str(exc)
     return text if text.startswith(f"{method}: ") else f"{method}: {text}"
+
+
+def controller_base_problem(plan: Plan, fmt: str | None, T_base_controller: FloatArray) -> str:
+    """Why the controller ``fmt``'s program cannot run on a robot whose controller measures
+    from ``T_base_controller`` (on the chain's base link), ``""`` when it can: an adaptive A-H
+    program on a base turned other than by 0 or 180 deg about z
+    (:func:`planner.program.build.ah_base_sign`), as the export refuses it."""
+    try:
+        program = measuring_program(plan, fmt)
+    except InputError:
+        return ""  # layout_problem says it
+    if program.adaptive and not program.steers_itself and ah_base_sign(T_base_controller) is None:
+        return f"{plan.method}: {AH_TURNED_BASE}"
+    return ""
 
 
 def layout_problem(plan: Plan, fmt: str | None = None) -> str:

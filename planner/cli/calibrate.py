@@ -120,7 +120,8 @@ def result_json(out: CalibrationOutput, with_frame: bool = True) -> dict[str, An
 
     Args:
         out: the calibration.
-        with_frame: include the frame (``T_base_wobj``, ``origin_m``, angles, quaternion);
+        with_frame: include the frame (``T_base_wobj``, ``T_controller_wobj``, and of the
+            latter ``origin_m``, angles, quaternion);
             ``False`` for an untrusted result printed without ``--force``.
     """
     T = out.T_base_wobj

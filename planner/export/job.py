@@ -21,7 +21,14 @@ from calib.frames import check_transform, invert_transform, make_transform
 from calib.plan.file import Plan, plan_digest
 from calib.probing import SearchCommand
 from planner.export.text import module_name
-from planner.program.build import AdaptiveSpec, adaptive_spec, measuring_program, safety_spec
+from planner.program.build import (
+    AH_TURNED_BASE,
+    AdaptiveSpec,
+    adaptive_spec,
+    ah_base_sign,
+    measuring_program,
+    safety_spec,
+)
 from planner.program.controllers import CONTROLLERS
 from planner.program.cycle_time import CycleTime
 from planner.program.model import MeasuringProgram
@@ -205,7 +212,8 @@ class ExportJob:
         sensor_input: name of the sensor's digital input (RAPID signal, KRL/UR input number).
         safety: the misplacement tolerance the safe starts are computed for.
         adaptive: the A-H specifics the adaptive programs are written from (searches
-            commanded in the frame estimated so far), or ``None`` when no controller runs the
+            commanded in the frame estimated so far; ``beta1`` in the controller's base frame,
+            :func:`planner.program.build.ah_base_sign`), or ``None`` when no controller runs the
             plan adaptively; a writer uses it only when its own program is adaptive.
         programs: the measuring program of every controller, by controller name: what each
             writer serialises (:meth:`program`).
@@ -294,30 +302,16 @@ def _ah_in_controller_base(
     programs: dict[str, MeasuringProgram],
     errors: dict[str, str],
 ) -> AdaptiveSpec | None:
-    """The A-H specifics as a controller computes them in its own base frame.
-
-    Eq. 11-12's P3 is the one step of the procedure that reads the base's axes: the side face
-    is taken to lean by ``beta1`` towards base +x. Every other step is built from the measured
-    points alone, and so is the same in any frame turned about z or shifted. A controller base
-    shifted only keeps ``beta1``; one turned 180 deg about z (a UR arm's Base) has the face
-    leaning towards its -x: ``-beta1`` there gives the same P3, hence the same searches.
-    Another turn: the adaptive A-H programs are refused (moved from ``programs`` to
-    ``errors``, which this changes), as their P3 would not be the one validate simulates.
-    """
-    R = np.asarray(T_base_controller, dtype=np.float64)[:3, :3]
-    if np.allclose(R, np.eye(4)[:3, :3], rtol=0.0, atol=1e-9):
-        return spec
-    if np.allclose(R, np.diag([-1.0, -1.0, 1.0]), rtol=0.0, atol=1e-9):
-        beta1 = -spec.settings.beta1_rad
+    """The A-H specifics as a controller computes them in its own base frame: ``beta1`` with
+    the sign :func:`planner.program.build.ah_base_sign` gives; a base turned otherwise refuses
+    the adaptive A-H programs (moved from ``programs`` to ``errors``, which this changes)."""
+    sign = ah_base_sign(T_base_controller)
+    if sign is not None:
+        beta1 = sign * spec.settings.beta1_rad
         return replace(spec, settings=msgspec.structs.replace(spec.settings, beta1_rad=beta1))
     for name in [n for n, p in programs.items() if p.adaptive and not p.steers_itself]:
         del programs[name]
-        errors[name] = (
-            "the adaptive A-H program computes P3 (eq. 11-12) from the side face's lean "
-            "towards the controller's base +x, and this controller's base frame is turned "
-            "from the robot's base link other than by 180 deg about z, so its searches would "
-            "not be the ones check and validate judge; use a best-fit or 3-2-1 procedure"
-        )
+        errors[name] = AH_TURNED_BASE
     return None
 
 

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from calib.errors import InputError, ProbeFailedError
 from calib.frames import small_motion
@@ -283,6 +284,34 @@ class AdaptiveSpec:
     index: dict[str, int]
     settings: Hultman2013
     face_coords_wobj: tuple[float, float, float]
+
+
+#: Why an adaptive A-H program is refused on a controller whose base is turned other than by
+#: 0 or 180 deg about z from the robot's base link (:func:`ah_base_sign`).
+AH_TURNED_BASE = (
+    "the adaptive A-H program computes P3 (eq. 11-12) from the side face's lean towards the "
+    "controller's base +x, and this controller's base frame is turned from the robot's base "
+    "link other than by 180 deg about z, so its searches would not be the ones check and "
+    "validate judge; use a best-fit or 3-2-1 procedure"
+)
+
+
+def ah_base_sign(T_base_controller: ArrayLike) -> float | None:
+    """The sign ``beta1`` takes in the controller's base frame, for the adaptive A-H program.
+
+    Eq. 11-12's P3 is the one step of the procedure that reads the base's axes (the side face
+    leans by ``beta1`` towards base +x); every other step is built from the measured points
+    alone, the same in any frame turned about z or shifted. ``1.0``: the controller's base is
+    the robot's base link turned by nothing (shifted at most); ``-1.0``: turned 180 deg about z
+    (a UR arm's Base: the face leans towards its -x); ``None``: turned otherwise (the adaptive
+    A-H program cannot run its searches there: :data:`AH_TURNED_BASE`).
+    """
+    R = np.asarray(T_base_controller, dtype=np.float64)[:3, :3]
+    if np.allclose(R, np.eye(3), rtol=0.0, atol=1e-9):
+        return 1.0
+    if np.allclose(R, np.diag([-1.0, -1.0, 1.0]), rtol=0.0, atol=1e-9):
+        return -1.0
+    return None
 
 
 def adaptive_spec(plan: Plan) -> AdaptiveSpec | None:

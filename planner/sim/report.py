@@ -260,10 +260,10 @@ def reach_warning(report: ValidationReport) -> str:
     hi = float(beta.ppf(0.975, k + 1, n - k)) if k < n else 1.0
     return (
         f"ONLY {n} OF {report.n_trials} TRIALS WERE CHECKED IN THE CELL, AND {k} OF THEM FAILED "
-        f"THERE ({k / n:.0%}; 95 % interval {lo:.0%} to {hi:.0%}; reach, limits or "
-        f"collisions): the {report.n_trials - n} unchecked trials could not fail so, so "
-        "'calibrated' above "
-        "overstates how many runs succeed; validate with --reach-trials "
+        f"THERE ({k / n:.0%}; 95 % interval {lo:.0%} to {hi:.0%}; reach, limits, "
+        f"singularities, collisions or moves): the {report.n_trials - n} unchecked trials "
+        "could not fail so, so 'calibrated' above overstates how many runs succeed; validate "
+        "with --reach-trials "
         f"{report.n_trials} for the figure"
     )
 

@@ -68,3 +68,10 @@ def test_the_table_refuses_a_point_whose_move_in_fails_as_check_does(app: Wobjca
     assert shown["C"].pose_status != "infeasible" and "collision: feeder_body – table" in row_c
     app.state.undo()
     _wait(lambda: app.check_of("D") is not None and app.check_of("D").via_cause is None, "undo")
+    # a finished check of the moves is asked again, never reused (helper-58: a result thrown
+    # away for a later edit was never asked for again after an undo back to its plan)
+    _wait(lambda: app.via_future is not None and app.via_future.done(), "the moves checked")
+    done = app.via_future
+    again = app.update_via_moves()
+    assert again is not done
+    again.result(60)

@@ -43,6 +43,7 @@ from planner.cell.scene.robot_body import load_robot_body
 from planner.cell.scene.tool import FLANGE, Tool, load_tool, tool_mount
 from planner.cell.scene.workobject import WorkObject, load_work_object
 from planner.errors import UnknownFrameError
+from planner.robot.controller_base import ControllerBase, controller_base
 from planner.robot.kinematics.chain import KinematicChain
 from planner.robot.kinematics.solver import IKSolver, make_ik_solver
 from planner.robot.reach import ReachModel, cell_reach_model
@@ -95,6 +96,8 @@ class CellScene:
         path = robot_urdf(str(robot)) if is_builtin(robot) else Path(robot)
         model = load_urdf(path)
         self.chain: KinematicChain = KinematicChain.from_model(model, base_link, tip_link)
+        #: the robot controller's base frame on the chain's base link (a UR arm's Base)
+        self.controller_base: ControllerBase = controller_base(model, self.chain.base_link)
         self.solver: IKSolver = make_ik_solver(self.chain)
         self.tool: Tool | None = None if tool is None else load_tool(tool)
         #: ``(4, 4)`` the tool's root frame in the flange (tip-link) frame.

@@ -170,3 +170,28 @@ def test_a_ur5s_measurements_calibrate_to_the_truth_and_paste_in_its_base(
     m = re.search(r"wobj_calibrated = p\[([^\]]*)\]", out)
     assert m is not None and "URDF link 'base'" in out
     np.testing.assert_allclose(_floats(m.group(1))[:3], T_ctrl[:3, 3], atol=1e-6)
+
+
+@pytest.mark.slow
+def test_check_refuses_the_ah_program_on_a_base_turned_a_quarter(tmp_path: Path) -> None:
+    """helper-58: the export refused the adaptive A-H programs on a controller base turned
+    other than by 0 or 180 deg about z, while check passed them: one rule for both now."""
+    from planner.builtins import robot_urdf
+    from planner.check.job import check_plan
+    from planner.suggest import moved_plan
+
+    text = Path(robot_urdf("builtin:irb4400")).read_text()
+    turned = (
+        '<link name="base"/><joint name="base_link-base" type="fixed">'
+        '<parent link="base_link"/><child link="base"/>'
+        '<origin xyz="0 0 0" rpy="0 0 1.5707963267948966"/></joint></robot>'
+    )
+    urdf = tmp_path / "irb4400_turned.urdf"
+    urdf.write_text(text.replace("</robot>", turned))
+    plan = load_plan(STATOR)
+    robot = msgspec.structs.replace(plan.cell.robot, urdf=str(urdf))
+    plan = msgspec.structs.replace(plan, cell=msgspec.structs.replace(plan.cell, robot=robot))
+    plan = moved_plan(plan, STATOR.parent, tmp_path)
+    rapid = check_plan(plan, tmp_path, fmt="rapid")
+    assert "eq. 11-12" in rapid.layout
+    assert "eq. 11-12" not in check_plan(plan, tmp_path, fmt="fanuc").layout  # nominal TP
