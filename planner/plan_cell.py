@@ -184,13 +184,6 @@ def plan_controller_base(plan: Plan, plan_dir: Path) -> ControllerBase:
     return controller_base(model, plan.cell.robot.base_link)
 
 
-def controller_T_base_wobj(plan: Plan, plan_dir: Path) -> FloatArray:
-    """``(4, 4)`` the nominal work object in the controller's base frame
-    (:func:`plan_controller_base`), m: what the exported programs declare."""
-    T_base_controller = plan_controller_base(plan, plan_dir).T_base_controller
-    return invert_transform(T_base_controller) @ nominal_T_base_wobj(plan)
-
-
 def controller_T_flange_tool(plan: Plan, plan_dir: Path) -> FloatArray:
     """``(4, 4)`` the tool's root frame in the robot controller's flange frame, m.
 
@@ -246,7 +239,6 @@ def tool_data(plan: Plan, plan_dir: Path) -> tuple[Any, str]:
 
 __all__ = [
     "T_base_world",
-    "controller_T_base_wobj",
     "default_cell_note",
     "nominal_T_base_wobj",
     "open_cell",

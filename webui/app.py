@@ -274,20 +274,19 @@ class WobjcalApp:
         if plan is None or any(p.id not in raw for p in plan.points):
             return done  # a later check of the missing points asks again
         checks = [raw[p.id] for p in plan.points]
-        key = (doc, gen, *checks)
+        asked: tuple[object, ...] = (doc, *checks)  # the very objects, compared by identity
         with self._lock:  # the same plan, checks and cell asked and still queued: that one
-            pending = self.via_future
-            asked = self._via_asked
+            pending, before = self.via_future, self._via_asked
             if (
                 pending is not None
                 and not pending.done()
-                and len(asked) == len(key)
-                and all(a is b for a, b in zip(asked[:1] + asked[2:], key[:1] + key[2:]))
-                and asked[1] == gen
+                and before[:1] == (gen,)
+                and len(before) == len(asked) + 1
+                and all(a is b for a, b in zip(before[1:], asked, strict=True))
             ):
                 return pending
             fut = self.worker.submit(lambda s: None if s is None else s.via_moves(plan, checks))
-            self._via_asked, self.via_future = key, fut
+            self._via_asked, self.via_future = (gen, *asked), fut
 
         def show(f: Future[tuple[PointCheck, ...] | None]) -> None:
             try:

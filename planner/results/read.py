@@ -154,9 +154,10 @@ def read_results(
             the folder holding them).
         kind: the controller (:data:`KINDS`), or ``None`` to detect it from the contents.
         T_controller_wobj: ``(4, 4)`` the nominal work object in the controller's base frame
-            as the program declares it (:func:`planner.plan_cell.controller_T_base_wobj`;
-            FANUC's ``PR[1]`` is checked against it and the user-frame points taken to the
-            base with it); ``None``: the plan's nominal work object in the robot base.
+            as the program declares it (``inv(T_base_controller) @ T_base_wobj``, the base
+            from :func:`planner.plan_cell.plan_controller_base`; FANUC's ``PR[1]`` is checked
+            against it and the user-frame points taken to the base with it); ``None``: the
+            plan's nominal work object in the robot base.
 
     Raises:
         ResultsError: a file of the wrong kind, malformed or partial, or another plan's
