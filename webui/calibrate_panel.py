@@ -71,6 +71,7 @@ class CalibratePanel(Panel):
             rows += [f"- {problem}" for problem in out.problems]
             rows.append("")
         rows += [f"- note: {note}" for note in out.notes]
+        rows += [""] if out.notes else []  # the list ends before the next paragraph
         rows += [
             f"shift from nominal: {np.round(delta[:3] * 1000.0, 3).tolist()} mm, "
             f"{np.round(np.degrees(delta[3:]), 4).tolist()} deg (wobj axes)",

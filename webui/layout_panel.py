@@ -376,17 +376,23 @@ class LayoutPanel(Panel):
                 before = check_plan(plan, cell=session.cell) if plan.points else None
             except InputError:
                 before = None  # the comparison says "not checked"
-            res = suggest_plan(
-                plan,
-                plan_dir,
-                target_m=None if add else target,
-                max_points=n_max,
-                add=add,
-                progress=progress,
-                cell=session.cell,
-                procedure=procedure,
-                objective=objective,
-            )
+            try:
+                res = suggest_plan(
+                    plan,
+                    plan_dir,
+                    target_m=None if add else target,
+                    max_points=n_max,
+                    add=add,
+                    progress=progress,
+                    cell=session.cell,
+                    procedure=procedure,
+                    objective=objective,
+                )
+            except InputError as exc:  # said as the page's button, not the command's flag
+                text = str(exc)
+                if text.startswith("--add: "):
+                    raise InputError("Add best point: " + text.removeprefix("--add: ")) from None
+                raise
             return before, res
 
         n_before, method_before = len(plan.points), plan.method

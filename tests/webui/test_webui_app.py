@@ -249,7 +249,11 @@ def test_measurements_upload_draws_calibrated_frame(app: WobjcalApp) -> None:
     T_world_wobj = plan.cell.robot.T_world_base.matrix() @ out.T_base_wobj
     np.testing.assert_allclose(T_world_wobj, true, atol=1e-9)
     assert app.server.scene.get_handle_by_name("/wobj_calibrated") is not None
-    assert "residual" in app.calibrate_panel.result_md.content
+    content = app.calibrate_panel.result_md.content
+    assert "residual" in content
+    # a note (a 3-2-1 has no redundancy) is a list item of its own, not run into the next line
+    # (helper-56, M6)
+    assert out.notes and "\n\nshift from nominal" in content
     with pytest.raises(ValueError, match=r"bad\.json"):
         app.calibrate_panel.calibrate("bad.json", b'{"schema": "wobjcal.measurements/9"}')
 
