@@ -91,3 +91,26 @@ def watched(item: pytest.Item) -> Generator[None, Any, Any]:
             pytrace=False,
         )
     return result
+
+
+def ur5_stator_plan(reference_dir: Path, folder: Path, edge_event_offset_m: float | None) -> Path:
+    """The shipped stator A-H plan with the vendor UR5 (``reference_dir``'s) as its robot and
+    the given edge-event offset (``None``: the sensor model's), saved in ``folder``; its path."""
+    import msgspec
+
+    from calib.plan.file import load_plan, save_plan
+    from planner.suggest import moved_plan
+
+    stator = Path(__file__).resolve().parents[1] / "assets" / "plans" / "stator_section_ah.json"
+    plan = load_plan(stator)
+    urdf = str(reference_dir / "robots" / "ur5" / "ur5.urdf")
+    plan = msgspec.structs.replace(
+        plan,
+        cell=msgspec.structs.replace(
+            plan.cell, robot=msgspec.structs.replace(plan.cell.robot, urdf=urdf)
+        ),
+        procedure=msgspec.structs.replace(plan.procedure, edge_event_offset_m=edge_event_offset_m),
+    )
+    path = folder / "stator_ur5.json"
+    save_plan(moved_plan(plan, stator.parent, folder), path)
+    return path

@@ -61,8 +61,7 @@ from planner.check.results import ConfData, PlanCheck, PointCheck, Status
 from planner.memo import Memo
 from planner.plan_cell import nominal_T_base_wobj, open_cell
 from planner.program.build import (
-    AH_TURNED_BASE,
-    ah_base_sign,
+    ah_base_problem,
     measuring_program,
     plan_settings,
     safety_spec,
@@ -371,9 +370,8 @@ def controller_base_problem(plan: Plan, fmt: str | None, T_base_controller: Floa
         program = measuring_program(plan, fmt)
     except InputError:
         return ""  # layout_problem says it
-    if program.adaptive and not program.steers_itself and ah_base_sign(T_base_controller) is None:
-        return f"{plan.method}: {AH_TURNED_BASE}"
-    return ""
+    why = ah_base_problem(program, T_base_controller)
+    return f"{plan.method}: {why}" if why else ""
 
 
 def layout_problem(plan: Plan, fmt: str | None = None) -> str:

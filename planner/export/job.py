@@ -22,9 +22,9 @@ from calib.plan.file import Plan, plan_digest
 from calib.probing import SearchCommand
 from planner.export.text import module_name
 from planner.program.build import (
-    AH_TURNED_BASE,
     AdaptiveSpec,
     adaptive_spec,
+    ah_base_problem,
     ah_base_sign,
     measuring_program,
     safety_spec,
@@ -309,9 +309,10 @@ def _ah_in_controller_base(
     if sign is not None:
         beta1 = sign * spec.settings.beta1_rad
         return replace(spec, settings=msgspec.structs.replace(spec.settings, beta1_rad=beta1))
-    for name in [n for n, p in programs.items() if p.adaptive and not p.steers_itself]:
-        del programs[name]
-        errors[name] = AH_TURNED_BASE
+    for name, program in list(programs.items()):
+        if why := ah_base_problem(program, T_base_controller):
+            del programs[name]
+            errors[name] = why
     return None
 
 

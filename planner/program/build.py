@@ -314,6 +314,14 @@ def ah_base_sign(T_base_controller: ArrayLike) -> float | None:
     return None
 
 
+def ah_base_problem(program: MeasuringProgram, T_base_controller: ArrayLike) -> str:
+    """:data:`AH_TURNED_BASE` when ``program`` is an adaptive A-H program (its frame updates
+    are the procedure's steps) and the controller's base is turned so that it cannot run it
+    (:func:`ah_base_sign`); ``""`` otherwise. Check and export refuse by this one rule."""
+    ah = program.adaptive and not program.steers_itself
+    return AH_TURNED_BASE if ah and ah_base_sign(T_base_controller) is None else ""
+
+
 def adaptive_spec(plan: Plan) -> AdaptiveSpec | None:
     """The A-H specifics an adaptive program is written from, or ``None``: the procedure has
     no adaptive layout, or the plan lacks a role."""

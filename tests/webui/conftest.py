@@ -20,3 +20,16 @@ def app(tmp_path_factory: pytest.TempPathFactory) -> Iterator[WobjcalApp]:
     a = run(box_plan(folder), port=free_port(), block=False, autosave_path=folder / "auto.json")
     yield a
     a.stop()
+
+
+@pytest.fixture(scope="module")
+def demo_app(tmp_path_factory: pytest.TempPathFactory) -> Iterator[WobjcalApp]:
+    """The UI on the built-in stator demo (``wobjcal ui`` with no plan), fresh, autosaving
+    into a folder of its own (one per module)."""
+    from webui.server import run
+    from webui.testing import free_port
+
+    folder = tmp_path_factory.mktemp("demo")
+    a = run(None, port=free_port(), block=False, autosave_path=folder / "auto.json", fresh=True)
+    yield a
+    a.stop()

@@ -6,7 +6,6 @@ limit (only marginal) instead of the search path that fails (D6)."""
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
 
 import msgspec
 import pytest
@@ -15,17 +14,6 @@ from calib.plan.file import Plan
 from planner.check.job import check_plan
 from webui.app import WobjcalApp
 from webui.status_table import table_rows
-
-
-@pytest.fixture(scope="module")
-def app(tmp_path_factory: pytest.TempPathFactory) -> Iterator[WobjcalApp]:
-    from webui.server import run
-    from webui.testing import free_port
-
-    folder = tmp_path_factory.mktemp("vias")
-    a = run(None, port=free_port(), block=False, autosave_path=folder / "auto.json", fresh=True)
-    yield a
-    a.stop()
 
 
 def _moved(plan: Plan, dx_m: float) -> Plan:
@@ -46,7 +34,8 @@ def _wait(pred: object, what: str, timeout_s: float = 60.0) -> None:
 
 
 @pytest.mark.slow
-def test_the_table_refuses_a_point_whose_move_in_fails_as_check_does(app: WobjcalApp) -> None:
+def test_the_table_refuses_a_point_whose_move_in_fails_as_check_does(demo_app: WobjcalApp) -> None:
+    app = demo_app
     source = app.state.doc.source
     assert isinstance(source, Plan)
     plan = _moved(source, 0.1)

@@ -16,12 +16,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-import msgspec
 import numpy as np
 import pytest
 
 from calib.frames import invert_transform, make_transform, matrix_from_rotvec, transform_points
-from calib.plan.file import Plan, load_plan, save_plan
+from calib.plan.file import Plan, load_plan
 from planner.calibrate.job import calibrate_plan
 from planner.export import export_files
 from planner.export.job import ToolData, build_job
@@ -31,23 +30,11 @@ from tests.controller_files import fanuc_va, ur_log
 from tests.fanuc_interp import TPMachine
 from tests.planner.export.test_fanuc_program_replay import tp_text
 from tests.planner.validate.test_program_trial_replay import _search_callback, _trial
+from tests.reference_data import ur5_stator_plan
 from tests.urscript_interp import UrMachine
 
 STATOR = Path(__file__).resolve().parents[3] / "assets" / "plans" / "stator_section_ah.json"
 TURNED_RAISED = make_transform(matrix_from_rotvec([0.0, 0.0, np.pi / 2]), [0.0, 0.0, 0.33])
-
-
-def _ur5_plan(reference_dir: Path, tmp_path: Path) -> Path:
-    from planner.suggest import moved_plan
-
-    plan = load_plan(STATOR)
-    robot = msgspec.structs.replace(
-        plan.cell.robot, urdf=str(reference_dir / "robots" / "ur5" / "ur5.urdf")
-    )
-    plan = msgspec.structs.replace(plan, cell=msgspec.structs.replace(plan.cell, robot=robot))
-    path = tmp_path / "stator_ur5.json"
-    save_plan(moved_plan(plan, STATOR.parent, tmp_path), path)
-    return path
 
 
 def _in_controller(search: Any, T_bc: np.ndarray) -> Any:
@@ -88,7 +75,7 @@ def _run(plan: Plan, job: Any, fmt: str, probe: Any, T_bc: np.ndarray, folder: P
 def test_a_controller_base_gives_the_frame_of_the_identity_pipeline(
     reference_dir: Path, tmp_path: Path, fmt: str, base: str
 ) -> None:
-    path = _ur5_plan(reference_dir, tmp_path)
+    path = ur5_stator_plan(reference_dir, tmp_path, edge_event_offset_m=None)
     plan, setup, probe, T_true = _trial(path, fmt, 3)
     T_bc = plan_controller_base(plan, path.parent).T_base_controller
     if base == "turned":

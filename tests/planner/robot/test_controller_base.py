@@ -23,7 +23,7 @@ from calib.frames import (
     random_transform,
     transform_points,
 )
-from calib.plan.file import Plan, load_plan, save_plan
+from calib.plan.file import Plan, load_plan
 from calib.plan.measurements import Measurements, save_measurements
 from planner.cli.main import main
 from planner.export_plan.job import export_program
@@ -31,6 +31,7 @@ from planner.plan_cell import nominal_T_base_wobj, plan_controller_base
 from planner.robot.controller_base import controller_base
 from planner.robot.kinematics.chain import KinematicChain
 from planner.robot.urdf import load_urdf
+from tests.reference_data import ur5_stator_plan
 
 REPO = Path(__file__).resolve().parents[3]
 STATOR = REPO / "assets" / "plans" / "stator_section_ah.json"
@@ -104,19 +105,8 @@ def test_only_a_fixed_base_link_is_the_controllers(
 
 
 def _ur5_plan(reference_dir: Path, tmp_path: Path) -> tuple[Plan, Path]:
-    """The shipped stator plan with the vendor UR5 as its robot, an ideal sensor (no edge
-    offset), saved in ``tmp_path``."""
-    from planner.suggest import moved_plan
-
-    plan = load_plan(STATOR)
-    robot = msgspec.structs.replace(plan.cell.robot, urdf=str(_ur5(reference_dir)))
-    plan = msgspec.structs.replace(
-        plan,
-        cell=msgspec.structs.replace(plan.cell, robot=robot),
-        procedure=msgspec.structs.replace(plan.procedure, edge_event_offset_m=0.0),
-    )
-    path = tmp_path / "stator_ur5.json"
-    save_plan(moved_plan(plan, STATOR.parent, tmp_path), path)
+    """The stator plan on the vendor UR5 with an ideal sensor (no edge offset)."""
+    path = ur5_stator_plan(reference_dir, tmp_path, edge_event_offset_m=0.0)
     return load_plan(path), path
 
 
